@@ -1,0 +1,85 @@
+// Cell-list neighbour search, every step: cell key + atomic histogram, (prefix scan in
+// prefix_scan.wgsl), scatter, deterministic rank within each slot, reorder of particle arrays.
+// The slot order within a cell is by previous sorted index, so the same input on the same
+// adapter always gives the same order (atomics only decide a provisional placement).
+
+@group(0) @binding(1) var<storage, read> pos: array<Pos>;
+@group(0) @binding(2) var<storage, read> code: array<u32>;
+@group(0) @binding(3) var<storage, read_write> keys: array<u32>;
+@group(0) @binding(4) var<storage, read_write> local_rank: array<u32>;
+@group(0) @binding(5) var<storage, read_write> counts: array<atomic<u32>>;
+@group(0) @binding(6) var<storage, read> cell_start: array<u32>;
+@group(0) @binding(7) var<storage, read_write> provisional: array<u32>;
+@group(0) @binding(8) var<storage, read_write> perm: array<u32>;
+
+@group(0) @binding(10) var<storage, read> pos_in: array<Pos>;
+@group(0) @binding(11) var<storage, read> velrho_in: array<vec4<f32>>;
+@group(0) @binding(12) var<storage, read> rate_in: array<vec4<f32>>;
+@group(0) @binding(13) var<storage, read> code_in: array<u32>;
+@group(0) @binding(14) var<storage, read_write> pos_out: array<Pos>;
+@group(0) @binding(15) var<storage, read_write> velrho_out: array<vec4<f32>>;
+@group(0) @binding(16) var<storage, read_write> rate_out: array<vec4<f32>>;
+@group(0) @binding(17) var<storage, read_write> code_out: array<u32>;
+
+// Slot of each particle (excluded particles go to the extra slot `hash_mask + 1`) and its
+// provisional place in that slot.
+@compute @workgroup_size(WG)
+fn cell_key(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles) {
+        return;
+    }
+    var key = params.hash_mask + 1u;
+    if (code_kind(code[i]) != KIND_EXCLUDED) {
+        key = slot_of_cell(cell_of(pos[i]));
+    }
+    keys[i] = key;
+    local_rank[i] = atomicAdd(&counts[key], 1u);
+}
+
+@compute @workgroup_size(WG)
+fn scatter(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles) {
+        return;
+    }
+    provisional[cell_start[keys[i]] + local_rank[i]] = i;
+}
+
+// Final place = slot start + number of particles of the same slot with a smaller previous
+// index. O(n_slot) per particle; the excluded slot keeps its provisional order (its particles
+// never interact, and outputs are written in id order).
+@compute @workgroup_size(WG)
+fn rank_in_cell(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let p = linear_index(gid, nwg);
+    if (p >= params.n_particles) {
+        return;
+    }
+    let i = provisional[p];
+    let key = keys[i];
+    let start = cell_start[key];
+    if (key > params.hash_mask) {
+        perm[p] = i;
+        return;
+    }
+    let end = cell_start[key + 1u];
+    var rank = 0u;
+    for (var q = start; q < end; q++) {
+        rank += select(0u, 1u, provisional[q] < i);
+    }
+    perm[start + rank] = i;
+}
+
+// Gathers every per-particle array into cell order.
+@compute @workgroup_size(WG)
+fn reorder(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let p = linear_index(gid, nwg);
+    if (p >= params.n_particles) {
+        return;
+    }
+    let i = perm[p];
+    pos_out[p] = pos_in[i];
+    velrho_out[p] = velrho_in[i];
+    rate_out[p] = rate_in[i];
+    code_out[p] = code_in[i];
+}

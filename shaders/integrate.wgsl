@@ -1,0 +1,130 @@
+// Time integration: velocity Verlet with a predicted velocity for the velocity-dependent terms
+// (a predictor–corrector; symplectic for the conservative part):
+//   predict:  x_{n+1} = x_n + dt v_n + ½dt² a_n,  v* = v_n + dt a_n,  ρ* = ρ_n + dt Dρ_n
+//   (evaluate a_{n+1}, Dρ_{n+1} at x_{n+1}, v*, ρ*)
+//   correct:  v_{n+1} = v* + ½dt (a_{n+1} − a_n),  ρ_{n+1} = ρ* + ½dt (Dρ_{n+1} − Dρ_n)
+// i.e. v_{n+1} = v_n + ½dt (a_n + a_{n+1}) and likewise for ρ (trapezoidal rule).
+// Variable dt from the CFL, force and viscous conditions (Monaghan 1989; Morris et al. 1997),
+// computed on the GPU by a max-reduction, so no per-particle data leaves the GPU.
+
+@group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
+@group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> code: array<u32>;
+@group(0) @binding(4) var<storage, read> rate: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> rate_old: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read_write> state: SimState;
+@group(0) @binding(7) var<storage, read> cell_start: array<u32>;
+
+var<workgroup> wg_speed: array<f32, WG>;
+var<workgroup> wg_accel: array<f32, WG>;
+
+fn all_finite(v: vec4<f32>) -> bool {
+    // NaN fails every comparison; |inf| fails the bound.
+    return all(abs(v) < vec4<f32>(3.0e38));
+}
+
+// Dynamic boundary particles never go below ρ0 (no suction at walls; DualSPHysics does the same).
+fn wall_density(rho: f32) -> f32 {
+    return max(rho, params.rho0);
+}
+
+fn exclude(i: u32) {
+    code[i] = with_kind(code[i], KIND_EXCLUDED);
+}
+
+@compute @workgroup_size(WG)
+fn predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles) {
+        return;
+    }
+    let dt = state.dt;
+    let kind = code_kind(code[i]);
+    let vr = velrho[i];
+    let r = rate[i];
+    if (kind == KIND_FLUID) {
+        let moved = move_by(pos[i], dt * vr.xyz + 0.5 * dt * dt * r.xyz);
+        pos[i] = moved.pos;
+        velrho[i] = vec4<f32>(vr.xyz + dt * r.xyz, vr.w + dt * r.w);
+        if (!moved.inside) {
+            exclude(i);
+        }
+    } else if (kind == KIND_WALL) {
+        velrho[i].w = wall_density(vr.w + dt * r.w);
+    }
+}
+
+@compute @workgroup_size(WG)
+fn correct(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    let i = linear_index(gid, nwg);
+    var speed = 0.0;
+    var accel = 0.0;
+    if (i < params.n_particles) {
+        let half_dt = 0.5 * state.dt;
+        let kind = code_kind(code[i]);
+        let r = rate[i];
+        let vr = velrho[i];
+        if (kind == KIND_FLUID) {
+            let v = vec4<f32>(vr.xyz + half_dt * (r.xyz - rate_old[i].xyz), vr.w + half_dt * (r.w - rate_old[i].w));
+            velrho[i] = v;
+            if (all_finite(v) && all_finite(r) && v.w > 0.0) {
+                speed = sound_speed_of(v.w) + length(v.xyz);
+                accel = length(r.xyz);
+            } else {
+                atomicAdd(&state.nan_count, 1u);
+                exclude(i);
+            }
+        } else if (kind == KIND_WALL) {
+            let rho = wall_density(vr.w + half_dt * (r.w - rate_old[i].w));
+            velrho[i].w = rho;
+            speed = sound_speed_of(rho);
+        }
+    }
+    // Workgroup max, then one atomic per workgroup (max is order-independent: deterministic).
+    wg_speed[li] = speed;
+    wg_accel[li] = accel;
+    workgroupBarrier();
+    for (var s = WG / 2u; s > 0u; s >>= 1u) {
+        if (li < s) {
+            wg_speed[li] = max(wg_speed[li], wg_speed[li + s]);
+            wg_accel[li] = max(wg_accel[li], wg_accel[li + s]);
+        }
+        workgroupBarrier();
+    }
+    if (li == 0u) {
+        // Non-negative f32 order like their bit patterns.
+        atomicMax(&state.max_speed_bits, bitcast<u32>(wg_speed[0]));
+        atomicMax(&state.max_accel_bits, bitcast<u32>(wg_accel[0]));
+    }
+}
+
+// One invocation: closes the step (advances time) and chooses the next dt.
+@compute @workgroup_size(1)
+fn timestep() {
+    let taken = state.dt;
+    state.t_rel += taken;
+    if (taken > 0.0) {
+        state.steps += 1u;
+    }
+    let max_speed = bitcast<f32>(atomicLoad(&state.max_speed_bits));
+    let max_accel = bitcast<f32>(atomicLoad(&state.max_accel_bits));
+    var dt = params.cfl * params.h / max(max_speed, 1e-12);
+    if (max_accel > 0.0) {
+        dt = min(dt, params.cfl * sqrt(params.h / max_accel));
+    }
+    if (VISCOSITY == 1u) {
+        dt = min(dt, 0.125 * params.h * params.h / params.nu);
+    }
+    state.dt_cfl = dt;
+    let remaining = state.t_target_rel - state.t_rel;
+    // A remainder of a few ulps counts as arrival, so the last step is never a sliver.
+    state.dt = select(min(dt, remaining), 0.0, remaining <= 1e-4 * dt);
+    atomicStore(&state.max_speed_bits, 0u);
+    atomicStore(&state.max_accel_bits, 0u);
+    let excluded_slot = params.hash_mask + 1u;
+    state.excluded = cell_start[excluded_slot + 1u] - cell_start[excluded_slot];
+}

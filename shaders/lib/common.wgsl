@@ -1,0 +1,202 @@
+// Shared declarations for every wgsph pass. Composed after the generated constants
+// (DIM, KERNEL, VISCOSITY, WG) and before the pass's own file; see src/gpu/shader.rs.
+
+// Run parameters, uploaded once per run. Mirrored by `layout::Params` (size checked by a test
+// against naga's reflection of this struct).
+struct Params {
+    // Neighbour grid. Positions are stored as (block, offset in block) so that f32 offsets stay
+    // small anywhere in a large domain; a block is `cells_per_block` cells of `cell_size`.
+    grid_cells: vec3<u32>,      // cells of the domain along x, y, z
+    hash_mask: u32,             // slots - 1; the slot table has `slots` (power of two) entries
+    block_size: f32,            // [m]
+    cell_size: f32,             // [m], = kernel support 2h
+    inv_cell_size: f32,
+    cells_per_block: u32,
+    domain_size: vec3<f32>,     // [m], domain extent from its min corner
+    n_particles: u32,
+    // Kernel
+    h: f32,
+    kernel_norm: f32,           // α_d of the kernel in DIM dimensions
+    eta2: f32,                  // 0.01 h², regularises 1/r² terms
+    mass: f32,                  // particle mass [kg]
+    // Fluid
+    rho0: f32,
+    tait_b: f32,                // B = c0² ρ0 / γ
+    gamma: f32,
+    c0: f32,
+    gravity: vec3<f32>,
+    alpha: f32,                 // Monaghan artificial viscosity
+    nu: f32,                    // laminar kinematic viscosity [m²/s]
+    delta_coef: f32,            // δ h c0 for δ-SPH (Molteni & Colagrossi 2009)
+    cfl: f32,
+    n_probes: u32,
+}
+
+// Time-stepping state that lives on the GPU; read back once per batch of steps.
+// Mirrored by `layout::SimState`.
+struct SimState {
+    t_rel: f32,                 // time since the host's base time [s]
+    t_target_rel: f32,          // the step sequence stops exactly here (dt clipped, then 0)
+    dt: f32,                    // step about to be taken
+    dt_cfl: f32,                // unclipped CFL step, for reporting
+    max_speed_bits: atomic<u32>,  // max over particles of c_i + |v_i| (f32 bits; non-negative)
+    max_accel_bits: atomic<u32>,  // max over fluid of |a_i| (f32 bits)
+    nan_count: atomic<u32>,     // fluid particles that became non-finite (cumulative)
+    excluded: u32,              // particles in the excluded slot at the last sort
+    steps: u32,                 // steps taken with dt > 0 since the host's base
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
+// Particle position: `off` is the offset from the lower corner of block `block`
+// (packed 11/11/10 bits for x/y/z).
+struct Pos {
+    off: vec3<f32>,
+    block: u32,
+}
+
+// `code` word: kind in the top 4 bits, stable particle id in the low 28.
+const KIND_SHIFT: u32 = 28u;
+const ID_MASK: u32 = 0x0FFFFFFFu;
+const KIND_FLUID: u32 = 0u;
+const KIND_WALL: u32 = 1u;
+const KIND_EXCLUDED: u32 = 15u;
+
+fn code_kind(code: u32) -> u32 {
+    return code >> KIND_SHIFT;
+}
+
+fn with_kind(code: u32, kind: u32) -> u32 {
+    return (code & ID_MASK) | (kind << KIND_SHIFT);
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+
+// Linear invocation index for dispatches that may be 2D (more than 65535 workgroups).
+fn linear_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return gid.x + gid.y * nwg.x * WG;
+}
+
+// ---- positions -------------------------------------------------------------------------
+
+fn unpack_block(b: u32) -> vec3<i32> {
+    return vec3<i32>(i32(b & 0x7FFu), i32((b >> 11u) & 0x7FFu), i32(b >> 22u));
+}
+
+fn pack_block(b: vec3<i32>) -> u32 {
+    return u32(b.x) | (u32(b.y) << 11u) | (u32(b.z) << 22u);
+}
+
+// x_i - x_j, exact block difference plus offset difference: precise for neighbours anywhere.
+fn rel_pos(pi: Pos, pj: Pos) -> vec3<f32> {
+    let db = vec3<f32>(unpack_block(pi.block) - unpack_block(pj.block));
+    return db * params.block_size + (pi.off - pj.off);
+}
+
+// Position from the domain's min corner, in f32 (for bounds checks and probes only).
+fn domain_pos(p: Pos) -> vec3<f32> {
+    return vec3<f32>(unpack_block(p.block)) * params.block_size + p.off;
+}
+
+struct Moved {
+    pos: Pos,
+    inside: bool,
+}
+
+// Displaces a particle by `d` and moves its offset back into [0, block_size) by changing
+// block (exact, by Sterbenz, for a shift of one block). `inside` says whether the new position
+// lies in the domain; outside it the block is clamped and the particle must be excluded.
+fn move_by(p: Pos, d: vec3<f32>) -> Moved {
+    let off = p.off + d;
+    let shift = floor(off / params.block_size);
+    let b = unpack_block(p.block) + vec3<i32>(shift);
+    let new_off = off - shift * params.block_size;
+    let x = vec3<f32>(b) * params.block_size + new_off;
+    let inside = all(x >= vec3<f32>(0.0)) && all(x <= params.domain_size)
+        && all(b >= vec3<i32>(0)) && all(b <= vec3<i32>(2047, 2047, 1023));
+    let bc = clamp(b, vec3<i32>(0), vec3<i32>(2047, 2047, 1023));
+    return Moved(Pos(new_off, pack_block(bc)), inside);
+}
+
+// ---- neighbour grid ----------------------------------------------------------------------
+
+fn cell_of(p: Pos) -> vec3<i32> {
+    let k = i32(params.cells_per_block);
+    let local = clamp(vec3<i32>(floor(p.off * params.inv_cell_size)), vec3<i32>(0), vec3<i32>(k - 1));
+    return unpack_block(p.block) * k + local;
+}
+
+// Hash slot of a cell: its linear index in the domain grid, wrapped to the (power of two)
+// slot table. Dense domains get no collisions and x-contiguous cells; sparse ones share slots,
+// which the distance test filters. Wrapping u32 arithmetic is intended.
+fn slot_of_cell(c: vec3<i32>) -> u32 {
+    let u = vec3<u32>(c);
+    return (u.x + params.grid_cells.x * (u.y + params.grid_cells.y * u.z)) & params.hash_mask;
+}
+
+// The distinct slots of the 3^DIM cells around `c` (two neighbour cells can share a slot;
+// visiting it twice would count its particles twice).
+fn neighbour_slots(c: vec3<i32>, slots: ptr<function, array<u32, 27>>) -> u32 {
+    var n = 0u;
+    let zr = select(0, 1, DIM == 3u);
+    for (var dz = -zr; dz <= zr; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let s = slot_of_cell(c + vec3<i32>(dx, dy, dz));
+                var seen = false;
+                for (var k = 0u; k < n; k++) {
+                    seen = seen || ((*slots)[k] == s);
+                }
+                if (!seen) {
+                    (*slots)[n] = s;
+                    n++;
+                }
+            }
+        }
+    }
+    return n;
+}
+
+// ---- smoothing kernels (support 2h, q = r/h) ---------------------------------------------
+
+// W(r) for q in [0, 2].
+fn kernel_w(q: f32) -> f32 {
+    if (KERNEL == 0u) {
+        // Cubic spline, Monaghan & Lattanzio (1985).
+        if (q < 1.0) {
+            return params.kernel_norm * (1.0 - 1.5 * q * q + 0.75 * q * q * q);
+        }
+        let t = max(2.0 - q, 0.0);
+        return params.kernel_norm * 0.25 * t * t * t;
+    }
+    // Wendland C2 (Wendland 1995): (1 - q/2)^4 (2q + 1).
+    let t = max(1.0 - 0.5 * q, 0.0);
+    return params.kernel_norm * t * t * t * t * (2.0 * q + 1.0);
+}
+
+// F(r) = W'(r) / r, so that ∇_i W_ij = x_ij F(r_ij). Finite at r = 0 for Wendland.
+fn kernel_f(q: f32) -> f32 {
+    let h2 = params.h * params.h;
+    if (KERNEL == 0u) {
+        if (q < 1.0) {
+            return params.kernel_norm / h2 * (-3.0 + 2.25 * q);
+        }
+        let t = max(2.0 - q, 0.0);
+        return -0.75 * params.kernel_norm * t * t / (h2 * max(q, 1e-6));
+    }
+    let t = max(1.0 - 0.5 * q, 0.0);
+    return -5.0 * params.kernel_norm / h2 * t * t * t;
+}
+
+// ---- equation of state -------------------------------------------------------------------
+
+// Tait: P = B((ρ/ρ0)^γ − 1) (Monaghan 1994, Batchelor 1967).
+fn pressure_of(rho: f32) -> f32 {
+    return params.tait_b * (pow(rho / params.rho0, params.gamma) - 1.0);
+}
+
+// Local sound speed c = c0 (ρ/ρ0)^((γ−1)/2).
+fn sound_speed_of(rho: f32) -> f32 {
+    return params.c0 * pow(rho / params.rho0, 0.5 * (params.gamma - 1.0));
+}

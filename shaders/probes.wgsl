@@ -1,0 +1,152 @@
+// Probes, sampled on the GPU so that no particle data leaves it: pressure at a point and wave
+// gauges (one invocation per probe, walking the cell list), and the surge front (a max over
+// fluid particles). Results are f32 bit patterns in `probe_out`, read back by the host.
+
+struct ProbeDef {
+    point: vec3<f32>,   // domain coordinates (from the domain's min corner)
+    kind: u32,          // PROBE_*
+    axis: vec3<f32>,    // unit vector (front probes)
+    pad: u32,
+}
+
+const PROBE_PRESSURE: u32 = 0u;
+const PROBE_HEIGHT: u32 = 1u;
+const PROBE_FRONT: u32 = 2u;
+
+@group(0) @binding(1) var<storage, read> pos: array<Pos>;
+@group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> code: array<u32>;
+@group(0) @binding(4) var<storage, read> cell_start: array<u32>;
+@group(0) @binding(5) var<storage, read> probes: array<ProbeDef>;
+@group(0) @binding(6) var<storage, read_write> probe_out: array<atomic<u32>>;
+
+fn pos_of_point(x: vec3<f32>) -> Pos {
+    let b = clamp(vec3<i32>(floor(x / params.block_size)), vec3<i32>(0), vec3<i32>(2047, 2047, 1023));
+    return Pos(x - vec3<f32>(b) * params.block_size, pack_block(b));
+}
+
+struct KernelSums {
+    volume: f32,        // Σ_j W V_j over fluid (the Shepard denominator)
+    pressure: f32,      // Σ_j P_j W V_j
+}
+
+fn fluid_sums(x: vec3<f32>) -> KernelSums {
+    let p = pos_of_point(x);
+    let support2 = 4.0 * params.h * params.h;
+    var sums = KernelSums(0.0, 0.0);
+    var slots: array<u32, 27>;
+    let n_slots = neighbour_slots(cell_of(p), &slots);
+    for (var s = 0u; s < n_slots; s++) {
+        for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
+            if (code_kind(code[j]) != KIND_FLUID) {
+                continue;
+            }
+            let x_ij = rel_pos(p, pos[j]);
+            let r2 = dot(x_ij, x_ij);
+            if (r2 < support2) {
+                let rho_j = velrho[j].w;
+                let wv = kernel_w(sqrt(r2) / params.h) * params.mass / rho_j;
+                sums.volume += wv;
+                sums.pressure += pressure_of(rho_j) * wv;
+            }
+        }
+    }
+    return sums;
+}
+
+// Shepard-normalised pressure; 0 (gauge pressure of air) where the kernel sees less than 10 %
+// fluid, so a dry sensor reads 0 rather than the pressure of one stray droplet.
+fn probe_pressure(x: vec3<f32>) -> f32 {
+    let s = fluid_sums(x);
+    if (s.volume < 0.1) {
+        return 0.0;
+    }
+    return s.pressure / s.volume;
+}
+
+// Free-surface height on the vertical line through x: highest point where the fluid volume
+// fraction Σ W V reaches ½, found by stepping down from the domain top by h/4 and
+// interpolating linearly.
+fn probe_height(x: vec3<f32>) -> f32 {
+    let up = DIM - 1u;
+    let step = 0.25 * params.h;
+    var point = x;
+    var above_z = params.domain_size[up];
+    var above = 0.0;
+    var z = params.domain_size[up];
+    loop {
+        if (z < x[up]) {
+            return 0.0;
+        }
+        point[up] = z;
+        let v = fluid_sums(point).volume;
+        if (v >= 0.5) {
+            if (z == params.domain_size[up]) {
+                return z - x[up];
+            }
+            let t = (v - 0.5) / max(v - above, 1e-6);
+            return mix(z, above_z, t) - x[up];
+        }
+        above = v;
+        above_z = z;
+        z -= step;
+    }
+    return 0.0;
+}
+
+@compute @workgroup_size(WG)
+fn probe_points(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let k = gid.x;
+    if (k >= params.n_probes) {
+        return;
+    }
+    let def = probes[k];
+    if (def.kind == PROBE_PRESSURE) {
+        atomicStore(&probe_out[k], bitcast<u32>(probe_pressure(def.point)));
+    } else if (def.kind == PROBE_HEIGHT) {
+        atomicStore(&probe_out[k], bitcast<u32>(probe_height(def.point)));
+    }
+}
+
+// Order-preserving map of f32 to u32, so atomicMax finds the largest float.
+fn ordered_bits(f: f32) -> u32 {
+    let b = bitcast<u32>(f);
+    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
+}
+
+var<workgroup> wg_front: array<f32, WG>;
+
+// Front probes: max over fluid of (x − origin)·axis. The host zeroes `probe_out` first
+// (0 is below every ordered value).
+@compute @workgroup_size(WG)
+fn probe_front(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    let i = linear_index(gid, nwg);
+    var fluid = false;
+    var x = vec3<f32>(0.0);
+    if (i < params.n_particles) {
+        fluid = code_kind(code[i]) == KIND_FLUID;
+        x = domain_pos(pos[i]);
+    }
+    for (var k = 0u; k < params.n_probes; k++) {
+        let def = probes[k];
+        if (def.kind != PROBE_FRONT) {
+            continue;
+        }
+        wg_front[li] = select(-3.0e38, dot(x - def.point, def.axis), fluid);
+        workgroupBarrier();
+        for (var s = WG / 2u; s > 0u; s >>= 1u) {
+            if (li < s) {
+                wg_front[li] = max(wg_front[li], wg_front[li + s]);
+            }
+            workgroupBarrier();
+        }
+        if (li == 0u) {
+            atomicMax(&probe_out[k], ordered_bits(wg_front[0]));
+        }
+        workgroupBarrier();
+    }
+}

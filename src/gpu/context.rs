@@ -1,0 +1,168 @@
+//! Adapter choice and device creation.
+//!
+//! Prefers a hardware GPU and falls back to a software/CPU adapter (Mesa lavapipe) so that
+//! everything runs headless; `--adapter` or `WGSPH_ADAPTER` (auto|gpu|cpu) override.
+
+use std::fmt;
+use std::str::FromStr;
+
+use anyhow::{anyhow, bail, Context, Result};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum AdapterChoice {
+    /// Best hardware GPU, else a CPU adapter.
+    #[default]
+    Auto,
+    /// A hardware GPU or nothing.
+    Gpu,
+    /// A CPU (software) adapter or nothing.
+    Cpu,
+}
+
+impl FromStr for AdapterChoice {
+    type Err = anyhow::Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "auto" => Ok(Self::Auto),
+            "gpu" => Ok(Self::Gpu),
+            "cpu" => Ok(Self::Cpu),
+            other => bail!("unknown adapter choice '{other}': use auto, gpu or cpu"),
+        }
+    }
+}
+
+impl fmt::Display for AdapterChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Auto => "auto",
+            Self::Gpu => "gpu",
+            Self::Cpu => "cpu",
+        })
+    }
+}
+
+impl AdapterChoice {
+    /// The command-line choice if given, else `WGSPH_ADAPTER`, else auto.
+    pub fn resolve(cli: Option<AdapterChoice>) -> Result<Self> {
+        if let Some(c) = cli {
+            return Ok(c);
+        }
+        match std::env::var("WGSPH_ADAPTER") {
+            Ok(v) if !v.trim().is_empty() => v
+                .parse()
+                .with_context(|| format!("environment variable WGSPH_ADAPTER={v}")),
+            _ => Ok(Self::Auto),
+        }
+    }
+}
+
+/// Rank of an adapter for `auto`: lower is preferred.
+fn preference(t: wgpu::DeviceType) -> u8 {
+    match t {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Cpu => 3,
+        wgpu::DeviceType::Other => 4,
+    }
+}
+
+fn is_hardware(t: wgpu::DeviceType) -> bool {
+    preference(t) <= 2
+}
+
+pub struct GpuContext {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    pub limits: wgpu::Limits,
+}
+
+/// Storage buffers one kernel binds at most (the reorder pass: 9); see shaders/cell_list.wgsl.
+pub const STORAGE_BUFFERS_PER_STAGE: u32 = 10;
+
+fn instance() -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = wgpu::Backends::PRIMARY;
+    wgpu::Instance::new(desc)
+}
+
+/// Every adapter wgpu can see (for `wgsph info`).
+pub fn list_adapters() -> Vec<(wgpu::AdapterInfo, wgpu::Limits)> {
+    let adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::PRIMARY));
+    adapters.iter().map(|a| (a.get_info(), a.limits())).collect()
+}
+
+impl GpuContext {
+    pub fn new(choice: AdapterChoice) -> Result<Self> {
+        let instance = instance();
+        let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::PRIMARY));
+        adapters.retain(|a| match choice {
+            AdapterChoice::Auto => true,
+            AdapterChoice::Gpu => is_hardware(a.get_info().device_type),
+            AdapterChoice::Cpu => a.get_info().device_type == wgpu::DeviceType::Cpu,
+        });
+        adapters.sort_by_key(|a| preference(a.get_info().device_type));
+        let adapter = adapters.into_iter().next().ok_or_else(|| {
+            anyhow!(
+                "no {} adapter found (adapter choice '{choice}'). For a software adapter install \
+                 Mesa's lavapipe: apt-get install mesa-vulkan-drivers libvulkan1",
+                match choice {
+                    AdapterChoice::Cpu => "CPU (software)",
+                    AdapterChoice::Gpu => "hardware GPU",
+                    AdapterChoice::Auto => "Vulkan/Metal/DX12",
+                }
+            )
+        })?;
+        let info = adapter.get_info();
+        let have = adapter.limits();
+        if have.max_storage_buffers_per_shader_stage < STORAGE_BUFFERS_PER_STAGE {
+            bail!(
+                "adapter '{}' allows {} storage buffers per shader stage; wgsph needs {}",
+                info.name,
+                have.max_storage_buffers_per_shader_stage,
+                STORAGE_BUFFERS_PER_STAGE
+            );
+        }
+        // Ask for what the adapter can give: particle arrays are as large as the binding and
+        // buffer limits allow; the solver checks its own needs against these.
+        let limits = wgpu::Limits {
+            max_storage_buffers_per_shader_stage: STORAGE_BUFFERS_PER_STAGE,
+            max_storage_buffer_binding_size: have.max_storage_buffer_binding_size,
+            max_buffer_size: have.max_buffer_size,
+            max_compute_workgroups_per_dimension: have.max_compute_workgroups_per_dimension,
+            ..wgpu::Limits::default()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("wgsph"),
+            required_features: wgpu::Features::empty(),
+            required_limits: limits.clone(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .with_context(|| format!("requesting a device from adapter '{}'", info.name))?;
+        Ok(Self {
+            device,
+            queue,
+            info,
+            limits,
+        })
+    }
+
+    /// "name (backend, device type)", as the run log and run.json name the adapter.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} ({:?}, {:?})",
+            self.info.name, self.info.backend, self.info.device_type
+        )
+    }
+
+    /// Blocks until all submitted work is done.
+    pub fn wait(&self) -> Result<()> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| anyhow!("GPU wait failed: {e}"))
+    }
+}

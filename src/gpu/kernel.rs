@@ -1,0 +1,135 @@
+//! A compute kernel: one entry point of a composed shader, its pipeline, and the bindings it
+//! really uses (reflected with naga), so bind groups can be built from one list of buffers.
+
+use anyhow::{anyhow, Context, Result};
+use wgpu::naga;
+
+use super::shader::{compose, Pass, ShaderConfig};
+
+/// A parsed and validated shader module, shared by the kernels of one pass.
+pub struct ShaderModule {
+    pub pass: Pass,
+    module: wgpu::ShaderModule,
+    naga: naga::Module,
+    info: naga::valid::ModuleInfo,
+}
+
+/// Parses and validates the composed source with naga (errors come out readable) and creates
+/// the wgpu module.
+pub fn parse(source: &str, label: &str) -> Result<(naga::Module, naga::valid::ModuleInfo)> {
+    let module = naga::front::wgsl::parse_str(source)
+        .map_err(|e| anyhow!("{label}: {}", e.emit_to_string(source)))?;
+    let info = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::empty(),
+    )
+    .validate(&module)
+    .map_err(|e| anyhow!("{label}: {}", e.emit_to_string(source)))?;
+    Ok((module, info))
+}
+
+impl ShaderModule {
+    pub fn new(device: &wgpu::Device, pass: Pass, cfg: ShaderConfig) -> Result<Self> {
+        let source = compose(pass, cfg);
+        let label = format!("{}.wgsl", pass.name());
+        let (naga, info) = parse(&source, &label)?;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(&label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        Ok(Self {
+            pass,
+            module,
+            naga,
+            info,
+        })
+    }
+
+    pub fn kernel(&self, device: &wgpu::Device, entry: &str) -> Result<Kernel> {
+        let index = self
+            .naga
+            .entry_points
+            .iter()
+            .position(|e| e.name == entry)
+            .ok_or_else(|| anyhow!("{}.wgsl has no entry point {entry}", self.pass.name()))?;
+        let uses = self.info.get_entry_point(index);
+        let mut bindings: Vec<u32> = self
+            .naga
+            .global_variables
+            .iter()
+            .filter(|(h, _)| !uses[*h].is_empty())
+            .filter_map(|(_, g)| g.binding.as_ref().map(|b| b.binding))
+            .collect();
+        bindings.sort_unstable();
+        let label = format!("{}::{entry}", self.pass.name());
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(&label),
+            layout: None,
+            module: &self.module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions::default(),
+            cache: None,
+        });
+        Ok(Kernel {
+            label,
+            pipeline,
+            bindings,
+        })
+    }
+}
+
+pub struct Kernel {
+    pub label: String,
+    pub pipeline: wgpu::ComputePipeline,
+    /// Binding numbers (group 0) the entry point uses.
+    pub bindings: Vec<u32>,
+}
+
+impl Kernel {
+    /// A bind group from `(binding, buffer)` pairs; pairs the kernel does not use are skipped,
+    /// a binding it uses but that is missing is an error.
+    pub fn bind(&self, device: &wgpu::Device, buffers: &[(u32, &wgpu::Buffer)]) -> Result<wgpu::BindGroup> {
+        let mut entries = Vec::with_capacity(self.bindings.len());
+        for &b in &self.bindings {
+            let buffer = buffers
+                .iter()
+                .find(|(n, _)| *n == b)
+                .map(|(_, buf)| *buf)
+                .with_context(|| format!("kernel {} needs binding {b}", self.label))?;
+            entries.push(wgpu::BindGroupEntry {
+                binding: b,
+                resource: buffer.as_entire_binding(),
+            });
+        }
+        Ok(device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(&self.label),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        }))
+    }
+
+    /// Records one dispatch covering `invocations` 1D invocations of WORKGROUP_SIZE.
+    pub fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, bind: &wgpu::BindGroup, invocations: u32) {
+        let groups = invocations.div_ceil(super::shader::WORKGROUP_SIZE).max(1);
+        self.dispatch_groups(pass, bind, groups);
+    }
+
+    /// Records one dispatch of `groups` workgroups, folded into 2D past 65535.
+    pub fn dispatch_groups(&self, pass: &mut wgpu::ComputePass<'_>, bind: &wgpu::BindGroup, groups: u32) {
+        let (x, y) = fold_groups(groups);
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, bind, &[]);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+}
+
+/// Workgroup grid for `groups` groups: x ≤ 65535, x·y ≥ groups. Kernels recover the linear
+/// index as gid.x + gid.y·(nwg.x·WG) and bounds-check it.
+pub fn fold_groups(groups: u32) -> (u32, u32) {
+    const MAX: u32 = 65535;
+    if groups <= MAX {
+        (groups, 1)
+    } else {
+        (MAX, groups.div_ceil(MAX))
+    }
+}

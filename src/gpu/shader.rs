@@ -1,0 +1,86 @@
+//! WGSL composition: generated constants + `shaders/lib/common.wgsl` + one pass file.
+//!
+//! The shaders are compiled into the binary (`include_str!`), so an installed `wgsph` needs no
+//! shader files at run time. Per-case choices (dimension, kernel, viscosity) are constants of
+//! the composed source, so the compiler removes the branches not taken.
+
+/// Invocations per workgroup of every 1D kernel.
+pub const WORKGROUP_SIZE: u32 = 128;
+
+pub const COMMON: &str = include_str!("../../shaders/lib/common.wgsl");
+
+/// One shader file per pass, named like its Rust module in `src/sph`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pass {
+    CellList,
+    PrefixScan,
+    Interaction,
+    Integrate,
+    Probes,
+}
+
+impl Pass {
+    pub const ALL: [Pass; 5] = [
+        Pass::CellList,
+        Pass::PrefixScan,
+        Pass::Interaction,
+        Pass::Integrate,
+        Pass::Probes,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Pass::CellList => "cell_list",
+            Pass::PrefixScan => "prefix_scan",
+            Pass::Interaction => "interaction",
+            Pass::Integrate => "integrate",
+            Pass::Probes => "probes",
+        }
+    }
+
+    fn source(self) -> &'static str {
+        match self {
+            Pass::CellList => include_str!("../../shaders/cell_list.wgsl"),
+            Pass::PrefixScan => include_str!("../../shaders/prefix_scan.wgsl"),
+            Pass::Interaction => include_str!("../../shaders/interaction.wgsl"),
+            Pass::Integrate => include_str!("../../shaders/integrate.wgsl"),
+            Pass::Probes => include_str!("../../shaders/probes.wgsl"),
+        }
+    }
+}
+
+/// Compile-time choices of a run, emitted as WGSL constants.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShaderConfig {
+    pub dim: u32,
+    /// 0 cubic spline, 1 Wendland C2.
+    pub kernel: u32,
+    /// 0 artificial (Monaghan), 1 laminar (Morris / Lo & Shao).
+    pub viscosity: u32,
+}
+
+impl Default for ShaderConfig {
+    fn default() -> Self {
+        Self {
+            dim: 3,
+            kernel: 1,
+            viscosity: 0,
+        }
+    }
+}
+
+/// The full WGSL source of `pass` for `cfg`.
+pub fn compose(pass: Pass, cfg: ShaderConfig) -> String {
+    format!(
+        "// wgsph: {name}.wgsl composed with lib/common.wgsl\n\
+         const DIM: u32 = {dim}u;\nconst KERNEL: u32 = {kernel}u;\n\
+         const VISCOSITY: u32 = {visc}u;\nconst WG: u32 = {wg}u;\n\n{common}\n{pass}",
+        name = pass.name(),
+        dim = cfg.dim,
+        kernel = cfg.kernel,
+        visc = cfg.viscosity,
+        wg = WORKGROUP_SIZE,
+        common = COMMON,
+        pass = pass.source(),
+    )
+}

@@ -1,0 +1,177 @@
+//! Host mirrors of the WGSL structs, `#[repr(C)]` + Pod. Their sizes and field offsets are
+//! checked against naga's layout of the composed shaders in the tests below.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Mirrors `Params` in shaders/lib/common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct Params {
+    pub grid_cells: [u32; 3],
+    pub hash_mask: u32,
+    pub block_size: f32,
+    pub cell_size: f32,
+    pub inv_cell_size: f32,
+    pub cells_per_block: u32,
+    pub domain_size: [f32; 3],
+    pub n_particles: u32,
+    pub h: f32,
+    pub kernel_norm: f32,
+    pub eta2: f32,
+    pub mass: f32,
+    pub rho0: f32,
+    pub tait_b: f32,
+    pub gamma: f32,
+    pub c0: f32,
+    pub gravity: [f32; 3],
+    pub alpha: f32,
+    pub nu: f32,
+    pub delta_coef: f32,
+    pub cfl: f32,
+    pub n_probes: u32,
+}
+
+/// Mirrors `SimState` in shaders/lib/common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct SimState {
+    pub t_rel: f32,
+    pub t_target_rel: f32,
+    pub dt: f32,
+    pub dt_cfl: f32,
+    pub max_speed_bits: u32,
+    pub max_accel_bits: u32,
+    pub nan_count: u32,
+    pub excluded: u32,
+    pub steps: u32,
+    pub pad: [u32; 3],
+}
+
+/// Mirrors `Pos`: offset from the block's lower corner + packed block coordinates.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct Pos {
+    pub off: [f32; 3],
+    pub block: u32,
+}
+
+/// Mirrors `ProbeDef` in shaders/probes.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct ProbeDef {
+    pub point: [f32; 3],
+    pub kind: u32,
+    pub axis: [f32; 3],
+    pub pad: u32,
+}
+
+pub const KIND_SHIFT: u32 = 28;
+pub const ID_MASK: u32 = 0x0FFF_FFFF;
+pub const KIND_EXCLUDED: u32 = 15;
+/// Largest block coordinate per axis (11/11/10 bits).
+pub const MAX_BLOCK: [u32; 3] = [2047, 2047, 1023];
+
+pub fn pack_block(b: [u32; 3]) -> u32 {
+    b[0] | (b[1] << 11) | (b[2] << 22)
+}
+
+pub fn unpack_block(b: u32) -> [u32; 3] {
+    [b & 0x7FF, (b >> 11) & 0x7FF, b >> 22]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::kernel::parse;
+    use crate::gpu::shader::{compose, Pass, ShaderConfig};
+    use wgpu::naga;
+
+    /// (size, [(member name, offset)]) of a struct type named `name` in the composed `pass`.
+    fn reflect(pass: Pass, name: &str) -> (u32, Vec<(String, u32)>) {
+        let (module, _) = parse(&compose(pass, ShaderConfig::default()), pass.name()).unwrap();
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        let (handle, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("{name} not in {}", pass.name()));
+        let members = match &ty.inner {
+            naga::TypeInner::Struct { members, .. } => members
+                .iter()
+                .map(|m| (m.name.clone().unwrap(), m.offset))
+                .collect(),
+            _ => panic!("{name} is not a struct"),
+        };
+        (layouter[handle].size, members)
+    }
+
+    fn offset(members: &[(String, u32)], field: &str) -> u32 {
+        members.iter().find(|(n, _)| n == field).unwrap().1
+    }
+
+    macro_rules! check_layout {
+        ($pass:expr, $wgsl:literal, $ty:ty, [$($field:ident),*]) => {{
+            let (size, members) = reflect($pass, $wgsl);
+            assert_eq!(size as usize, std::mem::size_of::<$ty>(), "size of {}", $wgsl);
+            $(
+                assert_eq!(
+                    offset(&members, stringify!($field)) as usize,
+                    std::mem::offset_of!($ty, $field),
+                    "offset of {}.{}", $wgsl, stringify!($field)
+                );
+            )*
+        }};
+    }
+
+    #[test]
+    fn params_matches_wgsl() {
+        check_layout!(
+            Pass::Interaction,
+            "Params",
+            Params,
+            [
+                grid_cells, hash_mask, block_size, cell_size, inv_cell_size, cells_per_block,
+                domain_size, n_particles, h, kernel_norm, eta2, mass, rho0, tait_b, gamma, c0,
+                gravity, alpha, nu, delta_coef, cfl, n_probes
+            ]
+        );
+    }
+
+    #[test]
+    fn sim_state_matches_wgsl() {
+        check_layout!(
+            Pass::Integrate,
+            "SimState",
+            SimState,
+            [t_rel, t_target_rel, dt, dt_cfl, max_speed_bits, max_accel_bits, nan_count, excluded, steps]
+        );
+    }
+
+    #[test]
+    fn pos_and_probe_match_wgsl() {
+        check_layout!(Pass::Interaction, "Pos", Pos, [off, block]);
+        check_layout!(Pass::Probes, "ProbeDef", ProbeDef, [point, kind, axis]);
+    }
+
+    #[test]
+    fn block_packing_round_trips() {
+        for b in [[0, 0, 0], [2047, 2047, 1023], [5, 1000, 3]] {
+            assert_eq!(unpack_block(pack_block(b)), b);
+        }
+    }
+
+    #[test]
+    fn every_pass_validates_in_2d_and_3d() {
+        for pass in Pass::ALL {
+            for dim in [2, 3] {
+                for kernel in [0, 1] {
+                    for viscosity in [0, 1] {
+                        let cfg = ShaderConfig { dim, kernel, viscosity };
+                        parse(&compose(pass, cfg), pass.name()).unwrap();
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,5 @@
+//! wgsph: GPU weakly-compressible SPH for fluid–solid interaction, on wgpu/WGSL.
+
+pub mod gpu;
+pub mod layout;
+pub mod scenario;

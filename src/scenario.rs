@@ -1,0 +1,121 @@
+//! The built, validated description of a run: what the solver consumes.
+//!
+//! A case file (`cases/*.toml`, parsed in [`crate::case`]) is turned into a [`Scenario`]; the
+//! solver never sees TOML. All quantities are SI. Coordinates are always 3-component: in 2D the
+//! third component is zero, `y` is up in 2D and `z` is up in 3D (the "vertical axis" is
+//! `dimension - 1`).
+
+/// What a particle is. Stored in the top bits of the GPU `code` word (see `shaders/lib/common.wgsl`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Kind {
+    Fluid = 0,
+    /// Fixed wall particle, dynamic boundary condition (Crespo et al. 2007).
+    Wall = 1,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Particle {
+    pub pos: [f64; 3],
+    pub vel: [f64; 3],
+    pub rho: f64,
+    pub kind: Kind,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KernelKind {
+    /// Monaghan & Lattanzio (1985) cubic B-spline, support 2h.
+    CubicSpline,
+    /// Wendland (1995) C2, support 2h.
+    WendlandC2,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Viscosity {
+    /// Monaghan (1992) artificial viscosity with coefficient alpha.
+    Artificial { alpha: f64 },
+    /// Laminar viscosity (Morris et al. 1997, in the form of Lo & Shao 2002), kinematic nu [m²/s].
+    Laminar { nu: f64 },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Physics {
+    /// 2 or 3.
+    pub dim: u32,
+    /// Initial particle spacing [m].
+    pub dx: f64,
+    /// Smoothing length [m]; kernel support is 2h.
+    pub h: f64,
+    pub kernel: KernelKind,
+    /// Reference density [kg/m³].
+    pub rho0: f64,
+    /// Numerical speed of sound [m/s].
+    pub c0: f64,
+    /// Tait exponent (7 for water).
+    pub gamma: f64,
+    /// Gravity [m/s²], 3 components (z = 0 in 2D).
+    pub gravity: [f64; 3],
+    pub viscosity: Viscosity,
+    /// δ-SPH density diffusion coefficient (Molteni & Colagrossi 2009); 0 disables it.
+    pub delta_sph: f64,
+    /// Mass of every particle [kg] (ρ0·dx^dim).
+    pub particle_mass: f64,
+}
+
+impl Physics {
+    /// Tait stiffness B = c0² ρ0 / γ [Pa].
+    pub fn tait_b(&self) -> f64 {
+        self.c0 * self.c0 * self.rho0 / self.gamma
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimeControl {
+    pub end_s: f64,
+    /// Interval between particle outputs (VTU) [s].
+    pub output_every_s: f64,
+    /// Interval between probe samples [s].
+    pub probe_every_s: f64,
+    /// Courant number for the time step.
+    pub cfl: f64,
+}
+
+/// Axis-aligned box; particles leaving it are excluded from the run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Domain {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ProbeKind {
+    /// Pressure at a point, kernel-interpolated (Shepard-normalised) from fluid particles.
+    Pressure { point: [f64; 3] },
+    /// Water height along the vertical line through `base` (a wave gauge): highest fluid
+    /// particle near the line, measured from `base`'s vertical coordinate.
+    Height { base: [f64; 3] },
+    /// Surge front: largest (x − origin)·axis over fluid particles.
+    Front { origin: [f64; 3], axis: [f64; 3] },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Probe {
+    pub name: String,
+    pub kind: ProbeKind,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    pub name: String,
+    pub physics: Physics,
+    pub time: TimeControl,
+    pub domain: Domain,
+    pub particles: Vec<Particle>,
+    pub probes: Vec<Probe>,
+}
+
+impl Scenario {
+    pub fn count(&self, kind: Kind) -> usize {
+        self.particles.iter().filter(|p| p.kind == kind).count()
+    }
+}
