@@ -3,3 +3,7 @@
 pub mod gpu;
 pub mod layout;
 pub mod scenario;
+pub mod sph;
+pub mod output;
+pub mod run;
+pub mod reference;

@@ -1,0 +1,427 @@
+//! Crash-safe output: particle snapshots (ParaView `.vtu` + `.pvd` series), probe CSV time
+//! series and the run summary JSON.
+//!
+//! Every file is written with [`write_atomic`]: the content goes to a temporary file in the same
+//! folder, is flushed and fsynced, then renamed onto the final name. A run killed at any moment
+//! therefore leaves either the previous complete version of a file or the new complete one, never
+//! a truncated file. Snapshot `.vtu` files are renamed into place before the `.pvd` that lists
+//! them is rewritten, so the series never references a missing or partial file.
+//!
+//! Layout of an output directory `DIR`:
+//!
+//! ```text
+//! DIR/particles.pvd                     series index (time + relative file per snapshot)
+//! DIR/particles/particles_000000.vtu    one file per snapshot, raw appended binary
+//! DIR/probes/<name>.csv                 "t_s,<column>" time series per probe
+//! DIR/run.json                          run summary
+//! ```
+
+mod atomic;
+mod probes_csv;
+mod pvd;
+mod run_summary;
+mod vtu;
+
+use std::fmt;
+use std::io;
+use std::path::{Path, PathBuf};
+
+pub use atomic::write_atomic;
+pub use probes_csv::ProbeWriter;
+pub use run_summary::RunSummary;
+
+/// Name of the series file inside the output directory.
+pub const PVD_FILE: &str = "particles.pvd";
+/// Name of the snapshot folder inside the output directory.
+pub const PARTICLES_DIR: &str = "particles";
+/// Name of the probe folder inside the output directory.
+pub const PROBES_DIR: &str = "probes";
+/// Name of the run summary file inside the output directory.
+pub const RUN_SUMMARY_FILE: &str = "run.json";
+
+/// Errors of the output module. Every message names the path involved and, for I/O failures,
+/// the OS error (which is part of the message rather than a chained `source`, so that
+/// `anyhow`'s `{:#}` does not print it twice).
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// An I/O operation (`action`, e.g. "create directory", "write", "rename") failed on `path`.
+    #[error("cannot {action} {}: {error}", path.display())]
+    Io {
+        action: &'static str,
+        path: PathBuf,
+        error: io::Error,
+    },
+    /// The run summary could not be serialized to JSON.
+    #[error("cannot serialize run summary for {}: {error}", path.display())]
+    Json {
+        path: PathBuf,
+        error: serde_json::Error,
+    },
+    /// A snapshot array does not have one entry per particle (`pos.len()`).
+    #[error(
+        "snapshot for {}: array `{array}` has {len} entries, expected {expected} (one per particle)",
+        path.display()
+    )]
+    SnapshotLength {
+        path: PathBuf,
+        array: &'static str,
+        len: usize,
+        expected: usize,
+    },
+    /// `ProbeWriter::record` got a number of values different from the number of probes.
+    #[error("probe writer for {}: record() got {got} values for {expected} probes", dir.display())]
+    ProbeCount {
+        dir: PathBuf,
+        expected: usize,
+        got: usize,
+    },
+    /// A probe name cannot be used as a file name (empty, path separator, duplicate, ...).
+    #[error("invalid probe name {name:?} in {}: {reason}", dir.display())]
+    ProbeName {
+        dir: PathBuf,
+        name: String,
+        reason: &'static str,
+    },
+}
+
+impl OutputError {
+    pub(crate) fn io(action: &'static str, path: &Path, error: io::Error) -> Self {
+        OutputError::Io {
+            action,
+            path: path.to_path_buf(),
+            error,
+        }
+    }
+}
+
+/// One snapshot of all particles, positions already in f64 world coordinates.
+#[derive(Clone, Copy)]
+pub struct Snapshot<'a> {
+    pub time_s: f64,
+    pub pos: &'a [[f64; 3]],
+    pub vel: &'a [[f32; 3]],
+    pub rho: &'a [f32],
+    pub pressure: &'a [f32],
+    /// 0 fluid, 1 wall, ...
+    pub kind: &'a [u32],
+    /// Stable particle id.
+    pub id: &'a [u32],
+}
+
+impl Snapshot<'_> {
+    /// Number of particles (`pos.len()`).
+    pub fn len(&self) -> usize {
+        self.pos.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.pos.is_empty()
+    }
+
+    /// Checks that every array has one entry per particle; `path` is only used in the error.
+    pub fn validate(&self, path: &Path) -> Result<(), OutputError> {
+        let n = self.pos.len();
+        let lens = [
+            ("vel", self.vel.len()),
+            ("rho", self.rho.len()),
+            ("pressure", self.pressure.len()),
+            ("kind", self.kind.len()),
+            ("id", self.id.len()),
+        ];
+        for (array, len) in lens {
+            if len != n {
+                return Err(OutputError::SnapshotLength {
+                    path: path.to_path_buf(),
+                    array,
+                    len,
+                    expected: n,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// An output directory: owns the snapshot series and creates probe writers.
+#[derive(Debug)]
+pub struct OutputDir {
+    dir: PathBuf,
+    /// (time, path relative to `dir` with '/' separators) of every snapshot written so far.
+    snapshots: Vec<(f64, String)>,
+}
+
+impl OutputDir {
+    /// Creates DIR, DIR/particles, DIR/probes (existing folders are fine). Errors name the path.
+    pub fn create(dir: &Path) -> Result<Self, OutputError> {
+        for d in [
+            dir.to_path_buf(),
+            dir.join(PARTICLES_DIR),
+            dir.join(PROBES_DIR),
+        ] {
+            std::fs::create_dir_all(&d).map_err(|e| OutputError::io("create directory", &d, e))?;
+        }
+        Ok(OutputDir {
+            dir: dir.to_path_buf(),
+            snapshots: Vec::new(),
+        })
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// DIR/particles.pvd
+    pub fn pvd_path(&self) -> PathBuf {
+        self.dir.join(PVD_FILE)
+    }
+
+    /// Number of snapshots written so far (also the index of the next one).
+    pub fn snapshot_count(&self) -> usize {
+        self.snapshots.len()
+    }
+
+    /// Writes DIR/particles/particles_NNNNNN.vtu (NNNNNN = index, 6 digits, starting at 0)
+    /// atomically, then rewrites DIR/particles.pvd atomically listing every snapshot written so
+    /// far (time + relative file). The .vtu is fully written and renamed before the .pvd that
+    /// references it. Returns the path of the .vtu.
+    pub fn write_snapshot(&mut self, snap: &Snapshot) -> Result<PathBuf, OutputError> {
+        let index = self.snapshots.len();
+        let rel = format!("{PARTICLES_DIR}/particles_{index:06}.vtu");
+        let vtu_path = self
+            .dir
+            .join(PARTICLES_DIR)
+            .join(format!("particles_{index:06}.vtu"));
+        snap.validate(&vtu_path)?;
+        write_atomic(&vtu_path, |w| vtu::write_vtu(w, snap))?;
+        // The .vtu is complete and in place: from now on it belongs to the series, even if
+        // rewriting the .pvd fails (the next snapshot's .pvd rewrite will list it).
+        self.snapshots.push((snap.time_s, rel));
+        let pvd_path = self.pvd_path();
+        write_atomic(&pvd_path, |w| pvd::write_pvd(w, &self.snapshots))?;
+        Ok(vtu_path)
+    }
+
+    /// Creates one CSV per probe at DIR/probes/<name>.csv with header `t_s,<column>` (written
+    /// at once, atomically); rows are appended with [`ProbeWriter::record`] and made durable by
+    /// [`ProbeWriter::flush`].
+    pub fn probe_writer(
+        &self,
+        names_and_columns: &[(String, String)],
+    ) -> Result<ProbeWriter, OutputError> {
+        ProbeWriter::create(&self.dir.join(PROBES_DIR), names_and_columns)
+    }
+
+    /// Writes DIR/run.json atomically (pretty-printed; non-finite numbers become `null`).
+    pub fn write_run_summary(&self, summary: &RunSummary) -> Result<(), OutputError> {
+        run_summary::write_run_summary(&self.dir.join(RUN_SUMMARY_FILE), summary)
+    }
+}
+
+/// Formats an f64 so that parsing it back gives the same value: shortest round-trip digits,
+/// plain notation for ordinary magnitudes, exponent notation for very large or small ones.
+/// Non-finite values are written as `nan`, `inf`, `-inf`.
+pub fn fmt_f64(x: f64) -> F64Text {
+    F64Text(x)
+}
+
+/// Display wrapper returned by [`fmt_f64`].
+#[derive(Clone, Copy, Debug)]
+pub struct F64Text(pub f64);
+
+impl fmt::Display for F64Text {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        if x.is_nan() {
+            f.write_str("nan")
+        } else if x.is_infinite() {
+            f.write_str(if x > 0.0 { "inf" } else { "-inf" })
+        } else {
+            let a = x.abs();
+            if a == 0.0 || (1e-5..1e16).contains(&a) {
+                write!(f, "{x}")
+            } else {
+                write!(f, "{x:e}")
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod test_util {
+    use std::path::PathBuf;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// A fresh, empty, unique folder under the system temp dir.
+    pub fn temp_dir(tag: &str) -> PathBuf {
+        static N: AtomicUsize = AtomicUsize::new(0);
+        let n = N.fetch_add(1, Ordering::Relaxed);
+        let d = std::env::temp_dir().join(format!(
+            "wgsph-output-test-{}-{}-{tag}",
+            std::process::id(),
+            n
+        ));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fmt_f64_round_trips() {
+        let vals = [
+            0.0,
+            -0.0,
+            0.01,
+            0.1 + 0.2,
+            1.0 / 3.0,
+            -2.5,
+            1e-5,
+            9.99e-6,
+            1e-300,
+            5e-324,
+            1e15,
+            1e16,
+            123456789012345680000.0,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            -1.2345678901234567e-7,
+        ];
+        for v in vals {
+            let s = fmt_f64(v).to_string();
+            let back: f64 = s.parse().unwrap();
+            assert_eq!(back.to_bits(), v.to_bits(), "{v:e} -> {s}");
+        }
+        assert_eq!(fmt_f64(0.01).to_string(), "0.01");
+        assert_eq!(fmt_f64(1e-300).to_string(), "1e-300");
+        assert_eq!(fmt_f64(f64::NAN).to_string(), "nan");
+        assert_eq!(fmt_f64(f64::INFINITY).to_string(), "inf");
+        assert_eq!(fmt_f64(f64::NEG_INFINITY).to_string(), "-inf");
+    }
+
+    #[test]
+    fn create_makes_subfolders_and_is_idempotent() {
+        let base = test_util::temp_dir("create");
+        let dir = base.join("a/b/out");
+        let out = OutputDir::create(&dir).unwrap();
+        assert_eq!(out.path(), dir.as_path());
+        assert!(dir.join("particles").is_dir());
+        assert!(dir.join("probes").is_dir());
+        OutputDir::create(&dir).unwrap();
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+
+    #[test]
+    fn create_error_names_path() {
+        let base = test_util::temp_dir("create-err");
+        let file = base.join("not-a-dir");
+        std::fs::write(&file, b"x").unwrap();
+        let dir = file.join("out");
+        let err = OutputDir::create(&dir).unwrap_err();
+        let msg = err.to_string();
+        assert!(msg.contains(&dir.display().to_string()), "{msg}");
+        assert!(msg.contains("os error"), "{msg}");
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+
+    #[test]
+    fn snapshot_length_mismatch_is_an_error_and_writes_nothing() {
+        let base = test_util::temp_dir("mismatch");
+        let mut out = OutputDir::create(&base).unwrap();
+        let pos = [[0.0; 3]; 2];
+        let vel = [[0.0f32; 3]; 2];
+        let s = [0.0f32; 2];
+        let u = [0u32; 2];
+        let short = [0u32; 1];
+        let snap = Snapshot {
+            time_s: 0.0,
+            pos: &pos,
+            vel: &vel,
+            rho: &s,
+            pressure: &s,
+            kind: &u,
+            id: &short,
+        };
+        let err = out.write_snapshot(&snap).unwrap_err();
+        assert!(matches!(
+            err,
+            OutputError::SnapshotLength { array: "id", .. }
+        ));
+        assert!(err.to_string().contains("particles_000000.vtu"));
+        assert_eq!(out.snapshot_count(), 0);
+        assert_eq!(
+            std::fs::read_dir(base.join("particles")).unwrap().count(),
+            0
+        );
+        assert!(!base.join("particles.pvd").exists());
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+
+    #[test]
+    fn snapshot_series_vtu_then_pvd() {
+        let base = test_util::temp_dir("series");
+        let mut out = OutputDir::create(&base).unwrap();
+        let times = [0.0, 0.01, 0.1 + 0.2];
+        for (k, &t) in times.iter().enumerate() {
+            let n = 5 + k;
+            let pos: Vec<[f64; 3]> = (0..n)
+                .map(|i| [i as f64 + t, 1e8 + 1.0 / 3.0, -1.0])
+                .collect();
+            let vel = vec![[0.5f32; 3]; n];
+            let rho = vec![1000.0f32; n];
+            let pressure = vec![0.0f32; n];
+            let kind = vec![0u32; n];
+            let id: Vec<u32> = (0..n as u32).rev().collect();
+            let snap = Snapshot {
+                time_s: t,
+                pos: &pos,
+                vel: &vel,
+                rho: &rho,
+                pressure: &pressure,
+                kind: &kind,
+                id: &id,
+            };
+            let p = out.write_snapshot(&snap).unwrap();
+            assert_eq!(p, base.join(format!("particles/particles_{k:06}.vtu")));
+            let v = vtu::reader::Vtu::parse(&std::fs::read(&p).unwrap());
+            assert_eq!(v.number_of_points, n);
+            assert_eq!(v.u32s("id"), id);
+            let pts = v.f64s("Points", 3);
+            assert_eq!(pts[3 * (n - 1)], pos[n - 1][0]);
+            assert_eq!(pts[1], 1e8 + 1.0 / 3.0);
+
+            // The .pvd lists exactly the snapshots written so far, each of which exists.
+            let pvd_text = std::fs::read_to_string(base.join("particles.pvd")).unwrap();
+            let listed = pvd::tests::parse_pvd(&pvd_text);
+            assert_eq!(listed.len(), k + 1);
+            for (j, (tj, file)) in listed.iter().enumerate() {
+                assert_eq!(tj.to_bits(), times[j].to_bits());
+                assert_eq!(file, &format!("particles/particles_{j:06}.vtu"));
+                assert!(base.join(file).is_file());
+            }
+        }
+        assert_eq!(out.snapshot_count(), 3);
+        // No temporary files left anywhere.
+        let mut names: Vec<String> = std::fs::read_dir(&base)
+            .unwrap()
+            .chain(std::fs::read_dir(base.join("particles")).unwrap())
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            [
+                "particles",
+                "particles.pvd",
+                "particles_000000.vtu",
+                "particles_000001.vtu",
+                "particles_000002.vtu",
+                "probes"
+            ]
+        );
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+}

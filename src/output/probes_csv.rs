@@ -1,0 +1,247 @@
+//! Probe time series as CSV files, one per probe, rewritten atomically on flush.
+
+use std::collections::HashSet;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::{fmt_f64, write_atomic, OutputError};
+
+struct ProbeFile {
+    path: PathBuf,
+    /// Full CSV text (header + every recorded row), kept in memory and rewritten on flush.
+    text: String,
+}
+
+/// Writes one CSV per probe (`t_s,<column>` header, one `t,value` row per [`record`] call).
+///
+/// Crash safety is by atomic rewrite: all rows stay in memory (already formatted) and every
+/// [`flush`] rewrites each CSV to a temporary file and renames it into place, so a killed run
+/// never leaves a truncated CSV — at worst the rows recorded since the last flush are missing.
+/// Dropping the writer flushes pending rows (best effort, errors ignored); call [`flush`] at the
+/// end of a run to see errors.
+///
+/// [`record`]: ProbeWriter::record
+/// [`flush`]: ProbeWriter::flush
+pub struct ProbeWriter {
+    dir: PathBuf,
+    files: Vec<ProbeFile>,
+    rows: usize,
+    dirty: bool,
+}
+
+impl ProbeWriter {
+    /// Validates the names and writes each `dir/<name>.csv` with its header line only.
+    pub(crate) fn create(
+        dir: &Path,
+        names_and_columns: &[(String, String)],
+    ) -> Result<Self, OutputError> {
+        let mut seen = HashSet::new();
+        let mut files = Vec::with_capacity(names_and_columns.len());
+        for (name, column) in names_and_columns {
+            let bad = |reason| OutputError::ProbeName {
+                dir: dir.to_path_buf(),
+                name: name.clone(),
+                reason,
+            };
+            if name.is_empty() || name == "." || name == ".." {
+                return Err(bad("not usable as a file name"));
+            }
+            if name.contains(['/', '\\', '\0', '\n', '\r']) {
+                return Err(bad("contains a path separator or control character"));
+            }
+            if column.is_empty() || column.contains([',', '"', '\n', '\r']) {
+                return Err(bad(
+                    "its column name is empty or contains ',', '\"' or a line break",
+                ));
+            }
+            if !seen.insert(name.as_str()) {
+                return Err(bad("used twice"));
+            }
+            files.push(ProbeFile {
+                path: dir.join(format!("{name}.csv")),
+                text: format!("t_s,{column}\n"),
+            });
+        }
+        let mut w = ProbeWriter {
+            dir: dir.to_path_buf(),
+            files,
+            rows: 0,
+            dirty: true,
+        };
+        w.flush()?;
+        Ok(w)
+    }
+
+    /// Number of probes.
+    pub fn len(&self) -> usize {
+        self.files.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.files.is_empty()
+    }
+
+    /// Number of rows recorded so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Paths of the CSV files, in probe order.
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        self.files.iter().map(|f| f.path.as_path())
+    }
+
+    /// Records one row `t,value` per probe; `values.len()` must equal the number of probes.
+    /// Rows only reach the disk on [`flush`](ProbeWriter::flush).
+    pub fn record(&mut self, t_s: f64, values: &[f64]) -> Result<(), OutputError> {
+        if values.len() != self.files.len() {
+            return Err(OutputError::ProbeCount {
+                dir: self.dir.clone(),
+                expected: self.files.len(),
+                got: values.len(),
+            });
+        }
+        for (f, &v) in self.files.iter_mut().zip(values) {
+            // Writing into a String cannot fail.
+            let _ = writeln!(f.text, "{},{}", fmt_f64(t_s), fmt_f64(v));
+        }
+        self.rows += 1;
+        self.dirty = true;
+        Ok(())
+    }
+
+    /// Makes the recorded rows durable by atomically rewriting every CSV (no-op when nothing was
+    /// recorded since the last successful flush).
+    pub fn flush(&mut self) -> Result<(), OutputError> {
+        if !self.dirty {
+            return Ok(());
+        }
+        for f in &self.files {
+            write_atomic(&f.path, |w| w.write_all(f.text.as_bytes()))?;
+        }
+        self.dirty = false;
+        Ok(())
+    }
+}
+
+impl Drop for ProbeWriter {
+    fn drop(&mut self) {
+        let _ = self.flush();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_util::temp_dir;
+    use super::super::{OutputDir, OutputError};
+
+    fn cols(v: &[(&str, &str)]) -> Vec<(String, String)> {
+        v.iter()
+            .map(|(a, b)| (a.to_string(), b.to_string()))
+            .collect()
+    }
+
+    #[test]
+    fn header_rows_and_flush() {
+        let d = temp_dir("probes");
+        let out = OutputDir::create(&d).unwrap();
+        let mut w = out
+            .probe_writer(&cols(&[
+                ("p1", "pressure_pa"),
+                ("h_left", "height_m"),
+                ("front", "front_m"),
+            ]))
+            .unwrap();
+        assert_eq!(w.len(), 3);
+        // Headers exist right away.
+        let p1 = d.join("probes/p1.csv");
+        assert_eq!(std::fs::read_to_string(&p1).unwrap(), "t_s,pressure_pa\n");
+        assert_eq!(
+            std::fs::read_to_string(d.join("probes/front.csv")).unwrap(),
+            "t_s,front_m\n"
+        );
+
+        w.record(0.0, &[101325.0, 0.3, 0.0]).unwrap();
+        w.record(0.1 + 0.2, &[f64::NAN, 1.0 / 3.0, 1e-300]).unwrap();
+        // Not yet durable.
+        assert_eq!(std::fs::read_to_string(&p1).unwrap(), "t_s,pressure_pa\n");
+        w.flush().unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&p1).unwrap(),
+            "t_s,pressure_pa\n0,101325\n0.30000000000000004,nan\n"
+        );
+        let h = std::fs::read_to_string(d.join("probes/h_left.csv")).unwrap();
+        let last = h.lines().last().unwrap();
+        let (t, v) = last.split_once(',').unwrap();
+        assert_eq!(t.parse::<f64>().unwrap(), 0.1 + 0.2);
+        assert_eq!(v.parse::<f64>().unwrap(), 1.0 / 3.0);
+        assert_eq!(
+            std::fs::read_to_string(d.join("probes/front.csv")).unwrap(),
+            "t_s,front_m\n0,0\n0.30000000000000004,1e-300\n"
+        );
+        assert_eq!(w.rows(), 2);
+
+        // More rows, flush again: whole file rewritten, no temp files left over.
+        w.record(1.0, &[1.0, 2.0, 3.0]).unwrap();
+        w.flush().unwrap();
+        w.flush().unwrap();
+        assert_eq!(std::fs::read_to_string(&p1).unwrap().lines().count(), 4);
+        let names: Vec<_> = std::fs::read_dir(d.join("probes"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        assert_eq!(names.len(), 3, "{names:?}");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn drop_flushes_pending_rows() {
+        let d = temp_dir("probes-drop");
+        let out = OutputDir::create(&d).unwrap();
+        {
+            let mut w = out.probe_writer(&cols(&[("a", "height_m")])).unwrap();
+            w.record(0.5, &[2.0]).unwrap();
+        }
+        assert_eq!(
+            std::fs::read_to_string(d.join("probes/a.csv")).unwrap(),
+            "t_s,height_m\n0.5,2\n"
+        );
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn wrong_value_count_and_bad_names() {
+        let d = temp_dir("probes-err");
+        let out = OutputDir::create(&d).unwrap();
+        let mut w = out
+            .probe_writer(&cols(&[("a", "height_m"), ("b", "height_m")]))
+            .unwrap();
+        let err = w.record(0.0, &[1.0]).unwrap_err();
+        assert!(matches!(
+            err,
+            OutputError::ProbeCount {
+                expected: 2,
+                got: 1,
+                ..
+            }
+        ));
+        assert!(err.to_string().contains("probes"));
+        assert_eq!(w.rows(), 0);
+
+        for bad in [
+            cols(&[("", "x")]),
+            cols(&[("..", "x")]),
+            cols(&[("a/b", "x")]),
+            cols(&[("a", "x,y")]),
+            cols(&[("a", "x"), ("a", "y")]),
+        ] {
+            let err = out.probe_writer(&bad).err().expect("must fail");
+            assert!(matches!(err, OutputError::ProbeName { .. }), "{err}");
+        }
+        // No probes at all is allowed.
+        let mut empty = out.probe_writer(&[]).unwrap();
+        empty.record(0.0, &[]).unwrap();
+        empty.flush().unwrap();
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}

@@ -1,0 +1,102 @@
+//! Run summary written to `DIR/run.json`.
+
+use std::path::Path;
+
+use super::{write_atomic, OutputError};
+
+/// Summary of a run, written as JSON at the end (and possibly on stop). Non-finite floats are
+/// written as `null` (JSON has no NaN).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RunSummary {
+    pub case: String,
+    pub adapter: String,
+    pub backend: String,
+    pub dimension: u32,
+    pub particles_fluid: u64,
+    pub particles_wall: u64,
+    pub particles_excluded: u64,
+    pub steps: u64,
+    pub simulated_time_s: f64,
+    pub wall_time_s: f64,
+    pub particle_steps_per_s: f64,
+    pub gpu_bytes_per_particle: f64,
+    pub outputs: u64,
+    /// "completed" | "stopped: <reason>"
+    pub status: String,
+}
+
+pub(crate) fn write_run_summary(path: &Path, summary: &RunSummary) -> Result<(), OutputError> {
+    let mut json = serde_json::to_vec_pretty(summary).map_err(|error| OutputError::Json {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    json.push(b'\n');
+    write_atomic(path, |w| w.write_all(&json))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_util::temp_dir;
+    use super::super::OutputDir;
+    use super::*;
+
+    fn sample() -> RunSummary {
+        RunSummary {
+            case: "dam_break_2d".into(),
+            adapter: "NVIDIA H100 \"quoted\"".into(),
+            backend: "Vulkan".into(),
+            dimension: 2,
+            particles_fluid: 123_456,
+            particles_wall: 7_890,
+            particles_excluded: 0,
+            steps: 10_000,
+            simulated_time_s: 0.1 + 0.2,
+            wall_time_s: 12.5,
+            particle_steps_per_s: 1.0 / 3.0 * 1e9,
+            gpu_bytes_per_particle: 212.0,
+            outputs: 51,
+            status: "completed".into(),
+        }
+    }
+
+    #[test]
+    fn writes_and_reads_back() {
+        let d = temp_dir("summary");
+        let out = OutputDir::create(&d).unwrap();
+        let s = sample();
+        out.write_run_summary(&s).unwrap();
+        let text = std::fs::read_to_string(d.join("run.json")).unwrap();
+        let back: RunSummary = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, s);
+        assert!(text.contains("\"status\": \"completed\""));
+        // Rewrite with a different status.
+        let s2 = RunSummary {
+            status: "stopped: NaN in density".into(),
+            ..s
+        };
+        out.write_run_summary(&s2).unwrap();
+        let back: RunSummary =
+            serde_json::from_str(&std::fs::read_to_string(d.join("run.json")).unwrap()).unwrap();
+        assert_eq!(back.status, "stopped: NaN in density");
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 3); // run.json, particles, probes
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn nan_becomes_null() {
+        let d = temp_dir("summary-nan");
+        let out = OutputDir::create(&d).unwrap();
+        let s = RunSummary {
+            wall_time_s: f64::NAN,
+            particle_steps_per_s: f64::INFINITY,
+            ..sample()
+        };
+        out.write_run_summary(&s).unwrap();
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("run.json")).unwrap()).unwrap();
+        assert!(v["wall_time_s"].is_null());
+        assert!(v["particle_steps_per_s"].is_null());
+        assert_eq!(v["steps"], 10_000);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}

@@ -1,0 +1,483 @@
+//! ParaView `.vtu` (VTK XML UnstructuredGrid) writer with raw appended binary data.
+//!
+//! Layout: the XML header declares every array with `format="appended"` and its byte `offset`
+//! into the appended section; `<AppendedData encoding="raw">_` is followed by one block per array,
+//! each a little-endian UInt64 byte count then the raw little-endian values
+//! (`header_type="UInt64"`, `byte_order="LittleEndian"`). Each particle is one VTK_VERTEX cell.
+
+use std::io::{self, Write};
+
+use super::Snapshot;
+
+/// VTK cell type of a single point.
+const VTK_VERTEX: u8 = 1;
+
+/// Scalar types that can be stored in the appended section.
+trait LeBytes: Copy {
+    const SIZE: usize;
+    const VTK_NAME: &'static str;
+    fn put(self, out: &mut Vec<u8>);
+}
+
+macro_rules! le_bytes {
+    ($t:ty, $name:literal) => {
+        impl LeBytes for $t {
+            const SIZE: usize = std::mem::size_of::<$t>();
+            const VTK_NAME: &'static str = $name;
+            #[inline(always)]
+            fn put(self, out: &mut Vec<u8>) {
+                out.extend_from_slice(&self.to_le_bytes());
+            }
+        }
+    };
+}
+le_bytes!(f64, "Float64");
+le_bytes!(f32, "Float32");
+le_bytes!(u32, "UInt32");
+le_bytes!(i32, "Int32");
+le_bytes!(i64, "Int64");
+le_bytes!(u8, "UInt8");
+
+/// Description of one appended array: XML element and byte offset of its block.
+struct ArrayDecl {
+    name: &'static str,
+    vtk_type: &'static str,
+    components: usize,
+    tuples: usize,
+    elem_size: usize,
+}
+
+impl ArrayDecl {
+    fn new<T: LeBytes>(name: &'static str, components: usize, tuples: usize) -> Self {
+        ArrayDecl {
+            name,
+            vtk_type: T::VTK_NAME,
+            components,
+            tuples,
+            elem_size: T::SIZE,
+        }
+    }
+
+    fn data_bytes(&self) -> u64 {
+        (self.tuples * self.components * self.elem_size) as u64
+    }
+
+    /// Block size in the appended section: UInt64 header + data.
+    fn block_bytes(&self) -> u64 {
+        8 + self.data_bytes()
+    }
+
+    fn xml(&self, indent: &str, offset: u64, extra: &str) -> String {
+        let comps = if self.components > 1 {
+            format!(" NumberOfComponents=\"{}\"", self.components)
+        } else {
+            String::new()
+        };
+        format!(
+            "{indent}<DataArray type=\"{}\" Name=\"{}\"{comps}{extra} format=\"appended\" offset=\"{offset}\"/>\n",
+            self.vtk_type, self.name
+        )
+    }
+}
+
+/// Writes one appended block: byte count as UInt64, then the values, encoded in chunks.
+fn write_block<T: LeBytes>(
+    w: &mut dyn Write,
+    decl: &ArrayDecl,
+    values: impl Iterator<Item = T>,
+    chunk: &mut Vec<u8>,
+) -> io::Result<()> {
+    const CHUNK_BYTES: usize = 1 << 16;
+    w.write_all(&decl.data_bytes().to_le_bytes())?;
+    let mut written = 0u64;
+    chunk.clear();
+    for v in values {
+        v.put(chunk);
+        if chunk.len() >= CHUNK_BYTES {
+            w.write_all(chunk)?;
+            written += chunk.len() as u64;
+            chunk.clear();
+        }
+    }
+    w.write_all(chunk)?;
+    written += chunk.len() as u64;
+    chunk.clear();
+    if written != decl.data_bytes() {
+        // Cannot happen for a validated snapshot; refuse to produce an inconsistent file.
+        return Err(io::Error::other(format!(
+            "array {} has {written} bytes, declared {}",
+            decl.name,
+            decl.data_bytes()
+        )));
+    }
+    Ok(())
+}
+
+/// Writes a complete `.vtu` for `snap` (arrays must all have `snap.len()` entries).
+pub(crate) fn write_vtu(w: &mut dyn Write, snap: &Snapshot) -> io::Result<()> {
+    let n = snap.len();
+    // Int32 cell indices while they fit (half the size), Int64 beyond.
+    let wide = n > i32::MAX as usize;
+    let index_decl = |name| {
+        if wide {
+            ArrayDecl::new::<i64>(name, 1, n)
+        } else {
+            ArrayDecl::new::<i32>(name, 1, n)
+        }
+    };
+
+    let time = ArrayDecl::new::<f64>("TimeValue", 1, 1);
+    let velocity = ArrayDecl::new::<f32>("velocity", 3, n);
+    let density = ArrayDecl::new::<f32>("density", 1, n);
+    let pressure = ArrayDecl::new::<f32>("pressure", 1, n);
+    let kind = ArrayDecl::new::<u32>("kind", 1, n);
+    let id = ArrayDecl::new::<u32>("id", 1, n);
+    let points = ArrayDecl::new::<f64>("Points", 3, n);
+    let connectivity = index_decl("connectivity");
+    let offsets = index_decl("offsets");
+    let types = ArrayDecl::new::<u8>("types", 1, n);
+
+    // Byte offsets of the blocks, in the order they are appended.
+    let order = [
+        &time,
+        &velocity,
+        &density,
+        &pressure,
+        &kind,
+        &id,
+        &points,
+        &connectivity,
+        &offsets,
+        &types,
+    ];
+    let mut off = [0u64; 10];
+    let mut acc = 0u64;
+    for (o, d) in off.iter_mut().zip(order) {
+        *o = acc;
+        acc += d.block_bytes();
+    }
+
+    let mut xml = String::with_capacity(2048);
+    xml.push_str("<?xml version=\"1.0\"?>\n");
+    xml.push_str(
+        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n",
+    );
+    xml.push_str("  <UnstructuredGrid>\n");
+    xml.push_str("    <FieldData>\n");
+    xml.push_str(&time.xml("      ", off[0], " NumberOfTuples=\"1\""));
+    xml.push_str("    </FieldData>\n");
+    xml.push_str(&format!(
+        "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">\n"
+    ));
+    xml.push_str("      <PointData Scalars=\"density\" Vectors=\"velocity\">\n");
+    for (d, o) in order[1..6].iter().zip(&off[1..6]) {
+        xml.push_str(&d.xml("        ", *o, ""));
+    }
+    xml.push_str("      </PointData>\n");
+    xml.push_str("      <Points>\n");
+    xml.push_str(&points.xml("        ", off[6], ""));
+    xml.push_str("      </Points>\n");
+    xml.push_str("      <Cells>\n");
+    for (d, o) in order[7..].iter().zip(&off[7..]) {
+        xml.push_str(&d.xml("        ", *o, ""));
+    }
+    xml.push_str("      </Cells>\n");
+    xml.push_str("    </Piece>\n");
+    xml.push_str("  </UnstructuredGrid>\n");
+    xml.push_str("  <AppendedData encoding=\"raw\">\n   _");
+    w.write_all(xml.as_bytes())?;
+
+    let mut chunk = Vec::with_capacity((1 << 16) + 64);
+    let c = &mut chunk;
+    write_block(w, &time, std::iter::once(snap.time_s), c)?;
+    write_block(w, &velocity, snap.vel.iter().flatten().copied(), c)?;
+    write_block(w, &density, snap.rho.iter().copied(), c)?;
+    write_block(w, &pressure, snap.pressure.iter().copied(), c)?;
+    write_block(w, &kind, snap.kind.iter().copied(), c)?;
+    write_block(w, &id, snap.id.iter().copied(), c)?;
+    write_block(w, &points, snap.pos.iter().flatten().copied(), c)?;
+    if wide {
+        write_block(w, &connectivity, 0..n as i64, c)?;
+        write_block(w, &offsets, 1..=n as i64, c)?;
+    } else {
+        write_block(w, &connectivity, 0..n as i32, c)?;
+        write_block(w, &offsets, 1..=n as i32, c)?;
+    }
+    write_block(w, &types, std::iter::repeat_n(VTK_VERTEX, n), c)?;
+
+    w.write_all(b"\n  </AppendedData>\n</VTKFile>\n")?;
+    Ok(())
+}
+
+/// Minimal reader for the files written above (tests only).
+#[cfg(test)]
+pub(crate) mod reader {
+    use std::collections::HashMap;
+
+    pub struct Array {
+        pub vtk_type: String,
+        pub components: usize,
+        pub data: Vec<u8>,
+    }
+
+    pub struct Vtu {
+        pub header: String,
+        pub number_of_points: usize,
+        pub number_of_cells: usize,
+        pub arrays: HashMap<String, Array>,
+    }
+
+    fn attr(elem: &str, name: &str) -> Option<String> {
+        let key = format!(" {name}=\"");
+        let start = elem.find(&key)? + key.len();
+        let len = elem[start..].find('"')?;
+        Some(elem[start..start + len].to_string())
+    }
+
+    impl Vtu {
+        pub fn parse(bytes: &[u8]) -> Vtu {
+            let marker = b"<AppendedData encoding=\"raw\">";
+            let m = bytes
+                .windows(marker.len())
+                .position(|w| w == marker)
+                .expect("AppendedData element");
+            let header = std::str::from_utf8(&bytes[..m]).unwrap().to_string();
+            let us = m + bytes[m..].iter().position(|&b| b == b'_').unwrap();
+            let base = us + 1;
+            assert!(bytes[m + marker.len()..us]
+                .iter()
+                .all(|b| b.is_ascii_whitespace()));
+            assert!(bytes.ends_with(b"</AppendedData>\n</VTKFile>\n"));
+
+            // Well-formedness of the XML part (enough for our fixed structure).
+            assert!(
+                header.starts_with("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\"")
+            );
+            assert!(header.contains("byte_order=\"LittleEndian\""));
+            assert!(header.contains("header_type=\"UInt64\""));
+            for tag in [
+                "UnstructuredGrid",
+                "Piece",
+                "PointData",
+                "Points",
+                "Cells",
+                "FieldData",
+            ] {
+                let open = header.matches(&format!("<{tag}>")).count()
+                    + header.matches(&format!("<{tag} ")).count();
+                let close = header.matches(&format!("</{tag}>")).count();
+                assert_eq!((open, close), (1, 1), "tag {tag}");
+            }
+            let piece = header.lines().find(|l| l.contains("<Piece ")).unwrap();
+            let number_of_points: usize = attr(piece, "NumberOfPoints").unwrap().parse().unwrap();
+            let number_of_cells: usize = attr(piece, "NumberOfCells").unwrap().parse().unwrap();
+
+            let mut arrays = HashMap::new();
+            let mut last_end = 0usize;
+            for line in header.lines().filter(|l| l.contains("<DataArray ")) {
+                assert!(line.trim_end().ends_with("/>"), "{line}");
+                assert_eq!(attr(line, "format").as_deref(), Some("appended"));
+                let name = attr(line, "Name").unwrap();
+                let vtk_type = attr(line, "type").unwrap();
+                let components = attr(line, "NumberOfComponents")
+                    .map(|c| c.parse().unwrap())
+                    .unwrap_or(1);
+                let offset: usize = attr(line, "offset").unwrap().parse().unwrap();
+                let at = base + offset;
+                let len = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+                let data = bytes[at + 8..at + 8 + len].to_vec();
+                last_end = last_end.max(at + 8 + len);
+                let prev = arrays.insert(
+                    name.clone(),
+                    Array {
+                        vtk_type,
+                        components,
+                        data,
+                    },
+                );
+                assert!(prev.is_none(), "duplicate array {name}");
+            }
+            // Nothing but the closing tags after the last block.
+            assert_eq!(&bytes[last_end..], b"\n  </AppendedData>\n</VTKFile>\n");
+            Vtu {
+                header,
+                number_of_points,
+                number_of_cells,
+                arrays,
+            }
+        }
+
+        pub fn array(&self, name: &str, vtk_type: &str, components: usize) -> &[u8] {
+            let a = self
+                .arrays
+                .get(name)
+                .unwrap_or_else(|| panic!("array {name}"));
+            assert_eq!(a.vtk_type, vtk_type, "type of {name}");
+            assert_eq!(a.components, components, "components of {name}");
+            &a.data
+        }
+
+        pub fn f64s(&self, name: &str, comps: usize) -> Vec<f64> {
+            self.array(name, "Float64", comps)
+                .chunks_exact(8)
+                .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+                .collect()
+        }
+
+        pub fn f32s(&self, name: &str, comps: usize) -> Vec<f32> {
+            self.array(name, "Float32", comps)
+                .chunks_exact(4)
+                .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                .collect()
+        }
+
+        pub fn u32s(&self, name: &str) -> Vec<u32> {
+            self.array(name, "UInt32", 1)
+                .chunks_exact(4)
+                .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+                .collect()
+        }
+
+        pub fn i32s(&self, name: &str) -> Vec<i32> {
+            self.array(name, "Int32", 1)
+                .chunks_exact(4)
+                .map(|c| i32::from_le_bytes(c.try_into().unwrap()))
+                .collect()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::reader::Vtu;
+    use super::*;
+
+    struct Owned {
+        pos: Vec<[f64; 3]>,
+        vel: Vec<[f32; 3]>,
+        rho: Vec<f32>,
+        p: Vec<f32>,
+        kind: Vec<u32>,
+        id: Vec<u32>,
+    }
+
+    impl Owned {
+        fn new(n: usize) -> Self {
+            let pos = (0..n)
+                .map(|i| {
+                    let x = i as f64;
+                    [1e6 + x / 3.0, -x * 0.1 - 1e-9, (x + 0.5).sqrt()]
+                })
+                .collect();
+            Owned {
+                pos,
+                vel: (0..n)
+                    .map(|i| [i as f32, -(i as f32) / 7.0, 0.25])
+                    .collect(),
+                rho: (0..n).map(|i| 1000.0 + i as f32 * 0.01).collect(),
+                p: (0..n).map(|i| i as f32 * 3.5 - 10.0).collect(),
+                kind: (0..n).map(|i| (i % 3 == 0) as u32).collect(),
+                id: (0..n).map(|i| (n - i) as u32 * 7 + 3).collect(),
+            }
+        }
+
+        fn snap(&self, t: f64) -> Snapshot<'_> {
+            Snapshot {
+                time_s: t,
+                pos: &self.pos,
+                vel: &self.vel,
+                rho: &self.rho,
+                pressure: &self.p,
+                kind: &self.kind,
+                id: &self.id,
+            }
+        }
+    }
+
+    fn to_bytes(snap: &Snapshot) -> Vec<u8> {
+        let mut buf = Vec::new();
+        write_vtu(&mut buf, snap).unwrap();
+        buf
+    }
+
+    #[test]
+    fn round_trip_all_arrays() {
+        let n = 20_000; // several encoding chunks per array
+        let o = Owned::new(n);
+        let bytes = to_bytes(&o.snap(0.125));
+        let v = Vtu::parse(&bytes);
+        assert_eq!(v.number_of_points, n);
+        assert_eq!(v.number_of_cells, n);
+        assert_eq!(v.arrays.len(), 10);
+
+        let pts = v.f64s("Points", 3);
+        let ids = v.u32s("id");
+        assert_eq!(pts.len(), 3 * n);
+        assert_eq!(ids, o.id);
+        for i in [0, 1, 2, n / 2, n - 1] {
+            for c in 0..3 {
+                assert_eq!(pts[3 * i + c].to_bits(), o.pos[i][c].to_bits());
+            }
+            assert_eq!(ids[i], o.id[i]);
+        }
+        let all_pos: Vec<f64> = o.pos.iter().flatten().copied().collect();
+        assert_eq!(pts, all_pos);
+        let all_vel: Vec<f32> = o.vel.iter().flatten().copied().collect();
+        assert_eq!(v.f32s("velocity", 3), all_vel);
+        assert_eq!(v.f32s("density", 1), o.rho);
+        assert_eq!(v.f32s("pressure", 1), o.p);
+        assert_eq!(v.u32s("kind"), o.kind);
+        assert_eq!(v.i32s("connectivity"), (0..n as i32).collect::<Vec<_>>());
+        assert_eq!(v.i32s("offsets"), (1..=n as i32).collect::<Vec<_>>());
+        assert!(v.array("types", "UInt8", 1).iter().all(|&t| t == 1));
+        assert_eq!(v.array("types", "UInt8", 1).len(), n);
+        assert_eq!(v.f64s("TimeValue", 1), vec![0.125]);
+        assert!(v
+            .header
+            .contains("<PointData Scalars=\"density\" Vectors=\"velocity\">"));
+    }
+
+    #[test]
+    fn zero_particles() {
+        let o = Owned::new(0);
+        let bytes = to_bytes(&o.snap(0.0));
+        let v = Vtu::parse(&bytes);
+        assert_eq!(v.number_of_points, 0);
+        assert_eq!(v.number_of_cells, 0);
+        assert_eq!(v.arrays.len(), 10);
+        assert!(v.f64s("Points", 3).is_empty());
+        assert!(v.u32s("id").is_empty());
+        assert!(v.i32s("offsets").is_empty());
+    }
+
+    #[test]
+    fn nan_values_are_kept_bitwise() {
+        let mut o = Owned::new(3);
+        o.pos[1] = [f64::NAN, f64::INFINITY, -0.0];
+        o.p[2] = f32::NAN;
+        let bytes = to_bytes(&o.snap(f64::NAN));
+        let v = Vtu::parse(&bytes);
+        let pts = v.f64s("Points", 3);
+        assert!(
+            pts[3].is_nan() && pts[4] == f64::INFINITY && pts[5].to_bits() == (-0.0f64).to_bits()
+        );
+        assert!(v.f32s("pressure", 1)[2].is_nan());
+        assert!(v.f64s("TimeValue", 1)[0].is_nan());
+    }
+
+    #[test]
+    fn file_size_matches_layout() {
+        let n = 1000;
+        let o = Owned::new(n);
+        let bytes = to_bytes(&o.snap(1.0));
+        let v = Vtu::parse(&bytes);
+        let data: usize = v.arrays.values().map(|a| a.data.len() + 8).sum();
+        // 24 + 12 + 4 + 4 + 4 + 4 + 4 + 4 + 1 bytes per particle, plus the time value.
+        assert_eq!(data, n * 61 + 16 + 9 * 8);
+        let header_end = v.header.len() + "<AppendedData encoding=\"raw\">\n   _".len();
+        assert_eq!(
+            bytes.len(),
+            header_end + data + "\n  </AppendedData>\n</VTKFile>\n".len()
+        );
+    }
+}

@@ -1,0 +1,28 @@
+//! Twin of shaders/cell_list.wgsl: the slot of each particle and the sorted order.
+
+use crate::sph::grid::Grid;
+
+/// Slot of each particle (given as GPU block + offset), `slots` for excluded ones.
+pub fn keys(grid: &Grid, pos: &[([f32; 3], [u32; 3])], excluded: &[bool]) -> Vec<u32> {
+    pos.iter()
+        .zip(excluded)
+        .map(|((off, b), &ex)| if ex { grid.slots } else { grid.slot_of(*off, *b) })
+        .collect()
+}
+
+/// The order the GPU sort must produce: stable by slot, ties by previous index; and the slot
+/// starts (slots + 2 entries). Excluded particles (the last slot) are not ordered by the GPU,
+/// so callers compare them as a set.
+pub fn sorted_order(grid: &Grid, keys: &[u32]) -> (Vec<usize>, Vec<u32>) {
+    let mut order: Vec<usize> = (0..keys.len()).collect();
+    order.sort_by_key(|&i| keys[i]);
+    let mut counts = vec![0u32; grid.slots as usize + 2];
+    for &k in keys {
+        counts[k as usize] += 1;
+    }
+    let mut start = vec![0u32; counts.len()];
+    for s in 1..counts.len() {
+        start[s] = start[s - 1] + counts[s - 1];
+    }
+    (order, start)
+}

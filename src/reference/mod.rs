@@ -1,0 +1,48 @@
+//! The CPU (f64) twin of `src/sph` and `shaders/`, with the same stage names. Brute force and
+//! plain: it exists to test the GPU kernels, not to run cases.
+
+pub mod cell_list;
+pub mod integrate;
+pub mod interaction;
+pub mod kernel;
+pub mod probes;
+
+use crate::scenario::{Physics, Viscosity};
+
+/// A particle as the reference sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RefParticle {
+    pub pos: [f64; 3],
+    pub vel: [f64; 3],
+    pub rho: f64,
+    /// 0 fluid, 1 wall (as in the GPU code word).
+    pub kind: u32,
+}
+
+pub const FLUID: u32 = 0;
+pub const WALL: u32 = 1;
+
+/// Tait equation of state, P = B((ρ/ρ0)^γ − 1).
+pub fn pressure(ph: &Physics, rho: f64) -> f64 {
+    ph.tait_b() * ((rho / ph.rho0).powf(ph.gamma) - 1.0)
+}
+
+/// c = c0 (ρ/ρ0)^((γ−1)/2).
+pub fn sound_speed(ph: &Physics, rho: f64) -> f64 {
+    ph.c0 * (rho / ph.rho0).powf(0.5 * (ph.gamma - 1.0))
+}
+
+pub fn laminar_nu(ph: &Physics) -> Option<f64> {
+    match ph.viscosity {
+        Viscosity::Laminar { nu } => Some(nu),
+        Viscosity::Artificial { .. } => None,
+    }
+}
+
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}

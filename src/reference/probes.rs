@@ -1,0 +1,65 @@
+//! Twin of shaders/probes.wgsl.
+
+use super::{dot, kernel, pressure, sub, RefParticle, FLUID};
+use crate::scenario::Physics;
+
+/// (Σ W V, Σ P W V) over fluid particles at x.
+fn sums(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> (f64, f64) {
+    let mut vol = 0.0;
+    let mut pw = 0.0;
+    for p in parts.iter().filter(|p| p.kind == FLUID) {
+        let d = sub(x, p.pos);
+        let r2 = dot(d, d);
+        if r2 < 4.0 * ph.h * ph.h {
+            let wv = kernel::w(ph.kernel, ph.dim, ph.h, r2.sqrt()) * ph.particle_mass / p.rho;
+            vol += wv;
+            pw += pressure(ph, p.rho) * wv;
+        }
+    }
+    (vol, pw)
+}
+
+/// Shepard-interpolated pressure; 0 where Σ W V < 0.1.
+pub fn pressure_at(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> f64 {
+    let (vol, pw) = sums(ph, parts, x);
+    if vol < 0.1 {
+        0.0
+    } else {
+        pw / vol
+    }
+}
+
+/// Height above `base` of the highest point of the vertical line where Σ W V reaches ½,
+/// stepping down by h/4 from `top` (the domain top) and interpolating linearly.
+pub fn height_at(ph: &Physics, parts: &[RefParticle], base: [f64; 3], top: f64) -> f64 {
+    let up = ph.dim as usize - 1;
+    let step = 0.25 * ph.h;
+    let mut x = base;
+    let (mut above, mut above_z) = (0.0, top);
+    let mut z = top;
+    while z >= base[up] {
+        x[up] = z;
+        let v = sums(ph, parts, x).0;
+        if v >= 0.5 {
+            if z == top {
+                return z - base[up];
+            }
+            let t = (v - 0.5) / (v - above).max(1e-6);
+            return z + (above_z - z) * t - base[up];
+        }
+        above = v;
+        above_z = z;
+        z -= step;
+    }
+    0.0
+}
+
+/// max over fluid of (x − origin)·axis (axis normalised).
+pub fn front(parts: &[RefParticle], origin: [f64; 3], axis: [f64; 3]) -> f64 {
+    let n = dot(axis, axis).sqrt();
+    parts
+        .iter()
+        .filter(|p| p.kind == FLUID)
+        .map(|p| dot(sub(p.pos, origin), axis) / n)
+        .fold(f64::NEG_INFINITY, f64::max)
+}

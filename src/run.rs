@@ -1,0 +1,136 @@
+//! Running a scenario to its end with outputs: particle snapshots at every output time, probe
+//! samples at every probe time, run.json at the end (also when the run stops early).
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+
+use crate::gpu::GpuContext;
+use crate::output::{OutputDir, RunSummary, Snapshot};
+use crate::scenario::{Kind, ProbeKind, Scenario};
+use crate::sph::Solver;
+
+/// Column name of a probe's CSV.
+pub fn probe_column(kind: &ProbeKind) -> &'static str {
+    match kind {
+        ProbeKind::Pressure { .. } => "pressure_pa",
+        ProbeKind::Height { .. } => "height_m",
+        ProbeKind::Front { .. } => "front_m",
+    }
+}
+
+/// What a finished (or stopped) run reports.
+pub struct RunReport {
+    pub summary: RunSummary,
+    /// Set when the run stopped before its end (instability); outputs up to then are kept.
+    pub stopped: Option<anyhow::Error>,
+}
+
+pub fn write_snapshot(out: &mut OutputDir, solver: &Solver) -> Result<()> {
+    let p = solver.read_particles()?;
+    out.write_snapshot(&Snapshot {
+        time_s: solver.time(),
+        pos: &p.pos,
+        vel: &p.vel,
+        rho: &p.rho,
+        pressure: &p.pressure,
+        kind: &p.kind,
+        id: &p.id,
+    })?;
+    Ok(())
+}
+
+/// Sample times of a series with interval `every` up to `end` (inclusive, `end` always last).
+fn schedule(every: f64, end: f64) -> impl Iterator<Item = f64> {
+    let n = (end / every - 1e-9).ceil().max(0.0) as u64;
+    (1..=n).map(move |k| (k as f64 * every).min(end))
+}
+
+/// Runs `sc` on `ctx`, writing into `dir`. `log` receives one line per output.
+pub fn run(ctx: &GpuContext, sc: &Scenario, dir: &Path, log: &mut dyn FnMut(&str)) -> Result<RunReport> {
+    let mut out = OutputDir::create(dir)?;
+    let names: Vec<(String, String)> =
+        sc.probes.iter().map(|p| (p.name.clone(), probe_column(&p.kind).to_string())).collect();
+    let mut probes = out.probe_writer(&names)?;
+    let mut solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
+    log(&format!(
+        "{}: {} particles ({} fluid, {} wall) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
+        sc.name,
+        sc.particles.len(),
+        sc.count(Kind::Fluid),
+        sc.count(Kind::Wall),
+        ctx.describe(),
+        solver.gpu_bytes() as f64 / sc.particles.len() as f64,
+        solver.dt()
+    ));
+    write_snapshot(&mut out, &solver)?;
+    if !sc.probes.is_empty() {
+        probes.record(0.0, &solver.sample_probes()?)?;
+    }
+    let started = Instant::now();
+    let every_out = sc.time.output_every_s;
+    let mut next_output = every_out.min(sc.time.end_s);
+    let mut stopped = None;
+    for t in schedule(sc.time.probe_every_s, sc.time.end_s) {
+        if let Err(e) = solver.advance_to(t) {
+            log(&format!("stopped: {e:#}; outputs up to t = {:.6} s are kept", next_output - every_out));
+            stopped = Some(e);
+            break;
+        }
+        if !sc.probes.is_empty() {
+            probes.record(solver.time(), &solver.sample_probes()?)?;
+        }
+        if solver.time() >= next_output - 1e-9 * every_out {
+            write_snapshot(&mut out, &solver)?;
+            probes.flush()?;
+            let wall = started.elapsed().as_secs_f64();
+            log(&format!(
+                "t = {:.4} s  steps {}  dt {:.3e} s  excluded {}  {:.3e} particle-steps/s",
+                solver.time(),
+                solver.steps(),
+                solver.dt(),
+                solver.excluded(),
+                solver.steps() as f64 * sc.particles.len() as f64 / wall.max(1e-9)
+            ));
+            next_output = (next_output + every_out).min(sc.time.end_s);
+        }
+    }
+    probes.flush()?;
+    let wall = started.elapsed().as_secs_f64();
+    let n = sc.particles.len() as f64;
+    let summary = RunSummary {
+        case: sc.name.clone(),
+        adapter: ctx.info.name.clone(),
+        backend: format!("{:?}", ctx.info.backend),
+        dimension: sc.physics.dim,
+        particles_fluid: sc.count(Kind::Fluid) as u64,
+        particles_wall: sc.count(Kind::Wall) as u64,
+        particles_excluded: solver.excluded(),
+        steps: solver.steps(),
+        simulated_time_s: solver.time(),
+        wall_time_s: wall,
+        particle_steps_per_s: solver.steps() as f64 * n / wall.max(1e-9),
+        gpu_bytes_per_particle: solver.gpu_bytes() as f64 / n,
+        outputs: out.snapshot_count() as u64,
+        status: match &stopped {
+            None => "completed".into(),
+            Some(e) => format!("stopped: {e:#}"),
+        },
+    };
+    out.write_run_summary(&summary)?;
+    Ok(RunReport { summary, stopped })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::schedule;
+
+    #[test]
+    fn schedule_ends_exactly_at_end() {
+        let t: Vec<f64> = schedule(0.1, 0.25).collect();
+        assert_eq!(t.len(), 3);
+        assert!((t[0] - 0.1).abs() < 1e-15 && (t[2] - 0.25).abs() < 1e-15);
+        assert_eq!(schedule(0.1, 0.3).count(), 3);
+    }
+}

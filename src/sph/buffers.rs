@@ -1,0 +1,98 @@
+//! Every GPU buffer of a run. Particle arrays come in two parities (the cell sort gathers
+//! from one into the other); everything else is single.
+
+use crate::gpu::buffers::{storage, storage_init, uniform_init};
+use crate::layout::{Params, Pos, ProbeDef, SimState};
+
+pub struct ParticleBuffers {
+    pub n: u32,
+    pub params: wgpu::Buffer,
+    pub state: wgpu::Buffer,
+    pub pos: [wgpu::Buffer; 2],
+    /// (v, ρ)
+    pub velrho: [wgpu::Buffer; 2],
+    /// kind << 28 | id
+    pub code: [wgpu::Buffer; 2],
+    /// (dv/dt, dρ/dt) of the last evaluation, in the current order.
+    pub rate: wgpu::Buffer,
+    /// The previous rates gathered into the new order by the sort.
+    pub rate_sorted: wgpu::Buffer,
+    pub keys: wgpu::Buffer,
+    /// Atomic rank within the slot, then (reused) the final permutation.
+    pub local_perm: wgpu::Buffer,
+    pub provisional: wgpu::Buffer,
+    /// Slot histogram, scanned in place into slot starts: slots + 2 entries (the extra slot
+    /// holds excluded particles, the last entry ends up = n).
+    pub cell_start: wgpu::Buffer,
+    /// Block sums of the prefix scan, one buffer per level (the last has one element).
+    pub scan_levels: Vec<wgpu::Buffer>,
+    pub scan_sizes: Vec<u32>,
+    pub probes: wgpu::Buffer,
+    pub probe_out: wgpu::Buffer,
+}
+
+/// Stand-in so a run without probes still binds a valid buffer.
+const EMPTY_PROBES: [ProbeDef; 1] = [ProbeDef { point: [0.0; 3], kind: 0, axis: [0.0; 3], pad: 0 }];
+
+pub struct InitialParticles<'a> {
+    pub pos: &'a [Pos],
+    pub velrho: &'a [[f32; 4]],
+    pub code: &'a [u32],
+}
+
+impl ParticleBuffers {
+    pub fn new(device: &wgpu::Device, params: &Params, slots: u32, init: &InitialParticles, probes: &[ProbeDef]) -> Self {
+        let n = init.pos.len() as u32;
+        let vec4 = 16 * n as u64;
+        let words = 4 * n as u64;
+        let mut scan_sizes = vec![slots + 2];
+        let block = 2 * crate::gpu::shader::WORKGROUP_SIZE;
+        while *scan_sizes.last().unwrap() > block {
+            let last = *scan_sizes.last().unwrap();
+            scan_sizes.push(last.div_ceil(block));
+        }
+        scan_sizes.push(1);
+        let scan_levels = scan_sizes[1..]
+            .iter()
+            .enumerate()
+            .map(|(l, &s)| storage(device, &format!("scan level {}", l + 1), 4 * s as u64))
+            .collect();
+        let zero_rates = vec![[0f32; 4]; init.pos.len()];
+        Self {
+            n,
+            params: uniform_init(device, "params", params),
+            state: storage_init(device, "sim state", &[SimState::default()]),
+            pos: [storage_init(device, "pos A", init.pos), storage(device, "pos B", vec4)],
+            velrho: [storage_init(device, "velrho A", init.velrho), storage(device, "velrho B", vec4)],
+            code: [storage_init(device, "code A", init.code), storage(device, "code B", words)],
+            rate: storage_init(device, "rate", &zero_rates),
+            rate_sorted: storage(device, "rate sorted", vec4),
+            keys: storage(device, "keys", words),
+            local_perm: storage(device, "local rank / perm", words),
+            provisional: storage(device, "provisional", words),
+            cell_start: storage(device, "cell start", 4 * (slots as u64 + 2)),
+            scan_levels,
+            scan_sizes,
+            probes: storage_init(device, "probe defs", if probes.is_empty() { &EMPTY_PROBES } else { probes }),
+            probe_out: storage(device, "probe out", 4 * probes.len().max(1) as u64),
+        }
+    }
+
+    /// GPU memory of everything that scales with the run (all buffers above).
+    pub fn bytes(&self) -> u64 {
+        let mut all: Vec<&wgpu::Buffer> = vec![
+            &self.params,
+            &self.state,
+            &self.rate,
+            &self.rate_sorted,
+            &self.keys,
+            &self.local_perm,
+            &self.provisional,
+            &self.cell_start,
+            &self.probes,
+            &self.probe_out,
+        ];
+        all.extend(self.pos.iter().chain(&self.velrho).chain(&self.code).chain(&self.scan_levels));
+        all.iter().map(|b| b.size()).sum()
+    }
+}

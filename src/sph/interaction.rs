@@ -1,0 +1,36 @@
+//! The neighbour sum: continuity, momentum, δ-SPH and viscosity (shaders/interaction.wgsl).
+
+use anyhow::Result;
+
+use super::buffers::ParticleBuffers;
+use crate::gpu::kernel::ShaderModule;
+use crate::gpu::Kernel;
+
+pub struct Interaction {
+    kernel: Kernel,
+    bind: [wgpu::BindGroup; 2],
+    n: u32,
+}
+
+impl Interaction {
+    pub fn new(device: &wgpu::Device, module: &ShaderModule, b: &ParticleBuffers) -> Result<Self> {
+        let kernel = module.kernel(device, "interaction")?;
+        let bufs = |p: usize| {
+            [
+                (0, &b.params),
+                (1, &b.pos[p]),
+                (2, &b.velrho[p]),
+                (3, &b.code[p]),
+                (4, &b.cell_start),
+                (5, &b.rate),
+            ]
+        };
+        let bind = [kernel.bind(device, &bufs(0))?, kernel.bind(device, &bufs(1))?];
+        Ok(Self { kernel, bind, n: b.n })
+    }
+
+    /// Evaluates the rates of the (sorted) arrays of parity `p` into `rate`.
+    pub fn encode(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.kernel.dispatch(pass, &self.bind[p], self.n);
+    }
+}

@@ -1,0 +1,345 @@
+//! The GPU solver: one module per pass, ordered here. A step is
+//! predict → cell-list sort → interaction → correct + time step, all on the GPU in one
+//! command encoder; the host reads back a 48-byte state once per batch of steps.
+
+pub mod buffers;
+pub mod cell_list;
+pub mod grid;
+pub mod integrate;
+pub mod interaction;
+pub mod probes;
+
+use anyhow::{bail, Context, Result};
+
+use crate::gpu::buffers::read;
+use crate::gpu::kernel::ShaderModule;
+use crate::gpu::shader::{Pass, ShaderConfig};
+use crate::gpu::GpuContext;
+use crate::layout::{pack_block, unpack_block, Params, Pos, SimState, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
+use crate::scenario::{KernelKind, Kind, Scenario, Viscosity};
+use buffers::{InitialParticles, ParticleBuffers};
+use cell_list::CellList;
+use grid::Grid;
+use integrate::Integrate;
+use interaction::Interaction;
+use probes::Probes;
+
+/// Most steps recorded into one submission before the host looks at the state again.
+const MAX_BATCH: u32 = 64;
+
+/// Why a run stopped before its end.
+#[derive(Debug, thiserror::Error)]
+#[error("run unstable at step {step}, t = {time_s:.6} s: {reason}")]
+pub struct Unstable {
+    pub step: u64,
+    pub time_s: f64,
+    pub reason: String,
+}
+
+/// Particles read back for output, in id order.
+#[derive(Clone, Debug, Default)]
+pub struct Particles {
+    pub pos: Vec<[f64; 3]>,
+    pub vel: Vec<[f32; 3]>,
+    pub rho: Vec<f32>,
+    pub pressure: Vec<f32>,
+    /// 0 fluid, 1 wall, 15 excluded.
+    pub kind: Vec<u32>,
+    pub id: Vec<u32>,
+}
+
+/// SPH kernel normalisation α_d (support 2h) of `kernel` in `dim` dimensions.
+pub fn kernel_norm(kernel: KernelKind, dim: u32, h: f64) -> f64 {
+    use std::f64::consts::PI;
+    match (kernel, dim) {
+        (KernelKind::CubicSpline, 2) => 10.0 / (7.0 * PI * h * h),
+        (KernelKind::CubicSpline, _) => 1.0 / (PI * h * h * h),
+        (KernelKind::WendlandC2, 2) => 7.0 / (4.0 * PI * h * h),
+        (KernelKind::WendlandC2, _) => 21.0 / (16.0 * PI * h * h * h),
+    }
+}
+
+pub struct Solver {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    pub grid: Grid,
+    pub params: Params,
+    buffers: ParticleBuffers,
+    cell_list: CellList,
+    interaction: Interaction,
+    integrate: Integrate,
+    probes: Probes,
+    parity: usize,
+    t_base: f64,
+    steps: u64,
+    state: SimState,
+    initial_dt: f32,
+    n_fluid: u64,
+    /// Stop when more than this fraction of the fluid has been excluded.
+    pub max_excluded_fraction: f64,
+}
+
+impl Solver {
+    pub fn new(ctx: &GpuContext, sc: &Scenario) -> Result<Self> {
+        let ph = &sc.physics;
+        let n = sc.particles.len();
+        if n == 0 {
+            bail!("the case has no particles");
+        }
+        if n > ID_MASK as usize {
+            bail!("{n} particles: at most {} fit the 28-bit particle id", ID_MASK);
+        }
+        let max_binding = ctx.limits.max_storage_buffer_binding_size as u64;
+        let fit = max_binding / 16;
+        if n as u64 > fit {
+            bail!(
+                "{n} particles do not fit adapter '{}': its largest storage binding is {} MiB, \
+                 which holds {fit} particles (16 bytes each per array)",
+                ctx.info.name,
+                max_binding >> 20
+            );
+        }
+        let grid = Grid::new(&sc.domain, ph.h, ph.dim, n)?;
+        let (alpha, nu, viscosity) = match ph.viscosity {
+            Viscosity::Artificial { alpha } => (alpha, 0.0, 0),
+            Viscosity::Laminar { nu } => (0.0, nu, 1),
+        };
+        let params = Params {
+            grid_cells: grid.cells,
+            hash_mask: grid.slots - 1,
+            block_size: grid.block_size,
+            cell_size: grid.cell_size as f32,
+            inv_cell_size: (1.0 / grid.cell_size) as f32,
+            cells_per_block: grid.cells_per_block,
+            domain_size: grid.extent.map(|e| e as f32),
+            n_particles: n as u32,
+            h: ph.h as f32,
+            kernel_norm: kernel_norm(ph.kernel, ph.dim, ph.h) as f32,
+            eta2: (0.01 * ph.h * ph.h) as f32,
+            mass: ph.particle_mass as f32,
+            rho0: ph.rho0 as f32,
+            tait_b: ph.tait_b() as f32,
+            gamma: ph.gamma as f32,
+            c0: ph.c0 as f32,
+            gravity: ph.gravity.map(|g| g as f32),
+            alpha: alpha as f32,
+            nu: nu as f32,
+            delta_coef: (ph.delta_sph * ph.h * ph.c0) as f32,
+            cfl: sc.time.cfl as f32,
+            n_probes: sc.probes.len() as u32,
+        };
+        let cfg = ShaderConfig {
+            dim: ph.dim,
+            kernel: match ph.kernel {
+                KernelKind::CubicSpline => 0,
+                KernelKind::WendlandC2 => 1,
+            },
+            viscosity,
+        };
+        let mut pos = Vec::with_capacity(n);
+        let mut velrho = Vec::with_capacity(n);
+        let mut code = Vec::with_capacity(n);
+        for (id, p) in sc.particles.iter().enumerate() {
+            let (off, b) = grid.to_block(p.pos);
+            pos.push(Pos { off, block: pack_block(b) });
+            velrho.push([p.vel[0] as f32, p.vel[1] as f32, p.vel[2] as f32, p.rho as f32]);
+            code.push(((p.kind as u32) << KIND_SHIFT) | id as u32);
+        }
+        let device = ctx.device.clone();
+        let defs = probes::probe_defs(&sc.probes, grid.origin);
+        let buffers = ParticleBuffers::new(
+            &device,
+            &params,
+            grid.slots,
+            &InitialParticles { pos: &pos, velrho: &velrho, code: &code },
+            &defs,
+        );
+        let module = |pass| ShaderModule::new(&device, pass, cfg);
+        let cell_list = CellList::new(&device, &module(Pass::CellList)?, &module(Pass::PrefixScan)?, &buffers)?;
+        let interaction = Interaction::new(&device, &module(Pass::Interaction)?, &buffers)?;
+        let integrate = Integrate::new(&device, &module(Pass::Integrate)?, &buffers)?;
+        let probes = Probes::new(&device, &module(Pass::Probes)?, &buffers, &defs)?;
+        let mut solver = Self {
+            device,
+            queue: ctx.queue.clone(),
+            grid,
+            params,
+            buffers,
+            cell_list,
+            interaction,
+            integrate,
+            probes,
+            parity: 0,
+            t_base: 0.0,
+            steps: 0,
+            state: SimState::default(),
+            initial_dt: 0.0,
+            n_fluid: sc.count(Kind::Fluid) as u64,
+            max_excluded_fraction: 0.05,
+        };
+        // Warm-up: one step with dt = 0 sorts the particles, evaluates the initial rates and
+        // chooses the first dt; it moves nothing and is not counted.
+        solver.submit_steps(1);
+        solver.state = solver.read_state()?;
+        solver.initial_dt = solver.state.dt_cfl;
+        Ok(solver)
+    }
+
+    pub fn time(&self) -> f64 {
+        self.t_base + self.state.t_rel as f64
+    }
+
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    pub fn dt(&self) -> f64 {
+        self.state.dt_cfl as f64
+    }
+
+    pub fn excluded(&self) -> u64 {
+        self.state.excluded as u64
+    }
+
+    pub fn particle_count(&self) -> u64 {
+        self.buffers.n as u64
+    }
+
+    /// GPU memory of the run's buffers, in bytes.
+    pub fn gpu_bytes(&self) -> u64 {
+        self.buffers.bytes()
+    }
+
+    fn read_state(&self) -> Result<SimState> {
+        Ok(read::<SimState>(&self.device, &self.queue, &self.buffers.state, 1)?[0])
+    }
+
+    /// Records `count` steps into one submission.
+    fn submit_steps(&mut self, count: u32) {
+        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("steps") });
+        for _ in 0..count {
+            let p = self.parity;
+            let q = 1 - p;
+            self.cell_list.clear(&mut encoder, &self.buffers);
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("step"), timestamp_writes: None });
+            self.integrate.encode_predict(&mut pass, p);
+            self.cell_list.encode(&mut pass, p);
+            self.interaction.encode(&mut pass, q);
+            self.integrate.encode_correct(&mut pass, q);
+            drop(pass);
+            self.parity = q;
+        }
+        self.queue.submit([encoder.finish()]);
+    }
+
+    /// Advances to exactly `t_target` (the last step is shortened to land on it).
+    pub fn advance_to(&mut self, t_target: f64) -> Result<()> {
+        // Re-base the GPU's f32 clock on the host's f64 one, so it only ever counts a short span.
+        self.t_base += self.state.t_rel as f64;
+        let remaining = t_target - self.t_base;
+        let mut st = self.state;
+        st.t_rel = 0.0;
+        st.t_target_rel = remaining as f32;
+        st.dt = if remaining > 1e-4 * st.dt_cfl as f64 { st.dt_cfl.min(remaining as f32) } else { 0.0 };
+        self.queue.write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
+        self.state = st;
+        while self.state.dt > 0.0 {
+            let left = (self.state.t_target_rel - self.state.t_rel).max(0.0);
+            let batch = ((left / self.state.dt_cfl.max(1e-30)).ceil() as u32 + 1).clamp(1, MAX_BATCH);
+            let before = self.state.steps;
+            self.submit_steps(batch);
+            self.state = self.read_state()?;
+            self.steps += (self.state.steps - before) as u64;
+            self.check_stability()?;
+        }
+        // Arrived: the host clock takes the exact target (the GPU's f32 clock is re-based on
+        // the next call anyway).
+        self.t_base = self.t_base.max(t_target);
+        self.state.t_rel = 0.0;
+        Ok(())
+    }
+
+    fn check_stability(&self) -> Result<()> {
+        let s = &self.state;
+        let fail = |reason: String| -> Result<()> {
+            Err(Unstable { step: self.steps, time_s: self.time(), reason }.into())
+        };
+        if s.nan_count > 0 {
+            return fail(format!(
+                "{} fluid particle(s) became non-finite; reduce time.cfl or check the case",
+                s.nan_count
+            ));
+        }
+        if s.excluded as f64 > self.max_excluded_fraction * self.n_fluid as f64 {
+            return fail(format!(
+                "{} of {} fluid particles left the domain (more than {:.0} %)",
+                s.excluded,
+                self.n_fluid,
+                100.0 * self.max_excluded_fraction
+            ));
+        }
+        if !(s.dt_cfl > 1e-4 * self.initial_dt) {
+            return fail(format!(
+                "the time step collapsed to {:e} s (started at {:e} s)",
+                s.dt_cfl, self.initial_dt
+            ));
+        }
+        Ok(())
+    }
+
+    /// Samples every probe at the current time.
+    pub fn sample_probes(&self) -> Result<Vec<f64>> {
+        if self.probes.is_empty() {
+            return Ok(Vec::new());
+        }
+        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("probes") });
+        self.probes.encode(&mut encoder, &self.buffers, self.parity);
+        self.queue.submit([encoder.finish()]);
+        let raw = read::<u32>(&self.device, &self.queue, &self.buffers.probe_out, self.params.n_probes as usize)?;
+        Ok(self.probes.decode(&raw))
+    }
+
+    /// Raw arrays of the current parity, in GPU (cell) order.
+    pub fn read_raw(&self) -> Result<(Vec<Pos>, Vec<[f32; 4]>, Vec<u32>)> {
+        let n = self.buffers.n as usize;
+        let p = self.parity;
+        Ok((
+            read(&self.device, &self.queue, &self.buffers.pos[p], n).context("reading positions")?,
+            read(&self.device, &self.queue, &self.buffers.velrho[p], n).context("reading velocities")?,
+            read(&self.device, &self.queue, &self.buffers.code[p], n).context("reading codes")?,
+        ))
+    }
+
+    /// Rates (dv/dt, dρ/dt) of the last evaluation, in GPU order.
+    pub fn read_rates(&self) -> Result<Vec<[f32; 4]>> {
+        read(&self.device, &self.queue, &self.buffers.rate, self.buffers.n as usize)
+    }
+
+    /// Slot starts of the last sort (slots + 2 entries).
+    pub fn read_cell_start(&self) -> Result<Vec<u32>> {
+        read(&self.device, &self.queue, &self.buffers.cell_start, self.grid.slots as usize + 2)
+    }
+
+    /// All particles in world coordinates, sorted by id.
+    pub fn read_particles(&self) -> Result<Particles> {
+        let (pos, velrho, code) = self.read_raw()?;
+        let mut order: Vec<usize> = (0..pos.len()).collect();
+        order.sort_unstable_by_key(|&i| code[i] & ID_MASK);
+        let b = self.params.tait_b as f64;
+        let (rho0, gamma) = (self.params.rho0 as f64, self.params.gamma as f64);
+        let mut out = Particles::default();
+        for i in order {
+            out.pos.push(self.grid.to_world(pos[i].off, unpack_block(pos[i].block)));
+            let v = velrho[i];
+            out.vel.push([v[0], v[1], v[2]]);
+            out.rho.push(v[3]);
+            out.pressure.push((b * ((v[3] as f64 / rho0).powf(gamma) - 1.0)) as f32);
+            out.kind.push(code[i] >> KIND_SHIFT);
+            out.id.push(code[i] & ID_MASK);
+        }
+        Ok(out)
+    }
+}
+
+/// Kind word of an excluded particle, for callers filtering outputs.
+pub const EXCLUDED: u32 = KIND_EXCLUDED;

@@ -1,0 +1,103 @@
+//! Probes sampled on the GPU (shaders/probes.wgsl); only one f32 per probe is read back.
+
+use anyhow::Result;
+
+use super::buffers::ParticleBuffers;
+use crate::gpu::kernel::ShaderModule;
+use crate::gpu::Kernel;
+use crate::layout::ProbeDef;
+use crate::scenario::{Probe, ProbeKind};
+
+pub const PROBE_PRESSURE: u32 = 0;
+pub const PROBE_HEIGHT: u32 = 1;
+pub const PROBE_FRONT: u32 = 2;
+
+/// GPU definitions of the probes, in domain coordinates (from the domain's min corner).
+pub fn probe_defs(probes: &[Probe], origin: [f64; 3]) -> Vec<ProbeDef> {
+    let rel = |p: &[f64; 3]| [0, 1, 2].map(|a| (p[a] - origin[a]) as f32);
+    probes
+        .iter()
+        .map(|p| match &p.kind {
+            ProbeKind::Pressure { point } => ProbeDef { point: rel(point), kind: PROBE_PRESSURE, ..Default::default() },
+            ProbeKind::Height { base } => ProbeDef { point: rel(base), kind: PROBE_HEIGHT, ..Default::default() },
+            ProbeKind::Front { origin: o, axis } => {
+                let norm = axis.iter().map(|a| a * a).sum::<f64>().sqrt();
+                ProbeDef {
+                    point: rel(o),
+                    kind: PROBE_FRONT,
+                    axis: axis.map(|a| (a / norm) as f32),
+                    pad: 0,
+                }
+            }
+        })
+        .collect()
+}
+
+/// Inverse of `ordered_bits` in probes.wgsl; 0 (no fluid at all) gives NaN.
+pub fn decode_ordered(bits: u32) -> f32 {
+    if bits == 0 {
+        f32::NAN
+    } else if bits & 0x8000_0000 != 0 {
+        f32::from_bits(bits & 0x7FFF_FFFF)
+    } else {
+        f32::from_bits(!bits)
+    }
+}
+
+pub struct Probes {
+    points: Kernel,
+    front: Kernel,
+    bind_points: [wgpu::BindGroup; 2],
+    bind_front: [wgpu::BindGroup; 2],
+    kinds: Vec<u32>,
+    n: u32,
+}
+
+impl Probes {
+    pub fn new(device: &wgpu::Device, module: &ShaderModule, b: &ParticleBuffers, defs: &[ProbeDef]) -> Result<Self> {
+        let points = module.kernel(device, "probe_points")?;
+        let front = module.kernel(device, "probe_front")?;
+        let bufs = |p: usize| {
+            [
+                (0, &b.params),
+                (1, &b.pos[p]),
+                (2, &b.velrho[p]),
+                (3, &b.code[p]),
+                (4, &b.cell_start),
+                (5, &b.probes),
+                (6, &b.probe_out),
+            ]
+        };
+        Ok(Self {
+            bind_points: [points.bind(device, &bufs(0))?, points.bind(device, &bufs(1))?],
+            bind_front: [front.bind(device, &bufs(0))?, front.bind(device, &bufs(1))?],
+            points,
+            front,
+            kinds: defs.iter().map(|d| d.kind).collect(),
+            n: b.n,
+        })
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.kinds.is_empty()
+    }
+
+    /// Records the probe evaluation on the arrays of parity `p` (cell list must be current).
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, b: &ParticleBuffers, p: usize) {
+        encoder.clear_buffer(&b.probe_out, 0, None);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("probes"), timestamp_writes: None });
+        self.points.dispatch(&mut pass, &self.bind_points[p], self.kinds.len() as u32);
+        if self.kinds.contains(&PROBE_FRONT) {
+            self.front.dispatch(&mut pass, &self.bind_front[p], self.n);
+        }
+    }
+
+    /// Values from the raw words read back.
+    pub fn decode(&self, raw: &[u32]) -> Vec<f64> {
+        self.kinds
+            .iter()
+            .zip(raw)
+            .map(|(&k, &w)| if k == PROBE_FRONT { decode_ordered(w) as f64 } else { f32::from_bits(w) as f64 })
+            .collect()
+    }
+}
