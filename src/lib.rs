@@ -7,3 +7,4 @@ pub mod sph;
 pub mod output;
 pub mod run;
 pub mod reference;
+pub mod case;

@@ -1,1 +1,132 @@
-fn main() {}
+//! The `wgsph` command: run a case, list adapters, benchmark.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+
+use wgsph::gpu::context::list_adapters;
+use wgsph::gpu::{AdapterChoice, GpuContext};
+
+#[derive(Parser)]
+#[command(name = "wgsph", version, about = "GPU SPH for fluid–solid interaction (wgpu/WGSL)")]
+struct Cli {
+    /// Adapter: auto (hardware GPU, else CPU), gpu, or cpu. Default: $WGSPH_ADAPTER, else auto.
+    #[arg(long, global = true)]
+    adapter: Option<AdapterChoice>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a case file and write outputs (VTU series, probe CSVs, run.json).
+    Run {
+        /// The case file (TOML), e.g. cases/dam_break_2d.toml.
+        case: PathBuf,
+        /// Output directory (default: out/<case name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a case field, e.g. --set particles.dx_m=0.005 (repeatable).
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        set: Vec<String>,
+    },
+    /// List the adapters wgpu sees and their limits.
+    Info,
+    /// Time N steps of a case (after a warm-up) and report particle-steps per second.
+    Bench {
+        case: PathBuf,
+        /// Steps to time.
+        #[arg(long, default_value_t = 200)]
+        steps: u64,
+        /// Steps run before timing (shader compilation, caches).
+        #[arg(long, default_value_t = 20)]
+        warmup: u64,
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        set: Vec<String>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn context(choice: Option<AdapterChoice>) -> Result<GpuContext> {
+    GpuContext::new(AdapterChoice::resolve(choice)?)
+}
+
+fn run(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        Command::Run { case, out, set } => {
+            let sc = wgsph::case::load(&case, &set)?;
+            let ctx = context(cli.adapter)?;
+            let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
+            let report = wgsph::run::run(&ctx, &sc, &dir, &mut |line| println!("{line}"))?;
+            let s = &report.summary;
+            println!(
+                "{}: {} steps to t = {:.4} s in {:.1} s wall ({:.3e} particle-steps/s); outputs in {}",
+                s.status,
+                s.steps,
+                s.simulated_time_s,
+                s.wall_time_s,
+                s.particle_steps_per_s,
+                dir.display()
+            );
+            Ok(if report.stopped.is_some() { ExitCode::from(2) } else { ExitCode::SUCCESS })
+        }
+        Command::Info => {
+            let adapters = list_adapters();
+            if adapters.is_empty() {
+                println!("no adapter found; for a software one: apt-get install mesa-vulkan-drivers libvulkan1");
+            }
+            for (info, limits) in adapters {
+                println!(
+                    "{} ({:?}, {:?}, driver {} {})\n  max storage binding {} MiB, max buffer {} MiB, \
+                     storage buffers/stage {}, workgroups/dim {}",
+                    info.name,
+                    info.backend,
+                    info.device_type,
+                    info.driver,
+                    info.driver_info,
+                    limits.max_storage_buffer_binding_size >> 20,
+                    limits.max_buffer_size >> 20,
+                    limits.max_storage_buffers_per_shader_stage,
+                    limits.max_compute_workgroups_per_dimension
+                );
+            }
+            let choice = AdapterChoice::resolve(cli.adapter)?;
+            match GpuContext::new(choice) {
+                Ok(ctx) => println!("'{choice}' selects: {}", ctx.describe()),
+                Err(e) => println!("'{choice}' selects nothing: {e:#}"),
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Bench { case, steps, warmup, set } => {
+            let sc = wgsph::case::load(&case, &set)?;
+            let ctx = context(cli.adapter)?;
+            let mut solver = wgsph::sph::Solver::new(&ctx, &sc).context("setting up the GPU solver")?;
+            solver.run_steps(warmup)?;
+            let start = Instant::now();
+            solver.run_steps(steps)?;
+            let wall = start.elapsed().as_secs_f64();
+            let n = solver.particle_count();
+            println!("case            {}", sc.name);
+            println!("adapter         {}", ctx.describe());
+            println!("particles       {n}");
+            println!("steps           {steps}");
+            println!("wall seconds    {wall:.3}");
+            println!("particle-steps/s {:.4e}", steps as f64 * n as f64 / wall);
+            println!("bytes/particle  {:.1}", solver.gpu_bytes() as f64 / n as f64);
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}

@@ -259,6 +259,27 @@ impl Solver {
         Ok(())
     }
 
+    /// Takes exactly `count` steps of CFL size (no target time), for benchmarks; waits for the
+    /// GPU at the end and checks stability.
+    pub fn run_steps(&mut self, count: u64) -> Result<()> {
+        self.t_base += self.state.t_rel as f64;
+        let mut st = self.state;
+        st.t_rel = 0.0;
+        st.t_target_rel = f32::MAX;
+        st.dt = st.dt_cfl;
+        self.queue.write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
+        let mut left = count;
+        while left > 0 {
+            let batch = left.min(MAX_BATCH as u64) as u32;
+            self.submit_steps(batch);
+            left -= batch as u64;
+        }
+        let before = st.steps;
+        self.state = self.read_state()?;
+        self.steps += (self.state.steps - before) as u64;
+        self.check_stability()
+    }
+
     fn check_stability(&self) -> Result<()> {
         let s = &self.state;
         let fail = |reason: String| -> Result<()> {
@@ -297,6 +318,35 @@ impl Solver {
         self.queue.submit([encoder.finish()]);
         let raw = read::<u32>(&self.device, &self.queue, &self.buffers.probe_out, self.params.n_probes as usize)?;
         Ok(self.probes.decode(&raw))
+    }
+
+    /// Test hook: re-runs only the interaction pass on the current arrays and returns the rates.
+    /// With `poison`, `rate` is first filled with NaN so an entry the kernel skips cannot pass.
+    #[doc(hidden)]
+    pub fn rerun_interaction(&self, poison: bool) -> Result<Vec<[f32; 4]>> {
+        if poison {
+            let nan = vec![f32::NAN; 4 * self.buffers.n as usize];
+            self.queue.write_buffer(&self.buffers.rate, 0, bytemuck::cast_slice(&nan));
+        }
+        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("interaction") });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("interaction"), timestamp_writes: None });
+        self.interaction.encode(&mut pass, self.parity);
+        drop(pass);
+        self.queue.submit([encoder.finish()]);
+        self.read_rates()
+    }
+
+    /// Test hook: takes exactly one step of `dt` (no clipping) and returns the new state.
+    #[doc(hidden)]
+    pub fn single_step(&mut self, dt: f32) -> Result<SimState> {
+        let mut st = self.state;
+        st.t_rel = 0.0;
+        st.t_target_rel = f32::MAX;
+        st.dt = dt;
+        self.queue.write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
+        self.submit_steps(1);
+        self.state = self.read_state()?;
+        Ok(self.state)
     }
 
     /// Raw arrays of the current parity, in GPU (cell) order.

@@ -1,0 +1,397 @@
+//! From a validated [`Case`] to the [`Scenario`]: geometric checks (blocks inside the tank and
+//! the domain, nothing too thin, probes inside the domain, particle budget), the particle
+//! lattices, the hydrostatic initial density and the default domain.
+
+use std::collections::HashSet;
+
+use crate::scenario::{Domain, Kind, Particle, Physics, ProbeKind, Scenario};
+
+use super::error::CaseError;
+use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
+use super::locate::Ctx;
+use super::validate::{Aabb, Case, Sound};
+
+/// Refuse cases with more particles than this.
+pub const MAX_PARTICLES: f64 = 200e6;
+/// Tolerance for "inside" tests of user boxes [m].
+const TOL: f64 = 1e-9;
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+fn inside(b: &Aabb, outer: &Aabb, dim: usize) -> Option<usize> {
+    (0..dim).find(|&a| b.min[a] < outer.min[a] - TOL || b.max[a] > outer.max[a] + TOL)
+}
+
+fn point_inside(p: [f64; 3], b: &Aabb, dim: usize) -> bool {
+    (0..dim).all(|a| b.min[a] - TOL <= p[a] && p[a] <= b.max[a] + TOL)
+}
+
+fn fmt_box(b: &Aabb, dim: usize) -> String {
+    format!("{:?} to {:?}", &b.min[..dim], &b.max[..dim])
+}
+
+fn fmt_count(n: f64) -> String {
+    if n < 1e12 {
+        format!("{n:.0}")
+    } else {
+        format!("{n:.2e}")
+    }
+}
+
+pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
+    let v = dim - 1;
+    let layers = case.tank.map_or(3, |t| t.layers as i64);
+
+    // Tank cells along each axis.
+    let tank = match case.tank {
+        None => None,
+        Some(t) => {
+            let mut n = [1.0; 3];
+            for (a, na) in n.iter_mut().enumerate().take(dim) {
+                *na = cells(t.inner.max[a] - t.inner.min[a], dx);
+                if *na < 1.0 {
+                    return Err(ctx.err(
+                        "tank.max_m",
+                        None,
+                        format!(
+                            "the tank is {} m along {}, less than one particle spacing dx = {dx} m",
+                            t.inner.max[a] - t.inner.min[a],
+                            AXES[a]
+                        ),
+                        "make the tank larger or particles.dx_m smaller",
+                    ));
+                }
+            }
+            Some((t, n))
+        }
+    };
+
+    // Fluid blocks: inside the tank, at least one particle thick, not overlapping.
+    let mut block_cells = Vec::with_capacity(case.blocks.len());
+    for (i, b) in case.blocks.iter().enumerate() {
+        let path = format!("fluid_block[{i}]");
+        if let Some((t, _)) = &tank {
+            if let Some(a) = inside(&b.bx, &t.inner, dim) {
+                let field = if b.bx.min[a] < t.inner.min[a] - TOL {
+                    "min_m"
+                } else {
+                    "max_m"
+                };
+                return Err(ctx.err(&format!("{path}.{field}"), Some(format!("{:?}", &(if field == "min_m" { b.bx.min } else { b.bx.max })[..dim])), format!("the block ({}) leaves the tank's inner box ({}) along {}", fmt_box(&b.bx, dim), fmt_box(&t.inner, dim), AXES[a]), "keep fluid blocks inside the tank: min_m >= tank.min_m and max_m <= tank.max_m"));
+            }
+        }
+        let mut n = [1.0; 3];
+        for (a, na) in n.iter_mut().enumerate().take(dim) {
+            let len = b.bx.max[a] - b.bx.min[a];
+            *na = cells(len, dx);
+            if *na < 1.0 {
+                return Err(ctx.err(&format!("{path}.max_m"), None, format!("the block is {len} m thick along {}, too thin to hold one particle at dx = {dx} m", AXES[a]), "make the block at least dx thick, or decrease particles.dx_m"));
+            }
+        }
+        for (j, other) in case.blocks[..i].iter().enumerate() {
+            if (0..dim)
+                .all(|a| b.bx.max[a].min(other.bx.max[a]) - b.bx.min[a].max(other.bx.min[a]) > TOL)
+            {
+                return Err(ctx.err(
+                    &path,
+                    None,
+                    format!(
+                        "overlaps fluid_block[{j}] ({}); particles would be created twice",
+                        fmt_box(&other.bx, dim)
+                    ),
+                    "make the blocks touch without overlapping",
+                ));
+            }
+        }
+        block_cells.push(n);
+    }
+
+    // The global lattice, continued by walls and obstacles.
+    let lat = Lattice {
+        origin: case.tank.map_or(case.blocks[0].bx.min, |t| t.inner.min),
+        dx,
+        dim,
+    };
+    let mut obstacle_ranges = Vec::with_capacity(case.obstacles.len());
+    for (i, o) in case.obstacles.iter().enumerate() {
+        let Some(r) = lat.range_in(o) else {
+            return Err(ctx.err(&format!("obstacle[{i}].max_m"), None, format!("the obstacle ({}) is too thin to hold one wall particle on the particle lattice (spacing dx = {dx} m)", fmt_box(o, dim)), "make it at least dx thick along every axis, or decrease particles.dx_m"));
+        };
+        obstacle_ranges.push(r);
+    }
+
+    // Particle budget, before anything is allocated.
+    let fluid_n: f64 = block_cells.iter().map(|n| n.iter().product::<f64>()).sum();
+    let wall_of = |n: [f64; 3]| TankWall {
+        n: n.map(|c| c.min(1e15) as i64),
+        layers,
+        open_top: case.tank.is_none_or(|t| t.open_top),
+        dim,
+    };
+    let tank_n = tank.map_or(0.0, |(_, n)| wall_of(n).count());
+    let obstacle_n: f64 = obstacle_ranges
+        .iter()
+        .map(|(lo, hi)| (0..dim).map(|a| hi[a] - lo[a] + 1.0).product::<f64>())
+        .sum();
+    let total = fluid_n + tank_n + obstacle_n;
+    if total.is_nan() || total > MAX_PARTICLES {
+        return Err(ctx.err("particles.dx_m", Some(format!("{dx}")), format!("the case would create about {} particles ({} fluid, {} wall), more than the limit of 200 million", fmt_count(total), fmt_count(fluid_n), fmt_count(tank_n + obstacle_n)), format!("increase particles.dx_m (the count scales as 1/dx^{dim}) or shrink the geometry")));
+    }
+    let wall = tank.map(|(_, n)| wall_of(n));
+
+    let domain = domain(ctx, &case, &lat, wall.as_ref())?;
+
+    // Speed of sound and the hydrostatic start.
+    let g = case.gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let c0 = match case.sound {
+        Sound::Speed(c) => c,
+        Sound::Coef(k) => {
+            let floor = |b: &Aabb| case.tank.map_or(b.min[v], |t| t.inner.min[v]);
+            let depth = case
+                .blocks
+                .iter()
+                .map(|b| b.bx.max[v] - floor(&b.bx))
+                .fold(0.0, f64::max);
+            let c = k * (g * depth).sqrt();
+            if !c.is_finite() || c <= 0.0 {
+                return Err(ctx.err("physics.sound_speed_coef", Some(format!("{k}")), format!("gives c0 = coef * sqrt(|g| * H) = {c} m/s with |g| = {g} m/s² and H = {depth} m"), "give physics.sound_speed_m_s instead"));
+            }
+            c
+        }
+    };
+    let tait_b = c0 * c0 * case.rho0 / case.gamma;
+    if !(tait_b.is_finite() && tait_b > 0.0) {
+        return Err(ctx.err("physics.sound_speed_m_s", Some(format!("{c0}")), format!("gives a Tait stiffness B = c0² rho0 / gamma = {tait_b} Pa that cannot be computed with"), "use a realistic speed of sound, about 10 times the largest flow speed"));
+    }
+    let mass = case.rho0 * dx.powi(dim as i32);
+    if !(mass.is_finite() && mass > 0.0) {
+        return Err(ctx.err(
+            "particles.dx_m",
+            Some(format!("{dx}")),
+            format!(
+                "gives a particle mass rho0 * dx^{dim} = {mass} kg that cannot be computed with"
+            ),
+            "use a spacing and density of realistic size",
+        ));
+    }
+    let rho_at = |depth: f64| {
+        case.rho0 * (1.0 + case.rho0 * g * depth.max(0.0) / tait_b).powf(1.0 / case.gamma)
+    };
+
+    // Fluid, minus what lies in (or within half a spacing of) an obstacle's particles.
+    let solids: Vec<(Aabb, Aabb)> = case
+        .obstacles
+        .iter()
+        .zip(&obstacle_ranges)
+        .map(|(o, (lo, hi))| {
+            let first = lat.pos(lo.map(|c| c as i64));
+            let last = lat.pos(hi.map(|c| c as i64));
+            (
+                *o,
+                Aabb {
+                    min: first,
+                    max: last,
+                },
+            )
+        })
+        .collect();
+    let blocked = |p: [f64; 3]| {
+        solids.iter().any(|(user, parts)| {
+            let d2: f64 = (0..dim)
+                .map(|a| {
+                    (parts.min[a] - p[a])
+                        .max(p[a] - parts.max[a])
+                        .max(0.0)
+                        .powi(2)
+                })
+                .sum();
+            point_inside(p, user, dim) || d2 < (dx * (1.0 - 1e-6)).powi(2)
+        })
+    };
+    let mut particles = Vec::with_capacity(total as usize);
+    for (b, n) in case.blocks.iter().zip(&block_cells) {
+        let top = b.bx.max[v];
+        for pos in block_points(b.bx.min, n.map(|c| c as i64), dx, dim) {
+            if !blocked(pos) {
+                particles.push(Particle {
+                    pos,
+                    vel: b.vel,
+                    rho: rho_at(top - pos[v]),
+                    kind: Kind::Fluid,
+                });
+            }
+        }
+    }
+
+    // Walls: tank, then obstacles (each lattice point once).
+    let reach = layers as f64 * dx + dx;
+    let wall_rho = |p: [f64; 3]| {
+        let over = case
+            .blocks
+            .iter()
+            .filter(|b| (0..v).all(|a| b.bx.min[a] - reach <= p[a] && p[a] <= b.bx.max[a] + reach));
+        match over.map(|b| b.bx.max[v]).reduce(f64::max) {
+            Some(top) => rho_at(top - p[v]),
+            None => case.rho0,
+        }
+    };
+    let mut push_wall = |pos: [f64; 3]| {
+        particles.push(Particle {
+            pos,
+            vel: [0.0; 3],
+            rho: wall_rho(pos),
+            kind: Kind::Wall,
+        })
+    };
+    if let Some(w) = &wall {
+        w.indices().into_iter().for_each(|i| push_wall(lat.pos(i)));
+    }
+    let mut seen = HashSet::new();
+    for (lo, hi) in &obstacle_ranges {
+        for idx in range_points(&lat, *lo, *hi) {
+            if !wall.is_some_and(|w| w.contains(idx)) && seen.insert(idx) {
+                push_wall(lat.pos(idx));
+            }
+        }
+    }
+
+    if let Some(p) = particles.iter().find(|p| !p.rho.is_finite()) {
+        return Err(ctx.err(
+            "physics.sound_speed_m_s",
+            Some(format!("{c0}")),
+            format!(
+                "is so small that the hydrostatic start density at {:?} is {}",
+                &p.pos[..dim],
+                p.rho
+            ),
+            "use a speed of sound about 10 times sqrt(|g| * H) or more",
+        ));
+    }
+
+    let physics = Physics {
+        dim: dim as u32,
+        dx,
+        h: case.h_over_dx * dx,
+        kernel: case.kernel,
+        rho0: case.rho0,
+        c0,
+        gamma: case.gamma,
+        gravity: case.gravity,
+        viscosity: case.viscosity,
+        delta_sph: case.delta_sph,
+        particle_mass: mass,
+    };
+    Ok(Scenario {
+        name: case.name,
+        physics,
+        time: case.time,
+        domain,
+        particles,
+        probes: case.probes,
+    })
+}
+
+/// The given domain, or the default one; checks that fluid, walls and probes lie inside it.
+fn domain(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    lat: &Lattice,
+    wall: Option<&TankWall>,
+) -> Result<Domain, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
+    let v = dim - 1;
+    let mut solid = case.obstacles.clone();
+    if let Some(w) = wall {
+        let (mut min, mut max) = ([0.0; 3], [0.0; 3]);
+        for a in 0..dim {
+            let (lo, hi) = w.outer(a);
+            min[a] = lat.origin[a] + lo as f64 * dx;
+            max[a] = lat.origin[a] + hi as f64 * dx;
+        }
+        solid.push(Aabb { min, max });
+    }
+    let d = match case.domain {
+        Some(d) => d,
+        None => {
+            let mut all: Vec<Aabb> = solid.clone();
+            if wall.is_none() {
+                all.extend(case.blocks.iter().map(|b| b.bx));
+            }
+            let mut d = all[0];
+            for b in &all[1..] {
+                for a in 0..dim {
+                    d.min[a] = d.min[a].min(b.min[a]);
+                    d.max[a] = d.max[a].max(b.max[a]);
+                }
+            }
+            let open = case.tank.is_none_or(|t| t.open_top);
+            if open {
+                // Room above for splashes: the tank's (or the fluid's) height.
+                d.max[v] += match wall {
+                    Some(w) => w.n[v] as f64 * dx,
+                    None => d.max[v] - d.min[v],
+                };
+            }
+            for a in 0..dim {
+                d.min[a] -= 2.0 * dx;
+                d.max[a] += 2.0 * dx;
+            }
+            d
+        }
+    };
+    let fix = "enlarge [domain] (or remove it to get the default, which encloses the tank)";
+    for (i, b) in case.blocks.iter().enumerate() {
+        if let Some(a) = inside(&b.bx, &d, dim) {
+            return Err(ctx.err(
+                &format!("fluid_block[{i}]"),
+                None,
+                format!(
+                    "the block ({}) leaves the domain ({}) along {}",
+                    fmt_box(&b.bx, dim),
+                    fmt_box(&d, dim),
+                    AXES[a]
+                ),
+                fix,
+            ));
+        }
+    }
+    for (i, b) in solid.iter().enumerate() {
+        if let Some(a) = inside(b, &d, dim) {
+            let path = if i < case.obstacles.len() {
+                format!("obstacle[{i}]")
+            } else {
+                "tank".to_string()
+            };
+            return Err(ctx.err(
+                &path,
+                None,
+                format!(
+                    "its particles ({}) leave the domain ({}) along {} and would be dropped",
+                    fmt_box(b, dim),
+                    fmt_box(&d, dim),
+                    AXES[a]
+                ),
+                fix,
+            ));
+        }
+    }
+    for (i, p) in case.probes.iter().enumerate() {
+        let (field, point) = match &p.kind {
+            ProbeKind::Pressure { point } => ("point_m", *point),
+            ProbeKind::Height { base } => ("base_m", *base),
+            ProbeKind::Front { origin, .. } => ("origin_m", *origin),
+        };
+        if !point_inside(point, &d, dim) {
+            return Err(ctx.err(
+                &format!("probe[{i}].{field}"),
+                Some(format!("{:?}", &point[..dim])),
+                format!("lies outside the domain ({})", fmt_box(&d, dim)),
+                "move the probe inside the domain",
+            ));
+        }
+    }
+    Ok(Domain {
+        min: d.min,
+        max: d.max,
+    })
+}

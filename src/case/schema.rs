@@ -1,0 +1,384 @@
+//! The case file as written: serde structs mirroring the TOML, every table with
+//! `deny_unknown_fields`, and a one-line help text per field for error messages.
+//! The meaning of each field is documented in `docs/cases.md`.
+
+use serde::Deserialize;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawCase {
+    pub name: Option<String>,
+    pub dimension: i64,
+    pub particles: RawParticles,
+    #[serde(default)]
+    pub physics: RawPhysics,
+    pub time: RawTime,
+    pub tank: Option<RawTank>,
+    #[serde(default)]
+    pub fluid_block: Vec<RawBlock>,
+    #[serde(default)]
+    pub obstacle: Vec<RawBox>,
+    pub domain: Option<RawBox>,
+    #[serde(default)]
+    pub probe: Vec<RawProbe>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawParticles {
+    pub dx_m: f64,
+    pub h_over_dx: Option<f64>,
+    pub kernel: Option<KernelName>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum KernelName {
+    CubicSpline,
+    WendlandC2,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawPhysics {
+    pub rho0_kg_m3: Option<f64>,
+    pub gravity_m_s2: Option<Vec<f64>>,
+    pub sound_speed_m_s: Option<f64>,
+    pub sound_speed_coef: Option<f64>,
+    pub gamma: Option<f64>,
+    pub viscosity: Option<ViscosityName>,
+    pub alpha: Option<f64>,
+    pub nu_m2_s: Option<f64>,
+    pub delta_sph: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum ViscosityName {
+    Artificial,
+    Laminar,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawTime {
+    pub end_s: f64,
+    pub output_every_s: f64,
+    pub probe_every_s: Option<f64>,
+    pub cfl: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawTank {
+    pub min_m: Vec<f64>,
+    pub max_m: Vec<f64>,
+    pub layers: Option<i64>,
+    pub open_top: Option<bool>,
+    pub wall: Option<WallName>,
+}
+
+/// Wall treatment. Only the dynamic boundary condition exists for now.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum WallName {
+    Dynamic,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawBlock {
+    pub min_m: Vec<f64>,
+    pub max_m: Vec<f64>,
+    pub velocity_m_s: Option<Vec<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawBox {
+    pub min_m: Vec<f64>,
+    pub max_m: Vec<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawProbe {
+    pub name: String,
+    pub kind: ProbeName,
+    pub point_m: Option<Vec<f64>>,
+    pub base_m: Option<Vec<f64>>,
+    pub origin_m: Option<Vec<f64>>,
+    pub axis: Option<Vec<f64>>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum ProbeName {
+    Pressure,
+    Height,
+    Front,
+}
+
+/// Help for one field: what it is and an example of a valid line.
+pub(super) struct FieldHelp {
+    /// Dotted path with array indices written `[]`.
+    pub path: &'static str,
+    pub meaning: &'static str,
+    pub example: &'static str,
+}
+
+const fn f(path: &'static str, meaning: &'static str, example: &'static str) -> FieldHelp {
+    FieldHelp {
+        path,
+        meaning,
+        example,
+    }
+}
+
+/// Every field of the schema (tables included), for "missing" and "wrong type" messages.
+pub(super) const FIELDS: &[FieldHelp] = &[
+    f(
+        "name",
+        "the case name (a string)",
+        "name = \"dam_break_2d\"",
+    ),
+    f("dimension", "the dimension, 2 or 3", "dimension = 2"),
+    f(
+        "particles",
+        "the [particles] table",
+        "[particles] with dx_m = 0.01",
+    ),
+    f(
+        "particles.dx_m",
+        "the initial particle spacing in metres",
+        "dx_m = 0.01",
+    ),
+    f(
+        "particles.h_over_dx",
+        "h / dx, a number in [1, 3]",
+        "h_over_dx = 1.3",
+    ),
+    f(
+        "particles.kernel",
+        "the kernel name",
+        "kernel = \"wendland_c2\"",
+    ),
+    f(
+        "physics",
+        "the [physics] table",
+        "[physics] with sound_speed_coef = 10.0",
+    ),
+    f(
+        "physics.rho0_kg_m3",
+        "the reference density in kg/m³",
+        "rho0_kg_m3 = 1000.0",
+    ),
+    f(
+        "physics.gravity_m_s2",
+        "the gravity vector in m/s²",
+        "gravity_m_s2 = [0.0, -9.81]",
+    ),
+    f(
+        "physics.sound_speed_m_s",
+        "the numerical speed of sound in m/s",
+        "sound_speed_m_s = 20.0",
+    ),
+    f(
+        "physics.sound_speed_coef",
+        "c0 / sqrt(|g| H), a positive number",
+        "sound_speed_coef = 10.0",
+    ),
+    f("physics.gamma", "the Tait exponent", "gamma = 7.0"),
+    f(
+        "physics.viscosity",
+        "the viscosity model",
+        "viscosity = \"artificial\"",
+    ),
+    f(
+        "physics.alpha",
+        "the artificial viscosity coefficient",
+        "alpha = 0.01",
+    ),
+    f(
+        "physics.nu_m2_s",
+        "the kinematic viscosity in m²/s",
+        "nu_m2_s = 1.0e-6",
+    ),
+    f(
+        "physics.delta_sph",
+        "the delta-SPH coefficient in [0, 1]",
+        "delta_sph = 0.1",
+    ),
+    f(
+        "time",
+        "the [time] table",
+        "[time] with end_s = 1.0 and output_every_s = 0.02",
+    ),
+    f("time.end_s", "the end time in seconds", "end_s = 1.0"),
+    f(
+        "time.output_every_s",
+        "the output interval in seconds",
+        "output_every_s = 0.02",
+    ),
+    f(
+        "time.probe_every_s",
+        "the probe sampling interval in seconds",
+        "probe_every_s = 0.005",
+    ),
+    f("time.cfl", "the Courant number in (0, 1]", "cfl = 0.2"),
+    f("tank", "the [tank] table", "[tank] with min_m and max_m"),
+    f(
+        "tank.min_m",
+        "the inner lower corner of the tank in metres",
+        "min_m = [0.0, 0.0]",
+    ),
+    f(
+        "tank.max_m",
+        "the inner upper corner of the tank in metres",
+        "max_m = [1.0, 0.6]",
+    ),
+    f(
+        "tank.layers",
+        "the number of wall-particle layers, 1 to 8",
+        "layers = 3",
+    ),
+    f(
+        "tank.open_top",
+        "whether the tank has no lid",
+        "open_top = true",
+    ),
+    f("tank.wall", "the wall treatment", "wall = \"dynamic\""),
+    f(
+        "fluid_block",
+        "a list of [[fluid_block]] tables",
+        "[[fluid_block]] with min_m and max_m",
+    ),
+    f(
+        "fluid_block[]",
+        "a [[fluid_block]] table",
+        "[[fluid_block]] with min_m and max_m",
+    ),
+    f(
+        "fluid_block[].min_m",
+        "the block's lower corner in metres",
+        "min_m = [0.0, 0.0]",
+    ),
+    f(
+        "fluid_block[].max_m",
+        "the block's upper corner in metres",
+        "max_m = [0.5, 0.5]",
+    ),
+    f(
+        "fluid_block[].velocity_m_s",
+        "the initial velocity in m/s",
+        "velocity_m_s = [0.0, 0.0]",
+    ),
+    f(
+        "obstacle",
+        "a list of [[obstacle]] tables",
+        "[[obstacle]] with min_m and max_m",
+    ),
+    f(
+        "obstacle[]",
+        "an [[obstacle]] table",
+        "[[obstacle]] with min_m and max_m",
+    ),
+    f(
+        "obstacle[].min_m",
+        "the obstacle's lower corner in metres",
+        "min_m = [0.6, 0.0]",
+    ),
+    f(
+        "obstacle[].max_m",
+        "the obstacle's upper corner in metres",
+        "max_m = [0.7, 0.1]",
+    ),
+    f(
+        "domain",
+        "the [domain] table",
+        "[domain] with min_m and max_m",
+    ),
+    f(
+        "domain.min_m",
+        "the domain's lower corner in metres",
+        "min_m = [-0.1, -0.1]",
+    ),
+    f(
+        "domain.max_m",
+        "the domain's upper corner in metres",
+        "max_m = [1.1, 1.2]",
+    ),
+    f(
+        "probe",
+        "a list of [[probe]] tables",
+        "[[probe]] with name, kind and its point",
+    ),
+    f(
+        "probe[]",
+        "a [[probe]] table",
+        "[[probe]] with name, kind and its point",
+    ),
+    f(
+        "probe[].name",
+        "the probe name, letters, digits, _ and -",
+        "name = \"P1\"",
+    ),
+    f("probe[].kind", "the probe kind", "kind = \"pressure\""),
+    f(
+        "probe[].point_m",
+        "the sampling point of a pressure probe",
+        "point_m = [0.5, 0.05]",
+    ),
+    f(
+        "probe[].base_m",
+        "the foot of a height gauge",
+        "base_m = [0.5, 0.0]",
+    ),
+    f(
+        "probe[].origin_m",
+        "the origin of a front probe",
+        "origin_m = [0.0, 0.0]",
+    ),
+    f(
+        "probe[].axis",
+        "the direction of a front probe",
+        "axis = [1.0, 0.0]",
+    ),
+];
+
+impl FieldHelp {
+    /// The TOML type the field takes, for "wrong type" messages.
+    pub(super) fn ty(&self) -> &'static str {
+        let value = self.example.split_once('=').map_or("", |(_, v)| v.trim());
+        match self.path {
+            "dimension" | "tank.layers" => "an integer",
+            "fluid_block" | "obstacle" | "probe" => "an array of tables",
+            _ if self.example.starts_with('[') => "a table",
+            _ if value.starts_with('"') => "a string",
+            _ if value.starts_with('[') => "an array of numbers",
+            _ if value == "true" || value == "false" => "a boolean",
+            _ => "a number",
+        }
+    }
+}
+
+/// The help for a concrete path such as `probe[3].name`.
+pub(super) fn help(path: &str) -> Option<&'static FieldHelp> {
+    let mut generic = String::with_capacity(path.len());
+    let mut in_index = false;
+    for c in path.chars() {
+        match c {
+            '[' => {
+                in_index = true;
+                generic.push('[');
+            }
+            ']' => {
+                in_index = false;
+                generic.push(']');
+            }
+            _ if in_index => {}
+            _ => generic.push(c),
+        }
+    }
+    FIELDS.iter().find(|h| h.path == generic)
+}

@@ -1,0 +1,955 @@
+//! Tests of the whole loader: the shipped cases, overrides, and one bad file per error class.
+
+use std::collections::HashMap;
+
+use super::*;
+use crate::scenario::{Kind, Particle, ProbeKind, Viscosity};
+
+const HYDROSTATIC: &str = include_str!("../../cases/hydrostatic_2d.toml");
+const DAM_2D: &str = include_str!("../../cases/dam_break_2d.toml");
+const DAM_3D: &str = include_str!("../../cases/dam_break_3d.toml");
+
+/// A small valid case; line numbers below refer to it.
+const BASE: &str = r#"dimension = 2
+
+[particles]
+dx_m = 0.1
+
+[physics]
+sound_speed_coef = 10.0
+
+[time]
+end_s = 1.0
+output_every_s = 0.1
+
+[tank]
+min_m = [0.0, 0.0]
+max_m = [1.0, 1.0]
+
+[[fluid_block]]
+min_m = [0.0, 0.0]
+max_m = [0.5, 0.5]
+
+[[probe]]
+name = "P1"
+kind = "pressure"
+point_m = [0.5, 0.05]
+"#;
+
+fn sets(s: &[&str]) -> Vec<String> {
+    s.iter().map(|s| s.to_string()).collect()
+}
+
+/// BASE with `from` replaced by `to` (which must occur).
+fn base_with(from: &str, to: &str) -> String {
+    assert!(BASE.contains(from), "{from}");
+    BASE.replacen(from, to, 1)
+}
+
+fn err_of(text: &str, overrides: &[&str]) -> String {
+    match load_str(text, "cases/t.toml", &sets(overrides)) {
+        Ok(_) => panic!("expected an error for:\n{text}\n{overrides:?}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// The error names the file with `line` (if given) and contains every word of `words`.
+fn assert_err(text: &str, overrides: &[&str], line: Option<usize>, words: &[&str]) {
+    let e = err_of(text, overrides);
+    match line {
+        Some(l) => assert!(
+            e.starts_with(&format!("cases/t.toml:{l}:")),
+            "line {l} expected: {e}"
+        ),
+        None => assert!(e.starts_with("cases/t.toml"), "{e}"),
+    }
+    for w in words {
+        assert!(e.contains(w), "`{w}` expected in: {e}");
+    }
+    assert!(e.contains("fix:"), "no fix in: {e}");
+}
+
+// ---------------------------------------------------------------- shipped cases
+
+/// Common invariants: particles inside the domain, no duplicates, fluid at least a spacing
+/// (minus rounding) away from walls, and walls below and on both sides of every fluid column.
+fn check_invariants(s: &Scenario) {
+    let dx = s.physics.dx;
+    let dim = s.physics.dim as usize;
+    let v = dim - 1;
+    assert!(s
+        .particles
+        .iter()
+        .all(|p| (0..3).all(|a| s.domain.min[a] <= p.pos[a] && p.pos[a] <= s.domain.max[a])));
+    assert!(s.particles.iter().all(|p| p.rho.is_finite()
+        && p.rho >= s.physics.rho0
+        && p.pos.iter().all(|c| c.is_finite())));
+    // Hash grid with cell dx.
+    let cell = |p: &[f64; 3]| p.map(|c| (c / dx).floor() as i64);
+    let mut grid: HashMap<[i64; 3], Vec<&Particle>> = HashMap::new();
+    for p in &s.particles {
+        grid.entry(cell(&p.pos)).or_default().push(p);
+    }
+    let zr = if dim == 3 { -1..=1 } else { 0..=0 };
+    for p in &s.particles {
+        let c = cell(&p.pos);
+        for i in -1..=1 {
+            for j in -1..=1 {
+                for k in zr.clone() {
+                    for q in grid
+                        .get(&[c[0] + i, c[1] + j, c[2] + k])
+                        .into_iter()
+                        .flatten()
+                    {
+                        if std::ptr::eq(*q, p) {
+                            continue;
+                        }
+                        let d2: f64 = (0..3).map(|a| (p.pos[a] - q.pos[a]).powi(2)).sum();
+                        let min = if p.kind != q.kind {
+                            0.5 * dx
+                        } else {
+                            0.99 * dx
+                        };
+                        assert!(d2.sqrt() >= min - 1e-9, "{p:?} too close to {q:?}");
+                    }
+                }
+            }
+        }
+    }
+    // Walls below and beside the fluid.
+    let fluid: Vec<_> = s
+        .particles
+        .iter()
+        .filter(|p| p.kind == Kind::Fluid)
+        .collect();
+    let walls: Vec<_> = s
+        .particles
+        .iter()
+        .filter(|p| p.kind == Kind::Wall)
+        .collect();
+    let lowest = walls.iter().map(|p| p.pos[v]).fold(f64::MAX, f64::min);
+    let fluid_low = fluid.iter().map(|p| p.pos[v]).fold(f64::MAX, f64::min);
+    assert!(lowest < fluid_low);
+    for a in 0..v {
+        let (fmin, fmax) = fluid.iter().fold((f64::MAX, f64::MIN), |(l, h), p| {
+            (l.min(p.pos[a]), h.max(p.pos[a]))
+        });
+        assert!(
+            walls.iter().any(|p| p.pos[a] < fmin),
+            "no wall before the fluid along axis {a}"
+        );
+        assert!(
+            walls.iter().any(|p| p.pos[a] > fmax),
+            "no wall after the fluid along axis {a}"
+        );
+    }
+    // Hydrostatic: in every fluid column, density decreases upward.
+    let mut columns: HashMap<Vec<i64>, Vec<(f64, f64)>> = HashMap::new();
+    for p in &fluid {
+        let key = (0..v).map(|a| (p.pos[a] / dx).floor() as i64).collect();
+        columns.entry(key).or_default().push((p.pos[v], p.rho));
+    }
+    for col in columns.values_mut() {
+        col.sort_by(|a, b| a.0.total_cmp(&b.0));
+        assert!(
+            col.windows(2).all(|w| w[1].1 < w[0].1),
+            "density not decreasing upward: {col:?}"
+        );
+    }
+    assert!((s.physics.particle_mass - s.physics.rho0 * dx.powi(dim as i32)).abs() < 1e-12);
+}
+
+#[test]
+fn hydrostatic_2d_builds() {
+    let s = load_str(HYDROSTATIC, "cases/hydrostatic_2d.toml", &[]).unwrap();
+    check_invariants(&s);
+    assert_eq!(s.name, "hydrostatic_2d");
+    assert_eq!(s.count(Kind::Fluid), 50 * 25);
+    // Outer box 56 x 33 minus the inner 50 x 30 cells.
+    assert_eq!(s.count(Kind::Wall), 56 * 33 - 50 * 30);
+    assert!((s.physics.particle_mass - 0.4).abs() < 1e-12);
+    assert!((s.physics.h - 0.026).abs() < 1e-12);
+    assert!((s.physics.c0 - 10.0 * (9.81_f64 * 0.5).sqrt()).abs() < 1e-9);
+    assert_eq!(s.physics.viscosity, Viscosity::Artificial { alpha: 0.02 });
+    assert_eq!(s.physics.gravity, [0.0, -9.81, 0.0]);
+    assert_eq!(s.time.probe_every_s, 0.01);
+    // The bottom fluid row: hydrostatic density at depth 0.49 m.
+    let b = s.physics.tait_b();
+    let expect = 1000.0 * (1.0 + 1000.0 * 9.81 * 0.49 / b).powf(1.0 / 7.0);
+    let bottom = s
+        .particles
+        .iter()
+        .find(|p| p.kind == Kind::Fluid && (p.pos[1] - 0.01).abs() < 1e-12)
+        .unwrap();
+    assert!((bottom.rho - expect).abs() < 1e-9);
+    // The floor under the water is hydrostatic too; the wall above the water is at rho0.
+    assert!(s
+        .particles
+        .iter()
+        .any(|p| p.kind == Kind::Wall && p.pos[1] < 0.0 && p.rho > expect));
+    assert!(s
+        .particles
+        .iter()
+        .filter(|p| p.kind == Kind::Wall && p.pos[1] > 0.5)
+        .all(|p| p.rho == 1000.0));
+    assert_eq!(s.probes.len(), 2);
+    assert_eq!(
+        s.probes[1].kind,
+        ProbeKind::Height {
+            base: [0.5, 0.0, 0.0]
+        }
+    );
+}
+
+#[test]
+fn dam_break_2d_builds() {
+    let s = load_str(DAM_2D, "cases/dam_break_2d.toml", &[]).unwrap();
+    check_invariants(&s);
+    assert_eq!(s.count(Kind::Fluid), 40 * 80);
+    let b = s
+        .particles
+        .iter()
+        .filter(|p| p.kind == Kind::Fluid)
+        .fold([f64::MAX, f64::MIN], |m, p| {
+            [m[0].min(p.pos[0]), m[1].max(p.pos[0])]
+        });
+    assert!((b[0] - 0.00365 / 2.0).abs() < 1e-12 && (b[1] - (0.146 - 0.00365 / 2.0)).abs() < 1e-9);
+    assert!(matches!(
+        s.probes[0].kind,
+        ProbeKind::Front {
+            axis: [1.0, 0.0, 0.0],
+            ..
+        }
+    ));
+    assert_eq!(s.time.end_s, 0.6);
+    assert!(s.domain.max[0] > 0.584 && s.domain.min[0] < 0.0 && s.domain.max[1] > 0.7);
+}
+
+#[test]
+fn dam_break_3d_builds() {
+    let s = load_str(DAM_3D, "cases/dam_break_3d.toml", &[]).unwrap();
+    check_invariants(&s);
+    let fluid = s.count(Kind::Fluid);
+    assert!((61 * 50 * 27..=61 * 50 * 28).contains(&fluid), "{fluid}");
+    // The box: 8 x 20 x 8 lattice points.
+    let in_box = s
+        .particles
+        .iter()
+        .filter(|p| {
+            p.kind == Kind::Wall
+                && p.pos[0] > 0.6
+                && p.pos[0] < 0.9
+                && p.pos[2] > 0.0
+                && p.pos[1] > 0.2
+                && p.pos[1] < 0.8
+        })
+        .count();
+    assert_eq!(in_box, 8 * 20 * 8);
+    assert_eq!(s.probes.len(), 12);
+    assert_eq!(s.physics.gravity, [0.0, 0.0, -9.81]);
+    assert!((s.physics.h - 0.03).abs() < 1e-12);
+    assert!(s.particles.len() < 250_000);
+}
+
+#[test]
+fn load_reads_files_and_reports_missing_ones() {
+    let dir = std::env::temp_dir().join(format!("wgsph_case_test_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("my_case.toml");
+    std::fs::write(&path, BASE).unwrap();
+    let s = load(&path, &[]).unwrap();
+    assert_eq!(s.name, "my_case");
+    let e = load(&dir.join("nope.toml"), &[]).unwrap_err().to_string();
+    assert!(e.contains("nope.toml") && e.contains("cannot read"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+// ---------------------------------------------------------------- overrides
+
+#[test]
+fn overrides_change_the_case() {
+    let s = load_str(
+        DAM_2D,
+        "d.toml",
+        &sets(&[
+            "particles.dx_m=0.0073",
+            "time.end_s=0.5",
+            "physics.viscosity=laminar",
+            "physics.alpha=nan",
+        ]),
+    );
+    // alpha with laminar is refused, even when set to anything.
+    assert!(s.unwrap_err().to_string().contains("physics.alpha"));
+    let s = load_str(
+        BASE,
+        "b.toml",
+        &sets(&[
+            "particles.dx_m=0.05",
+            "time.end_s=0.5",
+            "physics.viscosity=\"laminar\"",
+            "physics.nu_m2_s=1e-6",
+            "probe[0].point_m=[0.25, 0.1]",
+        ]),
+    )
+    .unwrap();
+    assert_eq!(s.count(Kind::Fluid), 100);
+    assert_eq!(s.time.end_s, 0.5);
+    assert_eq!(s.physics.viscosity, Viscosity::Laminar { nu: 1e-6 });
+    assert_eq!(
+        s.probes[0].kind,
+        ProbeKind::Pressure {
+            point: [0.25, 0.1, 0.0]
+        }
+    );
+    let s = load_str(
+        BASE,
+        "b.toml",
+        &sets(&["tank.open_top=false", "fluid_block.0.velocity_m_s=[1, 0]"]),
+    )
+    .unwrap();
+    assert!(s
+        .particles
+        .iter()
+        .any(|p| p.kind == Kind::Wall && p.pos[1] > 1.0));
+    assert!(s
+        .particles
+        .iter()
+        .filter(|p| p.kind == Kind::Fluid)
+        .all(|p| p.vel == [1.0, 0.0, 0.0]));
+}
+
+#[test]
+fn override_errors_name_the_set() {
+    assert_err(
+        BASE,
+        &["particles.dxm=0.01"],
+        None,
+        &[
+            "--set particles.dxm=0.01",
+            "particles.dxm",
+            "unknown field",
+            "dx_m, h_over_dx, kernel",
+        ],
+    );
+    assert_err(
+        BASE,
+        &["partcles.dx_m=0.01"],
+        None,
+        &["partcles", "unknown field", "particles"],
+    );
+    assert_err(
+        BASE,
+        &["particles.dx_m=-1"],
+        None,
+        &["particles.dx_m = -1 (from --set particles.dx_m=-1)", "> 0"],
+    );
+    assert_err(
+        BASE,
+        &["particles.dx_m=abc"],
+        None,
+        &["particles.dx_m", "--set particles.dx_m=abc", "wrong type"],
+    );
+    assert_err(
+        BASE,
+        &["particles.kernel=gauss"],
+        None,
+        &["particles.kernel", "\"cubic_spline\", \"wendland_c2\""],
+    );
+    assert_err(BASE, &["dx_m"], None, &["--set dx_m", "KEY=VALUE"]);
+    assert_err(BASE, &["probe[4].name=x"], None, &["probe[4]", "1 entries"]);
+    assert_err(
+        BASE,
+        &["domain.min_m=[0,0]"],
+        None,
+        &["domain.max_m", "--set domain.min_m=[0,0]", "missing"],
+    );
+    // An error elsewhere in the file still gets its line.
+    let text = base_with("end_s = 1.0", "end_s = 0.0");
+    assert_err(
+        &text,
+        &["particles.dx_m=0.05"],
+        Some(10),
+        &["time.end_s = 0", "> 0"],
+    );
+}
+
+#[test]
+fn every_documented_field_exists_in_the_schema() {
+    // Each leaf of the field-help table, set with its example, must not be an unknown field.
+    let full = DAM_3D;
+    for h in schema::FIELDS {
+        if !h.example.contains('=') || h.example.starts_with('[') {
+            continue;
+        }
+        let value = h.example.split_once('=').unwrap().1.trim();
+        let key = h.path.replace("[]", "[0]");
+        let r = load_str(full, "f.toml", &[format!("{key}={value}")]);
+        if let Err(e) = r {
+            assert!(!e.to_string().contains("unknown field"), "{key}: {e}");
+        }
+    }
+}
+
+// ---------------------------------------------------------------- bad files
+
+#[test]
+fn syntax_errors_give_line_and_column() {
+    let text = base_with("dx_m = 0.1", "dx_m = = 0.1");
+    let e = err_of(&text, &[]);
+    assert!(e.starts_with("cases/t.toml:4:"), "{e}");
+    assert!(e.contains("syntax") && e.contains("dx_m = = 0.1"), "{e}");
+    let e = err_of(&base_with("[tank]", "[tank"), &[]);
+    assert!(e.starts_with("cases/t.toml:13:"), "{e}");
+    let e = err_of(&base_with("end_s = 1.0", "end_s = 1.0\nend_s = 2.0"), &[]);
+    assert!(
+        e.starts_with("cases/t.toml:11:") && e.contains("duplicate"),
+        "{e}"
+    );
+}
+
+#[test]
+fn unknown_fields_list_the_allowed_ones() {
+    assert_err(
+        &base_with("dx_m = 0.1", "dx_m = 0.1\ndxx = 3"),
+        &[],
+        Some(5),
+        &["particles.dxx", "unknown field", "dx_m, h_over_dx, kernel"],
+    );
+    assert_err(
+        &base_with("dimension = 2", "dimension = 2\nsolver = 1"),
+        &[],
+        Some(2),
+        &["solver", "top level", "fluid_block"],
+    );
+    assert_err(
+        &base_with("kind = \"pressure\"", "kind = \"pressure\"\npoint = [1, 2]"),
+        &[],
+        Some(24),
+        &["probe[0].point", "point_m"],
+    );
+    assert_err(
+        &format!("{BASE}\n[output]\nformat = \"vtu\"\n"),
+        &[],
+        Some(26),
+        &["output", "unknown field"],
+    );
+}
+
+#[test]
+fn missing_fields_are_named() {
+    assert_err(
+        &base_with("dx_m = 0.1\n", ""),
+        &[],
+        Some(3),
+        &["particles.dx_m", "missing", "dx_m = 0.01"],
+    );
+    assert_err(
+        &base_with("end_s = 1.0\n", ""),
+        &[],
+        Some(9),
+        &["time.end_s", "missing"],
+    );
+    assert_err(
+        &base_with("dimension = 2\n", ""),
+        &[],
+        None,
+        &["dimension", "missing"],
+    );
+    assert_err(
+        &base_with("max_m = [0.5, 0.5]\n", ""),
+        &[],
+        Some(17),
+        &["fluid_block[0].max_m", "missing"],
+    );
+    assert_err(
+        &base_with("sound_speed_coef = 10.0\n", ""),
+        &[],
+        Some(6),
+        &["physics.sound_speed_coef", "exactly one"],
+    );
+    assert_err("", &[], None, &["missing"]);
+    let no_blocks = BASE.replace(
+        "[[fluid_block]]\nmin_m = [0.0, 0.0]\nmax_m = [0.5, 0.5]\n",
+        "",
+    );
+    assert_err(&no_blocks, &[], None, &["fluid_block", "at least one"]);
+}
+
+#[test]
+fn wrong_types_are_named() {
+    assert_err(
+        &base_with("dx_m = 0.1", "dx_m = \"0.1\""),
+        &[],
+        Some(4),
+        &["particles.dx_m = \"0.1\"", "wrong type", "found a string"],
+    );
+    assert_err(
+        &base_with("dimension = 2", "dimension = 2.0"),
+        &[],
+        Some(1),
+        &["dimension", "wrong type"],
+    );
+    assert_err(
+        &base_with("max_m = [1.0, 1.0]", "max_m = [1.0, \"a\"]"),
+        &[],
+        Some(15),
+        &["tank.max_m[1]", "wrong type"],
+    );
+    assert_err(
+        &base_with("max_m = [1.0, 1.0]", "max_m = 1.0"),
+        &[],
+        Some(15),
+        &["tank.max_m", "wrong type"],
+    );
+    let tankless = base_with("[tank]\nmin_m = [0.0, 0.0]\nmax_m = [1.0, 1.0]\n", "");
+    assert_err(
+        &format!("tank = 3\n{tankless}"),
+        &[],
+        Some(1),
+        &["tank = 3", "wrong type", "found an integer"],
+    );
+}
+
+#[test]
+fn bad_numbers_are_refused() {
+    let cases: &[(&str, &str, usize, &[&str])] = &[
+        (
+            "dx_m = 0.1",
+            "dx_m = -0.01",
+            4,
+            &["particles.dx_m = -0.01", "must be > 0", "spacing"],
+        ),
+        (
+            "dx_m = 0.1",
+            "dx_m = 0.0",
+            4,
+            &["particles.dx_m = 0", "> 0"],
+        ),
+        (
+            "dx_m = 0.1",
+            "dx_m = nan",
+            4,
+            &["particles.dx_m = NaN", "finite"],
+        ),
+        (
+            "dx_m = 0.1",
+            "dx_m = inf",
+            4,
+            &["particles.dx_m = inf", "finite"],
+        ),
+        (
+            "dx_m = 0.1",
+            "dx_m = 0.1\nh_over_dx = 3.5",
+            5,
+            &["particles.h_over_dx = 3.5", "[1, 3]"],
+        ),
+        (
+            "dx_m = 0.1",
+            "dx_m = 0.1\nh_over_dx = 0.5",
+            5,
+            &["particles.h_over_dx", "[1, 3]"],
+        ),
+        ("end_s = 1.0", "end_s = 0.0", 10, &["time.end_s", "> 0"]),
+        ("end_s = 1.0", "end_s = -inf", 10, &["time.end_s", "finite"]),
+        (
+            "output_every_s = 0.1",
+            "output_every_s = 0",
+            11,
+            &["time.output_every_s", "> 0"],
+        ),
+        (
+            "output_every_s = 0.1",
+            "output_every_s = 0.1\nprobe_every_s = 0.2",
+            12,
+            &["time.probe_every_s", "(0, 0.1]"],
+        ),
+        (
+            "output_every_s = 0.1",
+            "output_every_s = 0.1\ncfl = 1.5",
+            12,
+            &["time.cfl", "(0, 1]"],
+        ),
+        (
+            "output_every_s = 0.1",
+            "output_every_s = 0.1\ncfl = 0",
+            12,
+            &["time.cfl", "(0, 1]"],
+        ),
+        (
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\nrho0_kg_m3 = 0",
+            8,
+            &["physics.rho0_kg_m3", "> 0"],
+        ),
+        (
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = -1.0",
+            7,
+            &["physics.sound_speed_coef", "> 0"],
+        ),
+        (
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\ndelta_sph = 2",
+            8,
+            &["physics.delta_sph", "[0, 1]"],
+        ),
+        (
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\ngamma = 0.5",
+            8,
+            &["physics.gamma", "[1, 10]"],
+        ),
+        (
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\nalpha = -0.1",
+            8,
+            &["physics.alpha", "[0, 1]"],
+        ),
+        (
+            "max_m = [1.0, 1.0]",
+            "max_m = [1.0, 1.0]\nlayers = 0",
+            16,
+            &["tank.layers = 0", "between 1 and 8"],
+        ),
+        (
+            "max_m = [1.0, 1.0]",
+            "max_m = [1.0, 1.0]\nlayers = 99999999999",
+            16,
+            &["tank.layers", "between 1 and 8"],
+        ),
+        (
+            "dimension = 2",
+            "dimension = 4",
+            1,
+            &["dimension = 4", "2 or 3"],
+        ),
+        (
+            "point_m = [0.5, 0.05]",
+            "point_m = [0.5, nan]",
+            24,
+            &["probe[0].point_m[1] = NaN", "finite"],
+        ),
+    ];
+    for (from, to, line, words) in cases {
+        assert_err(&base_with(from, to), &[], Some(*line), words);
+    }
+}
+
+#[test]
+fn vectors_of_the_wrong_length_are_refused() {
+    assert_err(
+        &base_with(
+            "min_m = [0.0, 0.0]\nmax_m = [1.0, 1.0]",
+            "min_m = [0.0, 0.0, 0.0]\nmax_m = [1.0, 1.0]",
+        ),
+        &[],
+        Some(14),
+        &["tank.min_m", "3 components", "2D case needs 2"],
+    );
+    assert_err(
+        &base_with("point_m = [0.5, 0.05]", "point_m = []"),
+        &[],
+        Some(24),
+        &["probe[0].point_m", "0 components"],
+    );
+    assert_err(
+        &base_with(
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\ngravity_m_s2 = [0.0, 0.0, -9.81]",
+        ),
+        &[],
+        Some(8),
+        &["physics.gravity_m_s2", "3 components"],
+    );
+    assert_err(
+        &base_with("dimension = 2", "dimension = 3"),
+        &[],
+        Some(14),
+        &["tank.min_m", "2 components", "3D case needs 3"],
+    );
+}
+
+#[test]
+fn unknown_enum_strings_list_the_allowed_ones() {
+    assert_err(
+        &base_with("dx_m = 0.1", "dx_m = 0.1\nkernel = \"gaussian\""),
+        &[],
+        Some(5),
+        &[
+            "particles.kernel = \"gaussian\"",
+            "\"cubic_spline\", \"wendland_c2\"",
+        ],
+    );
+    assert_err(
+        &base_with("kind = \"pressure\"", "kind = \"velocity\""),
+        &[],
+        Some(23),
+        &["probe[0].kind", "\"pressure\", \"height\", \"front\""],
+    );
+    assert_err(
+        &base_with("max_m = [1.0, 1.0]", "max_m = [1.0, 1.0]\nwall = \"mdbc\""),
+        &[],
+        Some(16),
+        &["tank.wall", "\"dynamic\""],
+    );
+    assert_err(
+        &base_with(
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\nviscosity = \"sps\"",
+        ),
+        &[],
+        Some(8),
+        &["physics.viscosity", "\"artificial\", \"laminar\""],
+    );
+}
+
+#[test]
+fn options_that_do_not_go_together() {
+    assert_err(
+        &base_with(
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\nsound_speed_m_s = 20.0",
+        ),
+        &[],
+        Some(7),
+        &["both"],
+    );
+    assert_err(
+        &base_with(
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\nnu_m2_s = 1e-6",
+        ),
+        &[],
+        Some(8),
+        &["physics.nu_m2_s", "artificial"],
+    );
+    assert_err(
+        &base_with(
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\nviscosity = \"laminar\"",
+        ),
+        &[],
+        Some(6),
+        &["physics.nu_m2_s", "required"],
+    );
+    assert_err(
+        &base_with(
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\ngravity_m_s2 = [0.0, 0.0]",
+        ),
+        &[],
+        Some(7),
+        &["physics.sound_speed_coef", "sound_speed_m_s"],
+    );
+    assert_err(
+        &base_with(
+            "point_m = [0.5, 0.05]",
+            "point_m = [0.5, 0.05]\nbase_m = [0.5, 0.0]",
+        ),
+        &[],
+        Some(25),
+        &["probe[0].base_m", "not used"],
+    );
+    assert_err(
+        &base_with(
+            "kind = \"pressure\"\npoint_m = [0.5, 0.05]",
+            "kind = \"front\"\norigin_m = [0.0, 0.0]",
+        ),
+        &[],
+        Some(21),
+        &["probe[0].axis", "required"],
+    );
+    assert_err(
+        &base_with(
+            "kind = \"pressure\"\npoint_m = [0.5, 0.05]",
+            "kind = \"front\"\norigin_m = [0.0, 0.0]\naxis = [0.0, 0.0]",
+        ),
+        &[],
+        Some(25),
+        &["probe[0].axis", "non-zero"],
+    );
+    assert_err(
+        &base_with("name = \"P1\"", "name = \"P 1\""),
+        &[],
+        Some(22),
+        &["probe[0].name", "letters"],
+    );
+    assert_err(
+        &format!("{BASE}[[probe]]\nname = \"P1\"\nkind = \"height\"\nbase_m = [0.1, 0.0]\n"),
+        &[],
+        Some(26),
+        &["probe[1].name", "probe[0] already"],
+    );
+    assert_err(
+        &base_with("dimension = 2", "dimension = 2\nname = \"\""),
+        &[],
+        Some(2),
+        &["name", "non-empty"],
+    );
+}
+
+#[test]
+fn geometry_errors() {
+    // Fluid outside the tank.
+    assert_err(
+        &base_with("max_m = [0.5, 0.5]", "max_m = [1.5, 0.5]"),
+        &[],
+        Some(19),
+        &["fluid_block[0].max_m", "leaves the tank", "along x"],
+    );
+    // Tank min above max.
+    assert_err(
+        &base_with("max_m = [1.0, 1.0]", "max_m = [1.0, -1.0]"),
+        &[],
+        Some(15),
+        &["tank.max_m", "not above min_m[1]"],
+    );
+    // A block too thin for one particle.
+    assert_err(
+        &base_with("max_m = [0.5, 0.5]", "max_m = [0.5, 0.04]"),
+        &[],
+        Some(19),
+        &["fluid_block[0].max_m", "too thin", "along y"],
+    );
+    // Overlapping blocks.
+    assert_err(
+        &format!("{BASE}[[fluid_block]]\nmin_m = [0.4, 0.0]\nmax_m = [0.8, 0.2]\n"),
+        &[],
+        Some(25),
+        &["fluid_block[1]", "overlaps fluid_block[0]"],
+    );
+    // Obstacle too thin.
+    assert_err(
+        &format!("{BASE}[[obstacle]]\nmin_m = [0.61, 0.0]\nmax_m = [0.64, 0.2]\n"),
+        &[],
+        Some(27),
+        &["obstacle[0].max_m", "too thin"],
+    );
+    // Probe outside the domain.
+    assert_err(
+        &base_with("point_m = [0.5, 0.05]", "point_m = [0.5, 5.0]"),
+        &[],
+        Some(24),
+        &["probe[0].point_m", "outside the domain"],
+    );
+    // Fluid outside a given domain, tank walls outside a given domain.
+    let with_domain =
+        |min: &str, max: &str| format!("{BASE}[domain]\nmin_m = {min}\nmax_m = {max}\n");
+    assert_err(
+        &with_domain("[0.1, -1.0]", "[2.0, 2.0]"),
+        &[],
+        Some(17),
+        &["fluid_block[0]", "leaves the domain"],
+    );
+    assert_err(
+        &with_domain("[-0.1, -0.1]", "[2.0, 2.0]"),
+        &[],
+        Some(13),
+        &["tank", "leave the domain"],
+    );
+    // Too many particles.
+    assert_err(
+        &base_with("dx_m = 0.1", "dx_m = 1e-5"),
+        &[],
+        Some(4),
+        &["particles.dx_m", "2500000000 fluid", "200 million"],
+    );
+    assert_err(
+        &base_with("max_m = [0.5, 0.5]", "max_m = [0.5, 0.5]\n[tank2]"),
+        &[],
+        Some(20),
+        &["tank2", "unknown field"],
+    );
+}
+
+#[test]
+fn cases_without_tank_and_with_obstacles() {
+    let text = "dimension = 3\n[particles]\ndx_m = 0.1\n[physics]\nsound_speed_m_s = 20.0\n[time]\nend_s = 1.0\noutput_every_s = 0.1\n\
+                [[fluid_block]]\nmin_m = [0.0, 0.0, 0.0]\nmax_m = [1.0, 0.5, 0.5]\nvelocity_m_s = [1.0, 0.0, 0.0]\n\
+                [[obstacle]]\nmin_m = [0.2, 0.0, 0.0]\nmax_m = [0.4, 0.2, 0.2]\n\
+                [[obstacle]]\nmin_m = [0.3, 0.0, 0.0]\nmax_m = [0.5, 0.2, 0.2]\n";
+    let s = load_str(text, "x.toml", &[]).unwrap();
+    assert_eq!(s.physics.c0, 20.0);
+    // Obstacle lattice points 0.25..0.45 along x (overlap counted once), 0.05, 0.15 along y, z.
+    assert_eq!(s.count(Kind::Wall), 3 * 2 * 2);
+    // Fluid removed in and next to the obstacles: x < 0.55 for y, z < 0.25.
+    // Fluid on the obstacle's lattice points is removed; its lattice neighbours (dx away) stay.
+    assert!(s
+        .particles
+        .iter()
+        .filter(|p| p.kind == Kind::Fluid)
+        .all(|p| !(p.pos[0] > 0.2 && p.pos[0] < 0.5 && p.pos[1] < 0.2 && p.pos[2] < 0.2)));
+    assert_eq!(s.count(Kind::Fluid), 10 * 5 * 5 - 3 * 2 * 2);
+    // Default domain: the fluid's box, raised by its height, plus 2 dx.
+    assert!(
+        (s.domain.max[2] - (0.5 + 0.5 + 0.2)).abs() < 1e-12
+            && (s.domain.min[0] + 0.2).abs() < 1e-12
+    );
+}
+
+#[test]
+fn nothing_panics_on_hostile_values() {
+    let numbers = [
+        "nan",
+        "inf",
+        "-inf",
+        "0",
+        "-1",
+        "1e308",
+        "-1e308",
+        "1e-308",
+        "1e15",
+        "99999999999999",
+        "\"x\"",
+        "[]",
+        "[nan, nan]",
+        "[1e308, -1e308]",
+        "true",
+        "{}",
+    ];
+    // Every number (and vector) of BASE, and of a 3D variant, replaced by each hostile value.
+    let mut targets: Vec<(String, Vec<(usize, usize)>)> = Vec::new();
+    for text in [BASE.to_string(), DAM_3D.to_string()] {
+        let mut spans = Vec::new();
+        for (start, line) in text
+            .match_indices('\n')
+            .map(|(i, _)| i + 1)
+            .chain([0])
+            .map(|s| (s, &text[s..]))
+        {
+            let line = line.lines().next().unwrap_or("");
+            if line.starts_with('#') {
+                continue;
+            }
+            if let Some(eq) = line.find("= ") {
+                spans.push((start + eq + 2, start + line.len()));
+            }
+        }
+        targets.push((text, spans));
+    }
+    let mut n = 0;
+    for (text, spans) in &targets {
+        for &(a, b) in spans {
+            for v in numbers {
+                let t = format!("{}{}{}", &text[..a], v, &text[b..]);
+                let _ = load_str(&t, "h.toml", &[]);
+                n += 1;
+            }
+        }
+    }
+    for v in numbers {
+        for key in [
+            "particles.dx_m",
+            "tank.max_m",
+            "fluid_block[0].max_m",
+            "probe[0].point_m",
+            "physics.gravity_m_s2",
+            "time.end_s",
+            "obstacle.x",
+            "x[0].y",
+        ] {
+            let _ = load_str(BASE, "h.toml", &[format!("{key}={v}")]);
+        }
+    }
+    assert!(n > 100);
+}

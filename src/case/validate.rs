@@ -1,0 +1,463 @@
+//! Field-by-field checks of the deserialised case: finite numbers, ranges, vector lengths,
+//! options that go together, defaults. Produces a [`Case`] in SI with 3-component vectors.
+//! Geometric checks that need several fields at once live in `build.rs`.
+
+use crate::scenario::{KernelKind, Probe, TimeControl, Viscosity};
+
+use super::error::CaseError;
+use super::locate::Ctx;
+use super::schema::{KernelName, RawCase, ViscosityName, WallName};
+
+/// An axis-aligned box (3 components; in 2D the third is 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Aabb {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Sound {
+    Speed(f64),
+    Coef(f64),
+}
+
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Tank {
+    pub inner: Aabb,
+    pub layers: u32,
+    pub open_top: bool,
+}
+
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Block {
+    pub bx: Aabb,
+    pub vel: [f64; 3],
+}
+
+/// A case whose every field is individually valid.
+#[derive(Debug)]
+pub(super) struct Case {
+    pub name: String,
+    pub dim: usize,
+    pub dx: f64,
+    pub h_over_dx: f64,
+    pub kernel: KernelKind,
+    pub rho0: f64,
+    pub gravity: [f64; 3],
+    pub sound: Sound,
+    pub gamma: f64,
+    pub viscosity: Viscosity,
+    pub delta_sph: f64,
+    pub time: TimeControl,
+    pub tank: Option<Tank>,
+    pub blocks: Vec<Block>,
+    pub obstacles: Vec<Aabb>,
+    pub domain: Option<Aabb>,
+    pub probes: Vec<Probe>,
+}
+
+/// Allowed range of a number.
+#[derive(Clone, Copy)]
+enum Bound {
+    /// > 0
+    Positive,
+    /// [lo, hi]
+    Closed(f64, f64),
+    /// (lo, hi]
+    OpenClosed(f64, f64),
+}
+
+fn number(
+    ctx: &Ctx<'_>,
+    path: &str,
+    v: f64,
+    bound: Bound,
+    what: &str,
+    fix: &str,
+) -> Result<f64, CaseError> {
+    if !v.is_finite() {
+        return Err(ctx.err(
+            path,
+            Some(format!("{v}")),
+            format!("must be a finite number ({what})"),
+            fix,
+        ));
+    }
+    let (ok, rule) = match bound {
+        Bound::Positive => (v > 0.0, "must be > 0".to_string()),
+        Bound::Closed(lo, hi) => (lo <= v && v <= hi, format!("must be in [{lo}, {hi}]")),
+        Bound::OpenClosed(lo, hi) => (lo < v && v <= hi, format!("must be in ({lo}, {hi}]")),
+    };
+    if ok {
+        Ok(v)
+    } else {
+        Err(ctx.err(path, Some(format!("{v}")), format!("{rule} ({what})"), fix))
+    }
+}
+
+/// A `dim`-component vector of finite numbers, padded to 3 components.
+pub(super) fn vector(
+    ctx: &Ctx<'_>,
+    path: &str,
+    v: &[f64],
+    dim: usize,
+    what: &str,
+) -> Result<[f64; 3], CaseError> {
+    let axes = if dim == 2 {
+        "[x, y] with y up"
+    } else {
+        "[x, y, z] with z up"
+    };
+    if v.len() != dim {
+        return Err(ctx.err(
+            path,
+            Some(format!("{v:?}")),
+            format!(
+                "has {} components but this {dim}D case needs {dim}: {axes} ({what})",
+                v.len()
+            ),
+            format!("give {dim} numbers, {axes}"),
+        ));
+    }
+    let mut out = [0.0; 3];
+    for (i, &c) in v.iter().enumerate() {
+        if !c.is_finite() {
+            return Err(ctx.err(
+                &format!("{path}[{i}]"),
+                Some(format!("{c}")),
+                format!("must be a finite number ({what})"),
+                "give a finite number",
+            ));
+        }
+        out[i] = c;
+    }
+    Ok(out)
+}
+
+/// A box from `{path}.min_m` / `{path}.max_m` with min < max on every axis.
+fn aabb(
+    ctx: &Ctx<'_>,
+    path: &str,
+    min: &[f64],
+    max: &[f64],
+    dim: usize,
+    what: &str,
+) -> Result<Aabb, CaseError> {
+    let lo = vector(
+        ctx,
+        &format!("{path}.min_m"),
+        min,
+        dim,
+        &format!("the lower corner of {what}"),
+    )?;
+    let hi = vector(
+        ctx,
+        &format!("{path}.max_m"),
+        max,
+        dim,
+        &format!("the upper corner of {what}"),
+    )?;
+    for a in 0..dim {
+        if hi[a] <= lo[a] {
+            return Err(ctx.err(
+                &format!("{path}.max_m"),
+                Some(format!("{max:?}")),
+                format!(
+                    "max_m[{a}] = {} is not above min_m[{a}] = {} ({what} would be empty)",
+                    hi[a], lo[a]
+                ),
+                "make every component of max_m larger than that of min_m",
+            ));
+        }
+    }
+    Ok(Aabb { min: lo, max: hi })
+}
+
+pub(super) fn validate(
+    ctx: &Ctx<'_>,
+    raw: &RawCase,
+    default_name: &str,
+) -> Result<Case, CaseError> {
+    let dim = match raw.dimension {
+        2 => 2,
+        3 => 3,
+        d => {
+            return Err(ctx.err(
+                "dimension",
+                Some(d.to_string()),
+                "must be 2 or 3",
+                "write dimension = 2 (vectors [x, y], y up) or dimension = 3 ([x, y, z], z up)",
+            ))
+        }
+    };
+    let name = match &raw.name {
+        Some(n)
+            if n.trim().is_empty()
+                || n.chars().any(|c| c.is_control() || c == '/' || c == '\\') =>
+        {
+            return Err(ctx.err(
+                "name",
+                Some(format!("{n:?}")),
+                "must be a non-empty name without slashes or control characters",
+                "use letters, digits, `_` and `-`, e.g. name = \"dam_break_2d\"",
+            ))
+        }
+        Some(n) => n.clone(),
+        None => default_name.to_string(),
+    };
+
+    // [particles]
+    let p = &raw.particles;
+    let dx = number(
+        ctx,
+        "particles.dx_m",
+        p.dx_m,
+        Bound::Positive,
+        "the particle spacing in metres",
+        "give a positive spacing such as 0.01",
+    )?;
+    let h_over_dx = number(
+        ctx,
+        "particles.h_over_dx",
+        p.h_over_dx.unwrap_or(1.3),
+        Bound::Closed(1.0, 3.0),
+        "h = h_over_dx * dx; the kernel support is 2h",
+        "use a value between 1.0 and 3.0; 1.3 is usual for wendland_c2",
+    )?;
+    let kernel = match p.kernel.unwrap_or(KernelName::WendlandC2) {
+        KernelName::CubicSpline => KernelKind::CubicSpline,
+        KernelName::WendlandC2 => KernelKind::WendlandC2,
+    };
+
+    // [physics]
+    let ph = &raw.physics;
+    let rho0 = number(
+        ctx,
+        "physics.rho0_kg_m3",
+        ph.rho0_kg_m3.unwrap_or(1000.0),
+        Bound::Positive,
+        "the reference density in kg/m³",
+        "use e.g. 1000.0 for water",
+    )?;
+    let gravity = match &ph.gravity_m_s2 {
+        Some(g) => vector(ctx, "physics.gravity_m_s2", g, dim, "gravity in m/s²")?,
+        None => {
+            let mut g = [0.0; 3];
+            g[dim - 1] = -9.81;
+            g
+        }
+    };
+    let sound = match (ph.sound_speed_m_s, ph.sound_speed_coef) {
+        (Some(_), Some(_)) => {
+            return Err(ctx.err(
+                "physics.sound_speed_coef",
+                None,
+                "physics.sound_speed_m_s and physics.sound_speed_coef are both given",
+                "keep only one of them",
+            ))
+        }
+        (Some(c), None) => Sound::Speed(number(ctx, "physics.sound_speed_m_s", c, Bound::Positive, "the numerical speed of sound c0 in m/s", "give a positive speed, about 10 times the largest expected flow speed")?),
+        (None, Some(k)) => Sound::Coef(number(ctx, "physics.sound_speed_coef", k, Bound::Positive, "c0 = coef * sqrt(|g| * H)", "use e.g. 10.0")?),
+        (None, None) => {
+            return Err(ctx.err(
+                "physics.sound_speed_coef",
+                None,
+                "the speed of sound is not given: [physics] needs exactly one of sound_speed_m_s (c0 in m/s) or sound_speed_coef (c0 = coef * sqrt(|g| * H))",
+                "add sound_speed_coef = 10.0 to [physics]",
+            ))
+        }
+    };
+    let gamma = number(
+        ctx,
+        "physics.gamma",
+        ph.gamma.unwrap_or(7.0),
+        Bound::Closed(1.0, 10.0),
+        "the Tait exponent",
+        "use 7.0 for water",
+    )?;
+    let viscosity = match ph.viscosity.unwrap_or(ViscosityName::Artificial) {
+        ViscosityName::Artificial => {
+            if let Some(nu) = ph.nu_m2_s {
+                return Err(ctx.err("physics.nu_m2_s", Some(format!("{nu}")), "is only used with viscosity = \"laminar\", but the viscosity is \"artificial\"", "remove nu_m2_s, or set viscosity = \"laminar\""));
+            }
+            let alpha = number(
+                ctx,
+                "physics.alpha",
+                ph.alpha.unwrap_or(0.01),
+                Bound::Closed(0.0, 1.0),
+                "the artificial viscosity coefficient",
+                "use a small value such as 0.01 to 0.05",
+            )?;
+            Viscosity::Artificial { alpha }
+        }
+        ViscosityName::Laminar => {
+            if let Some(a) = ph.alpha {
+                return Err(ctx.err("physics.alpha", Some(format!("{a}")), "is only used with viscosity = \"artificial\", but the viscosity is \"laminar\"", "remove alpha, or set viscosity = \"artificial\""));
+            }
+            let Some(nu) = ph.nu_m2_s else {
+                return Err(ctx.err(
+                    "physics.nu_m2_s",
+                    None,
+                    "is required with viscosity = \"laminar\"",
+                    "add nu_m2_s = 1.0e-6 (water) to [physics]",
+                ));
+            };
+            let nu = number(
+                ctx,
+                "physics.nu_m2_s",
+                nu,
+                Bound::Positive,
+                "the kinematic viscosity in m²/s",
+                "use e.g. 1.0e-6 for water",
+            )?;
+            Viscosity::Laminar { nu }
+        }
+    };
+    let delta_sph = number(
+        ctx,
+        "physics.delta_sph",
+        ph.delta_sph.unwrap_or(0.1),
+        Bound::Closed(0.0, 1.0),
+        "the delta-SPH density diffusion coefficient; 0 disables it",
+        "use 0.1, or 0 to disable",
+    )?;
+
+    // [time]
+    let t = &raw.time;
+    let end_s = number(
+        ctx,
+        "time.end_s",
+        t.end_s,
+        Bound::Positive,
+        "the end time in seconds",
+        "give a positive duration such as 1.0",
+    )?;
+    let output_every_s = number(
+        ctx,
+        "time.output_every_s",
+        t.output_every_s,
+        Bound::Positive,
+        "the interval between particle outputs in seconds",
+        "give a positive interval such as 0.02",
+    )?;
+    let probe_every_s = number(
+        ctx,
+        "time.probe_every_s",
+        t.probe_every_s.unwrap_or(output_every_s),
+        Bound::OpenClosed(0.0, output_every_s),
+        "the probe sampling interval in seconds, at most time.output_every_s",
+        "give a positive interval no larger than output_every_s",
+    )?;
+    let cfl = number(
+        ctx,
+        "time.cfl",
+        t.cfl.unwrap_or(0.2),
+        Bound::OpenClosed(0.0, 1.0),
+        "the Courant number",
+        "use e.g. 0.2",
+    )?;
+    let time = TimeControl {
+        end_s,
+        output_every_s,
+        probe_every_s,
+        cfl,
+    };
+
+    // Geometry.
+    let tank = match &raw.tank {
+        None => None,
+        Some(tk) => {
+            let inner = aabb(ctx, "tank", &tk.min_m, &tk.max_m, dim, "the tank")?;
+            let layers = tk.layers.unwrap_or(3);
+            if !(1..=8).contains(&layers) {
+                return Err(ctx.err(
+                    "tank.layers",
+                    Some(layers.to_string()),
+                    "must be between 1 and 8 (the number of wall-particle layers)",
+                    "use 3, or enough layers to cover the kernel support 2h",
+                ));
+            }
+            // Only the dynamic boundary condition exists for now (Kind::Wall particles).
+            match tk.wall.unwrap_or(WallName::Dynamic) {
+                WallName::Dynamic => {}
+            }
+            Some(Tank {
+                inner,
+                layers: layers as u32,
+                open_top: tk.open_top.unwrap_or(true),
+            })
+        }
+    };
+    if raw.fluid_block.is_empty() {
+        return Err(ctx.err(
+            "fluid_block",
+            None,
+            "no fluid: at least one [[fluid_block]] is required",
+            "add a [[fluid_block]] table with min_m and max_m",
+        ));
+    }
+    let mut blocks = Vec::with_capacity(raw.fluid_block.len());
+    for (i, b) in raw.fluid_block.iter().enumerate() {
+        let path = format!("fluid_block[{i}]");
+        let bx = aabb(ctx, &path, &b.min_m, &b.max_m, dim, "the fluid block")?;
+        let vel = match &b.velocity_m_s {
+            Some(v) => vector(
+                ctx,
+                &format!("{path}.velocity_m_s"),
+                v,
+                dim,
+                "the initial velocity in m/s",
+            )?,
+            None => [0.0; 3],
+        };
+        blocks.push(Block { bx, vel });
+    }
+    let mut obstacles = Vec::with_capacity(raw.obstacle.len());
+    for (i, o) in raw.obstacle.iter().enumerate() {
+        obstacles.push(aabb(
+            ctx,
+            &format!("obstacle[{i}]"),
+            &o.min_m,
+            &o.max_m,
+            dim,
+            "the obstacle",
+        )?);
+    }
+    let domain = match &raw.domain {
+        Some(d) => Some(aabb(ctx, "domain", &d.min_m, &d.max_m, dim, "the domain")?),
+        None => None,
+    };
+    let mut probes: Vec<Probe> = Vec::with_capacity(raw.probe.len());
+    for (i, p) in raw.probe.iter().enumerate() {
+        let probe = super::probes::probe(ctx, i, p, dim)?;
+        if let Some(j) = probes.iter().position(|q| q.name == probe.name) {
+            return Err(ctx.err(
+                &format!("probe[{i}].name"),
+                Some(format!("{:?}", p.name)),
+                format!("probe[{j}] already has this name (names become file names)"),
+                "give every probe a different name",
+            ));
+        }
+        probes.push(probe);
+    }
+
+    Ok(Case {
+        name,
+        dim,
+        dx,
+        h_over_dx,
+        kernel,
+        rho0,
+        gravity,
+        sound,
+        gamma,
+        viscosity,
+        delta_sph,
+        time,
+        tank,
+        blocks,
+        obstacles,
+        domain,
+        probes,
+    })
+}

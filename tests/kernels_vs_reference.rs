@@ -1,0 +1,193 @@
+//! Layer 1: every GPU pass against the f64 CPU reference (src/reference) on random particle
+//! sets, 2D and 3D, both kernels, both viscosities, dense and sparse (hash-colliding) grids.
+
+mod common;
+use common::*;
+use wgsph::layout::{unpack_block, ID_MASK, KIND_SHIFT};
+use wgsph::reference::{self, RefParticle};
+use wgsph::scenario::*;
+use wgsph::sph::Solver;
+
+struct Setup {
+    dim: u32,
+    kernel: KernelKind,
+    viscosity: Viscosity,
+    /// Domain edge; much larger than the particle block forces hash collisions.
+    domain: f64,
+    seed: u64,
+}
+
+const BLOCK: f64 = 0.3;
+
+/// A jittered lattice of fluid over a two-layer wall floor, random velocities and densities.
+fn random_scenario(s: &Setup) -> Scenario {
+    let dx = 0.02;
+    let mut ph = physics(s.dim, dx, 15.0);
+    ph.kernel = s.kernel;
+    ph.viscosity = s.viscosity;
+    let mut rng = Rng(s.seed);
+    let up = s.dim as usize - 1;
+    let mut parts = Vec::new();
+    let mut max = [BLOCK; 3];
+    if s.dim == 2 {
+        max[2] = 0.0;
+    }
+    let o = 0.5 * (s.domain - BLOCK);
+    for p in lattice(s.dim, dx, [0.0; 3], max) {
+        let wall = p[up] < 2.0 * dx;
+        let mut pos = p;
+        let mut vel = [0.0; 3];
+        for a in 0..s.dim as usize {
+            pos[a] += o + if wall { 0.0 } else { rng.range(-0.2, 0.2) * dx };
+            if !wall {
+                vel[a] = rng.range(-0.5, 0.5);
+            }
+        }
+        let rho = if wall { 1000.0 * (1.0 + rng.range(0.0, 0.02)) } else { 1000.0 * (1.0 + rng.range(-0.005, 0.02)) };
+        parts.push(Particle { pos, vel, rho, kind: if wall { Kind::Wall } else { Kind::Fluid } });
+    }
+    let mut dmax = [s.domain; 3];
+    if s.dim == 2 {
+        dmax[2] = 0.0;
+    }
+    scenario(ph, parts, Domain { min: [0.0; 3], max: dmax }, vec![])
+}
+
+fn setups() -> Vec<Setup> {
+    let mut v = Vec::new();
+    let mut seed = 7;
+    for dim in [2, 3] {
+        for (kernel, viscosity, domain) in [
+            (KernelKind::WendlandC2, Viscosity::Artificial { alpha: 0.05 }, 0.4),
+            (KernelKind::CubicSpline, Viscosity::Laminar { nu: 1e-3 }, 0.4),
+            (KernelKind::WendlandC2, Viscosity::Laminar { nu: 1e-3 }, 8.0),
+        ] {
+            seed += 1;
+            v.push(Setup { dim, kernel, viscosity, domain, seed });
+        }
+    }
+    v
+}
+
+/// GPU arrays (current order) as reference particles, in world coordinates.
+fn gpu_particles(s: &Solver) -> (Vec<RefParticle>, Vec<u32>) {
+    let (pos, velrho, code) = s.read_raw().unwrap();
+    let parts = pos
+        .iter()
+        .zip(&velrho)
+        .zip(&code)
+        .map(|((p, v), c)| RefParticle {
+            pos: s.grid.to_world(p.off, unpack_block(p.block)),
+            vel: [v[0] as f64, v[1] as f64, v[2] as f64],
+            rho: v[3] as f64,
+            kind: c >> KIND_SHIFT,
+        })
+        .collect();
+    (parts, code)
+}
+
+/// max_i |gpu_i − cpu_i| / rms(cpu) over the components `comps`; NaN fails.
+fn rel_err(gpu: &[[f32; 4]], cpu: &[[f64; 4]], comps: std::ops::Range<usize>) -> f64 {
+    let mut sq = 0.0;
+    for c in cpu {
+        sq += comps.clone().map(|k| c[k] * c[k]).sum::<f64>();
+    }
+    let rms = (sq / cpu.len() as f64).sqrt().max(1e-30);
+    let mut worst = 0.0f64;
+    for (g, c) in gpu.iter().zip(cpu) {
+        let e = comps.clone().map(|k| (g[k] as f64 - c[k]).powi(2)).sum::<f64>().sqrt();
+        assert!(e.is_finite(), "non-finite GPU output {g:?} (reference {c:?})");
+        worst = worst.max(e / rms);
+    }
+    worst
+}
+
+#[test]
+fn cell_list_sort_matches_reference_exactly() {
+    for s in setups() {
+        let sc = random_scenario(&s);
+        let solver = Solver::new(gpu(), &sc).unwrap();
+        // The warm-up step sorted the initial (id-ordered) particles once: the GPU order must
+        // be the stable sort of the ids by slot.
+        let grid = &solver.grid;
+        let init: Vec<([f32; 3], [u32; 3])> = sc.particles.iter().map(|p| grid.to_block(p.pos)).collect();
+        let keys = reference::cell_list::keys(grid, &init, &vec![false; init.len()]);
+        let (order, start) = reference::cell_list::sorted_order(grid, &keys);
+        let (_, _, code) = solver.read_raw().unwrap();
+        let ids: Vec<usize> = code.iter().map(|c| (c & ID_MASK) as usize).collect();
+        assert_eq!(ids, order, "dim {} domain {}", s.dim, s.domain);
+        assert_eq!(solver.read_cell_start().unwrap(), start);
+        if s.domain > 1.0 {
+            let cells: u64 = grid.cells.iter().map(|&c| c as u64).product();
+            assert!(cells > grid.slots as u64, "sparse case must exercise hash collisions");
+        }
+    }
+}
+
+#[test]
+fn interaction_matches_reference() {
+    for s in setups() {
+        let sc = random_scenario(&s);
+        let solver = Solver::new(gpu(), &sc).unwrap();
+        let (parts, _) = gpu_particles(&solver);
+        let gpu_rates = solver.rerun_interaction(true).unwrap();
+        let cpu = reference::interaction::rates(&sc.physics, &parts);
+        let e_acc = rel_err(&gpu_rates, &cpu, 0..3);
+        let e_rho = rel_err(&gpu_rates, &cpu, 3..4);
+        println!("dim {} {:?} {:?}: accel err {e_acc:.2e}, drho err {e_rho:.2e}", s.dim, s.kernel, s.viscosity);
+        assert!(e_acc < 2e-4, "acceleration error {e_acc}");
+        assert!(e_rho < 2e-4, "density-rate error {e_rho}");
+    }
+}
+
+#[test]
+fn one_step_matches_reference() {
+    for s in setups() {
+        let sc = random_scenario(&s);
+        let mut solver = Solver::new(gpu(), &sc).unwrap();
+        let (before, code0) = gpu_particles(&solver);
+        let rates0: Vec<[f64; 4]> =
+            solver.read_rates().unwrap().iter().map(|r| r.map(|x| x as f64)).collect();
+        let dt = solver.dt() as f32;
+        let state = solver.single_step(dt).unwrap();
+        // CPU: predict, evaluate at the prediction, correct.
+        let ph = &sc.physics;
+        let dt = dt as f64;
+        let predicted: Vec<RefParticle> =
+            before.iter().zip(&rates0).map(|(p, r)| reference::integrate::predict(ph, p, *r, dt)).collect();
+        let rates1 = reference::interaction::rates(ph, &predicted);
+        let after_cpu: Vec<RefParticle> = predicted
+            .iter()
+            .zip(rates1.iter().zip(&rates0))
+            .map(|(p, (r1, r0))| reference::integrate::correct(ph, p, *r1, *r0, dt))
+            .collect();
+        // GPU, matched by id.
+        let (after_gpu, code1) = gpu_particles(&solver);
+        let mut by_id = vec![0usize; after_gpu.len()];
+        for (k, c) in code1.iter().enumerate() {
+            by_id[(c & ID_MASK) as usize] = k;
+        }
+        let mut worst = [0.0f64; 3];
+        let vscale = (before.iter().map(|p| p.vel.iter().map(|v| v * v).sum::<f64>()).sum::<f64>() / before.len() as f64).sqrt();
+        let drho_scale = rates0.iter().map(|r| r[3].abs()).fold(0.0, f64::max) * dt;
+        for (i, cpu) in after_cpu.iter().enumerate() {
+            let g = &after_gpu[by_id[(code0[i] & ID_MASK) as usize]];
+            let dx_cpu = reference::sub(cpu.pos, before[i].pos);
+            let dx_gpu = reference::sub(g.pos, before[i].pos);
+            let ex = reference::dot(reference::sub(dx_gpu, dx_cpu), reference::sub(dx_gpu, dx_cpu)).sqrt();
+            let ev = reference::dot(reference::sub(g.vel, cpu.vel), reference::sub(g.vel, cpu.vel)).sqrt();
+            let er = (g.rho - cpu.rho).abs();
+            assert!(ex.is_finite() && ev.is_finite() && er.is_finite());
+            worst[0] = worst[0].max(ex / (vscale * dt));
+            worst[1] = worst[1].max(ev / vscale);
+            worst[2] = worst[2].max(er / drho_scale);
+        }
+        let dt_cpu = reference::integrate::timestep(ph, sc.time.cfl, &after_cpu, &rates1);
+        let e_dt = (state.dt_cfl as f64 - dt_cpu).abs() / dt_cpu;
+        println!("dim {} {:?}: displacement {:.1e}, velocity {:.1e}, density {:.1e}, dt {:.1e}", s.dim, s.viscosity, worst[0], worst[1], worst[2], e_dt);
+        assert!(worst[0] < 1e-3, "displacement error {}", worst[0]);
+        assert!(worst[1] < 1e-4, "velocity error {}", worst[1]);
+        assert!(worst[2] < 2e-3, "density error {}", worst[2]);
+        assert!(e_dt < 1e-4, "time step error {e_dt}");
+    }
+}
