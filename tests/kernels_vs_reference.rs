@@ -191,3 +191,44 @@ fn one_step_matches_reference() {
         assert!(e_dt < 1e-4, "time step error {e_dt}");
     }
 }
+
+#[test]
+fn probes_match_reference() {
+    for s in setups().into_iter().filter(|s| s.domain < 1.0) {
+        let mut sc = random_scenario(&s);
+        let o = 0.5 * (s.domain - BLOCK);
+        let up = s.dim as usize - 1;
+        let mut centre = [o + 0.5 * BLOCK; 3];
+        let mut base = centre;
+        base[up] = o;
+        if s.dim == 2 {
+            centre[2] = 0.0;
+            base[2] = 0.0;
+        }
+        let mut axis = [0.3, -0.5, 0.2];
+        if s.dim == 2 {
+            axis[2] = 0.0;
+        }
+        sc.probes = vec![
+            Probe { name: "p".into(), kind: ProbeKind::Pressure { point: centre } },
+            Probe { name: "h".into(), kind: ProbeKind::Height { base } },
+            Probe { name: "f".into(), kind: ProbeKind::Front { origin: [0.01, 0.02, 0.0], axis } },
+        ];
+        let solver = Solver::new(gpu(), &sc).unwrap();
+        let (parts, _) = gpu_particles(&solver);
+        let gpu_values = solver.sample_probes().unwrap();
+        let ph = &sc.physics;
+        let top = s.domain;
+        let cpu = [
+            reference::probes::pressure_at(ph, &parts, centre),
+            reference::probes::height_at(ph, &parts, base, top),
+            reference::probes::front(&parts, [0.01, 0.02, 0.0], axis),
+        ];
+        println!("dim {}: GPU {gpu_values:?} CPU {cpu:?}", s.dim);
+        assert!((gpu_values[0] - cpu[0]).abs() < 1e-4 * cpu[0].abs().max(100.0), "pressure");
+        // The height search steps by h/4 from an f32 top; agreement to 1e-4 m is f32 rounding.
+        assert!((gpu_values[1] - cpu[1]).abs() < 1e-4, "height");
+        assert!((gpu_values[2] - cpu[2]).abs() < 1e-5, "front");
+        assert!(cpu[1] > 0.5 * BLOCK, "the gauge must see the block");
+    }
+}
