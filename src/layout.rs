@@ -131,9 +131,28 @@ mod tests {
             "Params",
             Params,
             [
-                grid_cells, hash_mask, block_size, cell_size, inv_cell_size, cells_per_block,
-                domain_size, n_particles, h, kernel_norm, eta2, mass, rho0, tait_b, gamma, c0,
-                gravity, alpha, nu, delta_coef, cfl, n_probes
+                grid_cells,
+                hash_mask,
+                block_size,
+                cell_size,
+                inv_cell_size,
+                cells_per_block,
+                domain_size,
+                n_particles,
+                h,
+                kernel_norm,
+                eta2,
+                mass,
+                rho0,
+                tait_b,
+                gamma,
+                c0,
+                gravity,
+                alpha,
+                nu,
+                delta_coef,
+                cfl,
+                n_probes
             ]
         );
     }
@@ -144,7 +163,17 @@ mod tests {
             Pass::Integrate,
             "SimState",
             SimState,
-            [t_rel, t_target_rel, dt, dt_cfl, max_speed_bits, max_accel_bits, nan_count, excluded, steps]
+            [
+                t_rel,
+                t_target_rel,
+                dt,
+                dt_cfl,
+                max_speed_bits,
+                max_accel_bits,
+                nan_count,
+                excluded,
+                steps
+            ]
         );
     }
 
@@ -167,7 +196,11 @@ mod tests {
             for dim in [2, 3] {
                 for kernel in [0, 1] {
                     for viscosity in [0, 1] {
-                        let cfg = ShaderConfig { dim, kernel, viscosity };
+                        let cfg = ShaderConfig {
+                            dim,
+                            kernel,
+                            viscosity,
+                        };
                         parse(&compose(pass, cfg), pass.name()).unwrap();
                     }
                 }

@@ -1,10 +1,10 @@
 //! wgsph: GPU weakly-compressible SPH for fluid–solid interaction, on wgpu/WGSL.
 
+pub mod case;
 pub mod gpu;
 pub mod layout;
+pub mod output;
+pub mod reference;
+pub mod run;
 pub mod scenario;
 pub mod sph;
-pub mod output;
-pub mod run;
-pub mod reference;
-pub mod case;

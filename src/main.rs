@@ -11,7 +11,11 @@ use wgsph::gpu::context::list_adapters;
 use wgsph::gpu::{AdapterChoice, GpuContext};
 
 #[derive(Parser)]
-#[command(name = "wgsph", version, about = "GPU SPH for fluid–solid interaction (wgpu/WGSL)")]
+#[command(
+    name = "wgsph",
+    version,
+    about = "GPU SPH for fluid–solid interaction (wgpu/WGSL)"
+)]
 struct Cli {
     /// Adapter: auto (hardware GPU, else CPU), gpu, or cpu. Default: $WGSPH_ADAPTER, else auto.
     #[arg(long, global = true)]
@@ -81,7 +85,11 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 s.particle_steps_per_s,
                 dir.display()
             );
-            Ok(if report.stopped.is_some() { ExitCode::from(2) } else { ExitCode::SUCCESS })
+            Ok(if report.stopped.is_some() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::SUCCESS
+            })
         }
         Command::Info => {
             let adapters = list_adapters();
@@ -110,10 +118,16 @@ fn run(cli: Cli) -> Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
-        Command::Bench { case, steps, warmup, set } => {
+        Command::Bench {
+            case,
+            steps,
+            warmup,
+            set,
+        } => {
             let sc = wgsph::case::load(&case, &set)?;
             let ctx = context(cli.adapter)?;
-            let mut solver = wgsph::sph::Solver::new(&ctx, &sc).context("setting up the GPU solver")?;
+            let mut solver =
+                wgsph::sph::Solver::new(&ctx, &sc).context("setting up the GPU solver")?;
             solver.run_steps(warmup)?;
             let start = Instant::now();
             solver.run_steps(steps)?;
@@ -125,7 +139,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
             println!("steps           {steps}");
             println!("wall seconds    {wall:.3}");
             println!("particle-steps/s {:.4e}", steps as f64 * n as f64 / wall);
-            println!("bytes/particle  {:.1}", solver.gpu_bytes() as f64 / n as f64);
+            println!(
+                "bytes/particle  {:.1}",
+                solver.gpu_bytes() as f64 / n as f64
+            );
             Ok(ExitCode::SUCCESS)
         }
     }

@@ -48,10 +48,18 @@ fn schedule(every: f64, end: f64) -> impl Iterator<Item = f64> {
 }
 
 /// Runs `sc` on `ctx`, writing into `dir`. `log` receives one line per output.
-pub fn run(ctx: &GpuContext, sc: &Scenario, dir: &Path, log: &mut dyn FnMut(&str)) -> Result<RunReport> {
+pub fn run(
+    ctx: &GpuContext,
+    sc: &Scenario,
+    dir: &Path,
+    log: &mut dyn FnMut(&str),
+) -> Result<RunReport> {
     let mut out = OutputDir::create(dir)?;
-    let names: Vec<(String, String)> =
-        sc.probes.iter().map(|p| (p.name.clone(), probe_column(&p.kind).to_string())).collect();
+    let names: Vec<(String, String)> = sc
+        .probes
+        .iter()
+        .map(|p| (p.name.clone(), probe_column(&p.kind).to_string()))
+        .collect();
     let mut probes = out.probe_writer(&names)?;
     let mut solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
     log(&format!(
@@ -74,7 +82,10 @@ pub fn run(ctx: &GpuContext, sc: &Scenario, dir: &Path, log: &mut dyn FnMut(&str
     let mut stopped = None;
     for t in schedule(sc.time.probe_every_s, sc.time.end_s) {
         if let Err(e) = solver.advance_to(t) {
-            log(&format!("stopped: {e:#}; outputs up to t = {:.6} s are kept", next_output - every_out));
+            log(&format!(
+                "stopped: {e:#}; outputs up to t = {:.6} s are kept",
+                next_output - every_out
+            ));
             stopped = Some(e);
             break;
         }

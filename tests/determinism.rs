@@ -21,7 +21,11 @@ fn same_case_twice_is_bit_identical() {
     assert_eq!(steps_a, steps_b);
     assert_eq!(ca, cb, "particle order differs");
     assert!(pa == pb, "positions differ");
-    let bits = |v: &Vec<[f32; 4]>| v.iter().flat_map(|x| x.map(f32::to_bits)).collect::<Vec<u32>>();
+    let bits = |v: &Vec<[f32; 4]>| {
+        v.iter()
+            .flat_map(|x| x.map(f32::to_bits))
+            .collect::<Vec<u32>>()
+    };
     assert_eq!(bits(&va), bits(&vb), "velocities/densities differ");
     assert_eq!(bits(&ra), bits(&rb), "rates differ");
 }

@@ -43,14 +43,31 @@ fn random_scenario(s: &Setup) -> Scenario {
                 vel[a] = rng.range(-0.5, 0.5);
             }
         }
-        let rho = if wall { 1000.0 * (1.0 + rng.range(0.0, 0.02)) } else { 1000.0 * (1.0 + rng.range(-0.005, 0.02)) };
-        parts.push(Particle { pos, vel, rho, kind: if wall { Kind::Wall } else { Kind::Fluid } });
+        let rho = if wall {
+            1000.0 * (1.0 + rng.range(0.0, 0.02))
+        } else {
+            1000.0 * (1.0 + rng.range(-0.005, 0.02))
+        };
+        parts.push(Particle {
+            pos,
+            vel,
+            rho,
+            kind: if wall { Kind::Wall } else { Kind::Fluid },
+        });
     }
     let mut dmax = [s.domain; 3];
     if s.dim == 2 {
         dmax[2] = 0.0;
     }
-    scenario(ph, parts, Domain { min: [0.0; 3], max: dmax }, vec![])
+    scenario(
+        ph,
+        parts,
+        Domain {
+            min: [0.0; 3],
+            max: dmax,
+        },
+        vec![],
+    )
 }
 
 fn setups() -> Vec<Setup> {
@@ -58,12 +75,26 @@ fn setups() -> Vec<Setup> {
     let mut seed = 7;
     for dim in [2, 3] {
         for (kernel, viscosity, domain) in [
-            (KernelKind::WendlandC2, Viscosity::Artificial { alpha: 0.05 }, 0.4),
-            (KernelKind::CubicSpline, Viscosity::Laminar { nu: 1e-3 }, 0.4),
+            (
+                KernelKind::WendlandC2,
+                Viscosity::Artificial { alpha: 0.05 },
+                0.4,
+            ),
+            (
+                KernelKind::CubicSpline,
+                Viscosity::Laminar { nu: 1e-3 },
+                0.4,
+            ),
             (KernelKind::WendlandC2, Viscosity::Laminar { nu: 1e-3 }, 8.0),
         ] {
             seed += 1;
-            v.push(Setup { dim, kernel, viscosity, domain, seed });
+            v.push(Setup {
+                dim,
+                kernel,
+                viscosity,
+                domain,
+                seed,
+            });
         }
     }
     v
@@ -95,8 +126,15 @@ fn rel_err(gpu: &[[f32; 4]], cpu: &[[f64; 4]], comps: std::ops::Range<usize>) ->
     let rms = (sq / cpu.len() as f64).sqrt().max(1e-30);
     let mut worst = 0.0f64;
     for (g, c) in gpu.iter().zip(cpu) {
-        let e = comps.clone().map(|k| (g[k] as f64 - c[k]).powi(2)).sum::<f64>().sqrt();
-        assert!(e.is_finite(), "non-finite GPU output {g:?} (reference {c:?})");
+        let e = comps
+            .clone()
+            .map(|k| (g[k] as f64 - c[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!(
+            e.is_finite(),
+            "non-finite GPU output {g:?} (reference {c:?})"
+        );
         worst = worst.max(e / rms);
     }
     worst
@@ -110,7 +148,8 @@ fn cell_list_sort_matches_reference_exactly() {
         // The warm-up step sorted the initial (id-ordered) particles once: the GPU order must
         // be the stable sort of the ids by slot.
         let grid = &solver.grid;
-        let init: Vec<([f32; 3], [u32; 3])> = sc.particles.iter().map(|p| grid.to_block(p.pos)).collect();
+        let init: Vec<([f32; 3], [u32; 3])> =
+            sc.particles.iter().map(|p| grid.to_block(p.pos)).collect();
         let keys = reference::cell_list::keys(grid, &init, &vec![false; init.len()]);
         let (order, start) = reference::cell_list::sorted_order(grid, &keys);
         let (_, _, code) = solver.read_raw().unwrap();
@@ -119,7 +158,10 @@ fn cell_list_sort_matches_reference_exactly() {
         assert_eq!(solver.read_cell_start().unwrap(), start);
         if s.domain > 1.0 {
             let cells: u64 = grid.cells.iter().map(|&c| c as u64).product();
-            assert!(cells > grid.slots as u64, "sparse case must exercise hash collisions");
+            assert!(
+                cells > grid.slots as u64,
+                "sparse case must exercise hash collisions"
+            );
         }
     }
 }
@@ -134,7 +176,10 @@ fn interaction_matches_reference() {
         let cpu = reference::interaction::rates(&sc.physics, &parts);
         let e_acc = rel_err(&gpu_rates, &cpu, 0..3);
         let e_rho = rel_err(&gpu_rates, &cpu, 3..4);
-        println!("dim {} {:?} {:?}: accel err {e_acc:.2e}, drho err {e_rho:.2e}", s.dim, s.kernel, s.viscosity);
+        println!(
+            "dim {} {:?} {:?}: accel err {e_acc:.2e}, drho err {e_rho:.2e}",
+            s.dim, s.kernel, s.viscosity
+        );
         assert!(e_acc < 2e-4, "acceleration error {e_acc}");
         assert!(e_rho < 2e-4, "density-rate error {e_rho}");
     }
@@ -146,15 +191,22 @@ fn one_step_matches_reference() {
         let sc = random_scenario(&s);
         let mut solver = Solver::new(gpu(), &sc).unwrap();
         let (before, code0) = gpu_particles(&solver);
-        let rates0: Vec<[f64; 4]> =
-            solver.read_rates().unwrap().iter().map(|r| r.map(|x| x as f64)).collect();
+        let rates0: Vec<[f64; 4]> = solver
+            .read_rates()
+            .unwrap()
+            .iter()
+            .map(|r| r.map(|x| x as f64))
+            .collect();
         let dt = solver.dt() as f32;
         let state = solver.single_step(dt).unwrap();
         // CPU: predict, evaluate at the prediction, correct.
         let ph = &sc.physics;
         let dt = dt as f64;
-        let predicted: Vec<RefParticle> =
-            before.iter().zip(&rates0).map(|(p, r)| reference::integrate::predict(ph, p, *r, dt)).collect();
+        let predicted: Vec<RefParticle> = before
+            .iter()
+            .zip(&rates0)
+            .map(|(p, r)| reference::integrate::predict(ph, p, *r, dt))
+            .collect();
         let rates1 = reference::interaction::rates(ph, &predicted);
         let after_cpu: Vec<RefParticle> = predicted
             .iter()
@@ -168,14 +220,27 @@ fn one_step_matches_reference() {
             by_id[(c & ID_MASK) as usize] = k;
         }
         let mut worst = [0.0f64; 3];
-        let vscale = (before.iter().map(|p| p.vel.iter().map(|v| v * v).sum::<f64>()).sum::<f64>() / before.len() as f64).sqrt();
+        let vscale = (before
+            .iter()
+            .map(|p| p.vel.iter().map(|v| v * v).sum::<f64>())
+            .sum::<f64>()
+            / before.len() as f64)
+            .sqrt();
         let drho_scale = rates0.iter().map(|r| r[3].abs()).fold(0.0, f64::max) * dt;
         for (i, cpu) in after_cpu.iter().enumerate() {
             let g = &after_gpu[by_id[(code0[i] & ID_MASK) as usize]];
             let dx_cpu = reference::sub(cpu.pos, before[i].pos);
             let dx_gpu = reference::sub(g.pos, before[i].pos);
-            let ex = reference::dot(reference::sub(dx_gpu, dx_cpu), reference::sub(dx_gpu, dx_cpu)).sqrt();
-            let ev = reference::dot(reference::sub(g.vel, cpu.vel), reference::sub(g.vel, cpu.vel)).sqrt();
+            let ex = reference::dot(
+                reference::sub(dx_gpu, dx_cpu),
+                reference::sub(dx_gpu, dx_cpu),
+            )
+            .sqrt();
+            let ev = reference::dot(
+                reference::sub(g.vel, cpu.vel),
+                reference::sub(g.vel, cpu.vel),
+            )
+            .sqrt();
             let er = (g.rho - cpu.rho).abs();
             assert!(ex.is_finite() && ev.is_finite() && er.is_finite());
             worst[0] = worst[0].max(ex / (vscale * dt));
@@ -184,7 +249,10 @@ fn one_step_matches_reference() {
         }
         let dt_cpu = reference::integrate::timestep(ph, sc.time.cfl, &after_cpu, &rates1);
         let e_dt = (state.dt_cfl as f64 - dt_cpu).abs() / dt_cpu;
-        println!("dim {} {:?}: displacement {:.1e}, velocity {:.1e}, density {:.1e}, dt {:.1e}", s.dim, s.viscosity, worst[0], worst[1], worst[2], e_dt);
+        println!(
+            "dim {} {:?}: displacement {:.1e}, velocity {:.1e}, density {:.1e}, dt {:.1e}",
+            s.dim, s.viscosity, worst[0], worst[1], worst[2], e_dt
+        );
         assert!(worst[0] < 1e-3, "displacement error {}", worst[0]);
         assert!(worst[1] < 1e-4, "velocity error {}", worst[1]);
         assert!(worst[2] < 2e-3, "density error {}", worst[2]);
@@ -210,9 +278,21 @@ fn probes_match_reference() {
             axis[2] = 0.0;
         }
         sc.probes = vec![
-            Probe { name: "p".into(), kind: ProbeKind::Pressure { point: centre } },
-            Probe { name: "h".into(), kind: ProbeKind::Height { base } },
-            Probe { name: "f".into(), kind: ProbeKind::Front { origin: [0.01, 0.02, 0.0], axis } },
+            Probe {
+                name: "p".into(),
+                kind: ProbeKind::Pressure { point: centre },
+            },
+            Probe {
+                name: "h".into(),
+                kind: ProbeKind::Height { base },
+            },
+            Probe {
+                name: "f".into(),
+                kind: ProbeKind::Front {
+                    origin: [0.01, 0.02, 0.0],
+                    axis,
+                },
+            },
         ];
         let solver = Solver::new(gpu(), &sc).unwrap();
         let (parts, _) = gpu_particles(&solver);
@@ -225,7 +305,10 @@ fn probes_match_reference() {
             reference::probes::front(&parts, [0.01, 0.02, 0.0], axis),
         ];
         println!("dim {}: GPU {gpu_values:?} CPU {cpu:?}", s.dim);
-        assert!((gpu_values[0] - cpu[0]).abs() < 1e-4 * cpu[0].abs().max(100.0), "pressure");
+        assert!(
+            (gpu_values[0] - cpu[0]).abs() < 1e-4 * cpu[0].abs().max(100.0),
+            "pressure"
+        );
         // The height search steps by h/4 from an f32 top; agreement to 1e-4 m is f32 rounding.
         assert!((gpu_values[1] - cpu[1]).abs() < 1e-4, "height");
         assert!((gpu_values[2] - cpu[2]).abs() < 1e-5, "front");

@@ -31,8 +31,14 @@ fn read_csv(path: &str) -> Vec<(f64, f64)> {
 fn hydrostatic_tank_settles_to_rho_g_h() {
     let sc = load("cases/hydrostatic_2d.toml", &["time.end_s=2.0"]);
     let ph = sc.physics.clone();
-    let probe = sc.probes.iter().position(|p| matches!(p.kind, ProbeKind::Pressure { .. })).unwrap();
-    let ProbeKind::Pressure { point } = sc.probes[probe].kind else { unreachable!() };
+    let probe = sc
+        .probes
+        .iter()
+        .position(|p| matches!(p.kind, ProbeKind::Pressure { .. }))
+        .unwrap();
+    let ProbeKind::Pressure { point } = sc.probes[probe].kind else {
+        unreachable!()
+    };
     let depth = 0.5 - point[1];
     let exact = ph.rho0 * 9.81 * depth;
     let n_fluid = sc.count(Kind::Fluid);
@@ -49,23 +55,41 @@ fn hydrostatic_tank_settles_to_rho_g_h() {
     }
     let mean = sum / count as f64;
     let err = (mean - exact) / exact;
-    println!("hydrostatic: p = {mean:.1} Pa at depth {depth} m, exact {exact:.1} Pa, error {:.2} %", 100.0 * err);
-    assert!(err.abs() < 0.02, "bottom pressure error {:.2} %", 100.0 * err);
+    println!(
+        "hydrostatic: p = {mean:.1} Pa at depth {depth} m, exact {exact:.1} Pa, error {:.2} %",
+        100.0 * err
+    );
+    assert!(
+        err.abs() < 0.02,
+        "bottom pressure error {:.2} %",
+        100.0 * err
+    );
     // No exclusions (mass conserved exactly: every particle carries the same mass) and no
     // fluid particle beyond the first layer of wall particles.
     assert_eq!(solver.excluded(), 0);
     let p = solver.read_particles().unwrap();
     let dx = ph.dx;
-    let fluid: Vec<&[f64; 3]> = p.pos.iter().zip(&p.kind).filter(|(_, k)| **k == 0).map(|(x, _)| x).collect();
+    let fluid: Vec<&[f64; 3]> = p
+        .pos
+        .iter()
+        .zip(&p.kind)
+        .filter(|(_, k)| **k == 0)
+        .map(|(x, _)| x)
+        .collect();
     assert_eq!(fluid.len(), n_fluid);
     for x in fluid {
-        assert!(x[0] > -0.5 * dx && x[0] < 1.0 + 0.5 * dx && x[1] > -0.5 * dx, "fluid particle crossed a wall: {x:?}");
+        assert!(
+            x[0] > -0.5 * dx && x[0] < 1.0 + 0.5 * dx && x[1] > -0.5 * dx,
+            "fluid particle crossed a wall: {x:?}"
+        );
     }
 }
 
 /// Linear interpolation of a monotone-in-t series.
 fn interp(series: &[(f64, f64)], t: f64) -> f64 {
-    let k = series.partition_point(|(ti, _)| *ti < t).clamp(1, series.len() - 1);
+    let k = series
+        .partition_point(|(ti, _)| *ti < t)
+        .clamp(1, series.len() - 1);
     let (t0, y0) = series[k - 1];
     let (t1, y1) = series[k];
     y0 + (y1 - y0) * (t - t0) / (t1 - t0)
@@ -77,7 +101,11 @@ fn dam_break_front() -> Vec<(f64, f64)> {
     let a: f64 = 0.146;
     let scale = (2.0 * 9.81 / a).sqrt();
     let t_end = 3.0 / scale;
-    let front = sc.probes.iter().position(|p| matches!(p.kind, ProbeKind::Front { .. })).unwrap();
+    let front = sc
+        .probes
+        .iter()
+        .position(|p| matches!(p.kind, ProbeKind::Front { .. }))
+        .unwrap();
     let mut solver = Solver::new(gpu(), &sc).unwrap();
     let mut sim = vec![(0.0, solver.sample_probes().unwrap()[front] / a)];
     let n = 60;
@@ -96,7 +124,9 @@ fn martin_moyce() -> Vec<(f64, f64)> {
 /// Least-squares slope of y(x).
 fn slope(points: &[(f64, f64)]) -> f64 {
     let n = points.len() as f64;
-    let (mx, my) = points.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
     let sxy: f64 = points.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
     let sxx: f64 = points.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
     sxy / sxx
@@ -107,11 +137,17 @@ fn slope(points: &[(f64, f64)]) -> f64 {
 #[test]
 fn dam_break_2d_front_speed_matches_martin_moyce() {
     let sim = dam_break_front();
-    let exp: Vec<(f64, f64)> = martin_moyce().into_iter().filter(|(t, _)| (1.0..=3.0).contains(t)).collect();
+    let exp: Vec<(f64, f64)> = martin_moyce()
+        .into_iter()
+        .filter(|(t, _)| (1.0..=3.0).contains(t))
+        .collect();
     let at_exp: Vec<(f64, f64)> = exp.iter().map(|&(t, _)| (t, interp(&sim, t))).collect();
     let (s_exp, s_sim) = (slope(&exp), slope(&at_exp));
     let e = (s_sim - s_exp) / s_exp;
-    println!("dam break 2D: front speed dZ/dT = {s_sim:.3} (Martin & Moyce {s_exp:.3}), error {:+.1} %", 100.0 * e);
+    println!(
+        "dam break 2D: front speed dZ/dT = {s_sim:.3} (Martin & Moyce {s_exp:.3}), error {:+.1} %",
+        100.0 * e
+    );
     assert!(e.abs() < 0.10, "front speed error {:.1} %", 100.0 * e);
 }
 
@@ -123,28 +159,49 @@ fn dam_break_2d_front_position_within_15_percent_of_martin_moyce() {
     let mut worst: f64 = 0.0;
     for (t, z) in martin_moyce().into_iter().filter(|(t, _)| *t <= 3.0) {
         let e = (interp(&sim, t) - z) / z;
-        println!("T = {t:.3}: Z sim {:.3}, Martin & Moyce {z:.3}, error {:+.1} %", interp(&sim, t), 100.0 * e);
+        println!(
+            "T = {t:.3}: Z sim {:.3}, Martin & Moyce {z:.3}, error {:+.1} %",
+            interp(&sim, t),
+            100.0 * e
+        );
         worst = worst.max(e.abs());
     }
-    assert!(worst < 0.15, "surge front deviates {:.1} % from Martin & Moyce", 100.0 * worst);
+    assert!(
+        worst < 0.15,
+        "surge front deviates {:.1} % from Martin & Moyce",
+        100.0 * worst
+    );
 }
 
 #[test]
 fn dam_break_3d_runs_and_conserves_mass() {
-    let sc = load("cases/dam_break_3d.toml", &["particles.dx_m=0.04", "time.end_s=0.06"]);
+    let sc = load(
+        "cases/dam_break_3d.toml",
+        &["particles.dx_m=0.04", "time.end_s=0.06"],
+    );
     let n = sc.particles.len();
     let n_fluid = sc.count(Kind::Fluid);
     let mut solver = Solver::new(gpu(), &sc).unwrap();
     solver.advance_to(0.06).unwrap();
     let p = solver.read_particles().unwrap();
-    println!("3D: {n} particles, {} steps, excluded {}", solver.steps(), solver.excluded());
+    println!(
+        "3D: {n} particles, {} steps, excluded {}",
+        solver.steps(),
+        solver.excluded()
+    );
     assert!(solver.steps() > 10);
     assert_eq!(p.pos.len(), n);
     // Mass: every fluid particle is still fluid (none lost) and all are finite.
     assert_eq!(p.kind.iter().filter(|&&k| k == 0).count(), n_fluid);
     assert!(p.pos.iter().all(|x| x.iter().all(|v| v.is_finite())));
     // The column has started to collapse: the front moved towards the obstacle (−x).
-    let min_x = p.pos.iter().zip(&p.kind).filter(|(_, k)| **k == 0).map(|(x, _)| x[0]).fold(f64::MAX, f64::min);
+    let min_x = p
+        .pos
+        .iter()
+        .zip(&p.kind)
+        .filter(|(_, k)| **k == 0)
+        .map(|(x, _)| x[0])
+        .fold(f64::MAX, f64::min);
     assert!(min_x < 1.992 - 0.01, "front at {min_x}");
     let probes = solver.sample_probes().unwrap();
     assert!(probes.iter().all(|v| v.is_finite()), "{probes:?}");

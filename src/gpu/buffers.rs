@@ -45,7 +45,12 @@ pub fn uniform_init<T: Pod>(device: &wgpu::Device, label: &str, value: &T) -> wg
 }
 
 /// Copies `buffer` (the first `len` elements) back to the host. Waits for the GPU.
-pub fn read<T: Pod>(device: &wgpu::Device, queue: &wgpu::Queue, buffer: &wgpu::Buffer, len: usize) -> Result<Vec<T>> {
+pub fn read<T: Pod>(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    len: usize,
+) -> Result<Vec<T>> {
     let bytes = (len * std::mem::size_of::<T>()) as u64;
     if bytes == 0 {
         return Ok(Vec::new());
@@ -56,7 +61,9 @@ pub fn read<T: Pod>(device: &wgpu::Device, queue: &wgpu::Queue, buffer: &wgpu::B
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("readback"),
+    });
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
     queue.submit([encoder.finish()]);
     let (tx, rx) = std::sync::mpsc::channel();

@@ -90,7 +90,10 @@ fn instance() -> wgpu::Instance {
 /// Every adapter wgpu can see (for `wgsph info`).
 pub fn list_adapters() -> Vec<(wgpu::AdapterInfo, wgpu::Limits)> {
     let adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::PRIMARY));
-    adapters.iter().map(|a| (a.get_info(), a.limits())).collect()
+    adapters
+        .iter()
+        .map(|a| (a.get_info(), a.limits()))
+        .collect()
 }
 
 impl GpuContext {

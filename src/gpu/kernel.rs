@@ -88,7 +88,11 @@ pub struct Kernel {
 impl Kernel {
     /// A bind group from `(binding, buffer)` pairs; pairs the kernel does not use are skipped,
     /// a binding it uses but that is missing is an error.
-    pub fn bind(&self, device: &wgpu::Device, buffers: &[(u32, &wgpu::Buffer)]) -> Result<wgpu::BindGroup> {
+    pub fn bind(
+        &self,
+        device: &wgpu::Device,
+        buffers: &[(u32, &wgpu::Buffer)],
+    ) -> Result<wgpu::BindGroup> {
         let mut entries = Vec::with_capacity(self.bindings.len());
         for &b in &self.bindings {
             let buffer = buffers
@@ -109,13 +113,23 @@ impl Kernel {
     }
 
     /// Records one dispatch covering `invocations` 1D invocations of WORKGROUP_SIZE.
-    pub fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, bind: &wgpu::BindGroup, invocations: u32) {
+    pub fn dispatch(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        bind: &wgpu::BindGroup,
+        invocations: u32,
+    ) {
         let groups = invocations.div_ceil(super::shader::WORKGROUP_SIZE).max(1);
         self.dispatch_groups(pass, bind, groups);
     }
 
     /// Records one dispatch of `groups` workgroups, folded into 2D past 65535.
-    pub fn dispatch_groups(&self, pass: &mut wgpu::ComputePass<'_>, bind: &wgpu::BindGroup, groups: u32) {
+    pub fn dispatch_groups(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        bind: &wgpu::BindGroup,
+        groups: u32,
+    ) {
         let (x, y) = fold_groups(groups);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, bind, &[]);

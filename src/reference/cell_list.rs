@@ -6,7 +6,13 @@ use crate::sph::grid::Grid;
 pub fn keys(grid: &Grid, pos: &[([f32; 3], [u32; 3])], excluded: &[bool]) -> Vec<u32> {
     pos.iter()
         .zip(excluded)
-        .map(|((off, b), &ex)| if ex { grid.slots } else { grid.slot_of(*off, *b) })
+        .map(|((off, b), &ex)| {
+            if ex {
+                grid.slots
+            } else {
+                grid.slot_of(*off, *b)
+            }
+        })
         .collect()
 }
 

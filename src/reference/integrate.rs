@@ -19,7 +19,13 @@ pub fn predict(ph: &Physics, p: &RefParticle, rate: [f64; 4], dt: f64) -> RefPar
 }
 
 /// v_{n+1} = v* + ½dt (a_{n+1} − a_n), likewise ρ (walls: only ρ, ≥ ρ0).
-pub fn correct(ph: &Physics, predicted: &RefParticle, rate_new: [f64; 4], rate_old: [f64; 4], dt: f64) -> RefParticle {
+pub fn correct(
+    ph: &Physics,
+    predicted: &RefParticle,
+    rate_new: [f64; 4],
+    rate_old: [f64; 4],
+    dt: f64,
+) -> RefParticle {
     let mut out = *predicted;
     if predicted.kind == FLUID {
         for a in 0..3 {

@@ -37,7 +37,8 @@ pub fn rates(ph: &Physics, parts: &[RefParticle]) -> Vec<[f64; 4]> {
                     continue;
                 }
                 if fluid_j {
-                    drho += delta_coef * 2.0 * (pi.rho - pj.rho) * f_ij * r2 / (r2 + eta2) * m / pj.rho;
+                    drho +=
+                        delta_coef * 2.0 * (pi.rho - pj.rho) * f_ij * r2 / (r2 + eta2) * m / pj.rho;
                 }
                 let mut pi_ij = 0.0;
                 match nu {

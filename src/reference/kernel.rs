@@ -101,14 +101,20 @@ mod tests {
                     if c == [0.0; 3] {
                         assert!(gnorm < 1e-12, "{kernel:?} {dim}D: |Σ∇W| = {gnorm}");
                     }
-                    assert!((wsum - 1.0).abs() < 0.1, "{kernel:?} {dim}D Shepard sum {wsum}");
+                    assert!(
+                        (wsum - 1.0).abs() < 0.1,
+                        "{kernel:?} {dim}D Shepard sum {wsum}"
+                    );
                 }
                 for k in 1..40 {
                     let r = 2.0 * h * k as f64 / 40.0;
                     let e = 1e-6;
                     let fd = (w(kernel, dim, h, r + e) - w(kernel, dim, h, r - e)) / (2.0 * e);
                     let an = f(kernel, dim, h, r) * r;
-                    assert!((fd - an).abs() < 1e-5 * kernel_norm(kernel, dim, h), "{kernel:?} r={r}");
+                    assert!(
+                        (fd - an).abs() < 1e-5 * kernel_norm(kernel, dim, h),
+                        "{kernel:?} r={r}"
+                    );
                 }
             }
         }

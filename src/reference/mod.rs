@@ -1,6 +1,9 @@
 //! The CPU (f64) twin of `src/sph` and `shaders/`, with the same stage names. Brute force and
 //! plain: it exists to test the GPU kernels, not to run cases.
 
+// Component loops written as in the equations read better than iterator chains here.
+#![allow(clippy::needless_range_loop)]
+
 pub mod cell_list;
 pub mod integrate;
 pub mod interaction;

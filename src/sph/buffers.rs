@@ -32,7 +32,12 @@ pub struct ParticleBuffers {
 }
 
 /// Stand-in so a run without probes still binds a valid buffer.
-const EMPTY_PROBES: [ProbeDef; 1] = [ProbeDef { point: [0.0; 3], kind: 0, axis: [0.0; 3], pad: 0 }];
+const EMPTY_PROBES: [ProbeDef; 1] = [ProbeDef {
+    point: [0.0; 3],
+    kind: 0,
+    axis: [0.0; 3],
+    pad: 0,
+}];
 
 pub struct InitialParticles<'a> {
     pub pos: &'a [Pos],
@@ -41,7 +46,13 @@ pub struct InitialParticles<'a> {
 }
 
 impl ParticleBuffers {
-    pub fn new(device: &wgpu::Device, params: &Params, slots: u32, init: &InitialParticles, probes: &[ProbeDef]) -> Self {
+    pub fn new(
+        device: &wgpu::Device,
+        params: &Params,
+        slots: u32,
+        init: &InitialParticles,
+        probes: &[ProbeDef],
+    ) -> Self {
         let n = init.pos.len() as u32;
         let vec4 = 16 * n as u64;
         let words = 4 * n as u64;
@@ -62,9 +73,18 @@ impl ParticleBuffers {
             n,
             params: uniform_init(device, "params", params),
             state: storage_init(device, "sim state", &[SimState::default()]),
-            pos: [storage_init(device, "pos A", init.pos), storage(device, "pos B", vec4)],
-            velrho: [storage_init(device, "velrho A", init.velrho), storage(device, "velrho B", vec4)],
-            code: [storage_init(device, "code A", init.code), storage(device, "code B", words)],
+            pos: [
+                storage_init(device, "pos A", init.pos),
+                storage(device, "pos B", vec4),
+            ],
+            velrho: [
+                storage_init(device, "velrho A", init.velrho),
+                storage(device, "velrho B", vec4),
+            ],
+            code: [
+                storage_init(device, "code A", init.code),
+                storage(device, "code B", words),
+            ],
             rate: storage_init(device, "rate", &zero_rates),
             rate_sorted: storage(device, "rate sorted", vec4),
             keys: storage(device, "keys", words),
@@ -73,7 +93,15 @@ impl ParticleBuffers {
             cell_start: storage(device, "cell start", 4 * (slots as u64 + 2)),
             scan_levels,
             scan_sizes,
-            probes: storage_init(device, "probe defs", if probes.is_empty() { &EMPTY_PROBES } else { probes }),
+            probes: storage_init(
+                device,
+                "probe defs",
+                if probes.is_empty() {
+                    &EMPTY_PROBES
+                } else {
+                    probes
+                },
+            ),
             probe_out: storage(device, "probe out", 4 * probes.len().max(1) as u64),
         }
     }
@@ -92,7 +120,13 @@ impl ParticleBuffers {
             &self.probes,
             &self.probe_out,
         ];
-        all.extend(self.pos.iter().chain(&self.velrho).chain(&self.code).chain(&self.scan_levels));
+        all.extend(
+            self.pos
+                .iter()
+                .chain(&self.velrho)
+                .chain(&self.code)
+                .chain(&self.scan_levels),
+        );
         all.iter().map(|b| b.size()).sum()
     }
 }

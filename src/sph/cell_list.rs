@@ -25,7 +25,12 @@ pub struct CellList {
 }
 
 impl CellList {
-    pub fn new(device: &wgpu::Device, cells: &ShaderModule, scan: &ShaderModule, b: &ParticleBuffers) -> Result<Self> {
+    pub fn new(
+        device: &wgpu::Device,
+        cells: &ShaderModule,
+        scan: &ShaderModule,
+        b: &ParticleBuffers,
+    ) -> Result<Self> {
         let cell_key = cells.kernel(device, "cell_key")?;
         let scatter = cells.kernel(device, "scatter")?;
         let rank_in_cell = cells.kernel(device, "rank_in_cell")?;
@@ -60,16 +65,26 @@ impl CellList {
             ]);
             v
         };
-        let bind_key = [cell_key.bind(device, &common(0))?, cell_key.bind(device, &common(1))?];
+        let bind_key = [
+            cell_key.bind(device, &common(0))?,
+            cell_key.bind(device, &common(1))?,
+        ];
         let bind_scatter = scatter.bind(device, &common(0))?;
         let bind_rank = rank_in_cell.bind(device, &common(0))?;
-        let bind_reorder = [reorder.bind(device, &reorder_bufs(0))?, reorder.bind(device, &reorder_bufs(1))?];
+        let bind_reorder = [
+            reorder.bind(device, &reorder_bufs(0))?,
+            reorder.bind(device, &reorder_bufs(1))?,
+        ];
         let mut levels: Vec<&wgpu::Buffer> = vec![&b.cell_start];
         levels.extend(b.scan_levels.iter());
         let mut bind_scan = Vec::new();
         for l in 0..b.scan_sizes.len() - 1 {
             let bufs = [(1, levels[l]), (2, levels[l + 1])];
-            let add = if l + 2 < levels.len() { Some(scan_add.bind(device, &bufs)?) } else { None };
+            let add = if l + 2 < levels.len() {
+                Some(scan_add.bind(device, &bufs)?)
+            } else {
+                None
+            };
             bind_scan.push((scan_blocks.bind(device, &bufs)?, add));
         }
         Ok(Self {
@@ -106,7 +121,8 @@ impl CellList {
     fn encode_scan(&self, pass: &mut wgpu::ComputePass<'_>) {
         let per_group = 2 * crate::gpu::shader::WORKGROUP_SIZE;
         for (l, (blocks, _)) in self.bind_scan.iter().enumerate() {
-            self.scan_blocks.dispatch_groups(pass, blocks, self.scan_sizes[l].div_ceil(per_group));
+            self.scan_blocks
+                .dispatch_groups(pass, blocks, self.scan_sizes[l].div_ceil(per_group));
         }
         for (l, (_, add)) in self.bind_scan.iter().enumerate().rev() {
             if let Some(add) = add {

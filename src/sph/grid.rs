@@ -33,7 +33,7 @@ impl Grid {
         let mut cells = [1u32; 3];
         for a in 0..dim as usize {
             extent[a] = domain.max[a] - domain.min[a];
-            if !(extent[a] > 0.0) || !extent[a].is_finite() {
+            if extent[a].is_nan() || extent[a] <= 0.0 || !extent[a].is_finite() {
                 bail!("the domain has no extent along axis {a}");
             }
             let n = (extent[a] / cell_size).ceil();
@@ -95,7 +95,9 @@ impl Grid {
             let local = ((off[a] * inv).floor() as i64).clamp(0, k - 1);
             (b[a] as i64 * k + local) as u32
         });
-        let lin = c[0].wrapping_add(self.cells[0].wrapping_mul(c[1].wrapping_add(self.cells[1].wrapping_mul(c[2]))));
+        let lin = c[0].wrapping_add(
+            self.cells[0].wrapping_mul(c[1].wrapping_add(self.cells[1].wrapping_mul(c[2]))),
+        );
         lin & (self.slots - 1)
     }
 }
@@ -131,7 +133,11 @@ mod tests {
     #[test]
     fn block_round_trip_is_precise_anywhere() {
         let g = Grid::new(&domain([100.0, 100.0, 10.0]), 0.01, 3, 1000).unwrap();
-        for p in [[0.0, 0.0, 0.0], [99.99, 50.123456, 9.87654], [37.5, 0.001, 4.0]] {
+        for p in [
+            [0.0, 0.0, 0.0],
+            [99.99, 50.123456, 9.87654],
+            [37.5, 0.001, 4.0],
+        ] {
             let (off, b) = g.to_block(p);
             let q = g.to_world(off, b);
             for a in 0..3 {

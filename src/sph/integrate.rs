@@ -35,8 +35,14 @@ impl Integrate {
             ]
         };
         Ok(Self {
-            bind_predict: [predict.bind(device, &bufs(0))?, predict.bind(device, &bufs(1))?],
-            bind_correct: [correct.bind(device, &bufs(0))?, correct.bind(device, &bufs(1))?],
+            bind_predict: [
+                predict.bind(device, &bufs(0))?,
+                predict.bind(device, &bufs(1))?,
+            ],
+            bind_correct: [
+                correct.bind(device, &bufs(0))?,
+                correct.bind(device, &bufs(1))?,
+            ],
             bind_timestep: timestep.bind(device, &bufs(0))?,
             predict,
             correct,

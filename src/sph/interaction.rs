@@ -25,8 +25,15 @@ impl Interaction {
                 (5, &b.rate),
             ]
         };
-        let bind = [kernel.bind(device, &bufs(0))?, kernel.bind(device, &bufs(1))?];
-        Ok(Self { kernel, bind, n: b.n })
+        let bind = [
+            kernel.bind(device, &bufs(0))?,
+            kernel.bind(device, &bufs(1))?,
+        ];
+        Ok(Self {
+            kernel,
+            bind,
+            n: b.n,
+        })
     }
 
     /// Evaluates the rates of the (sorted) arrays of parity `p` into `rate`.

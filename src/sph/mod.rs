@@ -15,7 +15,9 @@ use crate::gpu::buffers::read;
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::shader::{Pass, ShaderConfig};
 use crate::gpu::GpuContext;
-use crate::layout::{pack_block, unpack_block, Params, Pos, SimState, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
+use crate::layout::{
+    pack_block, unpack_block, Params, Pos, SimState, ID_MASK, KIND_EXCLUDED, KIND_SHIFT,
+};
 use crate::scenario::{KernelKind, Kind, Scenario, Viscosity};
 use buffers::{InitialParticles, ParticleBuffers};
 use cell_list::CellList;
@@ -26,6 +28,17 @@ use probes::Probes;
 
 /// Most steps recorded into one submission before the host looks at the state again.
 const MAX_BATCH: u32 = 64;
+
+/// A part of the step that benchmarks time on its own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Key, scan, scatter, rank and reorder.
+    CellList,
+    /// The neighbour sum.
+    Interaction,
+    /// A whole step.
+    Step,
+}
 
 /// Why a run stopped before its end.
 #[derive(Debug, thiserror::Error)]
@@ -47,6 +60,9 @@ pub struct Particles {
     pub kind: Vec<u32>,
     pub id: Vec<u32>,
 }
+
+/// (positions, (v, ρ), code words) as stored on the GPU.
+pub type RawParticles = (Vec<Pos>, Vec<[f32; 4]>, Vec<u32>);
 
 /// SPH kernel normalisation α_d (support 2h) of `kernel` in `dim` dimensions.
 pub fn kernel_norm(kernel: KernelKind, dim: u32, h: f64) -> f64 {
@@ -87,9 +103,12 @@ impl Solver {
             bail!("the case has no particles");
         }
         if n > ID_MASK as usize {
-            bail!("{n} particles: at most {} fit the 28-bit particle id", ID_MASK);
+            bail!(
+                "{n} particles: at most {} fit the 28-bit particle id",
+                ID_MASK
+            );
         }
-        let max_binding = ctx.limits.max_storage_buffer_binding_size as u64;
+        let max_binding = ctx.limits.max_storage_buffer_binding_size;
         let fit = max_binding / 16;
         if n as u64 > fit {
             bail!(
@@ -141,8 +160,16 @@ impl Solver {
         let mut code = Vec::with_capacity(n);
         for (id, p) in sc.particles.iter().enumerate() {
             let (off, b) = grid.to_block(p.pos);
-            pos.push(Pos { off, block: pack_block(b) });
-            velrho.push([p.vel[0] as f32, p.vel[1] as f32, p.vel[2] as f32, p.rho as f32]);
+            pos.push(Pos {
+                off,
+                block: pack_block(b),
+            });
+            velrho.push([
+                p.vel[0] as f32,
+                p.vel[1] as f32,
+                p.vel[2] as f32,
+                p.rho as f32,
+            ]);
             code.push(((p.kind as u32) << KIND_SHIFT) | id as u32);
         }
         let device = ctx.device.clone();
@@ -151,11 +178,20 @@ impl Solver {
             &device,
             &params,
             grid.slots,
-            &InitialParticles { pos: &pos, velrho: &velrho, code: &code },
+            &InitialParticles {
+                pos: &pos,
+                velrho: &velrho,
+                code: &code,
+            },
             &defs,
         );
         let module = |pass| ShaderModule::new(&device, pass, cfg);
-        let cell_list = CellList::new(&device, &module(Pass::CellList)?, &module(Pass::PrefixScan)?, &buffers)?;
+        let cell_list = CellList::new(
+            &device,
+            &module(Pass::CellList)?,
+            &module(Pass::PrefixScan)?,
+            &buffers,
+        )?;
         let interaction = Interaction::new(&device, &module(Pass::Interaction)?, &buffers)?;
         let integrate = Integrate::new(&device, &module(Pass::Integrate)?, &buffers)?;
         let probes = Probes::new(&device, &module(Pass::Probes)?, &buffers, &defs)?;
@@ -216,12 +252,19 @@ impl Solver {
 
     /// Records `count` steps into one submission.
     fn submit_steps(&mut self, count: u32) {
-        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("steps") });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("steps"),
+            });
         for _ in 0..count {
             let p = self.parity;
             let q = 1 - p;
             self.cell_list.clear(&mut encoder, &self.buffers);
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("step"), timestamp_writes: None });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("step"),
+                timestamp_writes: None,
+            });
             self.integrate.encode_predict(&mut pass, p);
             self.cell_list.encode(&mut pass, p);
             self.interaction.encode(&mut pass, q);
@@ -240,12 +283,18 @@ impl Solver {
         let mut st = self.state;
         st.t_rel = 0.0;
         st.t_target_rel = remaining as f32;
-        st.dt = if remaining > 1e-4 * st.dt_cfl as f64 { st.dt_cfl.min(remaining as f32) } else { 0.0 };
-        self.queue.write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
+        st.dt = if remaining > 1e-4 * st.dt_cfl as f64 {
+            st.dt_cfl.min(remaining as f32)
+        } else {
+            0.0
+        };
+        self.queue
+            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
         self.state = st;
         while self.state.dt > 0.0 {
             let left = (self.state.t_target_rel - self.state.t_rel).max(0.0);
-            let batch = ((left / self.state.dt_cfl.max(1e-30)).ceil() as u32 + 1).clamp(1, MAX_BATCH);
+            let batch =
+                ((left / self.state.dt_cfl.max(1e-30)).ceil() as u32 + 1).clamp(1, MAX_BATCH);
             let before = self.state.steps;
             self.submit_steps(batch);
             self.state = self.read_state()?;
@@ -267,7 +316,8 @@ impl Solver {
         st.t_rel = 0.0;
         st.t_target_rel = f32::MAX;
         st.dt = st.dt_cfl;
-        self.queue.write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
+        self.queue
+            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
         let mut left = count;
         while left > 0 {
             let batch = left.min(MAX_BATCH as u64) as u32;
@@ -280,10 +330,53 @@ impl Solver {
         self.check_stability()
     }
 
+    /// Benchmark hook: records `reps` repetitions of `stage`, submits them and waits. After
+    /// `CellList` alone the rates no longer match the particle order, so a solver timed that way
+    /// is for benchmarking only.
+    pub fn time_stage(&mut self, stage: Stage, reps: u64) -> Result<std::time::Duration> {
+        if stage == Stage::Step {
+            let start = std::time::Instant::now();
+            self.run_steps(reps)?;
+            return Ok(start.elapsed());
+        }
+        let start = std::time::Instant::now();
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("stage"),
+            });
+        for _ in 0..reps {
+            if stage == Stage::CellList {
+                self.cell_list.clear(&mut encoder, &self.buffers);
+            }
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("stage"),
+                timestamp_writes: None,
+            });
+            match stage {
+                Stage::CellList => {
+                    self.cell_list.encode(&mut pass, self.parity);
+                    self.parity = 1 - self.parity;
+                }
+                Stage::Interaction | Stage::Step => self.interaction.encode(&mut pass, self.parity),
+            }
+        }
+        self.queue.submit([encoder.finish()]);
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| anyhow::anyhow!("GPU wait failed: {e}"))?;
+        Ok(start.elapsed())
+    }
+
     fn check_stability(&self) -> Result<()> {
         let s = &self.state;
         let fail = |reason: String| -> Result<()> {
-            Err(Unstable { step: self.steps, time_s: self.time(), reason }.into())
+            Err(Unstable {
+                step: self.steps,
+                time_s: self.time(),
+                reason,
+            }
+            .into())
         };
         if s.nan_count > 0 {
             return fail(format!(
@@ -299,7 +392,7 @@ impl Solver {
                 100.0 * self.max_excluded_fraction
             ));
         }
-        if !(s.dt_cfl > 1e-4 * self.initial_dt) {
+        if s.dt_cfl.is_nan() || s.dt_cfl <= 1e-4 * self.initial_dt {
             return fail(format!(
                 "the time step collapsed to {:e} s (started at {:e} s)",
                 s.dt_cfl, self.initial_dt
@@ -313,10 +406,19 @@ impl Solver {
         if self.probes.is_empty() {
             return Ok(Vec::new());
         }
-        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("probes") });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("probes"),
+            });
         self.probes.encode(&mut encoder, &self.buffers, self.parity);
         self.queue.submit([encoder.finish()]);
-        let raw = read::<u32>(&self.device, &self.queue, &self.buffers.probe_out, self.params.n_probes as usize)?;
+        let raw = read::<u32>(
+            &self.device,
+            &self.queue,
+            &self.buffers.probe_out,
+            self.params.n_probes as usize,
+        )?;
         Ok(self.probes.decode(&raw))
     }
 
@@ -326,10 +428,18 @@ impl Solver {
     pub fn rerun_interaction(&self, poison: bool) -> Result<Vec<[f32; 4]>> {
         if poison {
             let nan = vec![f32::NAN; 4 * self.buffers.n as usize];
-            self.queue.write_buffer(&self.buffers.rate, 0, bytemuck::cast_slice(&nan));
+            self.queue
+                .write_buffer(&self.buffers.rate, 0, bytemuck::cast_slice(&nan));
         }
-        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("interaction") });
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("interaction"), timestamp_writes: None });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("interaction"),
+            });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("interaction"),
+            timestamp_writes: None,
+        });
         self.interaction.encode(&mut pass, self.parity);
         drop(pass);
         self.queue.submit([encoder.finish()]);
@@ -343,31 +453,44 @@ impl Solver {
         st.t_rel = 0.0;
         st.t_target_rel = f32::MAX;
         st.dt = dt;
-        self.queue.write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
+        self.queue
+            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
         self.submit_steps(1);
         self.state = self.read_state()?;
         Ok(self.state)
     }
 
     /// Raw arrays of the current parity, in GPU (cell) order.
-    pub fn read_raw(&self) -> Result<(Vec<Pos>, Vec<[f32; 4]>, Vec<u32>)> {
+    pub fn read_raw(&self) -> Result<RawParticles> {
         let n = self.buffers.n as usize;
         let p = self.parity;
         Ok((
-            read(&self.device, &self.queue, &self.buffers.pos[p], n).context("reading positions")?,
-            read(&self.device, &self.queue, &self.buffers.velrho[p], n).context("reading velocities")?,
+            read(&self.device, &self.queue, &self.buffers.pos[p], n)
+                .context("reading positions")?,
+            read(&self.device, &self.queue, &self.buffers.velrho[p], n)
+                .context("reading velocities")?,
             read(&self.device, &self.queue, &self.buffers.code[p], n).context("reading codes")?,
         ))
     }
 
     /// Rates (dv/dt, dρ/dt) of the last evaluation, in GPU order.
     pub fn read_rates(&self) -> Result<Vec<[f32; 4]>> {
-        read(&self.device, &self.queue, &self.buffers.rate, self.buffers.n as usize)
+        read(
+            &self.device,
+            &self.queue,
+            &self.buffers.rate,
+            self.buffers.n as usize,
+        )
     }
 
     /// Slot starts of the last sort (slots + 2 entries).
     pub fn read_cell_start(&self) -> Result<Vec<u32>> {
-        read(&self.device, &self.queue, &self.buffers.cell_start, self.grid.slots as usize + 2)
+        read(
+            &self.device,
+            &self.queue,
+            &self.buffers.cell_start,
+            self.grid.slots as usize + 2,
+        )
     }
 
     /// All particles in world coordinates, sorted by id.
@@ -379,11 +502,13 @@ impl Solver {
         let (rho0, gamma) = (self.params.rho0 as f64, self.params.gamma as f64);
         let mut out = Particles::default();
         for i in order {
-            out.pos.push(self.grid.to_world(pos[i].off, unpack_block(pos[i].block)));
+            out.pos
+                .push(self.grid.to_world(pos[i].off, unpack_block(pos[i].block)));
             let v = velrho[i];
             out.vel.push([v[0], v[1], v[2]]);
             out.rho.push(v[3]);
-            out.pressure.push((b * ((v[3] as f64 / rho0).powf(gamma) - 1.0)) as f32);
+            out.pressure
+                .push((b * ((v[3] as f64 / rho0).powf(gamma) - 1.0)) as f32);
             out.kind.push(code[i] >> KIND_SHIFT);
             out.id.push(code[i] & ID_MASK);
         }

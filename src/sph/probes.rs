@@ -18,8 +18,16 @@ pub fn probe_defs(probes: &[Probe], origin: [f64; 3]) -> Vec<ProbeDef> {
     probes
         .iter()
         .map(|p| match &p.kind {
-            ProbeKind::Pressure { point } => ProbeDef { point: rel(point), kind: PROBE_PRESSURE, ..Default::default() },
-            ProbeKind::Height { base } => ProbeDef { point: rel(base), kind: PROBE_HEIGHT, ..Default::default() },
+            ProbeKind::Pressure { point } => ProbeDef {
+                point: rel(point),
+                kind: PROBE_PRESSURE,
+                ..Default::default()
+            },
+            ProbeKind::Height { base } => ProbeDef {
+                point: rel(base),
+                kind: PROBE_HEIGHT,
+                ..Default::default()
+            },
             ProbeKind::Front { origin: o, axis } => {
                 let norm = axis.iter().map(|a| a * a).sum::<f64>().sqrt();
                 ProbeDef {
@@ -54,7 +62,12 @@ pub struct Probes {
 }
 
 impl Probes {
-    pub fn new(device: &wgpu::Device, module: &ShaderModule, b: &ParticleBuffers, defs: &[ProbeDef]) -> Result<Self> {
+    pub fn new(
+        device: &wgpu::Device,
+        module: &ShaderModule,
+        b: &ParticleBuffers,
+        defs: &[ProbeDef],
+    ) -> Result<Self> {
         let points = module.kernel(device, "probe_points")?;
         let front = module.kernel(device, "probe_front")?;
         let bufs = |p: usize| {
@@ -69,7 +82,10 @@ impl Probes {
             ]
         };
         Ok(Self {
-            bind_points: [points.bind(device, &bufs(0))?, points.bind(device, &bufs(1))?],
+            bind_points: [
+                points.bind(device, &bufs(0))?,
+                points.bind(device, &bufs(1))?,
+            ],
             bind_front: [front.bind(device, &bufs(0))?, front.bind(device, &bufs(1))?],
             points,
             front,
@@ -85,8 +101,12 @@ impl Probes {
     /// Records the probe evaluation on the arrays of parity `p` (cell list must be current).
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, b: &ParticleBuffers, p: usize) {
         encoder.clear_buffer(&b.probe_out, 0, None);
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("probes"), timestamp_writes: None });
-        self.points.dispatch(&mut pass, &self.bind_points[p], self.kinds.len() as u32);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("probes"),
+            timestamp_writes: None,
+        });
+        self.points
+            .dispatch(&mut pass, &self.bind_points[p], self.kinds.len() as u32);
         if self.kinds.contains(&PROBE_FRONT) {
             self.front.dispatch(&mut pass, &self.bind_front[p], self.n);
         }
@@ -97,7 +117,13 @@ impl Probes {
         self.kinds
             .iter()
             .zip(raw)
-            .map(|(&k, &w)| if k == PROBE_FRONT { decode_ordered(w) as f64 } else { f32::from_bits(w) as f64 })
+            .map(|(&k, &w)| {
+                if k == PROBE_FRONT {
+                    decode_ordered(w) as f64
+                } else {
+                    f32::from_bits(w) as f64
+                }
+            })
             .collect()
     }
 }

@@ -12,7 +12,8 @@ pub fn gpu() -> &'static GpuContext {
     static CTX: OnceLock<GpuContext> = OnceLock::new();
     CTX.get_or_init(|| {
         let choice = AdapterChoice::resolve(None).expect("WGSPH_ADAPTER");
-        GpuContext::new(choice).expect("a GPU or software (lavapipe) adapter is required for the tests")
+        GpuContext::new(choice)
+            .expect("a GPU or software (lavapipe) adapter is required for the tests")
     })
 }
 
@@ -38,14 +39,26 @@ pub fn physics(dim: u32, dx: f64, c0: f64) -> Physics {
 /// Lattice points min + (i + ½)dx inside [min, max] (3 components, the unused one 0 in 2D).
 pub fn lattice(dim: u32, dx: f64, min: [f64; 3], max: [f64; 3]) -> Vec<[f64; 3]> {
     let n: Vec<usize> = (0..3)
-        .map(|a| if a < dim as usize { ((max[a] - min[a]) / dx).round() as usize } else { 1 })
+        .map(|a| {
+            if a < dim as usize {
+                ((max[a] - min[a]) / dx).round() as usize
+            } else {
+                1
+            }
+        })
         .collect();
     let mut out = Vec::new();
     for k in 0..n[2] {
         for j in 0..n[1] {
             for i in 0..n[0] {
                 let idx = [i, j, k];
-                let p = [0, 1, 2].map(|a| if a < dim as usize { min[a] + (idx[a] as f64 + 0.5) * dx } else { 0.0 });
+                let p = [0, 1, 2].map(|a| {
+                    if a < dim as usize {
+                        min[a] + (idx[a] as f64 + 0.5) * dx
+                    } else {
+                        0.0
+                    }
+                });
                 out.push(p);
             }
         }
@@ -53,11 +66,21 @@ pub fn lattice(dim: u32, dx: f64, min: [f64; 3], max: [f64; 3]) -> Vec<[f64; 3]>
     out
 }
 
-pub fn scenario(physics: Physics, particles: Vec<Particle>, domain: Domain, probes: Vec<Probe>) -> Scenario {
+pub fn scenario(
+    physics: Physics,
+    particles: Vec<Particle>,
+    domain: Domain,
+    probes: Vec<Probe>,
+) -> Scenario {
     Scenario {
         name: "test".into(),
         physics,
-        time: TimeControl { end_s: 1.0, output_every_s: 0.1, probe_every_s: 0.1, cfl: 0.2 },
+        time: TimeControl {
+            end_s: 1.0,
+            output_every_s: 0.1,
+            probe_every_s: 0.1,
+            cfl: 0.2,
+        },
         domain,
         particles,
         probes,

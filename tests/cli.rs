@@ -1,0 +1,126 @@
+//! The `wgsph` command as a user runs it: a short real run writes every output; bad case files
+//! fail with a message naming file, line and field, never a panic.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn wgsph() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_wgsph"))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("wgsph-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+#[test]
+fn run_writes_snapshots_probes_and_summary() {
+    let out = temp_dir("run");
+    let o = wgsph()
+        .args([
+            "run",
+            "cases/hydrostatic_2d.toml",
+            "--set",
+            "time.end_s=0.05",
+            "--set",
+            "time.output_every_s=0.025",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(stdout.contains("completed"), "{stdout}");
+    let pvd = std::fs::read_to_string(out.join("particles.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 3, "t = 0, 0.025, 0.05");
+    for f in [
+        "particles/particles_000002.vtu",
+        "probes/p_bottom.csv",
+        "probes/height.csv",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let csv = std::fs::read_to_string(out.join("probes/p_bottom.csv")).unwrap();
+    assert!(csv.starts_with("t_s,pressure_pa\n"));
+    assert_eq!(
+        csv.lines().count(),
+        1 + 6,
+        "header + t = 0, 0.01, ..., 0.05"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(summary["status"], "completed");
+    assert!(summary["steps"].as_u64().unwrap() > 10);
+    assert!(summary["particle_steps_per_s"].as_f64().unwrap() > 0.0);
+    assert!(summary["gpu_bytes_per_particle"].as_f64().unwrap() > 0.0);
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// Writes `text` as a case file and runs it; returns (exit code, stderr).
+fn run_bad(name: &str, text: &str) -> (i32, String) {
+    let dir = temp_dir(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join(format!("{name}.toml"));
+    std::fs::write(&case, text).unwrap();
+    let o = wgsph()
+        .arg("run")
+        .arg(&case)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn good_case() -> String {
+    std::fs::read_to_string("cases/hydrostatic_2d.toml").unwrap()
+}
+
+#[test]
+fn bad_case_files_fail_with_file_line_and_field() {
+    let good = good_case();
+    let cases = [
+        (
+            "missing_field",
+            good.replace("end_s = 2.0", ""),
+            vec!["time", "end_s"],
+        ),
+        (
+            "wrong_type",
+            good.replace("dx_m = 0.02", "dx_m = \"fine\""),
+            vec![":", "particles.dx_m"],
+        ),
+        (
+            "negative_dx",
+            good.replace("dx_m = 0.02", "dx_m = -0.02"),
+            vec![":", "particles.dx_m", "> 0"],
+        ),
+        (
+            "fluid_outside_tank",
+            good.replace("max_m = [1.0, 0.5]", "max_m = [1.5, 0.5]"),
+            vec!["fluid_block", "tank"],
+        ),
+    ];
+    for (name, text, words) in cases {
+        let (code, err) = run_bad(name, &text);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(!err.contains("panicked"), "{name} panicked: {err}");
+        assert!(
+            err.contains(&format!("{name}.toml")),
+            "{name}: message must name the file: {err}"
+        );
+        for w in words {
+            assert!(err.contains(w), "{name}: message must mention '{w}': {err}");
+        }
+    }
+}
