@@ -4,18 +4,119 @@
 // Continuity (the seed's eq. 1; Monaghan 1992):  dρ_i/dt = Σ_j m_j v_ij·∇_i W_ij
 //   + δ-SPH diffusion between fluid particles (Molteni & Colagrossi 2009, eq. 8):
 //     δ h c0 Σ_j 2 (ρ_j − ρ_i) (x_ji·∇_i W_ij)/(r² + η²) V_j
+//   + the seed's density-rate correction between materials, m_j v_ij·∇_i W_ij (ρ_i/ρ_j), used
+//     for fluid–ghost pairs.
 // Momentum (the seed's eq. 2 with σ = −P I; Monaghan 1992):
 //   dv_i/dt = −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij + g
 //   artificial viscosity Π_ij = −α c0 μ_ij / ρ̄_ij, μ_ij = h v_ij·x_ij/(r² + η²) when v_ij·x_ij < 0
 //   (Monaghan 1992, eq. 4.2), or laminar viscosity (Lo & Shao 2002, eq. 8; Morris et al. 1997):
 //   Σ_j m_j 4ν (x_ij·∇_i W_ij) / ((ρ_i + ρ_j)(r² + η²)) v_ij
-// Wall particles (dynamic boundary, Crespo et al. 2007) get only dρ/dt, from fluid neighbours.
+// Walls, by kind of the neighbour j of a fluid particle:
+//   dynamic boundary particles (Crespo et al. 2007) and fixed ghosts (values set by ghost.wgsl)
+//   enter the sums like fluid; repulsive particles exert only the Lennard-Jones force
+//   D((r0/r)^12 − (r0/r)^4) x_ij/r² for r < r0 (Monaghan 1994, eq. 3.2); mirror planes add, for
+//   each fluid j near the image of i, the ghost x_g = 2x_w − x_j with p_g = p_j, ρ_g = ρ_j and
+//   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip).
+// Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
+// get nothing.
+
+struct MirrorPlane {
+    point: vec3<f32>,
+    no_slip: u32,
+    normal: vec3<f32>,
+    pad: u32,
+}
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read> code: array<u32>;
 @group(0) @binding(4) var<storage, read> cell_start: array<u32>;
 @group(0) @binding(5) var<storage, read_write> rate: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> mirror_planes: array<MirrorPlane>;
+
+// The state of particle i that every pair term needs.
+struct Particle {
+    v: vec3<f32>,
+    rho: f32,
+    p_over_rho2: f32,
+}
+
+// (dv/dt, dρ/dt) contribution to fluid particle i of a pressure-carrying neighbour j
+// (fluid, dynamic wall, ghost or mirror image) at x_ij = x_i − x_j.
+fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_j: vec3<f32>, rho_j: f32, diffuse: bool, rho_ratio: f32) -> vec4<f32> {
+    let v_ij = pi.v - v_j;
+    let f_ij = kernel_f(sqrt(r2) / params.h);
+    let dw_ij = x_ij * f_ij;
+    var drho = params.mass * dot(v_ij, dw_ij) * rho_ratio;
+    if (diffuse) {
+        drho += params.delta_coef * 2.0 * (pi.rho - rho_j) * f_ij * r2 / (r2 + params.eta2) * params.mass / rho_j;
+    }
+    var acc = vec3<f32>(0.0);
+    var pi_ij = 0.0;
+    if (VISCOSITY == 0u) {
+        let vx = dot(v_ij, x_ij);
+        if (vx < 0.0) {
+            let mu = params.h * vx / (r2 + params.eta2);
+            pi_ij = -params.alpha * params.c0 * mu / (0.5 * (pi.rho + rho_j));
+        }
+    } else {
+        acc += params.mass * 4.0 * params.nu * r2 * f_ij / ((pi.rho + rho_j) * (r2 + params.eta2)) * v_ij;
+    }
+    let p_over_rho2_j = pressure_of(rho_j) / (rho_j * rho_j);
+    acc -= params.mass * (pi.p_over_rho2 + p_over_rho2_j + pi_ij) * dw_ij;
+    return vec4<f32>(acc, drho);
+}
+
+// Lennard-Jones repulsion of a boundary particle at x_ij (Monaghan 1994).
+fn repulsion(x_ij: vec3<f32>, r2: f32) -> vec3<f32> {
+    let r0 = params.repulsive_r0;
+    if (r2 >= r0 * r0 || r2 <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let q2 = r0 * r0 / r2;
+    let q4 = q2 * q2;
+    let q12 = q4 * q4 * q4;
+    return params.repulsive_d * (q12 - q4) / r2 * x_ij;
+}
+
+// Sum over the mirror images, in the planes near x_i, of the fluid particles near i's image.
+fn mirror_rates(i: u32, pi: Particle) -> vec4<f32> {
+    var out = vec4<f32>(0.0);
+    let support2 = 4.0 * params.h * params.h;
+    let xi = domain_pos(pos[i]);
+    for (var k = 0u; k < params.n_mirror_planes; k++) {
+        let plane = mirror_planes[k];
+        let n = plane.normal;
+        let d = dot(xi - plane.point, n);
+        if (d >= 2.0 * params.h) {
+            continue;
+        }
+        let image = pos_of_point(xi - 2.0 * d * n);
+        var slots: array<u32, 27>;
+        let n_slots = neighbour_slots(cell_of(image), &slots);
+        for (var s = 0u; s < n_slots; s++) {
+            for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
+                if (code_kind(code[j]) != KIND_FLUID) {
+                    continue;
+                }
+                let x = rel_pos(image, pos[j]);
+                let r2 = dot(x, x);
+                if (r2 >= support2) {
+                    continue;
+                }
+                // x_i − x_g is the reflection of x_i' − x_j.
+                let x_ig = x - 2.0 * dot(x, n) * n;
+                let vr_j = velrho[j];
+                var v_g = vr_j.xyz - 2.0 * dot(vr_j.xyz, n) * n;
+                if (plane.no_slip != 0u) {
+                    v_g = -vr_j.xyz;
+                }
+                out += pair_rates(pi, x_ig, r2, v_g, vr_j.w, true, 1.0);
+            }
+        }
+    }
+    return out;
+}
 
 @compute @workgroup_size(WG)
 fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -24,65 +125,50 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         return;
     }
     let kind_i = code_kind(code[i]);
-    if (kind_i == KIND_EXCLUDED) {
+    if (kind_i != KIND_FLUID && kind_i != KIND_WALL) {
         rate[i] = vec4<f32>(0.0);
         return;
     }
     let fluid_i = kind_i == KIND_FLUID;
-    let pi = pos[i];
-    let vi = velrho[i].xyz;
-    let rho_i = velrho[i].w;
-    let p_over_rho2_i = pressure_of(rho_i) / (rho_i * rho_i);
+    let p_i = pos[i];
+    let pi = Particle(velrho[i].xyz, velrho[i].w, pressure_of(velrho[i].w) / (velrho[i].w * velrho[i].w));
     let support2 = 4.0 * params.h * params.h;
-    let inv_h = 1.0 / params.h;
 
-    var acc = vec3<f32>(0.0);
-    var drho = 0.0;
+    var r = vec4<f32>(0.0);
     var slots: array<u32, 27>;
-    let n_slots = neighbour_slots(cell_of(pi), &slots);
+    let n_slots = neighbour_slots(cell_of(p_i), &slots);
     for (var s = 0u; s < n_slots; s++) {
         let start = cell_start[slots[s]];
         let end = cell_start[slots[s] + 1u];
         for (var j = start; j < end; j++) {
-            let x_ij = rel_pos(pi, pos[j]);
+            let x_ij = rel_pos(p_i, pos[j]);
             let r2 = dot(x_ij, x_ij);
             if (r2 >= support2 || j == i) {
                 continue;
             }
             let kind_j = code_kind(code[j]);
-            let fluid_j = kind_j == KIND_FLUID;
-            if (!fluid_i && !fluid_j) {
+            if (!fluid_i) {
+                // Dynamic wall particle: continuity with fluid neighbours only.
+                if (kind_j == KIND_FLUID) {
+                    let vr_j = velrho[j];
+                    r.w += params.mass * dot(pi.v - vr_j.xyz, x_ij * kernel_f(sqrt(r2) / params.h));
+                }
+                continue;
+            }
+            if (kind_j == KIND_REPULSIVE) {
+                r += vec4<f32>(repulsion(x_ij, r2), 0.0);
                 continue;
             }
             let vr_j = velrho[j];
-            let rho_j = vr_j.w;
-            let v_ij = vi - vr_j.xyz;
-            let f_ij = kernel_f(sqrt(r2) * inv_h);
-            let dw_ij = x_ij * f_ij;
-            drho += params.mass * dot(v_ij, dw_ij);
-            if (!fluid_i) {
-                continue;
-            }
-            if (fluid_j) {
-                drho += params.delta_coef * 2.0 * (rho_i - rho_j) * f_ij * r2 / (r2 + params.eta2)
-                    * params.mass / rho_j;
-            }
-            var pi_ij = 0.0;
-            if (VISCOSITY == 0u) {
-                let vx = dot(v_ij, x_ij);
-                if (vx < 0.0) {
-                    let mu = params.h * vx / (r2 + params.eta2);
-                    pi_ij = -params.alpha * params.c0 * mu / (0.5 * (rho_i + rho_j));
-                }
-            } else {
-                acc += params.mass * 4.0 * params.nu * r2 * f_ij / ((rho_i + rho_j) * (r2 + params.eta2)) * v_ij;
-            }
-            let p_over_rho2_j = pressure_of(rho_j) / (rho_j * rho_j);
-            acc -= params.mass * (p_over_rho2_i + p_over_rho2_j + pi_ij) * dw_ij;
+            let ghost = is_ghost(kind_j);
+            r += pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.w, kind_j == KIND_FLUID, select(1.0, pi.rho / vr_j.w, ghost));
         }
     }
     if (fluid_i) {
-        acc += params.gravity;
+        if (params.n_mirror_planes > 0u) {
+            r += mirror_rates(i, pi);
+        }
+        r += vec4<f32>(params.gravity, 0.0);
     }
-    rate[i] = vec4<f32>(acc, drho);
+    rate[i] = r;
 }

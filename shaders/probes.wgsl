@@ -20,11 +20,6 @@ const PROBE_FRONT: u32 = 2u;
 @group(0) @binding(5) var<storage, read> probes: array<ProbeDef>;
 @group(0) @binding(6) var<storage, read_write> probe_out: array<atomic<u32>>;
 
-fn pos_of_point(x: vec3<f32>) -> Pos {
-    let b = clamp(vec3<i32>(floor(x / params.block_size)), vec3<i32>(0), vec3<i32>(2047, 2047, 1023));
-    return Pos(x - vec3<f32>(b) * params.block_size, pack_block(b));
-}
-
 struct KernelSums {
     volume: f32,        // Σ_j W V_j over fluid (the Shepard denominator)
     pressure: f32,      // Σ_j P_j W V_j

@@ -29,6 +29,10 @@ pub struct Params {
     pub delta_coef: f32,
     pub cfl: f32,
     pub n_probes: u32,
+    pub n_mirror_planes: u32,
+    pub ghost_mls: u32,
+    pub repulsive_d: f32,
+    pub repulsive_r0: f32,
 }
 
 /// Mirrors `SimState` in shaders/lib/common.wgsl.
@@ -62,6 +66,18 @@ pub struct ProbeDef {
     pub point: [f32; 3],
     pub kind: u32,
     pub axis: [f32; 3],
+    pub pad: u32,
+}
+
+/// Mirrors `MirrorPlane` in shaders/interaction.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct MirrorPlane {
+    /// A point of the plane, in domain coordinates.
+    pub point: [f32; 3],
+    pub no_slip: u32,
+    /// Unit normal into the fluid.
+    pub normal: [f32; 3],
     pub pad: u32,
 }
 
@@ -152,7 +168,11 @@ mod tests {
                 nu,
                 delta_coef,
                 cfl,
-                n_probes
+                n_probes,
+                n_mirror_planes,
+                ghost_mls,
+                repulsive_d,
+                repulsive_r0
             ]
         );
     }
@@ -181,6 +201,12 @@ mod tests {
     fn pos_and_probe_match_wgsl() {
         check_layout!(Pass::Interaction, "Pos", Pos, [off, block]);
         check_layout!(Pass::Probes, "ProbeDef", ProbeDef, [point, kind, axis]);
+        check_layout!(
+            Pass::Interaction,
+            "MirrorPlane",
+            MirrorPlane,
+            [point, no_slip, normal]
+        );
     }
 
     #[test]

@@ -12,6 +12,19 @@ pub enum Kind {
     Fluid = 0,
     /// Fixed wall particle, dynamic boundary condition (Crespo et al. 2007).
     Wall = 1,
+    /// Fixed ghost particle (the seed's improved interface), no-slip: pressure and velocity
+    /// interpolated from the fluid every step, v_g = 2 v_wall − Σ v_j W^I_gj V_j.
+    GhostNoSlip = 2,
+    /// Fixed ghost particle, free-slip: the interpolated velocity's normal part reversed.
+    GhostFreeSlip = 3,
+    /// Repulsive-force boundary particle (Monaghan 1994, Lennard-Jones form).
+    Repulsive = 4,
+}
+
+impl Kind {
+    pub fn is_fluid(self) -> bool {
+        self == Kind::Fluid
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -104,6 +117,50 @@ pub struct Probe {
     pub kind: ProbeKind,
 }
 
+/// How ghost particles interpolate pressure and velocity from the fluid (the kernel W^I).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GhostCorrection {
+    /// W_gj / Σ_k W_gk V_k (zeroth order).
+    Shepard,
+    /// First-order moving least squares (falls back to Shepard where ill-conditioned).
+    Mls,
+}
+
+/// A straight wall treated with mirrored ghosts: every fluid particle within 2h of the plane
+/// has a mirror image x_g = 2 x_w − x_i with p_g = p_i, ρ_g = ρ_i.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MirrorPlane {
+    /// A point of the plane.
+    pub point: [f64; 3],
+    /// Unit normal pointing into the fluid.
+    pub normal: [f64; 3],
+    /// No-slip: v_g = −v_i (wall at rest); free-slip: only the normal component reversed.
+    pub no_slip: bool,
+}
+
+/// Parameters of the wall treatments other than dynamic boundary particles.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WallParams {
+    pub ghost_correction: GhostCorrection,
+    /// Lennard-Jones strength D [m²/s²] of repulsive walls (Monaghan 1994: about 5 g H).
+    pub repulsive_d: f64,
+    /// Lennard-Jones cut-off r0 [m] (the initial particle spacing).
+    pub repulsive_r0: f64,
+    pub mirror_planes: Vec<MirrorPlane>,
+}
+
+impl WallParams {
+    /// Defaults for a case of spacing `dx` and highest water column `height` [m].
+    pub fn defaults(dx: f64, height: f64, gravity: f64) -> Self {
+        Self {
+            ghost_correction: GhostCorrection::Mls,
+            repulsive_d: 5.0 * gravity * height,
+            repulsive_r0: dx,
+            mirror_planes: Vec::new(),
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scenario {
     pub name: String,
@@ -112,10 +169,16 @@ pub struct Scenario {
     pub domain: Domain,
     pub particles: Vec<Particle>,
     pub probes: Vec<Probe>,
+    pub walls: WallParams,
 }
 
 impl Scenario {
     pub fn count(&self, kind: Kind) -> usize {
         self.particles.iter().filter(|p| p.kind == kind).count()
+    }
+
+    /// Particles of every boundary kind.
+    pub fn boundary_count(&self) -> usize {
+        self.particles.iter().filter(|p| !p.kind.is_fluid()).count()
     }
 }

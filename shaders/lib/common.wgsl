@@ -30,6 +30,11 @@ struct Params {
     delta_coef: f32,            // δ h c0 for δ-SPH (Molteni & Colagrossi 2009)
     cfl: f32,
     n_probes: u32,
+    // Walls
+    n_mirror_planes: u32,
+    ghost_mls: u32,             // 1: ghosts interpolate with MLS, 0: Shepard
+    repulsive_d: f32,           // Lennard-Jones D [m²/s²] (Monaghan 1994)
+    repulsive_r0: f32,          // Lennard-Jones cut-off r0 [m]
 }
 
 // Time-stepping state that lives on the GPU; read back once per batch of steps.
@@ -60,8 +65,15 @@ struct Pos {
 const KIND_SHIFT: u32 = 28u;
 const ID_MASK: u32 = 0x0FFFFFFFu;
 const KIND_FLUID: u32 = 0u;
-const KIND_WALL: u32 = 1u;
+const KIND_WALL: u32 = 1u;            // dynamic boundary particle
+const KIND_GHOST_NO_SLIP: u32 = 2u;   // fixed ghost, no-slip
+const KIND_GHOST_FREE_SLIP: u32 = 3u; // fixed ghost, free-slip
+const KIND_REPULSIVE: u32 = 4u;       // repulsive-force boundary particle
 const KIND_EXCLUDED: u32 = 15u;
+
+fn is_ghost(kind: u32) -> bool {
+    return kind == KIND_GHOST_NO_SLIP || kind == KIND_GHOST_FREE_SLIP;
+}
 
 fn code_kind(code: u32) -> u32 {
     return code >> KIND_SHIFT;
@@ -97,6 +109,12 @@ fn rel_pos(pi: Pos, pj: Pos) -> vec3<f32> {
 // Position from the domain's min corner, in f32 (for bounds checks and probes only).
 fn domain_pos(p: Pos) -> vec3<f32> {
     return vec3<f32>(unpack_block(p.block)) * params.block_size + p.off;
+}
+
+// A point given in domain coordinates, as a Pos (for probes and mirror images).
+fn pos_of_point(x: vec3<f32>) -> Pos {
+    let b = clamp(vec3<i32>(floor(x / params.block_size)), vec3<i32>(0), vec3<i32>(2047, 2047, 1023));
+    return Pos(x - vec3<f32>(b) * params.block_size, pack_block(b));
 }
 
 struct Moved {

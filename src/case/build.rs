@@ -4,7 +4,7 @@
 
 use std::collections::HashSet;
 
-use crate::scenario::{Domain, Kind, Particle, Physics, ProbeKind, Scenario};
+use crate::scenario::{Domain, Kind, Particle, Physics, ProbeKind, Scenario, WallParams};
 
 use super::error::CaseError;
 use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
@@ -281,6 +281,8 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
         delta_sph: case.delta_sph,
         particle_mass: mass,
     };
+    let g = case.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
+    let walls = WallParams::defaults(dx, highest_column(&particles, dim, dx), g);
     Ok(Scenario {
         name: case.name,
         physics,
@@ -288,6 +290,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
         domain,
         particles,
         probes: case.probes,
+        walls,
     })
 }
 
@@ -394,4 +397,21 @@ fn domain(
         min: d.min,
         max: d.max,
     })
+}
+
+/// Height of the fluid from its lowest to its highest particle (+ dx), the H of the default
+/// repulsive-wall strength D = 5 g H.
+fn highest_column(particles: &[Particle], dim: usize, dx: f64) -> f64 {
+    let up = dim - 1;
+    let (lo, hi) = particles
+        .iter()
+        .filter(|p| p.kind == Kind::Fluid)
+        .fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+            (lo.min(p.pos[up]), hi.max(p.pos[up]))
+        });
+    if lo > hi {
+        dx
+    } else {
+        hi - lo + dx
+    }
 }

@@ -8,6 +8,8 @@
 pub const WORKGROUP_SIZE: u32 = 128;
 
 pub const COMMON: &str = include_str!("../../shaders/lib/common.wgsl");
+/// First-order moving least squares (`shaders/lib/mls.wgsl`).
+pub const MLS: &str = include_str!("../../shaders/lib/mls.wgsl");
 
 /// One shader file per pass, named like its Rust module in `src/sph`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -17,15 +19,17 @@ pub enum Pass {
     Interaction,
     Integrate,
     Probes,
+    Ghost,
 }
 
 impl Pass {
-    pub const ALL: [Pass; 5] = [
+    pub const ALL: [Pass; 6] = [
         Pass::CellList,
         Pass::PrefixScan,
         Pass::Interaction,
         Pass::Integrate,
         Pass::Probes,
+        Pass::Ghost,
     ];
 
     pub fn name(self) -> &'static str {
@@ -35,6 +39,7 @@ impl Pass {
             Pass::Interaction => "interaction",
             Pass::Integrate => "integrate",
             Pass::Probes => "probes",
+            Pass::Ghost => "ghost",
         }
     }
 
@@ -45,6 +50,15 @@ impl Pass {
             Pass::Interaction => include_str!("../../shaders/interaction.wgsl"),
             Pass::Integrate => include_str!("../../shaders/integrate.wgsl"),
             Pass::Probes => include_str!("../../shaders/probes.wgsl"),
+            Pass::Ghost => include_str!("../../shaders/ghost.wgsl"),
+        }
+    }
+
+    /// Library files (after common.wgsl) this pass uses.
+    pub fn libs(self) -> &'static [&'static str] {
+        match self {
+            Pass::Ghost => &[MLS],
+            _ => &[],
         }
     }
 }
@@ -74,13 +88,14 @@ pub fn compose(pass: Pass, cfg: ShaderConfig) -> String {
     format!(
         "// wgsph: {name}.wgsl composed with lib/common.wgsl\n\
          const DIM: u32 = {dim}u;\nconst KERNEL: u32 = {kernel}u;\n\
-         const VISCOSITY: u32 = {visc}u;\nconst WG: u32 = {wg}u;\n\n{common}\n{pass}",
+         const VISCOSITY: u32 = {visc}u;\nconst WG: u32 = {wg}u;\n\n{common}\n{libs}\n{pass}",
         name = pass.name(),
         dim = cfg.dim,
         kernel = cfg.kernel,
         visc = cfg.viscosity,
         wg = WORKGROUP_SIZE,
         common = COMMON,
+        libs = pass.libs().concat(),
         pass = pass.source(),
     )
 }

@@ -1,72 +1,164 @@
 //! Twin of shaders/interaction.wgsl, brute force over all pairs (no cell list), f64.
 
-use super::{dot, kernel, laminar_nu, pressure, sub, RefParticle, FLUID};
-use crate::scenario::{Physics, Viscosity};
+use super::{
+    dot, kernel, laminar_nu, pressure, sub, RefParticle, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP,
+    REPULSIVE, WALL,
+};
+use crate::scenario::{Physics, Viscosity, WallParams};
 
-/// (dv/dt, dρ/dt) of every particle; walls get only dρ/dt.
-pub fn rates(ph: &Physics, parts: &[RefParticle]) -> Vec<[f64; 4]> {
+struct Pair<'a> {
+    ph: &'a Physics,
+    eta2: f64,
+    alpha: f64,
+    nu: Option<f64>,
+}
+
+impl Pair<'_> {
+    /// (dv/dt, dρ/dt) on fluid particle i from a pressure-carrying neighbour at x_ij.
+    #[allow(clippy::too_many_arguments)]
+    fn rates(
+        &self,
+        pi: &RefParticle,
+        x_ij: [f64; 3],
+        v_j: [f64; 3],
+        rho_j: f64,
+        diffuse: bool,
+        rho_ratio: f64,
+    ) -> [f64; 4] {
+        let (ph, m, h) = (self.ph, self.ph.particle_mass, self.ph.h);
+        let r2 = dot(x_ij, x_ij);
+        let f_ij = kernel::f(ph.kernel, ph.dim, h, r2.sqrt());
+        let dw = x_ij.map(|x| x * f_ij);
+        let v_ij = sub(pi.vel, v_j);
+        let mut drho = m * dot(v_ij, dw) * rho_ratio;
+        if diffuse {
+            drho += ph.delta_sph * h * ph.c0 * 2.0 * (pi.rho - rho_j) * f_ij * r2
+                / (r2 + self.eta2)
+                * m
+                / rho_j;
+        }
+        let mut acc = [0.0; 3];
+        let mut pi_ij = 0.0;
+        match self.nu {
+            None => {
+                let vx = dot(v_ij, x_ij);
+                if vx < 0.0 {
+                    let mu = h * vx / (r2 + self.eta2);
+                    pi_ij = -self.alpha * ph.c0 * mu / (0.5 * (pi.rho + rho_j));
+                }
+            }
+            Some(nu) => {
+                let c = m * 4.0 * nu * r2 * f_ij / ((pi.rho + rho_j) * (r2 + self.eta2));
+                for a in 0..3 {
+                    acc[a] += c * v_ij[a];
+                }
+            }
+        }
+        let p = pressure(ph, pi.rho) / (pi.rho * pi.rho)
+            + pressure(ph, rho_j) / (rho_j * rho_j)
+            + pi_ij;
+        for a in 0..3 {
+            acc[a] -= m * p * dw[a];
+        }
+        [acc[0], acc[1], acc[2], drho]
+    }
+}
+
+/// Lennard-Jones repulsion D((r0/r)^12 − (r0/r)^4) x/r² for r < r0 (Monaghan 1994).
+pub fn repulsion(walls: &WallParams, x_ij: [f64; 3]) -> [f64; 3] {
+    let r2 = dot(x_ij, x_ij);
+    let r0 = walls.repulsive_r0;
+    if r2 >= r0 * r0 || r2 <= 0.0 {
+        return [0.0; 3];
+    }
+    let q2 = r0 * r0 / r2;
+    let f = walls.repulsive_d * (q2.powi(6) - q2.powi(2)) / r2;
+    x_ij.map(|x| f * x)
+}
+
+fn add(a: &mut [f64; 4], b: [f64; 4]) {
+    for k in 0..4 {
+        a[k] += b[k];
+    }
+}
+
+/// (dv/dt, dρ/dt) of every particle: fluid gets everything, dynamic walls only dρ/dt from
+/// fluid neighbours, ghosts and repulsive particles nothing.
+pub fn rates(ph: &Physics, walls: &WallParams, parts: &[RefParticle]) -> Vec<[f64; 4]> {
     let h = ph.h;
-    let m = ph.particle_mass;
-    let eta2 = 0.01 * h * h;
-    let delta_coef = ph.delta_sph * h * ph.c0;
-    let alpha = match ph.viscosity {
-        Viscosity::Artificial { alpha } => alpha,
-        Viscosity::Laminar { .. } => 0.0,
+    let pair = Pair {
+        ph,
+        eta2: 0.01 * h * h,
+        alpha: match ph.viscosity {
+            Viscosity::Artificial { alpha } => alpha,
+            Viscosity::Laminar { .. } => 0.0,
+        },
+        nu: laminar_nu(ph),
     };
-    let nu = laminar_nu(ph);
+    let support2 = 4.0 * h * h;
     parts
         .iter()
         .enumerate()
         .map(|(i, pi)| {
-            let fluid_i = pi.kind == FLUID;
-            let p_i = pressure(ph, pi.rho) / (pi.rho * pi.rho);
-            let mut acc = [0.0; 3];
-            let mut drho = 0.0;
+            let mut r = [0.0; 4];
+            if pi.kind == WALL {
+                for (j, pj) in parts.iter().enumerate() {
+                    let x_ij = sub(pi.pos, pj.pos);
+                    let r2 = dot(x_ij, x_ij);
+                    if j != i && r2 < support2 && pj.kind == FLUID {
+                        let f_ij = kernel::f(ph.kernel, ph.dim, h, r2.sqrt());
+                        r[3] += ph.particle_mass * dot(sub(pi.vel, pj.vel), x_ij.map(|x| x * f_ij));
+                    }
+                }
+                return r;
+            }
+            if pi.kind != FLUID {
+                return r;
+            }
             for (j, pj) in parts.iter().enumerate() {
                 let x_ij = sub(pi.pos, pj.pos);
                 let r2 = dot(x_ij, x_ij);
-                let fluid_j = pj.kind == FLUID;
-                if j == i || r2 >= 4.0 * h * h || (!fluid_i && !fluid_j) {
+                if j == i || r2 >= support2 {
                     continue;
                 }
-                let f_ij = kernel::f(ph.kernel, ph.dim, h, r2.sqrt());
-                let dw = x_ij.map(|x| x * f_ij);
-                let v_ij = sub(pi.vel, pj.vel);
-                drho += m * dot(v_ij, dw);
-                if !fluid_i {
+                if pj.kind == REPULSIVE {
+                    let f = repulsion(walls, x_ij);
+                    add(&mut r, [f[0], f[1], f[2], 0.0]);
                     continue;
                 }
-                if fluid_j {
-                    drho +=
-                        delta_coef * 2.0 * (pi.rho - pj.rho) * f_ij * r2 / (r2 + eta2) * m / pj.rho;
+                let ghost = pj.kind == GHOST_NO_SLIP || pj.kind == GHOST_FREE_SLIP;
+                let ratio = if ghost { pi.rho / pj.rho } else { 1.0 };
+                add(
+                    &mut r,
+                    pair.rates(pi, x_ij, pj.vel, pj.rho, pj.kind == FLUID, ratio),
+                );
+            }
+            // Mirror images of the fluid particles j across each plane near i.
+            for plane in &walls.mirror_planes {
+                let n = plane.normal;
+                if dot(sub(pi.pos, plane.point), n) >= 2.0 * h {
+                    continue;
                 }
-                let mut pi_ij = 0.0;
-                match nu {
-                    None => {
-                        let vx = dot(v_ij, x_ij);
-                        if vx < 0.0 {
-                            let mu = h * vx / (r2 + eta2);
-                            pi_ij = -alpha * ph.c0 * mu / (0.5 * (pi.rho + pj.rho));
-                        }
+                for pj in parts.iter().filter(|p| p.kind == FLUID) {
+                    let dj = dot(sub(pj.pos, plane.point), n);
+                    let x_g = [0, 1, 2].map(|a| pj.pos[a] - 2.0 * dj * n[a]);
+                    let x_ig = sub(pi.pos, x_g);
+                    if dot(x_ig, x_ig) >= support2 {
+                        continue;
                     }
-                    Some(nu) => {
-                        let c = m * 4.0 * nu * r2 * f_ij / ((pi.rho + pj.rho) * (r2 + eta2));
-                        for a in 0..3 {
-                            acc[a] += c * v_ij[a];
-                        }
-                    }
-                }
-                let p_j = pressure(ph, pj.rho) / (pj.rho * pj.rho);
-                for a in 0..3 {
-                    acc[a] -= m * (p_i + p_j + pi_ij) * dw[a];
+                    let vn = dot(pj.vel, n);
+                    let v_g = if plane.no_slip {
+                        pj.vel.map(|v| -v)
+                    } else {
+                        [0, 1, 2].map(|a| pj.vel[a] - 2.0 * vn * n[a])
+                    };
+                    add(&mut r, pair.rates(pi, x_ig, v_g, pj.rho, true, 1.0));
                 }
             }
-            if fluid_i {
-                for a in 0..3 {
-                    acc[a] += ph.gravity[a];
-                }
+            for a in 0..3 {
+                r[a] += ph.gravity[a];
             }
-            [acc[0], acc[1], acc[2], drho]
+            r
         })
         .collect()
 }

@@ -5,6 +5,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod cell_list;
+pub mod ghost;
 pub mod integrate;
 pub mod interaction;
 pub mod kernel;
@@ -24,6 +25,9 @@ pub struct RefParticle {
 
 pub const FLUID: u32 = 0;
 pub const WALL: u32 = 1;
+pub const GHOST_NO_SLIP: u32 = 2;
+pub const GHOST_FREE_SLIP: u32 = 3;
+pub const REPULSIVE: u32 = 4;
 
 /// Tait equation of state, P = B((ρ/ρ0)^γ − 1).
 pub fn pressure(ph: &Physics, rho: f64) -> f64 {

@@ -2,7 +2,7 @@
 //! from one into the other); everything else is single.
 
 use crate::gpu::buffers::{storage, storage_init, uniform_init};
-use crate::layout::{Params, Pos, ProbeDef, SimState};
+use crate::layout::{MirrorPlane, Params, Pos, ProbeDef, SimState};
 
 pub struct ParticleBuffers {
     pub n: u32,
@@ -29,6 +29,7 @@ pub struct ParticleBuffers {
     pub scan_sizes: Vec<u32>,
     pub probes: wgpu::Buffer,
     pub probe_out: wgpu::Buffer,
+    pub mirror_planes: wgpu::Buffer,
 }
 
 /// Stand-in so a run without probes still binds a valid buffer.
@@ -52,6 +53,7 @@ impl ParticleBuffers {
         slots: u32,
         init: &InitialParticles,
         probes: &[ProbeDef],
+        planes: &[MirrorPlane],
     ) -> Self {
         let n = init.pos.len() as u32;
         let vec4 = 16 * n as u64;
@@ -103,6 +105,15 @@ impl ParticleBuffers {
                 },
             ),
             probe_out: storage(device, "probe out", 4 * probes.len().max(1) as u64),
+            mirror_planes: if planes.is_empty() {
+                storage(
+                    device,
+                    "mirror planes",
+                    std::mem::size_of::<MirrorPlane>() as u64,
+                )
+            } else {
+                storage_init(device, "mirror planes", planes)
+            },
         }
     }
 
@@ -119,6 +130,7 @@ impl ParticleBuffers {
             &self.cell_start,
             &self.probes,
             &self.probe_out,
+            &self.mirror_planes,
         ];
         all.extend(
             self.pos

@@ -23,6 +23,7 @@ impl Interaction {
                 (3, &b.code[p]),
                 (4, &b.cell_start),
                 (5, &b.rate),
+                (6, &b.mirror_planes),
             ]
         };
         let bind = [

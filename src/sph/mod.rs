@@ -4,6 +4,7 @@
 
 pub mod buffers;
 pub mod cell_list;
+pub mod ghost;
 pub mod grid;
 pub mod integrate;
 pub mod interaction;
@@ -18,9 +19,10 @@ use crate::gpu::GpuContext;
 use crate::layout::{
     pack_block, unpack_block, Params, Pos, SimState, ID_MASK, KIND_EXCLUDED, KIND_SHIFT,
 };
-use crate::scenario::{KernelKind, Kind, Scenario, Viscosity};
+use crate::scenario::{GhostCorrection, KernelKind, Kind, Scenario, Viscosity};
 use buffers::{InitialParticles, ParticleBuffers};
 use cell_list::CellList;
+use ghost::Ghost;
 use grid::Grid;
 use integrate::Integrate;
 use interaction::Interaction;
@@ -64,6 +66,20 @@ pub struct Particles {
 /// (positions, (v, ρ), code words) as stored on the GPU.
 pub type RawParticles = (Vec<Pos>, Vec<[f32; 4]>, Vec<u32>);
 
+/// GPU mirror planes in domain coordinates.
+fn mirror_planes(sc: &Scenario, origin: [f64; 3]) -> Vec<crate::layout::MirrorPlane> {
+    sc.walls
+        .mirror_planes
+        .iter()
+        .map(|m| crate::layout::MirrorPlane {
+            point: [0, 1, 2].map(|a| (m.point[a] - origin[a]) as f32),
+            no_slip: m.no_slip as u32,
+            normal: m.normal.map(|x| x as f32),
+            pad: 0,
+        })
+        .collect()
+}
+
 /// SPH kernel normalisation α_d (support 2h) of `kernel` in `dim` dimensions.
 pub fn kernel_norm(kernel: KernelKind, dim: u32, h: f64) -> f64 {
     use std::f64::consts::PI;
@@ -83,6 +99,8 @@ pub struct Solver {
     buffers: ParticleBuffers,
     cell_list: CellList,
     interaction: Interaction,
+    ghost: Ghost,
+    has_ghosts: bool,
     integrate: Integrate,
     probes: Probes,
     parity: usize,
@@ -146,6 +164,10 @@ impl Solver {
             delta_coef: (ph.delta_sph * ph.h * ph.c0) as f32,
             cfl: sc.time.cfl as f32,
             n_probes: sc.probes.len() as u32,
+            n_mirror_planes: sc.walls.mirror_planes.len() as u32,
+            ghost_mls: (sc.walls.ghost_correction == GhostCorrection::Mls) as u32,
+            repulsive_d: sc.walls.repulsive_d as f32,
+            repulsive_r0: sc.walls.repulsive_r0 as f32,
         };
         let cfg = ShaderConfig {
             dim: ph.dim,
@@ -174,6 +196,7 @@ impl Solver {
         }
         let device = ctx.device.clone();
         let defs = probes::probe_defs(&sc.probes, grid.origin);
+        let planes = mirror_planes(sc, grid.origin);
         let buffers = ParticleBuffers::new(
             &device,
             &params,
@@ -184,6 +207,7 @@ impl Solver {
                 code: &code,
             },
             &defs,
+            &planes,
         );
         let module = |pass| ShaderModule::new(&device, pass, cfg);
         let cell_list = CellList::new(
@@ -193,6 +217,7 @@ impl Solver {
             &buffers,
         )?;
         let interaction = Interaction::new(&device, &module(Pass::Interaction)?, &buffers)?;
+        let ghost = Ghost::new(&device, &module(Pass::Ghost)?, &buffers)?;
         let integrate = Integrate::new(&device, &module(Pass::Integrate)?, &buffers)?;
         let probes = Probes::new(&device, &module(Pass::Probes)?, &buffers, &defs)?;
         let mut solver = Self {
@@ -203,6 +228,11 @@ impl Solver {
             buffers,
             cell_list,
             interaction,
+            ghost,
+            has_ghosts: sc
+                .particles
+                .iter()
+                .any(|p| matches!(p.kind, Kind::GhostNoSlip | Kind::GhostFreeSlip)),
             integrate,
             probes,
             parity: 0,
@@ -267,6 +297,9 @@ impl Solver {
             });
             self.integrate.encode_predict(&mut pass, p);
             self.cell_list.encode(&mut pass, p);
+            if self.has_ghosts {
+                self.ghost.encode(&mut pass, q);
+            }
             self.interaction.encode(&mut pass, q);
             self.integrate.encode_correct(&mut pass, q);
             drop(pass);

@@ -72,6 +72,7 @@ pub fn scenario(
     domain: Domain,
     probes: Vec<Probe>,
 ) -> Scenario {
+    let physics_dx = physics.dx;
     Scenario {
         name: "test".into(),
         physics,
@@ -81,6 +82,7 @@ pub fn scenario(
             probe_every_s: 0.1,
             cfl: 0.2,
         },
+        walls: WallParams::defaults(physics_dx, 0.5, 9.81),
         domain,
         particles,
         probes,

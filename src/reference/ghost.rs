@@ -1,0 +1,162 @@
+//! Twin of shaders/ghost.wgsl: ghost pressure (as ρ) and velocity interpolated from the fluid.
+
+use super::{dot, kernel, pressure, sub, RefParticle, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP};
+use crate::scenario::{GhostCorrection, Physics, WallParams};
+
+/// Smallest accepted MLS pivot relative to A00 = Σ W V (as `MLS_MIN_PIVOT` in mls.wgsl).
+pub const MLS_MIN_PIVOT: f64 = 0.03;
+
+/// The smallest pivot of the elimination relative to A00 (the conditioning the GPU tests).
+pub fn min_pivot_ratio(dim: usize, a: [[f64; 4]; 4]) -> f64 {
+    let n = dim + 1;
+    let mut m = a;
+    let mut worst = f64::MAX;
+    for k in 0..n {
+        let piv = (k..n)
+            .max_by(|&x, &y| m[x][k].abs().total_cmp(&m[y][k].abs()))
+            .unwrap();
+        m.swap(k, piv);
+        worst = worst.min(m[k][k].abs() / a[0][0]);
+        if m[k][k] == 0.0 {
+            return 0.0;
+        }
+        for r in k + 1..n {
+            let f = m[r][k] / m[k][k];
+            for c in 0..n {
+                m[r][c] -= f * m[k][c];
+            }
+        }
+    }
+    worst
+}
+
+/// The MLS moment matrix Σ_j W_gj V_j b bᵀ, b = [1, x_gj/h], over fluid particles.
+pub fn moment_matrix(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> [[f64; 4]; 4] {
+    let mut a = [[0.0; 4]; 4];
+    for j in parts.iter().filter(|p| p.kind == FLUID) {
+        let d = sub(x, j.pos);
+        let r = dot(d, d).sqrt();
+        if r < 2.0 * ph.h {
+            let wv = kernel::w(ph.kernel, ph.dim, ph.h, r) * ph.particle_mass / j.rho;
+            let b = basis(ph.dim as usize, ph.h, d);
+            for r in 0..4 {
+                for c in 0..4 {
+                    a[r][c] += wv * b[r] * b[c];
+                }
+            }
+        }
+    }
+    a
+}
+
+/// β = A⁻¹ e1 of the (d+1)×(d+1) MLS system, None when a pivot is below MLS_MIN_PIVOT·A00
+/// (as the GPU).
+pub fn mls_beta(dim: usize, a: [[f64; 4]; 4]) -> Option<[f64; 4]> {
+    let n = dim + 1;
+    let mut m = a;
+    let mut rhs = [1.0, 0.0, 0.0, 0.0];
+    let tiny = MLS_MIN_PIVOT * a[0][0];
+    if a[0][0] <= 0.0 {
+        return None;
+    }
+    for k in 0..n {
+        let piv = (k..n)
+            .max_by(|&x, &y| m[x][k].abs().total_cmp(&m[y][k].abs()))
+            .unwrap();
+        if m[piv][k].abs() <= tiny {
+            return None;
+        }
+        m.swap(k, piv);
+        rhs.swap(k, piv);
+        for r in 0..n {
+            if r != k {
+                let f = m[r][k] / m[k][k];
+                for c in 0..n {
+                    m[r][c] -= f * m[k][c];
+                }
+                rhs[r] -= f * rhs[k];
+            }
+        }
+    }
+    let mut beta = [0.0; 4];
+    for k in 0..n {
+        beta[k] = rhs[k] / m[k][k];
+    }
+    Some(beta)
+}
+
+/// [1, x/h] with the unused z left 0 in 2D.
+pub fn basis(dim: usize, h: f64, x: [f64; 3]) -> [f64; 4] {
+    [
+        1.0,
+        x[0] / h,
+        x[1] / h,
+        if dim == 3 { x[2] / h } else { 0.0 },
+    ]
+}
+
+/// Sets (v, ρ) of every ghost from the fluid; other particles are returned unchanged.
+pub fn interpolate(ph: &Physics, walls: &WallParams, parts: &[RefParticle]) -> Vec<RefParticle> {
+    let dim = ph.dim as usize;
+    let h = ph.h;
+    parts
+        .iter()
+        .map(|g| {
+            if g.kind != GHOST_NO_SLIP && g.kind != GHOST_FREE_SLIP {
+                return *g;
+            }
+            let mut a = [[0.0; 4]; 4];
+            let mut m_p = [0.0; 4];
+            let mut m_v = [[0.0; 4]; 3];
+            let mut toward = [0.0; 3];
+            for j in parts.iter().filter(|p| p.kind == FLUID) {
+                let x = sub(g.pos, j.pos);
+                let r2 = dot(x, x);
+                if r2 >= 4.0 * h * h {
+                    continue;
+                }
+                let wv = kernel::w(ph.kernel, ph.dim, h, r2.sqrt()) * ph.particle_mass / j.rho;
+                let b = basis(dim, h, x);
+                let p = pressure(ph, j.rho) + j.rho * dot(ph.gravity, x);
+                for r in 0..4 {
+                    for c in 0..4 {
+                        a[r][c] += wv * b[r] * b[c];
+                    }
+                    m_p[r] += p * wv * b[r];
+                    for k in 0..3 {
+                        m_v[k][r] += j.vel[k] * wv * b[r];
+                    }
+                }
+                for k in 0..3 {
+                    toward[k] -= x[k] * wv;
+                }
+            }
+            let (mut p, mut v) = (0.0, [0.0; 3]);
+            if a[0][0] > 1e-6 {
+                let mut beta = [1.0 / a[0][0], 0.0, 0.0, 0.0];
+                if walls.ghost_correction == GhostCorrection::Mls {
+                    if let Some(b) = mls_beta(dim, a) {
+                        beta = b;
+                    }
+                }
+                let d4 = |m: [f64; 4]| (0..4).map(|k| beta[k] * m[k]).sum::<f64>();
+                p = d4(m_p);
+                v = [d4(m_v[0]), d4(m_v[1]), d4(m_v[2])];
+            }
+            let mut out = *g;
+            out.vel = v.map(|x| -x);
+            if g.kind == GHOST_FREE_SLIP {
+                let len = dot(toward, toward).sqrt();
+                let n = if len > 0.0 {
+                    toward.map(|x| x / len)
+                } else {
+                    [0.0; 3]
+                };
+                let vn = dot(v, n);
+                out.vel = [0, 1, 2].map(|k| v[k] - 2.0 * vn * n[k]);
+            }
+            out.rho = ph.rho0 * (1.0 + p / ph.tait_b()).max(0.5).powf(1.0 / ph.gamma);
+            out
+        })
+        .collect()
+}
