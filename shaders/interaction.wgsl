@@ -16,7 +16,8 @@
 //   enter the sums like fluid; repulsive particles exert only the Lennard-Jones force
 //   D((r0/r)^12 − (r0/r)^4) x_ij/r² for r < r0 (Monaghan 1994, eq. 3.2); mirror planes add, for
 //   each fluid j near the image of i, the ghost x_g = 2x_w − x_j with p_g = p_j, ρ_g = ρ_j and
-//   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip).
+//   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip); near a corner
+//   also the double image across both planes.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
 // get nothing.
 
@@ -79,39 +80,73 @@ fn repulsion(x_ij: vec3<f32>, r2: f32) -> vec3<f32> {
     return params.repulsive_d * (q12 - q4) / r2 * x_ij;
 }
 
-// Sum over the mirror images, in the planes near x_i, of the fluid particles near i's image.
-fn mirror_rates(i: u32, pi: Particle) -> vec4<f32> {
+const NO_PLANE: u32 = 0xFFFFFFFFu;
+
+fn reflect_vec(v: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    return v - 2.0 * dot(v, n) * n;
+}
+
+fn reflect_point(x: vec3<f32>, plane: MirrorPlane) -> vec3<f32> {
+    return x - 2.0 * dot(x - plane.point, plane.normal) * plane.normal;
+}
+
+// Velocity of a ghost across `plane`: normal part reversed (free-slip) or all (no-slip).
+fn ghost_velocity(v: vec3<f32>, plane: MirrorPlane) -> vec3<f32> {
+    return select(reflect_vec(v, plane.normal), -v, plane.no_slip != 0u);
+}
+
+// Ghosts seen by i through plane k1, or through k1 and then k2 (the corner image, without
+// which fluid leaks out of corners). `image` is i reflected the opposite way, so that the
+// ghosts of i's neighbourhood are the fluid particles near `image`, transformed back.
+fn image_rates(pi: Particle, image: vec3<f32>, k1: u32, k2: u32) -> vec4<f32> {
     var out = vec4<f32>(0.0);
     let support2 = 4.0 * params.h * params.h;
+    let p1 = mirror_planes[k1];
+    let double = k2 != NO_PLANE;
+    let p2 = mirror_planes[select(k1, k2, double)];
+    let at = pos_of_point(image);
+    var slots: array<u32, 27>;
+    let n_slots = neighbour_slots(cell_of(at), &slots);
+    for (var s = 0u; s < n_slots; s++) {
+        for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
+            if (code_kind(code[j]) != KIND_FLUID) {
+                continue;
+            }
+            let x = rel_pos(at, pos[j]);
+            let r2 = dot(x, x);
+            if (r2 >= support2) {
+                continue;
+            }
+            var x_ig = x;
+            var v_g = velrho[j].xyz;
+            if (double) {
+                x_ig = reflect_vec(x_ig, p2.normal);
+                v_g = ghost_velocity(v_g, p2);
+            }
+            x_ig = reflect_vec(x_ig, p1.normal);
+            v_g = ghost_velocity(v_g, p1);
+            out += pair_rates(pi, x_ig, r2, v_g, velrho[j].w, true, 1.0);
+        }
+    }
+    return out;
+}
+
+// Sum over the mirror images across the planes (and pairs of planes) within 2h of i.
+fn mirror_rates(i: u32, pi: Particle) -> vec4<f32> {
+    var out = vec4<f32>(0.0);
     let xi = domain_pos(pos[i]);
-    for (var k = 0u; k < params.n_mirror_planes; k++) {
-        let plane = mirror_planes[k];
-        let n = plane.normal;
-        let d = dot(xi - plane.point, n);
-        if (d >= 2.0 * params.h) {
+    let reach = 2.0 * params.h;
+    for (var k1 = 0u; k1 < params.n_mirror_planes; k1++) {
+        let p1 = mirror_planes[k1];
+        if (dot(xi - p1.point, p1.normal) >= reach) {
             continue;
         }
-        let image = pos_of_point(xi - 2.0 * d * n);
-        var slots: array<u32, 27>;
-        let n_slots = neighbour_slots(cell_of(image), &slots);
-        for (var s = 0u; s < n_slots; s++) {
-            for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
-                if (code_kind(code[j]) != KIND_FLUID) {
-                    continue;
-                }
-                let x = rel_pos(image, pos[j]);
-                let r2 = dot(x, x);
-                if (r2 >= support2) {
-                    continue;
-                }
-                // x_i − x_g is the reflection of x_i' − x_j.
-                let x_ig = x - 2.0 * dot(x, n) * n;
-                let vr_j = velrho[j];
-                var v_g = vr_j.xyz - 2.0 * dot(vr_j.xyz, n) * n;
-                if (plane.no_slip != 0u) {
-                    v_g = -vr_j.xyz;
-                }
-                out += pair_rates(pi, x_ig, r2, v_g, vr_j.w, true, 1.0);
+        let once = reflect_point(xi, p1);
+        out += image_rates(pi, once, k1, NO_PLANE);
+        for (var k2 = k1 + 1u; k2 < params.n_mirror_planes; k2++) {
+            let p2 = mirror_planes[k2];
+            if (dot(xi - p2.point, p2.normal) < reach) {
+                out += image_rates(pi, reflect_point(once, p2), k1, k2);
             }
         }
     }

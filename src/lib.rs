@@ -4,6 +4,7 @@ pub mod case;
 pub mod gpu;
 pub mod layout;
 pub mod output;
+pub mod plot;
 pub mod reference;
 pub mod run;
 pub mod scenario;

@@ -37,6 +37,32 @@ enum Command {
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         set: Vec<String>,
     },
+    /// Plot every probe time series of a finished run as PNG (DIR/plots/<probe>.png).
+    Plot {
+        /// The run's output directory (the --out of `wgsph run`).
+        dir: PathBuf,
+        /// Overlay reference data on a probe and report the error against it:
+        /// PROBE=FILE.csv[:XSCALE:YSCALE] ('#' comments, a header, two columns; x and y are
+        /// multiplied by the scales). Repeatable. Errors also go to DIR/plots/errors.csv.
+        #[arg(long = "reference", value_name = "PROBE=FILE[:XSCALE:YSCALE]")]
+        references: Vec<wgsph::plot::ReferenceSpec>,
+        /// Draw the same probes of another run on the same axes: LABEL=DIR. Repeatable.
+        #[arg(long = "with", value_name = "LABEL=DIR")]
+        others: Vec<wgsph::plot::OtherRun>,
+        /// Legend label of DIR's run (default: its case name).
+        #[arg(long)]
+        label: Option<String>,
+        /// Plot only this probe (repeatable; default: all).
+        #[arg(long = "probe", value_name = "NAME")]
+        probes: Vec<String>,
+        /// Plot (and compare) only up to this time, in seconds.
+        #[arg(long)]
+        t_max: Option<f64>,
+        /// Centred moving average of the simulated series over this many seconds, before
+        /// drawing and comparing (default: raw samples).
+        #[arg(long, value_name = "SECONDS")]
+        smooth: Option<f64>,
+    },
     /// List the adapters wgpu sees and their limits.
     Info,
     /// Time N steps of a case (after a warm-up) and report particle-steps per second.
@@ -90,6 +116,49 @@ fn run(cli: Cli) -> Result<ExitCode> {
             } else {
                 ExitCode::SUCCESS
             })
+        }
+        Command::Plot {
+            dir,
+            references,
+            others,
+            label,
+            probes,
+            t_max,
+            smooth,
+        } => {
+            let opts = wgsph::plot::PlotOptions {
+                references,
+                label,
+                others,
+                probes,
+                t_max_s: t_max,
+                smooth_s: smooth,
+            };
+            let report = wgsph::plot::plot_run(&dir, &opts)?;
+            for p in &report.pngs {
+                println!("wrote {}", p.display());
+            }
+            for e in &report.errors {
+                println!(
+                    "{}{} {} vs {}: {} points, t in [{:.4}, {:.4}] s: RMS error {:.4e}, max |error| {:.4e} at t = {:.4} s, peak {:.4e} (reference {:.4e})",
+                    e.run,
+                    if e.smooth_s > 0.0 { format!(" ({} s average)", e.smooth_s) } else { String::new() },
+                    e.probe,
+                    e.reference,
+                    e.points,
+                    e.t_start_s,
+                    e.t_end_s,
+                    e.rms_error,
+                    e.max_abs_error,
+                    e.t_max_abs_error_s,
+                    e.peak_sim,
+                    e.peak_reference
+                );
+            }
+            if let Some(p) = &report.errors_csv {
+                println!("wrote {}", p.display());
+            }
+            Ok(ExitCode::SUCCESS)
         }
         Command::Info => {
             let adapters = list_adapters();

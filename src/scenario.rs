@@ -73,6 +73,20 @@ pub struct Physics {
     pub delta_sph: f64,
     /// Mass of every particle [kg] (ρ0·dx^dim).
     pub particle_mass: f64,
+    /// Periodic density re-initialisation of the fluid (Shepard or MLS filter).
+    pub density_filter: DensityFilter,
+}
+
+/// Density re-initialisation every `every` steps (Colagrossi & Landrini 2003): the fluid
+/// densities are replaced by a kernel interpolation of the densities around each particle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DensityFilter {
+    #[default]
+    None,
+    /// Zeroth order: ρ_i = Σ_j m_j W_ij / Σ_j W_ij m_j/ρ_j.
+    Shepard { every: u32 },
+    /// First-order moving least squares: ρ_i = Σ_j m_j W^MLS_ij (Shepard where ill-conditioned).
+    Mls { every: u32 },
 }
 
 impl Physics {
@@ -170,6 +184,9 @@ pub struct Scenario {
     pub particles: Vec<Particle>,
     pub probes: Vec<Probe>,
     pub walls: WallParams,
+    /// Periodic axes: a particle leaving the domain through one face re-enters through the
+    /// opposite one, and neighbours are found across it (minimum image).
+    pub periodic: [bool; 3],
 }
 
 impl Scenario {

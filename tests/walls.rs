@@ -11,7 +11,7 @@ use wgsph::sph::Solver;
 const L: f64 = 0.3;
 
 /// Jittered fluid over a no-slip ghost floor, a repulsive left wall, a free-slip ghost right
-/// wall, and a mirror lid just above the fluid.
+/// wall, a mirror lid just above the fluid and a no-slip mirror plane on the right.
 fn wall_scenario(dim: u32, correction: GhostCorrection, seed: u64) -> Scenario {
     let dx = 0.02;
     let mut ph = physics(dim, dx, 15.0);
@@ -65,11 +65,13 @@ fn wall_scenario(dim: u32, correction: GhostCorrection, seed: u64) -> Scenario {
     point[up] = o + L + 0.5 * dx;
     let mut normal = [0.0; 3];
     normal[up] = -1.0;
-    sc.walls.mirror_planes = vec![MirrorPlane {
-        point,
-        normal,
-        no_slip: false,
-    }];
+    // A second plane on the right makes a corner with the lid (double images).
+    let mut right = [0.0; 3];
+    right[0] = o + L;
+    sc.walls.mirror_planes = vec![
+        MirrorPlane { point, normal, no_slip: false },
+        MirrorPlane { point: right, normal: [-1.0, 0.0, 0.0], no_slip: true },
+    ];
     sc
 }
 
@@ -95,7 +97,7 @@ fn ghosts_repulsion_and_mirrors_match_reference() {
             let solver = Solver::new(gpu(), &sc).unwrap();
             let gpu_parts = gpu_particles(&solver);
             // Ghost values: the reference interpolates from the GPU's fluid.
-            let cpu_parts = reference::ghost::interpolate(&sc.physics, &sc.walls, &gpu_parts);
+            let cpu_parts = reference::ghost::interpolate(&sc.physics, &sc.walls, &reference::Space::of(&sc), &gpu_parts);
             let mut ghosts = 0;
             let (mut ev, mut er) = (0.0f64, 0.0f64);
             for (g, c) in gpu_parts.iter().zip(&cpu_parts) {
@@ -103,7 +105,7 @@ fn ghosts_repulsion_and_mirrors_match_reference() {
                 // the threshold: those few are left out of the comparison.
                 let ratio = reference::ghost::min_pivot_ratio(
                     sc.physics.dim as usize,
-                    reference::ghost::moment_matrix(&sc.physics, &gpu_parts, g.pos),
+                    reference::ghost::moment_matrix(&sc.physics, &reference::Space::of(&sc), &gpu_parts, g.pos),
                 );
                 let borderline = correction == GhostCorrection::Mls
                     && (ratio / reference::ghost::MLS_MIN_PIVOT - 1.0).abs() < 0.1;
@@ -119,7 +121,7 @@ fn ghosts_repulsion_and_mirrors_match_reference() {
             }
             // Rates: the reference evaluates on the GPU's own ghost values.
             let gpu_rates = solver.rerun_interaction(true).unwrap();
-            let cpu_rates = reference::interaction::rates(&sc.physics, &sc.walls, &gpu_parts);
+            let cpu_rates = reference::interaction::rates(&sc.physics, &sc.walls, &reference::Space::of(&sc), &gpu_parts);
             let rms = (cpu_rates
                 .iter()
                 .map(|r| r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
@@ -172,7 +174,7 @@ fn mls_ghosts_extrapolate_a_linear_pressure_exactly() {
             let mut worst: f64 = 0.0;
             let mut checked = 0;
             for g in parts.iter().filter(|p| p.kind == reference::GHOST_NO_SLIP) {
-                let a = reference::ghost::moment_matrix(&ph, &parts, g.pos);
+                let a = reference::ghost::moment_matrix(&ph, &reference::Space::OPEN, &parts, g.pos);
                 if reference::ghost::min_pivot_ratio(dim as usize, a)
                     < 1.2 * reference::ghost::MLS_MIN_PIVOT
                 {

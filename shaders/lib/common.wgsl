@@ -8,10 +8,10 @@ struct Params {
     // small anywhere in a large domain; a block is `cells_per_block` cells of `cell_size`.
     grid_cells: vec3<u32>,      // cells of the domain along x, y, z
     hash_mask: u32,             // slots - 1; the slot table has `slots` (power of two) entries
-    block_size: f32,            // [m]
-    cell_size: f32,             // [m], = kernel support 2h
-    inv_cell_size: f32,
+    block_size: vec3<f32>,      // [m] per axis
     cells_per_block: u32,
+    inv_cell_size: vec3<f32>,   // cells are 2h, or the period split in whole cells
+    periodic: u32,              // bit a: axis a is periodic
     domain_size: vec3<f32>,     // [m], domain extent from its min corner
     n_particles: u32,
     // Kernel
@@ -100,10 +100,19 @@ fn pack_block(b: vec3<i32>) -> u32 {
     return u32(b.x) | (u32(b.y) << 11u) | (u32(b.z) << 22u);
 }
 
-// x_i - x_j, exact block difference plus offset difference: precise for neighbours anywhere.
+fn periodic_axes() -> vec3<bool> {
+    return vec3<bool>((params.periodic & 1u) != 0u, (params.periodic & 2u) != 0u, (params.periodic & 4u) != 0u);
+}
+
+// x_i - x_j, exact block difference plus offset difference: precise for neighbours anywhere;
+// the nearest image on periodic axes.
 fn rel_pos(pi: Pos, pj: Pos) -> vec3<f32> {
     let db = vec3<f32>(unpack_block(pi.block) - unpack_block(pj.block));
-    return db * params.block_size + (pi.off - pj.off);
+    let x = db * params.block_size + (pi.off - pj.off);
+    if (params.periodic == 0u) {
+        return x;
+    }
+    return select(x, x - params.domain_size * round(x / params.domain_size), periodic_axes());
 }
 
 // Position from the domain's min corner, in f32 (for bounds checks and probes only).
@@ -128,9 +137,18 @@ struct Moved {
 fn move_by(p: Pos, d: vec3<f32>) -> Moved {
     let off = p.off + d;
     let shift = floor(off / params.block_size);
-    let b = unpack_block(p.block) + vec3<i32>(shift);
-    let new_off = off - shift * params.block_size;
-    let x = vec3<f32>(b) * params.block_size + new_off;
+    var b = unpack_block(p.block) + vec3<i32>(shift);
+    var new_off = off - shift * params.block_size;
+    var x = vec3<f32>(b) * params.block_size + new_off;
+    let wrap = periodic_axes() & ((x < vec3<f32>(0.0)) | (x >= params.domain_size));
+    if (any(wrap)) {
+        // Re-entry through the opposite face: re-block from the wrapped domain position (the
+        // f32 rounding of the domain coordinate is paid once per crossing).
+        x = select(x, x - params.domain_size * floor(x / params.domain_size), wrap);
+        let bw = floor(x / params.block_size);
+        b = select(b, vec3<i32>(bw), wrap);
+        new_off = select(new_off, x - bw * params.block_size, wrap);
+    }
     let inside = all(x >= vec3<f32>(0.0)) && all(x <= params.domain_size)
         && all(b >= vec3<i32>(0)) && all(b <= vec3<i32>(2047, 2047, 1023));
     let bc = clamp(b, vec3<i32>(0), vec3<i32>(2047, 2047, 1023));
@@ -142,7 +160,12 @@ fn move_by(p: Pos, d: vec3<f32>) -> Moved {
 fn cell_of(p: Pos) -> vec3<i32> {
     let k = i32(params.cells_per_block);
     let local = clamp(vec3<i32>(floor(p.off * params.inv_cell_size)), vec3<i32>(0), vec3<i32>(k - 1));
-    return unpack_block(p.block) * k + local;
+    let c = unpack_block(p.block) * k + local;
+    if (params.periodic == 0u) {
+        return c;
+    }
+    // A particle wrapped to exactly the period's end belongs to cell 0.
+    return select(c, c % vec3<i32>(params.grid_cells), periodic_axes());
 }
 
 // Hash slot of a cell: its linear index in the domain grid, wrapped to the (power of two)
@@ -161,7 +184,12 @@ fn neighbour_slots(c: vec3<i32>, slots: ptr<function, array<u32, 27>>) -> u32 {
     for (var dz = -zr; dz <= zr; dz++) {
         for (var dy = -1; dy <= 1; dy++) {
             for (var dx = -1; dx <= 1; dx++) {
-                let s = slot_of_cell(c + vec3<i32>(dx, dy, dz));
+                var cn = c + vec3<i32>(dx, dy, dz);
+                if (params.periodic != 0u) {
+                    let n = vec3<i32>(params.grid_cells);
+                    cn = select(cn, (cn + n) % n, periodic_axes());
+                }
+                let s = slot_of_cell(cn);
                 var seen = false;
                 for (var k = 0u; k < n; k++) {
                     seen = seen || ((*slots)[k] == s);

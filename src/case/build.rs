@@ -4,12 +4,14 @@
 
 use std::collections::HashSet;
 
-use crate::scenario::{Domain, Kind, Particle, Physics, ProbeKind, Scenario, WallParams};
+use crate::scenario::{
+    Domain, Kind, MirrorPlane, Particle, Physics, ProbeKind, Scenario, WallParams,
+};
 
 use super::error::CaseError;
 use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
 use super::locate::Ctx;
-use super::validate::{Aabb, Case, Sound};
+use super::validate::{Aabb, Case, Sound, Treatment};
 
 /// Refuse cases with more particles than this.
 pub const MAX_PARTICLES: f64 = 200e6;
@@ -41,6 +43,13 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
     let (dim, dx) = (case.dim, case.dx);
     let v = dim - 1;
     let layers = case.tank.map_or(3, |t| t.layers as i64);
+    // Particle layers of the tank wall: `layers` for dynamic and fixed-ghost walls, the one
+    // nearest the fluid for repulsive walls, none for mirror planes.
+    let wall_layers = case.tank.map_or(layers, |t| match t.wall {
+        Treatment::Dynamic | Treatment::FixedGhost { .. } => layers,
+        Treatment::Repulsive => 1,
+        Treatment::Mirror { .. } => 0,
+    });
 
     // Tank cells along each axis.
     let tank = match case.tank {
@@ -124,14 +133,23 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
     let fluid_n: f64 = block_cells.iter().map(|n| n.iter().product::<f64>()).sum();
     let wall_of = |n: [f64; 3]| TankWall {
         n: n.map(|c| c.min(1e15) as i64),
-        layers,
+        layers: wall_layers,
         open_top: case.tank.is_none_or(|t| t.open_top),
         dim,
     };
     let tank_n = tank.map_or(0.0, |(_, n)| wall_of(n).count());
     let obstacle_n: f64 = obstacle_ranges
         .iter()
-        .map(|(lo, hi)| (0..dim).map(|a| hi[a] - lo[a] + 1.0).product::<f64>())
+        .zip(&case.obstacle_walls)
+        .map(|((lo, hi), t)| {
+            let n = (0..dim).map(|a| hi[a] - lo[a] + 1.0);
+            let all: f64 = n.clone().product();
+            if *t == Treatment::Repulsive {
+                all - n.map(|c| (c - 2.0).max(0.0)).product::<f64>()
+            } else {
+                all
+            }
+        })
         .sum();
     let total = fluid_n + tank_n + obstacle_n;
     if total.is_nan() || total > MAX_PARTICLES {
@@ -235,22 +253,69 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
             None => case.rho0,
         }
     };
-    let mut push_wall = |pos: [f64; 3]| {
+    // Mirror walls have no particles (their TankWall has no layers).
+    let mut push_wall = |pos: [f64; 3], t: Treatment| {
+        let (kind, rho) = match t {
+            Treatment::Dynamic => (Kind::Wall, wall_rho(pos)),
+            Treatment::Repulsive => (Kind::Repulsive, case.rho0),
+            Treatment::FixedGhost { no_slip: true } | Treatment::Mirror { no_slip: true } => {
+                (Kind::GhostNoSlip, wall_rho(pos))
+            }
+            Treatment::FixedGhost { no_slip: false } | Treatment::Mirror { no_slip: false } => {
+                (Kind::GhostFreeSlip, wall_rho(pos))
+            }
+        };
         particles.push(Particle {
             pos,
             vel: [0.0; 3],
-            rho: wall_rho(pos),
-            kind: Kind::Wall,
+            rho,
+            kind,
         })
     };
-    if let Some(w) = &wall {
-        w.indices().into_iter().for_each(|i| push_wall(lat.pos(i)));
+    if let (Some(w), Some(t)) = (&wall, case.tank) {
+        w.indices()
+            .into_iter()
+            .for_each(|i| push_wall(lat.pos(i), t.wall));
     }
     let mut seen = HashSet::new();
-    for (lo, hi) in &obstacle_ranges {
+    for ((lo, hi), &t) in obstacle_ranges.iter().zip(&case.obstacle_walls) {
+        let (first, last) = (lo.map(|c| c as i64), hi.map(|c| c as i64));
         for idx in range_points(&lat, *lo, *hi) {
+            // A repulsive obstacle is only its surface: points with a lattice neighbour outside.
+            let surface = (0..dim).any(|a| idx[a] == first[a] || idx[a] == last[a]);
+            if t == Treatment::Repulsive && !surface {
+                continue;
+            }
             if !wall.is_some_and(|w| w.contains(idx)) && seen.insert(idx) {
-                push_wall(lat.pos(idx));
+                push_wall(lat.pos(idx), t);
+            }
+        }
+    }
+
+    // Mirror planes on every face of the tank's inner box on the lattice (origin + n dx), the
+    // lid only when the top is closed; normals point into the fluid.
+    let mut mirror_planes = Vec::new();
+    if let (Some(w), Some(t)) = (&wall, case.tank) {
+        if let Treatment::Mirror { no_slip } = t.wall {
+            for a in 0..dim {
+                let mut normal = [0.0; 3];
+                normal[a] = 1.0;
+                mirror_planes.push(MirrorPlane {
+                    point: lat.origin,
+                    normal,
+                    no_slip,
+                });
+                if a == v && t.open_top {
+                    continue;
+                }
+                let mut point = lat.origin;
+                point[a] += w.n[a] as f64 * dx;
+                normal[a] = -1.0;
+                mirror_planes.push(MirrorPlane {
+                    point,
+                    normal,
+                    no_slip,
+                });
             }
         }
     }
@@ -280,9 +345,18 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
         viscosity: case.viscosity,
         delta_sph: case.delta_sph,
         particle_mass: mass,
+        density_filter: case.density_filter,
     };
     let g = case.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
-    let walls = WallParams::defaults(dx, highest_column(&particles, dim, dx), g);
+    let mut walls = WallParams::defaults(dx, highest_column(&particles, dim, dx), g);
+    walls.ghost_correction = case.walls.ghost_correction;
+    if let Some(d) = case.walls.repulsive_d {
+        walls.repulsive_d = d;
+    }
+    if let Some(r0) = case.walls.repulsive_r0 {
+        walls.repulsive_r0 = r0;
+    }
+    walls.mirror_planes = mirror_planes;
     Ok(Scenario {
         name: case.name,
         physics,
@@ -291,6 +365,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
         particles,
         probes: case.probes,
         walls,
+        periodic: [false; 3],
     })
 }
 

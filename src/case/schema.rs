@@ -17,8 +17,9 @@ pub(super) struct RawCase {
     #[serde(default)]
     pub fluid_block: Vec<RawBlock>,
     #[serde(default)]
-    pub obstacle: Vec<RawBox>,
+    pub obstacle: Vec<RawObstacle>,
     pub domain: Option<RawBox>,
+    pub walls: Option<RawWalls>,
     #[serde(default)]
     pub probe: Vec<RawProbe>,
 }
@@ -50,6 +51,16 @@ pub(super) struct RawPhysics {
     pub alpha: Option<f64>,
     pub nu_m2_s: Option<f64>,
     pub delta_sph: Option<f64>,
+    pub density_filter: Option<DensityFilterName>,
+    pub density_filter_every: Option<i64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum DensityFilterName {
+    None,
+    Shepard,
+    Mls,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -76,13 +87,63 @@ pub(super) struct RawTank {
     pub layers: Option<i64>,
     pub open_top: Option<bool>,
     pub wall: Option<WallName>,
+    pub slip: Option<SlipName>,
 }
 
-/// Wall treatment. Only the dynamic boundary condition exists for now.
+/// Wall treatment of the tank or of an obstacle (`docs/cases.md`, "Wall treatments").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub(super) enum WallName {
     Dynamic,
+    Repulsive,
+    Mirror,
+    FixedGhost,
+}
+
+impl WallName {
+    /// The name as written in a case file.
+    pub(super) fn as_str(self) -> &'static str {
+        match self {
+            WallName::Dynamic => "dynamic",
+            WallName::Repulsive => "repulsive",
+            WallName::Mirror => "mirror",
+            WallName::FixedGhost => "fixed_ghost",
+        }
+    }
+}
+
+/// Velocity condition of mirror and fixed-ghost walls.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum SlipName {
+    NoSlip,
+    FreeSlip,
+}
+
+/// An obstacle: a box and its wall treatment.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawObstacle {
+    pub min_m: Vec<f64>,
+    pub max_m: Vec<f64>,
+    pub wall: Option<WallName>,
+    pub slip: Option<SlipName>,
+}
+
+/// Parameters of the wall treatments: `[walls]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawWalls {
+    pub ghost_correction: Option<GhostCorrectionName>,
+    pub repulsive_d_m2_s2: Option<f64>,
+    pub repulsive_r0_m: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum GhostCorrectionName {
+    Shepard,
+    Mls,
 }
 
 #[derive(Debug, Deserialize)]
@@ -210,6 +271,16 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "delta_sph = 0.1",
     ),
     f(
+        "physics.density_filter",
+        "the density re-initialisation filter: none, shepard or mls",
+        "density_filter = \"shepard\"",
+    ),
+    f(
+        "physics.density_filter_every",
+        "the steps between density filters, 1 to 10000",
+        "density_filter_every = 30",
+    ),
+    f(
         "time",
         "the [time] table",
         "[time] with end_s = 1.0 and output_every_s = 0.02",
@@ -247,7 +318,16 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "whether the tank has no lid",
         "open_top = true",
     ),
-    f("tank.wall", "the wall treatment", "wall = \"dynamic\""),
+    f(
+        "tank.wall",
+        "the tank's wall treatment: dynamic, repulsive, mirror or fixed_ghost",
+        "wall = \"dynamic\"",
+    ),
+    f(
+        "tank.slip",
+        "the velocity condition of mirror and fixed_ghost walls",
+        "slip = \"no_slip\"",
+    ),
     f(
         "fluid_block",
         "a list of [[fluid_block]] tables",
@@ -294,6 +374,16 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "max_m = [0.7, 0.1]",
     ),
     f(
+        "obstacle[].wall",
+        "the obstacle's wall treatment: dynamic, repulsive or fixed_ghost",
+        "wall = \"dynamic\"",
+    ),
+    f(
+        "obstacle[].slip",
+        "the velocity condition of a fixed_ghost obstacle",
+        "slip = \"no_slip\"",
+    ),
+    f(
         "domain",
         "the [domain] table",
         "[domain] with min_m and max_m",
@@ -307,6 +397,26 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "domain.max_m",
         "the domain's upper corner in metres",
         "max_m = [1.1, 1.2]",
+    ),
+    f(
+        "walls",
+        "the [walls] table",
+        "[walls] with ghost_correction = \"mls\"",
+    ),
+    f(
+        "walls.ghost_correction",
+        "the ghost interpolation, shepard or mls",
+        "ghost_correction = \"mls\"",
+    ),
+    f(
+        "walls.repulsive_d_m2_s2",
+        "the Lennard-Jones strength D of repulsive walls in m²/s²",
+        "repulsive_d_m2_s2 = 24.5",
+    ),
+    f(
+        "walls.repulsive_r0_m",
+        "the Lennard-Jones cut-off r0 of repulsive walls in metres",
+        "repulsive_r0_m = 0.01",
     ),
     f(
         "probe",
@@ -351,7 +461,7 @@ impl FieldHelp {
     pub(super) fn ty(&self) -> &'static str {
         let value = self.example.split_once('=').map_or("", |(_, v)| v.trim());
         match self.path {
-            "dimension" | "tank.layers" => "an integer",
+            "dimension" | "tank.layers" | "physics.density_filter_every" => "an integer",
             "fluid_block" | "obstacle" | "probe" => "an array of tables",
             _ if self.example.starts_with('[') => "a table",
             _ if value.starts_with('"') => "a string",

@@ -953,3 +953,7 @@ fn nothing_panics_on_hostile_values() {
     }
     assert!(n > 100);
 }
+
+mod walls;
+
+mod density_filter;

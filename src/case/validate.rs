@@ -2,11 +2,14 @@
 //! options that go together, defaults. Produces a [`Case`] in SI with 3-component vectors.
 //! Geometric checks that need several fields at once live in `build.rs`.
 
-use crate::scenario::{KernelKind, Probe, TimeControl, Viscosity};
+use crate::scenario::{DensityFilter, GhostCorrection, KernelKind, Probe, TimeControl, Viscosity};
 
 use super::error::CaseError;
 use super::locate::Ctx;
-use super::schema::{KernelName, RawCase, ViscosityName, WallName};
+use super::schema::{
+    DensityFilterName, GhostCorrectionName, KernelName, RawCase, RawPhysics, SlipName,
+    ViscosityName, WallName,
+};
 
 /// An axis-aligned box (3 components; in 2D the third is 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,6 +29,30 @@ pub(super) struct Tank {
     pub inner: Aabb,
     pub layers: u32,
     pub open_top: bool,
+    pub wall: Treatment,
+}
+
+/// The wall treatment of the tank or of an obstacle (`docs/cases.md`, "Wall treatments").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Treatment {
+    /// Dynamic boundary particles (Crespo et al. 2007), `Kind::Wall`.
+    Dynamic,
+    /// One layer of Lennard-Jones boundary particles (Monaghan 1994), `Kind::Repulsive`.
+    Repulsive,
+    /// Mirror planes on the tank's faces, no particles (tank only).
+    Mirror { no_slip: bool },
+    /// Fixed ghost particles, `Kind::GhostNoSlip` / `Kind::GhostFreeSlip`.
+    FixedGhost { no_slip: bool },
+}
+
+/// `[walls]`, with the defaults that need the built particles left as `None`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct WallSettings {
+    pub ghost_correction: GhostCorrection,
+    /// Lennard-Jones strength D [m²/s²]; default 5 |g| H.
+    pub repulsive_d: Option<f64>,
+    /// Lennard-Jones cut-off r0 [m]; default dx.
+    pub repulsive_r0: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -48,11 +75,15 @@ pub(super) struct Case {
     pub gamma: f64,
     pub viscosity: Viscosity,
     pub delta_sph: f64,
+    pub density_filter: DensityFilter,
     pub time: TimeControl,
     pub tank: Option<Tank>,
     pub blocks: Vec<Block>,
     pub obstacles: Vec<Aabb>,
+    /// The wall treatment of each obstacle (never `Mirror`).
+    pub obstacle_walls: Vec<Treatment>,
     pub domain: Option<Aabb>,
+    pub walls: WallSettings,
     pub probes: Vec<Probe>,
 }
 
@@ -321,6 +352,7 @@ pub(super) fn validate(
         "the delta-SPH density diffusion coefficient; 0 disables it",
         "use 0.1, or 0 to disable",
     )?;
+    let density_filter = density_filter(ctx, ph)?;
 
     // [time]
     let t = &raw.time;
@@ -377,14 +409,12 @@ pub(super) fn validate(
                     "use 3, or enough layers to cover the kernel support 2h",
                 ));
             }
-            // Only the dynamic boundary condition exists for now (Kind::Wall particles).
-            match tk.wall.unwrap_or(WallName::Dynamic) {
-                WallName::Dynamic => {}
-            }
+            let wall = treatment(ctx, "tank", tk.wall, tk.slip)?;
             Some(Tank {
                 inner,
                 layers: layers as u32,
                 open_top: tk.open_top.unwrap_or(true),
+                wall,
             })
         }
     };
@@ -413,16 +443,59 @@ pub(super) fn validate(
         blocks.push(Block { bx, vel });
     }
     let mut obstacles = Vec::with_capacity(raw.obstacle.len());
+    let mut obstacle_walls = Vec::with_capacity(raw.obstacle.len());
     for (i, o) in raw.obstacle.iter().enumerate() {
-        obstacles.push(aabb(
-            ctx,
-            &format!("obstacle[{i}]"),
-            &o.min_m,
-            &o.max_m,
-            dim,
-            "the obstacle",
-        )?);
+        let path = format!("obstacle[{i}]");
+        obstacles.push(aabb(ctx, &path, &o.min_m, &o.max_m, dim, "the obstacle")?);
+        if o.wall == Some(WallName::Mirror) {
+            return Err(ctx.err(
+                &format!("{path}.wall"),
+                Some("\"mirror\"".into()),
+                "mirror ghosts are for the tank's straight faces; use fixed_ghost for obstacles",
+                "use wall = \"fixed_ghost\" (or \"dynamic\" or \"repulsive\")",
+            ));
+        }
+        obstacle_walls.push(treatment(ctx, &path, o.wall, o.slip)?);
     }
+    let walls = match &raw.walls {
+        None => WallSettings {
+            ghost_correction: GhostCorrection::Mls,
+            repulsive_d: None,
+            repulsive_r0: None,
+        },
+        Some(w) => WallSettings {
+            ghost_correction: match w.ghost_correction.unwrap_or(GhostCorrectionName::Mls) {
+                GhostCorrectionName::Shepard => GhostCorrection::Shepard,
+                GhostCorrectionName::Mls => GhostCorrection::Mls,
+            },
+            repulsive_d: w
+                .repulsive_d_m2_s2
+                .map(|d| {
+                    number(
+                        ctx,
+                        "walls.repulsive_d_m2_s2",
+                        d,
+                        Bound::Positive,
+                        "the Lennard-Jones strength D of repulsive walls in m²/s²",
+                        "use about 5 |g| H, e.g. 24.5 for 0.5 m of water, or remove it for that default",
+                    )
+                })
+                .transpose()?,
+            repulsive_r0: w
+                .repulsive_r0_m
+                .map(|r| {
+                    number(
+                        ctx,
+                        "walls.repulsive_r0_m",
+                        r,
+                        Bound::Positive,
+                        "the Lennard-Jones cut-off r0 of repulsive walls in metres",
+                        "use the particle spacing dx_m, or remove it for that default",
+                    )
+                })
+                .transpose()?,
+        },
+    };
     let domain = match &raw.domain {
         Some(d) => Some(aabb(ctx, "domain", &d.min_m, &d.max_m, dim, "the domain")?),
         None => None,
@@ -453,11 +526,82 @@ pub(super) fn validate(
         gamma,
         viscosity,
         delta_sph,
+        density_filter,
         time,
         tank,
         blocks,
         obstacles,
+        obstacle_walls,
         domain,
+        walls,
         probes,
+    })
+}
+
+/// `physics.density_filter` with `physics.density_filter_every` (default 30, only with a filter).
+fn density_filter(ctx: &Ctx<'_>, ph: &RawPhysics) -> Result<DensityFilter, CaseError> {
+    let name = ph.density_filter.unwrap_or(DensityFilterName::None);
+    if name == DensityFilterName::None {
+        if let Some(n) = ph.density_filter_every {
+            return Err(ctx.err(
+                "physics.density_filter_every",
+                Some(n.to_string()),
+                "is only used with density_filter = \"shepard\" or \"mls\", but the filter is \"none\"",
+                "remove density_filter_every, or set density_filter = \"shepard\" or \"mls\"",
+            ));
+        }
+        return Ok(DensityFilter::None);
+    }
+    let every = ph.density_filter_every.unwrap_or(30);
+    if !(1..=10_000).contains(&every) {
+        return Err(ctx.err(
+            "physics.density_filter_every",
+            Some(every.to_string()),
+            "must be between 1 and 10000 (the number of time steps between two density filters)",
+            "use e.g. 30 (a filter every few tens of steps is usual)",
+        ));
+    }
+    let every = every as u32;
+    Ok(match name {
+        DensityFilterName::Shepard => DensityFilter::Shepard { every },
+        _ => DensityFilter::Mls { every },
+    })
+}
+
+/// The treatment of `{path}.wall` with `{path}.slip` (only for mirror and fixed_ghost walls).
+fn treatment(
+    ctx: &Ctx<'_>,
+    path: &str,
+    wall: Option<WallName>,
+    slip: Option<SlipName>,
+) -> Result<Treatment, CaseError> {
+    let wall = wall.unwrap_or(WallName::Dynamic);
+    let no_slip = slip.unwrap_or(SlipName::NoSlip) == SlipName::NoSlip;
+    Ok(match wall {
+        WallName::Dynamic | WallName::Repulsive => {
+            if let Some(s) = slip {
+                let written = if s == SlipName::NoSlip {
+                    "\"no_slip\""
+                } else {
+                    "\"free_slip\""
+                };
+                return Err(ctx.err(
+                    &format!("{path}.slip"),
+                    Some(written.into()),
+                    format!(
+                        "is only used with wall = \"mirror\" or \"fixed_ghost\", but the wall is \"{}\"",
+                        wall.as_str()
+                    ),
+                    "remove slip, or set wall = \"fixed_ghost\"",
+                ));
+            }
+            if wall == WallName::Dynamic {
+                Treatment::Dynamic
+            } else {
+                Treatment::Repulsive
+            }
+        }
+        WallName::Mirror => Treatment::Mirror { no_slip },
+        WallName::FixedGhost => Treatment::FixedGhost { no_slip },
     })
 }

@@ -20,16 +20,18 @@ pub enum Pass {
     Integrate,
     Probes,
     Ghost,
+    DensityFilter,
 }
 
 impl Pass {
-    pub const ALL: [Pass; 6] = [
+    pub const ALL: [Pass; 7] = [
         Pass::CellList,
         Pass::PrefixScan,
         Pass::Interaction,
         Pass::Integrate,
         Pass::Probes,
         Pass::Ghost,
+        Pass::DensityFilter,
     ];
 
     pub fn name(self) -> &'static str {
@@ -40,6 +42,7 @@ impl Pass {
             Pass::Integrate => "integrate",
             Pass::Probes => "probes",
             Pass::Ghost => "ghost",
+            Pass::DensityFilter => "density_filter",
         }
     }
 
@@ -51,13 +54,14 @@ impl Pass {
             Pass::Integrate => include_str!("../../shaders/integrate.wgsl"),
             Pass::Probes => include_str!("../../shaders/probes.wgsl"),
             Pass::Ghost => include_str!("../../shaders/ghost.wgsl"),
+            Pass::DensityFilter => include_str!("../../shaders/density_filter.wgsl"),
         }
     }
 
     /// Library files (after common.wgsl) this pass uses.
     pub fn libs(self) -> &'static [&'static str] {
         match self {
-            Pass::Ghost => &[MLS],
+            Pass::Ghost | Pass::DensityFilter => &[MLS],
             _ => &[],
         }
     }

@@ -1,6 +1,6 @@
 //! Twin of shaders/ghost.wgsl: ghost pressure (as ρ) and velocity interpolated from the fluid.
 
-use super::{dot, kernel, pressure, sub, RefParticle, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP};
+use super::{dot, kernel, pressure, RefParticle, Space, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP};
 use crate::scenario::{GhostCorrection, Physics, WallParams};
 
 /// Smallest accepted MLS pivot relative to A00 = Σ W V (as `MLS_MIN_PIVOT` in mls.wgsl).
@@ -31,10 +31,15 @@ pub fn min_pivot_ratio(dim: usize, a: [[f64; 4]; 4]) -> f64 {
 }
 
 /// The MLS moment matrix Σ_j W_gj V_j b bᵀ, b = [1, x_gj/h], over fluid particles.
-pub fn moment_matrix(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> [[f64; 4]; 4] {
+pub fn moment_matrix(
+    ph: &Physics,
+    space: &Space,
+    parts: &[RefParticle],
+    x: [f64; 3],
+) -> [[f64; 4]; 4] {
     let mut a = [[0.0; 4]; 4];
     for j in parts.iter().filter(|p| p.kind == FLUID) {
-        let d = sub(x, j.pos);
+        let d = space.sub(x, j.pos);
         let r = dot(d, d).sqrt();
         if r < 2.0 * ph.h {
             let wv = kernel::w(ph.kernel, ph.dim, ph.h, r) * ph.particle_mass / j.rho;
@@ -96,7 +101,12 @@ pub fn basis(dim: usize, h: f64, x: [f64; 3]) -> [f64; 4] {
 }
 
 /// Sets (v, ρ) of every ghost from the fluid; other particles are returned unchanged.
-pub fn interpolate(ph: &Physics, walls: &WallParams, parts: &[RefParticle]) -> Vec<RefParticle> {
+pub fn interpolate(
+    ph: &Physics,
+    walls: &WallParams,
+    space: &Space,
+    parts: &[RefParticle],
+) -> Vec<RefParticle> {
     let dim = ph.dim as usize;
     let h = ph.h;
     parts
@@ -110,7 +120,7 @@ pub fn interpolate(ph: &Physics, walls: &WallParams, parts: &[RefParticle]) -> V
             let mut m_v = [[0.0; 4]; 3];
             let mut toward = [0.0; 3];
             for j in parts.iter().filter(|p| p.kind == FLUID) {
-                let x = sub(g.pos, j.pos);
+                let x = space.sub(g.pos, j.pos);
                 let r2 = dot(x, x);
                 if r2 >= 4.0 * h * h {
                     continue;

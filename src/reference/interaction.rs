@@ -1,10 +1,10 @@
 //! Twin of shaders/interaction.wgsl, brute force over all pairs (no cell list), f64.
 
 use super::{
-    dot, kernel, laminar_nu, pressure, sub, RefParticle, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP,
+    dot, kernel, laminar_nu, pressure, sub, RefParticle, Space, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP,
     REPULSIVE, WALL,
 };
-use crate::scenario::{Physics, Viscosity, WallParams};
+use crate::scenario::{MirrorPlane, Physics, Viscosity, WallParams};
 
 struct Pair<'a> {
     ph: &'a Physics,
@@ -84,7 +84,12 @@ fn add(a: &mut [f64; 4], b: [f64; 4]) {
 
 /// (dv/dt, dρ/dt) of every particle: fluid gets everything, dynamic walls only dρ/dt from
 /// fluid neighbours, ghosts and repulsive particles nothing.
-pub fn rates(ph: &Physics, walls: &WallParams, parts: &[RefParticle]) -> Vec<[f64; 4]> {
+pub fn rates(
+    ph: &Physics,
+    walls: &WallParams,
+    space: &Space,
+    parts: &[RefParticle],
+) -> Vec<[f64; 4]> {
     let h = ph.h;
     let pair = Pair {
         ph,
@@ -103,7 +108,7 @@ pub fn rates(ph: &Physics, walls: &WallParams, parts: &[RefParticle]) -> Vec<[f6
             let mut r = [0.0; 4];
             if pi.kind == WALL {
                 for (j, pj) in parts.iter().enumerate() {
-                    let x_ij = sub(pi.pos, pj.pos);
+                    let x_ij = space.sub(pi.pos, pj.pos);
                     let r2 = dot(x_ij, x_ij);
                     if j != i && r2 < support2 && pj.kind == FLUID {
                         let f_ij = kernel::f(ph.kernel, ph.dim, h, r2.sqrt());
@@ -116,7 +121,7 @@ pub fn rates(ph: &Physics, walls: &WallParams, parts: &[RefParticle]) -> Vec<[f6
                 return r;
             }
             for (j, pj) in parts.iter().enumerate() {
-                let x_ij = sub(pi.pos, pj.pos);
+                let x_ij = space.sub(pi.pos, pj.pos);
                 let r2 = dot(x_ij, x_ij);
                 if j == i || r2 >= support2 {
                     continue;
@@ -133,26 +138,37 @@ pub fn rates(ph: &Physics, walls: &WallParams, parts: &[RefParticle]) -> Vec<[f6
                     pair.rates(pi, x_ij, pj.vel, pj.rho, pj.kind == FLUID, ratio),
                 );
             }
-            // Mirror images of the fluid particles j across each plane near i.
-            for plane in &walls.mirror_planes {
-                let n = plane.normal;
-                if dot(sub(pi.pos, plane.point), n) >= 2.0 * h {
-                    continue;
+            // Mirror images of the fluid across each plane near i, and across pairs of planes
+            // (corners).
+            let near: Vec<&MirrorPlane> = walls
+                .mirror_planes
+                .iter()
+                .filter(|p| dot(sub(pi.pos, p.point), p.normal) < 2.0 * h)
+                .collect();
+            let mut chains: Vec<Vec<&MirrorPlane>> = near.iter().map(|p| vec![*p]).collect();
+            for a in 0..near.len() {
+                for b in a + 1..near.len() {
+                    chains.push(vec![near[a], near[b]]);
                 }
+            }
+            for chain in chains {
                 for pj in parts.iter().filter(|p| p.kind == FLUID) {
-                    let dj = dot(sub(pj.pos, plane.point), n);
-                    let x_g = [0, 1, 2].map(|a| pj.pos[a] - 2.0 * dj * n[a]);
-                    let x_ig = sub(pi.pos, x_g);
-                    if dot(x_ig, x_ig) >= support2 {
-                        continue;
+                    let (mut x_g, mut v_g) = (pj.pos, pj.vel);
+                    for plane in chain.iter().rev() {
+                        let n = plane.normal;
+                        let d = dot(sub(x_g, plane.point), n);
+                        x_g = [0, 1, 2].map(|a| x_g[a] - 2.0 * d * n[a]);
+                        let vn = dot(v_g, n);
+                        v_g = if plane.no_slip {
+                            v_g.map(|v| -v)
+                        } else {
+                            [0, 1, 2].map(|a| v_g[a] - 2.0 * vn * n[a])
+                        };
                     }
-                    let vn = dot(pj.vel, n);
-                    let v_g = if plane.no_slip {
-                        pj.vel.map(|v| -v)
-                    } else {
-                        [0, 1, 2].map(|a| pj.vel[a] - 2.0 * vn * n[a])
-                    };
-                    add(&mut r, pair.rates(pi, x_ig, v_g, pj.rho, true, 1.0));
+                    let x_ig = sub(pi.pos, x_g);
+                    if dot(x_ig, x_ig) < support2 {
+                        add(&mut r, pair.rates(pi, x_ig, v_g, pj.rho, true, 1.0));
+                    }
                 }
             }
             for a in 0..3 {

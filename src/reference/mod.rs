@@ -5,6 +5,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod cell_list;
+pub mod density_filter;
 pub mod ghost;
 pub mod integrate;
 pub mod interaction;
@@ -43,6 +44,40 @@ pub fn laminar_nu(ph: &Physics) -> Option<f64> {
     match ph.viscosity {
         Viscosity::Laminar { nu } => Some(nu),
         Viscosity::Artificial { .. } => None,
+    }
+}
+
+/// Where particles live: the domain extent and its periodic axes (minimum-image distances).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Space {
+    pub extent: [f64; 3],
+    pub periodic: [bool; 3],
+}
+
+impl Space {
+    /// No periodic axis.
+    pub const OPEN: Space = Space {
+        extent: [0.0; 3],
+        periodic: [false; 3],
+    };
+
+    pub fn of(sc: &crate::scenario::Scenario) -> Space {
+        Space {
+            extent: [0, 1, 2].map(|a| sc.domain.max[a] - sc.domain.min[a]),
+            periodic: sc.periodic,
+        }
+    }
+
+    /// a − b, the nearest image on periodic axes.
+    pub fn sub(&self, a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|k| {
+            let d = a[k] - b[k];
+            if self.periodic[k] {
+                d - self.extent[k] * (d / self.extent[k]).round()
+            } else {
+                d
+            }
+        })
     }
 }
 

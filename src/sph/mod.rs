@@ -4,6 +4,7 @@
 
 pub mod buffers;
 pub mod cell_list;
+pub mod density_filter;
 pub mod ghost;
 pub mod grid;
 pub mod integrate;
@@ -22,6 +23,7 @@ use crate::layout::{
 use crate::scenario::{GhostCorrection, KernelKind, Kind, Scenario, Viscosity};
 use buffers::{InitialParticles, ParticleBuffers};
 use cell_list::CellList;
+use density_filter::DensityFilter;
 use ghost::Ghost;
 use grid::Grid;
 use integrate::Integrate;
@@ -99,6 +101,8 @@ pub struct Solver {
     buffers: ParticleBuffers,
     cell_list: CellList,
     interaction: Interaction,
+    /// Shepard/MLS density re-initialisation, if the case asks for one.
+    density_filter: Option<DensityFilter>,
     ghost: Ghost,
     has_ghosts: bool,
     integrate: Integrate,
@@ -136,7 +140,7 @@ impl Solver {
                 max_binding >> 20
             );
         }
-        let grid = Grid::new(&sc.domain, ph.h, ph.dim, n)?;
+        let grid = Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic)?;
         let (alpha, nu, viscosity) = match ph.viscosity {
             Viscosity::Artificial { alpha } => (alpha, 0.0, 0),
             Viscosity::Laminar { nu } => (0.0, nu, 1),
@@ -145,9 +149,12 @@ impl Solver {
             grid_cells: grid.cells,
             hash_mask: grid.slots - 1,
             block_size: grid.block_size,
-            cell_size: grid.cell_size as f32,
-            inv_cell_size: (1.0 / grid.cell_size) as f32,
             cells_per_block: grid.cells_per_block,
+            inv_cell_size: grid.cell_size.map(|c| (1.0 / c) as f32),
+            periodic: (0..3)
+                .filter(|&a| grid.periodic[a])
+                .map(|a| 1u32 << a)
+                .sum(),
             domain_size: grid.extent.map(|e| e as f32),
             n_particles: n as u32,
             h: ph.h as f32,
@@ -218,6 +225,10 @@ impl Solver {
         )?;
         let interaction = Interaction::new(&device, &module(Pass::Interaction)?, &buffers)?;
         let ghost = Ghost::new(&device, &module(Pass::Ghost)?, &buffers)?;
+        let density_filter = match ph.density_filter {
+            crate::scenario::DensityFilter::None => None,
+            mode => DensityFilter::new(&device, &module(Pass::DensityFilter)?, &buffers, mode)?,
+        };
         let integrate = Integrate::new(&device, &module(Pass::Integrate)?, &buffers)?;
         let probes = Probes::new(&device, &module(Pass::Probes)?, &buffers, &defs)?;
         let mut solver = Self {
@@ -228,6 +239,7 @@ impl Solver {
             buffers,
             cell_list,
             interaction,
+            density_filter,
             ghost,
             has_ghosts: sc
                 .particles
@@ -302,6 +314,9 @@ impl Solver {
             }
             self.interaction.encode(&mut pass, q);
             self.integrate.encode_correct(&mut pass, q);
+            if let Some(f) = &self.density_filter {
+                f.encode(&mut pass, q);
+            }
             drop(pass);
             self.parity = q;
         }
@@ -477,6 +492,34 @@ impl Solver {
         drop(pass);
         self.queue.submit([encoder.finish()]);
         self.read_rates()
+    }
+
+    /// Test hook: applies the density filter of the case once to the current arrays (whatever
+    /// the step count). With `poison`, the filter's output buffer is first filled with NaN, so a
+    /// fluid particle the filter skips gets a NaN density.
+    #[doc(hidden)]
+    pub fn run_density_filter(&mut self, poison: bool) -> Result<()> {
+        let Some(f) = &self.density_filter else {
+            bail!("the case has no density filter");
+        };
+        if poison {
+            let nan = vec![f32::NAN; 4 * self.buffers.n as usize];
+            self.queue
+                .write_buffer(&self.buffers.rate_sorted, 0, bytemuck::cast_slice(&nan));
+        }
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("density filter"),
+            });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("density filter"),
+            timestamp_writes: None,
+        });
+        f.encode_now(&mut pass, self.parity);
+        drop(pass);
+        self.queue.submit([encoder.finish()]);
+        Ok(())
     }
 
     /// Test hook: takes exactly one step of `dt` (no clipping) and returns the new state.

@@ -33,6 +33,7 @@ pub fn physics(dim: u32, dx: f64, c0: f64) -> Physics {
         viscosity: Viscosity::Artificial { alpha: 0.02 },
         delta_sph: 0.1,
         particle_mass: 1000.0 * dx.powi(dim as i32),
+        density_filter: DensityFilter::None,
     }
 }
 
@@ -83,6 +84,7 @@ pub fn scenario(
             cfl: 0.2,
         },
         walls: WallParams::defaults(physics_dx, 0.5, 9.81),
+        periodic: [false; 3],
         domain,
         particles,
         probes,

@@ -1,0 +1,149 @@
+// Density re-initialisation of the fluid (Colagrossi & Landrini 2003), every N steps after the
+// corrector, on the sorted arrays of the step:
+//   Shepard: ρ_i = Σ_j m_j W_ij / Σ_j W_ij V_j,                  V_j = m_j/ρ_j
+//   MLS:     ρ_i = Σ_j m_j W^MLS_ij,  W^MLS_ij = (β0 + β·x_ij/h) W_ij,  β = A⁻¹ e1,
+//            A = Σ_j W_ij V_j [1, x_ij/h][1, x_ij/h]ᵀ (shaders/lib/mls.wgsl; Colagrossi &
+//            Landrini 2003; Rabczuk, Belytschko & Xiao 2004)
+// j runs over i itself and every fluid, dynamic-wall and ghost particle within 2h; repulsive
+// particles carry no density (the interaction ignores theirs) and excluded ones are gone.
+// MLS falls back to Shepard where mls_solve finds A ill-conditioned (a pivot below
+// MLS_MIN_PIVOT·A00) or the MLS density is not positive and finite; Shepard falls back to the
+// old density if ever its result is not (it cannot be for finite data: j = i is always there).
+//
+// Two dispatches, so that no particle reads an already-filtered neighbour: `density_filter_*`
+// writes the new density into `filtered` (the `rate_sorted` buffer, free after the corrector),
+// `apply_density` copies it into velrho.w of the fluid. `filter_gate` (one invocation, after the
+// time-step kernel) decides whether this step filters: it writes the indirect dispatch size of
+// the two kernels, the full grid on every `every`-th step with dt > 0 (state.steps counts them)
+// and zero otherwise, so a step that does not filter costs one invocation.
+
+@group(0) @binding(1) var<storage, read> pos: array<Pos>;
+@group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> code: array<u32>;
+@group(0) @binding(4) var<storage, read> cell_start: array<u32>;
+@group(0) @binding(5) var<storage, read_write> filtered: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read_write> state: SimState;
+
+// Mirrored by `sph::density_filter::FilterCtl`.
+struct FilterCtl {
+    every: u32,         // filter every `every` steps
+    last: u32,          // state.steps of the last filter (0: none yet)
+    groups_x: u32,      // the dispatch grid of one invocation per particle
+    groups_y: u32,
+}
+
+@group(0) @binding(7) var<storage, read_write> ctl: FilterCtl;
+// Indirect dispatch arguments (x, y, z) of the two particle kernels.
+@group(0) @binding(8) var<storage, read_write> args: array<u32, 3>;
+
+// Neighbours whose density enters the filter.
+fn counts(kind: u32) -> bool {
+    return kind == KIND_FLUID || kind == KIND_WALL || is_ghost(kind);
+}
+
+fn positive_finite(x: f32) -> bool {
+    return x > 0.0 && x < 3.0e38;
+}
+
+// The filtered density of fluid particle i.
+fn filter_density(i: u32, mls: bool) -> f32 {
+    let p_i = pos[i];
+    let support2 = 4.0 * params.h * params.h;
+    var sum_mw = 0.0;  // Σ m_j W_ij
+    var sum_wv = 0.0;  // Σ W_ij V_j
+    var a = mls_zero();
+    var slots: array<u32, 27>;
+    let n_slots = neighbour_slots(cell_of(p_i), &slots);
+    // First pass: the Shepard sums and the MLS moment matrix.
+    for (var s = 0u; s < n_slots; s++) {
+        for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
+            if (j != i && !counts(code_kind(code[j]))) {
+                continue;
+            }
+            let x_ij = rel_pos(p_i, pos[j]);
+            let r2 = dot(x_ij, x_ij);
+            if (r2 >= support2) {
+                continue;
+            }
+            let w = kernel_w(sqrt(r2) / params.h);
+            let wv = w * params.mass / velrho[j].w;
+            sum_mw += params.mass * w;
+            sum_wv += wv;
+            if (mls) {
+                a = mls_add(a, x_ij, wv);
+            }
+        }
+    }
+    let rho_old = velrho[i].w;
+    var rho = sum_mw / sum_wv;
+    if (!positive_finite(rho)) {
+        rho = rho_old;
+    }
+    if (mls) {
+        let sol = mls_solve(a);
+        if (sol.ok) {
+            // Second pass: Σ m_j W_ij (β0 + β·x_ij/h).
+            var rho_mls = 0.0;
+            for (var s = 0u; s < n_slots; s++) {
+                for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
+                    if (j != i && !counts(code_kind(code[j]))) {
+                        continue;
+                    }
+                    let x_ij = rel_pos(p_i, pos[j]);
+                    let r2 = dot(x_ij, x_ij);
+                    if (r2 >= support2) {
+                        continue;
+                    }
+                    rho_mls += params.mass * kernel_w(sqrt(r2) / params.h) * mls_weight(sol.beta, x_ij);
+                }
+            }
+            if (positive_finite(rho_mls)) {
+                rho = rho_mls;
+            }
+        }
+    }
+    return rho;
+}
+
+fn filter_all(gid: vec3<u32>, nwg: vec3<u32>, mls: bool) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles) {
+        return;
+    }
+    if (code_kind(code[i]) == KIND_FLUID) {
+        filtered[i] = vec4<f32>(0.0, 0.0, 0.0, filter_density(i, mls));
+    }
+}
+
+@compute @workgroup_size(WG)
+fn density_filter_shepard(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    filter_all(gid, nwg, false);
+}
+
+@compute @workgroup_size(WG)
+fn density_filter_mls(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    filter_all(gid, nwg, true);
+}
+
+@compute @workgroup_size(WG)
+fn apply_density(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles) {
+        return;
+    }
+    if (code_kind(code[i]) == KIND_FLUID) {
+        velrho[i].w = filtered[i].w;
+    }
+}
+
+@compute @workgroup_size(1)
+fn filter_gate() {
+    let steps = state.steps;
+    let on = steps != ctl.last && steps % ctl.every == 0u;
+    if (on) {
+        ctl.last = steps;
+    }
+    args[0] = select(0u, ctl.groups_x, on);
+    args[1] = select(0u, ctl.groups_y, on);
+    args[2] = select(0u, 1u, on);
+}

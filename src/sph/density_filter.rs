@@ -1,0 +1,119 @@
+//! Density re-initialisation of the fluid, Shepard or MLS (shaders/density_filter.wgsl): every
+//! `every` steps (counted on the GPU, steps with dt > 0 only), after the corrector.
+
+use anyhow::{bail, Result};
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+use super::buffers::ParticleBuffers;
+use crate::gpu::buffers::STORAGE;
+use crate::gpu::kernel::{fold_groups, ShaderModule};
+use crate::gpu::shader::WORKGROUP_SIZE;
+use crate::gpu::Kernel;
+use crate::scenario::DensityFilter as Mode;
+
+/// Mirror of `FilterCtl` in shaders/density_filter.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+struct FilterCtl {
+    every: u32,
+    last: u32,
+    groups_x: u32,
+    groups_y: u32,
+}
+
+pub struct DensityFilter {
+    gate: Kernel,
+    filter: Kernel,
+    apply: Kernel,
+    bind_gate: wgpu::BindGroup,
+    bind_filter: [wgpu::BindGroup; 2],
+    bind_apply: [wgpu::BindGroup; 2],
+    /// Indirect dispatch arguments written by the gate.
+    args: wgpu::Buffer,
+    n: u32,
+}
+
+impl DensityFilter {
+    /// The filter of `mode`, or None for `Mode::None`.
+    pub fn new(
+        device: &wgpu::Device,
+        module: &ShaderModule,
+        b: &ParticleBuffers,
+        mode: Mode,
+    ) -> Result<Option<Self>> {
+        let (entry, every) = match mode {
+            Mode::None => return Ok(None),
+            Mode::Shepard { every } => ("density_filter_shepard", every),
+            Mode::Mls { every } => ("density_filter_mls", every),
+        };
+        if every == 0 {
+            bail!("the density filter interval must be at least one step");
+        }
+        let (groups_x, groups_y) = fold_groups(b.n.div_ceil(WORKGROUP_SIZE).max(1));
+        let ctl = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("density filter ctl"),
+            contents: bytemuck::bytes_of(&FilterCtl {
+                every,
+                last: 0,
+                groups_x,
+                groups_y,
+            }),
+            usage: STORAGE,
+        });
+        let args = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("density filter dispatch"),
+            contents: bytemuck::cast_slice(&[0u32; 3]),
+            usage: STORAGE | wgpu::BufferUsages::INDIRECT,
+        });
+        let gate = module.kernel(device, "filter_gate")?;
+        let filter = module.kernel(device, entry)?;
+        let apply = module.kernel(device, "apply_density")?;
+        let bufs = |p: usize| {
+            [
+                (0, &b.params),
+                (1, &b.pos[p]),
+                (2, &b.velrho[p]),
+                (3, &b.code[p]),
+                (4, &b.cell_start),
+                (5, &b.rate_sorted),
+                (6, &b.state),
+                (7, &ctl),
+                (8, &args),
+            ]
+        };
+        Ok(Some(Self {
+            bind_gate: gate.bind(device, &bufs(0))?,
+            bind_filter: [
+                filter.bind(device, &bufs(0))?,
+                filter.bind(device, &bufs(1))?,
+            ],
+            bind_apply: [apply.bind(device, &bufs(0))?, apply.bind(device, &bufs(1))?],
+            gate,
+            filter,
+            apply,
+            args,
+            n: b.n,
+        }))
+    }
+
+    /// Filters the (sorted, corrected) arrays of parity `p` if this step is an `every`-th one;
+    /// record after the time-step kernel.
+    pub fn encode(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.gate.dispatch_groups(pass, &self.bind_gate, 1);
+        for (kernel, bind) in [
+            (&self.filter, &self.bind_filter),
+            (&self.apply, &self.bind_apply),
+        ] {
+            pass.set_pipeline(&kernel.pipeline);
+            pass.set_bind_group(0, &bind[p], &[]);
+            pass.dispatch_workgroups_indirect(&self.args, 0);
+        }
+    }
+
+    /// Filters the arrays of parity `p` now, whatever the step (test hook).
+    pub fn encode_now(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.filter.dispatch(pass, &self.bind_filter[p], self.n);
+        self.apply.dispatch(pass, &self.bind_apply[p], self.n);
+    }
+}

@@ -1,0 +1,413 @@
+//! Density re-initialisation (Shepard and MLS, shaders/density_filter.wgsl): the GPU filter
+//! against the f64 reference on random particle sets, exact reproduction of a linear density by
+//! MLS (and not by Shepard near a free surface), isolated particles, the every-N-steps cadence,
+//! and the hydrostatic tank with each filter.
+
+mod common;
+use common::*;
+use std::path::Path;
+use wgsph::layout::{unpack_block, KIND_SHIFT};
+use wgsph::reference::{self, RefParticle};
+use wgsph::scenario::*;
+use wgsph::sph::Solver;
+
+const MODES: [DensityFilter; 2] = [
+    DensityFilter::Shepard { every: 1 },
+    DensityFilter::Mls { every: 1 },
+];
+
+fn is_mls(m: DensityFilter) -> bool {
+    matches!(m, DensityFilter::Mls { .. })
+}
+
+/// GPU arrays (current order) as reference particles, in world coordinates.
+fn gpu_particles(s: &Solver) -> Vec<RefParticle> {
+    let (pos, velrho, code) = s.read_raw().unwrap();
+    pos.iter()
+        .zip(&velrho)
+        .zip(&code)
+        .map(|((p, v), c)| RefParticle {
+            pos: s.grid.to_world(p.off, unpack_block(p.block)),
+            vel: [v[0] as f64, v[1] as f64, v[2] as f64],
+            rho: v[3] as f64,
+            kind: c >> KIND_SHIFT,
+        })
+        .collect()
+}
+
+/// Densities of the current arrays (GPU order).
+fn gpu_rho(s: &Solver) -> Vec<f64> {
+    s.read_raw()
+        .unwrap()
+        .1
+        .iter()
+        .map(|v| v[3] as f64)
+        .collect()
+}
+
+/// A jittered lattice of fluid (with a free surface on top) over a two-layer floor whose
+/// particles are dynamic walls, fixed ghosts or repulsive particles; random densities.
+fn random_scenario(dim: u32, kernel: KernelKind, domain: f64, seed: u64) -> Scenario {
+    let dx = 0.02;
+    let mut ph = physics(dim, dx, 15.0);
+    ph.kernel = kernel;
+    let mut rng = Rng(seed);
+    let up = dim as usize - 1;
+    let block = 0.3;
+    let mut max = [block; 3];
+    if dim == 2 {
+        max[2] = 0.0;
+    }
+    let o = 0.5 * (domain - block);
+    let mut parts = Vec::new();
+    for p in lattice(dim, dx, [0.0; 3], max) {
+        let wall = p[up] < 2.0 * dx;
+        let mut pos = p;
+        for c in pos.iter_mut().take(dim as usize) {
+            *c += o + if wall {
+                0.0
+            } else {
+                rng.range(-0.25, 0.25) * dx
+            };
+        }
+        let kind = if !wall {
+            Kind::Fluid
+        } else {
+            match (rng.next_f64() * 4.0) as u32 {
+                0 => Kind::GhostNoSlip,
+                1 => Kind::Repulsive,
+                _ => Kind::Wall,
+            }
+        };
+        parts.push(Particle {
+            pos,
+            vel: [0.0; 3],
+            rho: 1000.0 * (1.0 + rng.range(0.0, 0.02)),
+            kind,
+        });
+    }
+    // Spray: sparse fluid particles above the surface, some with too few neighbours for MLS
+    // (in the small domain, those above its top are excluded by the first step).
+    for _ in 0..40 {
+        let mut pos = [0.0; 3];
+        for c in pos.iter_mut().take(dim as usize) {
+            *c = o + rng.range(0.0, block);
+        }
+        pos[up] = o + block + rng.range(0.5, 4.0) * dx;
+        parts.push(Particle {
+            pos,
+            vel: [0.0; 3],
+            rho: 1000.0 * (1.0 + rng.range(0.0, 0.02)),
+            kind: Kind::Fluid,
+        });
+    }
+    let mut dmax = [domain; 3];
+    if dim == 2 {
+        dmax[2] = 0.0;
+    }
+    scenario(
+        ph,
+        parts,
+        Domain {
+            min: [0.0; 3],
+            max: dmax,
+        },
+        vec![],
+    )
+}
+
+/// max over fluid particles of |gpu − cpu| / cpu; non-finite GPU values fail.
+fn rel_err(parts: &[RefParticle], gpu: &[f64], cpu: &[f64]) -> f64 {
+    let mut worst = 0.0f64;
+    for ((p, g), c) in parts.iter().zip(gpu).zip(cpu) {
+        assert!(g.is_finite(), "non-finite GPU density {g} (reference {c})");
+        if p.kind == reference::FLUID {
+            worst = worst.max((g - c).abs() / c);
+        }
+    }
+    worst
+}
+
+#[test]
+fn gpu_filters_match_reference() {
+    let mut seed = 21;
+    for dim in [2, 3] {
+        for (kernel, domain) in [
+            (KernelKind::WendlandC2, 0.4),
+            (KernelKind::CubicSpline, 0.4),
+            // A domain much larger than the particles: hash collisions in the cell list.
+            (KernelKind::WendlandC2, 8.0),
+        ] {
+            seed += 1;
+            let mut filtered = Vec::new();
+            for mode in MODES {
+                let mut sc = random_scenario(dim, kernel, domain, seed);
+                sc.physics.density_filter = mode;
+                let mut solver = Solver::new(gpu(), &sc).unwrap();
+                let parts = gpu_particles(&solver);
+                let cpu = reference::density_filter::filter(&sc.physics, &parts, is_mls(mode));
+                solver.run_density_filter(true).unwrap();
+                let gpu = gpu_rho(&solver);
+                let err = rel_err(&parts, &gpu, &cpu);
+                let fluid = parts.iter().filter(|p| p.kind == reference::FLUID);
+                let mls_used = (0..parts.len())
+                    .filter(|&i| parts[i].kind == reference::FLUID)
+                    .filter(|&i| {
+                        reference::density_filter::density_of(&sc.physics, &parts, i, true).1
+                    })
+                    .count();
+                let change = parts
+                    .iter()
+                    .zip(&cpu)
+                    .map(|(p, c)| (c - p.rho).abs() / p.rho)
+                    .fold(0.0, f64::max);
+                println!(
+                    "{dim}D {kernel:?} domain {domain} {mode:?}: {} fluid, MLS on {mls_used}, \
+                     largest change {change:.1e}, GPU vs reference {err:.1e}",
+                    fluid.count()
+                );
+                assert!(err < 1e-5, "density error {err}");
+                let n_fluid = parts.iter().filter(|p| p.kind == reference::FLUID).count();
+                assert!(
+                    mls_used < n_fluid && mls_used > n_fluid * 3 / 4,
+                    "the set must exercise both MLS and its Shepard fallback"
+                );
+                // Non-fluid densities are untouched.
+                for ((p, g), c) in parts.iter().zip(&gpu).zip(&cpu) {
+                    if p.kind != reference::FLUID {
+                        assert_eq!(*g as f32, *c as f32);
+                    }
+                }
+                assert!(change > 1e-3, "the filter must change the densities");
+                filtered.push(cpu);
+            }
+            // MLS and Shepard differ by far more than the tolerance.
+            let diff = filtered[0]
+                .iter()
+                .zip(&filtered[1])
+                .map(|(a, b)| (a - b).abs() / a)
+                .fold(0.0, f64::max);
+            assert!(diff > 1e-4, "MLS and Shepard differ by only {diff}");
+        }
+    }
+}
+
+/// A free fluid block (surfaces on every side) of jittered particles with the linear density
+/// ρ0 (1 + c·z) along the vertical axis z.
+fn linear_scenario(dim: u32, mode: DensityFilter) -> (Scenario, impl Fn([f64; 3]) -> f64) {
+    let dx = 0.02;
+    let mut ph = physics(dim, dx, 15.0);
+    ph.density_filter = mode;
+    let up = dim as usize - 1;
+    let c = 0.5;
+    let rho = move |x: [f64; 3]| 1000.0 * (1.0 + c * x[up]);
+    let n = if dim == 2 { 20.0 } else { 8.0 };
+    let mut max = [0.5 + n * dx; 3];
+    let mut min = [0.5; 3];
+    if dim == 2 {
+        max[2] = 0.0;
+        min[2] = 0.0;
+    }
+    let mut rng = Rng(99);
+    let parts = lattice(dim, dx, min, max)
+        .into_iter()
+        .map(|mut pos| {
+            for c in pos.iter_mut().take(dim as usize) {
+                *c += rng.range(-0.3, 0.3) * dx;
+            }
+            Particle {
+                pos,
+                vel: [0.0; 3],
+                rho: rho(pos),
+                kind: Kind::Fluid,
+            }
+        })
+        .collect();
+    let mut dmax = [1.5; 3];
+    if dim == 2 {
+        dmax[2] = 0.0;
+    }
+    let sc = scenario(
+        ph,
+        parts,
+        Domain {
+            min: [0.0; 3],
+            max: dmax,
+        },
+        vec![],
+    );
+    (sc, rho)
+}
+
+#[test]
+fn mls_reproduces_a_linear_density_and_shepard_does_not_near_the_surface() {
+    for dim in [2, 3] {
+        let up = dim as usize - 1;
+        let mut worst_surface = [0.0f64; 2];
+        let mut worst_interior = [0.0f64; 2];
+        for (m, mode) in MODES.into_iter().enumerate() {
+            let (sc, rho) = linear_scenario(dim, mode);
+            let h = sc.physics.h;
+            let top = sc
+                .particles
+                .iter()
+                .map(|p| p.pos[up])
+                .fold(f64::MIN, f64::max);
+            let mut solver = Solver::new(gpu(), &sc).unwrap();
+            let parts = gpu_particles(&solver);
+            solver.run_density_filter(true).unwrap();
+            let gpu = gpu_rho(&solver);
+            let (mut n_surface, mut n_interior) = (0, 0);
+            for (i, (p, g)) in parts.iter().zip(&gpu).enumerate() {
+                assert!(g.is_finite());
+                let exact = rho(p.pos);
+                let e = (g - exact).abs() / exact;
+                // Within h of the top surface, and anywhere more than 2h inside the block.
+                let depth = (0..dim as usize)
+                    .map(|a| {
+                        let (lo, hi) =
+                            sc.particles.iter().fold((f64::MAX, f64::MIN), |(l, u), q| {
+                                (l.min(q.pos[a]), u.max(q.pos[a]))
+                            });
+                        (p.pos[a] - lo).min(hi - p.pos[a])
+                    })
+                    .fold(f64::MAX, f64::min);
+                if top - p.pos[up] < h {
+                    n_surface += 1;
+                    worst_surface[m] = worst_surface[m].max(e);
+                } else if depth > 2.0 * h {
+                    n_interior += 1;
+                    worst_interior[m] = worst_interior[m].max(e);
+                }
+                if is_mls(mode) {
+                    // Every particle of the block (corners too) is MLS-corrected...
+                    assert!(reference::density_filter::density_of(&sc.physics, &parts, i, true).1);
+                    // ...so every one gets its own linear value.
+                    assert!(e < 1e-5, "MLS error {e:.2e} at {:?}", p.pos);
+                }
+            }
+            assert!(n_surface > 5 && n_interior > 5, "{n_surface} {n_interior}");
+        }
+        println!(
+            "{dim}D linear density: MLS error surface {:.1e} interior {:.1e}; \
+             Shepard error surface {:.1e} interior {:.1e}",
+            worst_surface[1], worst_interior[1], worst_surface[0], worst_interior[0]
+        );
+        assert!(
+            worst_surface[0] > 1e-3 && worst_surface[0] > 100.0 * worst_surface[1],
+            "Shepard should miss a linear field at the surface"
+        );
+    }
+}
+
+#[test]
+fn isolated_particles_get_finite_densities() {
+    for dim in [2, 3] {
+        for mode in MODES {
+            let (mut sc, _) = linear_scenario(dim, mode);
+            let h = sc.physics.h;
+            let alone = Particle {
+                pos: [1.2, 1.2, if dim == 3 { 1.2 } else { 0.0 }],
+                vel: [0.0; 3],
+                rho: 1010.0,
+                kind: Kind::Fluid,
+            };
+            let mut pair = [alone, alone];
+            for (k, p) in pair.iter_mut().enumerate() {
+                p.pos[0] = 0.2 + 0.7 * h * k as f64;
+                p.rho = 990.0 + 20.0 * k as f64;
+            }
+            sc.particles.push(alone);
+            sc.particles.extend(pair);
+            let n = sc.particles.len();
+            let mut solver = Solver::new(gpu(), &sc).unwrap();
+            solver.run_density_filter(true).unwrap();
+            let p = solver.read_particles().unwrap();
+            assert!(p.rho.iter().all(|r| r.is_finite() && *r > 0.0));
+            println!(
+                "{dim}D {mode:?}: alone {} (was 1010), pair {} {} (were 990, 1010)",
+                p.rho[n - 3],
+                p.rho[n - 2],
+                p.rho[n - 1]
+            );
+            assert!((p.rho[n - 3] - 1010.0).abs() < 1e-3);
+            assert!(p.rho[n - 2] > 990.0 && p.rho[n - 2] < 1010.0);
+            assert!(p.rho[n - 1] > 990.0 && p.rho[n - 1] < 1010.0);
+        }
+    }
+}
+
+#[test]
+fn the_filter_runs_every_n_steps() {
+    // Tiny steps barely change the densities; the filter changes the random ones by ~1 %.
+    let every = 3;
+    let mut sc = random_scenario(2, KernelKind::WendlandC2, 0.4, 5);
+    sc.physics.gravity = [0.0; 3];
+    sc.physics.density_filter = DensityFilter::Mls { every };
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    let dt = 1e-9;
+    let mut filtered_at = Vec::new();
+    for step in 1..=3 * every {
+        let before = solver.read_particles().unwrap();
+        solver.single_step(dt).unwrap();
+        let after = solver.read_particles().unwrap();
+        let change = before
+            .rho
+            .iter()
+            .zip(&after.rho)
+            .zip(&after.kind)
+            .filter(|(_, k)| **k == 0)
+            .map(|((a, b), _)| ((a - b) / a).abs())
+            .fold(0.0f32, f32::max);
+        println!("step {step}: largest fluid density change {change:.1e}");
+        if change > 1e-4 {
+            filtered_at.push(step);
+        } else {
+            assert!(change < 1e-6, "step {step}: change {change}");
+        }
+    }
+    assert_eq!(filtered_at, vec![every, 2 * every, 3 * every]);
+}
+
+/// Mean bottom pressure over t ∈ (1, 2] s of the shipped hydrostatic tank with `set`.
+fn hydrostatic_pressure(set: &[&str]) -> (f64, f64) {
+    let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+    let sc = wgsph::case::load(Path::new("cases/hydrostatic_2d.toml"), &set).unwrap();
+    let probe = sc
+        .probes
+        .iter()
+        .position(|p| matches!(p.kind, ProbeKind::Pressure { .. }))
+        .unwrap();
+    let ProbeKind::Pressure { point } = sc.probes[probe].kind else {
+        unreachable!()
+    };
+    let exact = sc.physics.rho0 * 9.81 * (0.5 - point[1]);
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    let (mut sum, mut count) = (0.0, 0);
+    for k in 1..=40 {
+        let t = 0.05 * k as f64;
+        solver.advance_to(t).unwrap();
+        if t > 1.0 + 1e-9 {
+            sum += solver.sample_probes().unwrap()[probe];
+            count += 1;
+        }
+    }
+    assert_eq!(solver.excluded(), 0);
+    (sum / count as f64, exact)
+}
+
+#[test]
+fn hydrostatic_tank_with_each_filter() {
+    for filter in ["shepard", "mls"] {
+        let (p, exact) = hydrostatic_pressure(&[
+            &format!("physics.density_filter={filter}"),
+            "physics.density_filter_every=20",
+        ]);
+        let err = (p - exact) / exact;
+        println!(
+            "hydrostatic, {filter} every 20 steps: p = {p:.1} Pa, exact {exact:.1} Pa, error {:.2} %",
+            100.0 * err
+        );
+        assert!(err.abs() < 0.02, "{filter}: bottom pressure error {err}");
+    }
+}

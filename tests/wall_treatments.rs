@@ -1,0 +1,118 @@
+//! Hydrostatic tank (cases/hydrostatic_2d.toml) with each wall treatment: pressure 0.45 m deep
+//! against ρ0·g·(H − z), pressure noise along the floor, and penetration. The numbers printed
+//! here are the table in docs/validation.md.
+
+mod common;
+use common::gpu;
+use std::path::Path;
+use wgsph::sph::Solver;
+
+struct Outcome {
+    /// Relative error of the probe pressure averaged over t ∈ (1, 2] s.
+    error: f64,
+    /// Standard deviation of the pressure of the fluid particles within dx of the floor,
+    /// relative to ρ0·g·H, at t = 2 s.
+    noise: f64,
+    /// Lowest fluid particle and farthest out on the sides, relative to the inner faces [m]
+    /// (negative: beyond the face).
+    margin: f64,
+    excluded: u64,
+}
+
+fn hydrostatic(set: &[&str]) -> Outcome {
+    let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+    let sc = wgsph::case::load(Path::new("cases/hydrostatic_2d.toml"), &set).unwrap();
+    let exact = 1000.0 * 9.81 * 0.45;
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    let (mut sum, mut count) = (0.0, 0);
+    for k in 1..=40 {
+        let t = 0.05 * k as f64;
+        solver.advance_to(t).unwrap();
+        if k > 20 {
+            sum += solver.sample_probes().unwrap()[0];
+            count += 1;
+        }
+    }
+    let p = solver.read_particles().unwrap();
+    let dx = sc.physics.dx;
+    let floor: Vec<f64> = p
+        .pos
+        .iter()
+        .zip(&p.kind)
+        .zip(&p.pressure)
+        .filter(|((x, k), _)| **k == 0 && x[1] < dx)
+        .map(|(_, pr)| *pr as f64)
+        .collect();
+    let mean = floor.iter().sum::<f64>() / floor.len() as f64;
+    let std = (floor.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / floor.len() as f64).sqrt();
+    let margin = p
+        .pos
+        .iter()
+        .zip(&p.kind)
+        .filter(|(_, k)| **k == 0)
+        .map(|(x, _)| x[1].min(x[0]).min(1.0 - x[0]))
+        .fold(f64::MAX, f64::min);
+    Outcome {
+        error: (sum / count as f64 - exact) / exact,
+        noise: std / (1000.0 * 9.81 * 0.5),
+        margin,
+        excluded: solver.excluded(),
+    }
+}
+
+fn report(name: &str, o: &Outcome) {
+    println!(
+        "| {name} | {:+.2} % | {:.2} % | {:.4} m | {} |",
+        100.0 * o.error,
+        100.0 * o.noise,
+        o.margin,
+        o.excluded
+    );
+}
+
+#[test]
+fn fixed_ghost_mls_no_slip() {
+    let o = hydrostatic(&["tank.wall=\"fixed_ghost\"", "walls.ghost_correction=\"mls\""]);
+    report("fixed_ghost (MLS, no-slip)", &o);
+    assert!(o.error.abs() < 0.02, "pressure error {:.2} %", 100.0 * o.error);
+    assert!(o.margin > 0.0 && o.excluded == 0, "penetration: {}", o.margin);
+}
+
+#[test]
+fn fixed_ghost_shepard_free_slip() {
+    let o = hydrostatic(&["tank.wall=\"fixed_ghost\"", "tank.slip=\"free_slip\"", "walls.ghost_correction=\"shepard\""]);
+    report("fixed_ghost (Shepard, free-slip)", &o);
+    assert!(o.error.abs() < 0.02, "pressure error {:.2} %", 100.0 * o.error);
+    assert!(o.margin > 0.0 && o.excluded == 0, "penetration: {}", o.margin);
+}
+
+#[test]
+fn mirror_free_slip() {
+    let o = hydrostatic(&["tank.wall=\"mirror\"", "tank.slip=\"free_slip\""]);
+    report("mirror (free-slip)", &o);
+    assert!(o.error.abs() < 0.02, "pressure error {:.2} %", 100.0 * o.error);
+    assert!(o.margin > 0.0 && o.excluded == 0, "penetration: {}", o.margin);
+}
+
+#[test]
+fn dynamic_boundary() {
+    let o = hydrostatic(&[]);
+    report("dynamic", &o);
+    assert!(o.error.abs() < 0.02, "pressure error {:.2} %", 100.0 * o.error);
+    assert_eq!(o.excluded, 0);
+}
+
+#[test]
+fn repulsive_holds_the_water() {
+    let o = hydrostatic(&["tank.wall=\"repulsive\""]);
+    report("repulsive (Lennard-Jones)", &o);
+    assert_eq!(o.excluded, 0, "water leaked through the repulsive wall");
+}
+
+#[test]
+#[ignore = "fails: repulsive walls overpredict the pressure by ~5 % (the talk: 'the coefficient of repulsive force is uncertain, low accuracy'); kept visible, not loosened"]
+fn repulsive_pressure_within_2_percent() {
+    let o = hydrostatic(&["tank.wall=\"repulsive\""]);
+    report("repulsive (Lennard-Jones)", &o);
+    assert!(o.error.abs() < 0.02, "pressure error {:.2} %", 100.0 * o.error);
+}
