@@ -20,6 +20,8 @@
 @group(0) @binding(15) var<storage, read_write> velrho_out: array<vec4<f32>>;
 @group(0) @binding(16) var<storage, read_write> rate_out: array<vec4<f32>>;
 @group(0) @binding(17) var<storage, read_write> code_out: array<u32>;
+@group(0) @binding(18) var<storage, read> energy_in: array<vec2<f32>>;
+@group(0) @binding(19) var<storage, read_write> energy_out: array<vec2<f32>>;
 
 // Slot of each particle (excluded particles go to the extra slot `hash_mask + 1`) and its
 // provisional place in that slot.
@@ -82,4 +84,14 @@ fn reorder(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     velrho_out[p] = velrho_in[i];
     rate_out[p] = rate_in[i];
     code_out[p] = code_in[i];
+}
+
+// Gathers (e, de/dt) into cell order; a separate dispatch, only when the energy equation is on.
+@compute @workgroup_size(WG)
+fn reorder_energy(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let p = linear_index(gid, nwg);
+    if (p >= params.n_particles) {
+        return;
+    }
+    energy_out[p] = energy_in[perm[p]];
 }

@@ -14,6 +14,9 @@
 @group(0) @binding(5) var<storage, read> rate_old: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> state: SimState;
 @group(0) @binding(7) var<storage, read> cell_start: array<u32>;
+// (e, de/dt of the last evaluation) and the new de/dt, when ENERGY.
+@group(0) @binding(8) var<storage, read_write> energy: array<vec2<f32>>;
+@group(0) @binding(9) var<storage, read> energy_rate: array<f32>;
 
 var<workgroup> wg_speed: array<f32, WG>;
 var<workgroup> wg_accel: array<f32, WG>;
@@ -46,6 +49,9 @@ fn predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         let moved = move_by(pos[i], dt * vr.xyz + 0.5 * dt * dt * r.xyz);
         pos[i] = moved.pos;
         velrho[i] = vec4<f32>(vr.xyz + dt * r.xyz, vr.w + dt * r.w);
+        if (ENERGY) {
+            energy[i].x += dt * energy[i].y;
+        }
         if (!moved.inside) {
             exclude(i);
         }
@@ -71,6 +77,10 @@ fn correct(
         if (kind == KIND_FLUID) {
             let v = vec4<f32>(vr.xyz + half_dt * (r.xyz - rate_old[i].xyz), vr.w + half_dt * (r.w - rate_old[i].w));
             velrho[i] = v;
+            if (ENERGY) {
+                let e = energy[i];
+                energy[i] = vec2<f32>(e.x + half_dt * (energy_rate[i] - e.y), energy_rate[i]);
+            }
             if (all_finite(v) && all_finite(r) && v.w > 0.0) {
                 speed = sound_speed_of(v.w) + length(v.xyz);
                 accel = length(r.xyz);

@@ -20,6 +20,9 @@
 //   also the double image across both planes.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
 // get nothing.
+// Energy (the seed's eq. 3 with σ = −P I, when ENERGY): de_i/dt = ½ Σ_j m_j (P_i/ρ_i² + P_j/ρ_j²
+//   + Π_ij) v_ij·∇_i W_ij (Monaghan 1992, eq. 2.19 with the artificial-viscosity heating);
+//   laminar viscous heating is not included.
 
 struct MirrorPlane {
     point: vec3<f32>,
@@ -34,6 +37,7 @@ struct MirrorPlane {
 @group(0) @binding(4) var<storage, read> cell_start: array<u32>;
 @group(0) @binding(5) var<storage, read_write> rate: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read> mirror_planes: array<MirrorPlane>;
+@group(0) @binding(7) var<storage, read_write> energy_rate: array<f32>;
 
 // The state of particle i that every pair term needs.
 struct Particle {
@@ -42,9 +46,14 @@ struct Particle {
     p_over_rho2: f32,
 }
 
-// (dv/dt, dρ/dt) contribution to fluid particle i of a pressure-carrying neighbour j
-// (fluid, dynamic wall, ghost or mirror image) at x_ij = x_i − x_j.
-fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_j: vec3<f32>, rho_j: f32, diffuse: bool, rho_ratio: f32) -> vec4<f32> {
+struct PairRates {
+    rate: vec4<f32>,    // (dv/dt, dρ/dt)
+    de: f32,            // de/dt
+}
+
+// Contribution to fluid particle i of a pressure-carrying neighbour j (fluid, dynamic wall,
+// ghost or mirror image) at x_ij = x_i − x_j.
+fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_j: vec3<f32>, rho_j: f32, diffuse: bool, rho_ratio: f32) -> PairRates {
     let v_ij = pi.v - v_j;
     let f_ij = kernel_f(sqrt(r2) / params.h);
     let dw_ij = x_ij * f_ij;
@@ -64,8 +73,13 @@ fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_j: vec3<f32>, rho_j: f32
         acc += params.mass * 4.0 * params.nu * r2 * f_ij / ((pi.rho + rho_j) * (r2 + params.eta2)) * v_ij;
     }
     let p_over_rho2_j = pressure_of(rho_j) / (rho_j * rho_j);
-    acc -= params.mass * (pi.p_over_rho2 + p_over_rho2_j + pi_ij) * dw_ij;
-    return vec4<f32>(acc, drho);
+    let pressure_term = pi.p_over_rho2 + p_over_rho2_j + pi_ij;
+    acc -= params.mass * pressure_term * dw_ij;
+    var de = 0.0;
+    if (ENERGY) {
+        de = 0.5 * params.mass * pressure_term * dot(v_ij, dw_ij);
+    }
+    return PairRates(vec4<f32>(acc, drho), de);
 }
 
 // Lennard-Jones repulsion of a boundary particle at x_ij (Monaghan 1994).
@@ -98,8 +112,8 @@ fn ghost_velocity(v: vec3<f32>, plane: MirrorPlane) -> vec3<f32> {
 // Ghosts seen by i through plane k1, or through k1 and then k2 (the corner image, without
 // which fluid leaks out of corners). `image` is i reflected the opposite way, so that the
 // ghosts of i's neighbourhood are the fluid particles near `image`, transformed back.
-fn image_rates(pi: Particle, image: vec3<f32>, k1: u32, k2: u32) -> vec4<f32> {
-    var out = vec4<f32>(0.0);
+fn image_rates(pi: Particle, image: vec3<f32>, k1: u32, k2: u32) -> PairRates {
+    var out = PairRates(vec4<f32>(0.0), 0.0);
     let support2 = 4.0 * params.h * params.h;
     let p1 = mirror_planes[k1];
     let double = k2 != NO_PLANE;
@@ -125,15 +139,21 @@ fn image_rates(pi: Particle, image: vec3<f32>, k1: u32, k2: u32) -> vec4<f32> {
             }
             x_ig = reflect_vec(x_ig, p1.normal);
             v_g = ghost_velocity(v_g, p1);
-            out += pair_rates(pi, x_ig, r2, v_g, velrho[j].w, true, 1.0);
+            let pr = pair_rates(pi, x_ig, r2, v_g, velrho[j].w, true, 1.0);
+            out.rate += pr.rate;
+            out.de += pr.de;
         }
     }
     return out;
 }
 
+fn add_rates(a: PairRates, b: PairRates) -> PairRates {
+    return PairRates(a.rate + b.rate, a.de + b.de);
+}
+
 // Sum over the mirror images across the planes (and pairs of planes) within 2h of i.
-fn mirror_rates(i: u32, pi: Particle) -> vec4<f32> {
-    var out = vec4<f32>(0.0);
+fn mirror_rates(i: u32, pi: Particle) -> PairRates {
+    var out = PairRates(vec4<f32>(0.0), 0.0);
     let xi = domain_pos(pos[i]);
     let reach = 2.0 * params.h;
     for (var k1 = 0u; k1 < params.n_mirror_planes; k1++) {
@@ -142,11 +162,11 @@ fn mirror_rates(i: u32, pi: Particle) -> vec4<f32> {
             continue;
         }
         let once = reflect_point(xi, p1);
-        out += image_rates(pi, once, k1, NO_PLANE);
+        out = add_rates(out, image_rates(pi, once, k1, NO_PLANE));
         for (var k2 = k1 + 1u; k2 < params.n_mirror_planes; k2++) {
             let p2 = mirror_planes[k2];
             if (dot(xi - p2.point, p2.normal) < reach) {
-                out += image_rates(pi, reflect_point(once, p2), k1, k2);
+                out = add_rates(out, image_rates(pi, reflect_point(once, p2), k1, k2));
             }
         }
     }
@@ -160,6 +180,9 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         return;
     }
     let kind_i = code_kind(code[i]);
+    if (ENERGY) {
+        energy_rate[i] = 0.0;
+    }
     if (kind_i != KIND_FLUID && kind_i != KIND_WALL) {
         rate[i] = vec4<f32>(0.0);
         return;
@@ -170,6 +193,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let support2 = 4.0 * params.h * params.h;
 
     var r = vec4<f32>(0.0);
+    var de = 0.0;
     var slots: array<u32, 27>;
     let n_slots = neighbour_slots(cell_of(p_i), &slots);
     for (var s = 0u; s < n_slots; s++) {
@@ -196,14 +220,21 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             }
             let vr_j = velrho[j];
             let ghost = is_ghost(kind_j);
-            r += pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.w, kind_j == KIND_FLUID, select(1.0, pi.rho / vr_j.w, ghost));
+            let pr = pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.w, kind_j == KIND_FLUID, select(1.0, pi.rho / vr_j.w, ghost));
+            r += pr.rate;
+            de += pr.de;
         }
     }
     if (fluid_i) {
         if (params.n_mirror_planes > 0u) {
-            r += mirror_rates(i, pi);
+            let m = mirror_rates(i, pi);
+            r += m.rate;
+            de += m.de;
         }
         r += vec4<f32>(params.gravity, 0.0);
+        if (ENERGY) {
+            energy_rate[i] = de;
+        }
     }
     rate[i] = r;
 }

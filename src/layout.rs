@@ -223,12 +223,10 @@ mod tests {
             for dim in [2, 3] {
                 for kernel in [0, 1] {
                     for viscosity in [0, 1] {
-                        let cfg = ShaderConfig {
-                            dim,
-                            kernel,
-                            viscosity,
-                        };
-                        parse(&compose(pass, cfg), pass.name()).unwrap();
+                        for energy in [false, true] {
+                            let cfg = ShaderConfig { dim, kernel, viscosity, energy };
+                            parse(&compose(pass, cfg), pass.name()).unwrap();
+                        }
                     }
                 }
             }

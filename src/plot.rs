@@ -331,7 +331,7 @@ fn probe_names(dir: &Path) -> Result<Vec<String>> {
 /// Centred moving average over a window of `width` (same units as t): each sample becomes the
 /// mean of the finite samples within ±width/2 of it (edges included). `width` ≤ 0 returns the series unchanged.
 pub fn moving_average(series: &[(f64, f64)], width: f64) -> Vec<(f64, f64)> {
-    if !(width > 0.0) {
+    if width.is_nan() || width <= 0.0 {
         return series.to_vec();
     }
     // A sample exactly at the window's edge is in, whatever the rounding of t.

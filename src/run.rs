@@ -37,6 +37,10 @@ pub fn write_snapshot(out: &mut OutputDir, solver: &Solver) -> Result<()> {
         pressure: &p.pressure,
         kind: &p.kind,
         id: &p.id,
+        extra: &match &p.energy {
+            Some(e) => vec![("energy", e.as_slice())],
+            None => vec![],
+        },
     })?;
     Ok(())
 }

@@ -75,6 +75,8 @@ pub struct Physics {
     pub particle_mass: f64,
     /// Periodic density re-initialisation of the fluid (Shepard or MLS filter).
     pub density_filter: DensityFilter,
+    /// Integrate the specific internal energy (the seed's energy equation); off by default.
+    pub energy: bool,
 }
 
 /// Density re-initialisation every `every` steps (Colagrossi & Landrini 2003): the fluid

@@ -346,6 +346,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
         delta_sph: case.delta_sph,
         particle_mass: mass,
         density_filter: case.density_filter,
+        energy: case.energy,
     };
     let g = case.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
     let mut walls = WallParams::defaults(dx, highest_column(&particles, dim, dx), g);

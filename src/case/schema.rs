@@ -53,6 +53,7 @@ pub(super) struct RawPhysics {
     pub delta_sph: Option<f64>,
     pub density_filter: Option<DensityFilterName>,
     pub density_filter_every: Option<i64>,
+    pub energy: Option<bool>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -279,6 +280,11 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "physics.density_filter_every",
         "the steps between density filters, 1 to 10000",
         "density_filter_every = 30",
+    ),
+    f(
+        "physics.energy",
+        "whether to integrate the energy equation",
+        "energy = true",
     ),
     f(
         "time",

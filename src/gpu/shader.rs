@@ -75,6 +75,8 @@ pub struct ShaderConfig {
     pub kernel: u32,
     /// 0 artificial (Monaghan), 1 laminar (Morris / Lo & Shao).
     pub viscosity: u32,
+    /// Whether the energy equation is integrated.
+    pub energy: bool,
 }
 
 impl Default for ShaderConfig {
@@ -83,6 +85,7 @@ impl Default for ShaderConfig {
             dim: 3,
             kernel: 1,
             viscosity: 0,
+            energy: false,
         }
     }
 }
@@ -92,11 +95,12 @@ pub fn compose(pass: Pass, cfg: ShaderConfig) -> String {
     format!(
         "// wgsph: {name}.wgsl composed with lib/common.wgsl\n\
          const DIM: u32 = {dim}u;\nconst KERNEL: u32 = {kernel}u;\n\
-         const VISCOSITY: u32 = {visc}u;\nconst WG: u32 = {wg}u;\n\n{common}\n{libs}\n{pass}",
+         const VISCOSITY: u32 = {visc}u;\nconst ENERGY: bool = {energy};\nconst WG: u32 = {wg}u;\n\n{common}\n{libs}\n{pass}",
         name = pass.name(),
         dim = cfg.dim,
         kernel = cfg.kernel,
         visc = cfg.viscosity,
+        energy = cfg.energy,
         wg = WORKGROUP_SIZE,
         common = COMMON,
         libs = pass.libs().concat(),

@@ -106,6 +106,8 @@ pub struct Snapshot<'a> {
     pub kind: &'a [u32],
     /// Stable particle id.
     pub id: &'a [u32],
+    /// Further per-particle scalars written as PointData (e.g. `("energy", e)`).
+    pub extra: &'a [(&'a str, &'a [f32])],
 }
 
 impl Snapshot<'_> {
@@ -128,6 +130,16 @@ impl Snapshot<'_> {
             ("kind", self.kind.len()),
             ("id", self.id.len()),
         ];
+        for (_, a) in self.extra {
+            if a.len() != n {
+                return Err(OutputError::SnapshotLength {
+                    path: path.to_path_buf(),
+                    array: "extra",
+                    len: a.len(),
+                    expected: n,
+                });
+            }
+        }
         for (array, len) in lens {
             if len != n {
                 return Err(OutputError::SnapshotLength {
@@ -337,6 +349,7 @@ mod tests {
         let u = [0u32; 2];
         let short = [0u32; 1];
         let snap = Snapshot {
+            extra: &[],
             time_s: 0.0,
             pos: &pos,
             vel: &vel,
@@ -376,6 +389,7 @@ mod tests {
             let kind = vec![0u32; n];
             let id: Vec<u32> = (0..n as u32).rev().collect();
             let snap = Snapshot {
+                extra: &[],
                 time_s: t,
                 pos: &pos,
                 vel: &vel,

@@ -39,16 +39,16 @@ le_bytes!(i64, "Int64");
 le_bytes!(u8, "UInt8");
 
 /// Description of one appended array: XML element and byte offset of its block.
-struct ArrayDecl {
-    name: &'static str,
+struct ArrayDecl<'a> {
+    name: &'a str,
     vtk_type: &'static str,
     components: usize,
     tuples: usize,
     elem_size: usize,
 }
 
-impl ArrayDecl {
-    fn new<T: LeBytes>(name: &'static str, components: usize, tuples: usize) -> Self {
+impl<'a> ArrayDecl<'a> {
+    fn new<T: LeBytes>(name: &'a str, components: usize, tuples: usize) -> Self {
         ArrayDecl {
             name,
             vtk_type: T::VTK_NAME,
@@ -156,6 +156,17 @@ pub(crate) fn write_vtu(w: &mut dyn Write, snap: &Snapshot) -> io::Result<()> {
         *o = acc;
         acc += d.block_bytes();
     }
+    // Extra scalars are appended after the fixed blocks.
+    let extra: Vec<(ArrayDecl, u64)> = snap
+        .extra
+        .iter()
+        .map(|(name, _)| {
+            let d = ArrayDecl::new::<f32>(name, 1, n);
+            let o = acc;
+            acc += d.block_bytes();
+            (d, o)
+        })
+        .collect();
 
     let mut xml = String::with_capacity(2048);
     xml.push_str("<?xml version=\"1.0\"?>\n");
@@ -171,6 +182,9 @@ pub(crate) fn write_vtu(w: &mut dyn Write, snap: &Snapshot) -> io::Result<()> {
     ));
     xml.push_str("      <PointData Scalars=\"density\" Vectors=\"velocity\">\n");
     for (d, o) in order[1..6].iter().zip(&off[1..6]) {
+        xml.push_str(&d.xml("        ", *o, ""));
+    }
+    for (d, o) in &extra {
         xml.push_str(&d.xml("        ", *o, ""));
     }
     xml.push_str("      </PointData>\n");
@@ -204,6 +218,9 @@ pub(crate) fn write_vtu(w: &mut dyn Write, snap: &Snapshot) -> io::Result<()> {
         write_block(w, &offsets, 1..=n as i32, c)?;
     }
     write_block(w, &types, std::iter::repeat_n(VTK_VERTEX, n), c)?;
+    for ((d, _), (_, values)) in extra.iter().zip(snap.extra) {
+        write_block(w, d, values.iter().copied(), c)?;
+    }
 
     w.write_all(b"\n  </AppendedData>\n</VTKFile>\n")?;
     Ok(())
@@ -383,6 +400,7 @@ mod tests {
 
         fn snap(&self, t: f64) -> Snapshot<'_> {
             Snapshot {
+                extra: &[],
                 time_s: t,
                 pos: &self.pos,
                 vel: &self.vel,

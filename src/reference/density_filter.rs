@@ -9,7 +9,7 @@
 //! pivot of A is below `MLS_MIN_PIVOT`·A00 or when the MLS density is not positive and finite.
 
 use super::ghost::{basis, mls_beta};
-use super::{dot, kernel, sub, RefParticle, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP, WALL};
+use super::{dot, kernel, RefParticle, Space, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP, WALL};
 use crate::scenario::Physics;
 
 /// Whether a neighbour of this kind enters the filter's sums.
@@ -17,15 +17,21 @@ pub fn counts(kind: u32) -> bool {
     matches!(kind, FLUID | WALL | GHOST_NO_SLIP | GHOST_FREE_SLIP)
 }
 
-/// (j, x_ij, W_ij V_j) of every counted particle within 2h of particle `i` (i itself included).
-fn neighbours(ph: &Physics, parts: &[RefParticle], i: usize) -> Vec<(usize, [f64; 3], f64)> {
+/// (j, x_ij, W_ij V_j) of every counted particle within 2h of particle `i` (i itself included);
+/// x_ij is the nearest image on periodic axes.
+fn neighbours(
+    ph: &Physics,
+    space: &Space,
+    parts: &[RefParticle],
+    i: usize,
+) -> Vec<(usize, [f64; 3], f64)> {
     let xi = parts[i].pos;
     parts
         .iter()
         .enumerate()
         .filter(|(j, p)| *j == i || counts(p.kind))
         .filter_map(|(j, p)| {
-            let x = sub(xi, p.pos);
+            let x = space.sub(xi, p.pos);
             let r = dot(x, x).sqrt();
             (r < 2.0 * ph.h).then(|| {
                 (
@@ -40,10 +46,15 @@ fn neighbours(ph: &Physics, parts: &[RefParticle], i: usize) -> Vec<(usize, [f64
 
 /// The MLS correction β of particle `i` (in the basis [1, x/h]), None where the moment matrix is
 /// ill-conditioned (the Shepard fallback).
-pub fn mls_beta_of(ph: &Physics, parts: &[RefParticle], i: usize) -> Option<[f64; 4]> {
+pub fn mls_beta_of(
+    ph: &Physics,
+    space: &Space,
+    parts: &[RefParticle],
+    i: usize,
+) -> Option<[f64; 4]> {
     let dim = ph.dim as usize;
     let mut a = [[0.0; 4]; 4];
-    for (_, x, wv) in neighbours(ph, parts, i) {
+    for (_, x, wv) in neighbours(ph, space, parts, i) {
         let b = basis(dim, ph.h, x);
         for r in 0..4 {
             for c in 0..4 {
@@ -56,11 +67,16 @@ pub fn mls_beta_of(ph: &Physics, parts: &[RefParticle], i: usize) -> Option<[f64
 
 /// W^MLS_ij V_j for every neighbour j of `i` (None where MLS falls back to Shepard): the weights
 /// with which Σ_j f_j W^MLS_ij V_j reproduces linear fields f exactly.
-pub fn mls_weights(ph: &Physics, parts: &[RefParticle], i: usize) -> Option<Vec<(usize, f64)>> {
-    let beta = mls_beta_of(ph, parts, i)?;
+pub fn mls_weights(
+    ph: &Physics,
+    space: &Space,
+    parts: &[RefParticle],
+    i: usize,
+) -> Option<Vec<(usize, f64)>> {
+    let beta = mls_beta_of(ph, space, parts, i)?;
     let dim = ph.dim as usize;
     Some(
-        neighbours(ph, parts, i)
+        neighbours(ph, space, parts, i)
             .into_iter()
             .map(|(j, x, wv)| {
                 let b = basis(dim, ph.h, x);
@@ -71,8 +87,14 @@ pub fn mls_weights(ph: &Physics, parts: &[RefParticle], i: usize) -> Option<Vec<
 }
 
 /// The filtered density of particle `i` and whether MLS was used (false: Shepard).
-pub fn density_of(ph: &Physics, parts: &[RefParticle], i: usize, mls: bool) -> (f64, bool) {
-    let nb = neighbours(ph, parts, i);
+pub fn density_of(
+    ph: &Physics,
+    space: &Space,
+    parts: &[RefParticle],
+    i: usize,
+    mls: bool,
+) -> (f64, bool) {
+    let nb = neighbours(ph, space, parts, i);
     // m_j W_ij = ρ_j (W_ij V_j).
     let (mw, wv) = nb.iter().fold((0.0, 0.0), |(mw, wv), &(j, _, w)| {
         (mw + parts[j].rho * w, wv + w)
@@ -84,7 +106,7 @@ pub fn density_of(ph: &Physics, parts: &[RefParticle], i: usize, mls: bool) -> (
         parts[i].rho
     };
     if mls {
-        if let Some(w) = mls_weights(ph, parts, i) {
+        if let Some(w) = mls_weights(ph, space, parts, i) {
             let rho: f64 = w.iter().map(|&(j, w)| parts[j].rho * w).sum();
             if rho.is_finite() && rho > 0.0 {
                 return (rho, true);
@@ -95,11 +117,11 @@ pub fn density_of(ph: &Physics, parts: &[RefParticle], i: usize, mls: bool) -> (
 }
 
 /// The densities after one filter: fluid particles filtered, all others unchanged.
-pub fn filter(ph: &Physics, parts: &[RefParticle], mls: bool) -> Vec<f64> {
+pub fn filter(ph: &Physics, space: &Space, parts: &[RefParticle], mls: bool) -> Vec<f64> {
     (0..parts.len())
         .map(|i| {
             if parts[i].kind == FLUID {
-                density_of(ph, parts, i, mls).0
+                density_of(ph, space, parts, i, mls).0
             } else {
                 parts[i].rho
             }
@@ -127,6 +149,7 @@ mod tests {
             delta_sph: 0.0,
             particle_mass: 1000.0 * dx.powi(dim as i32),
             density_filter: DensityFilter::Mls { every: 1 },
+            energy: false,
         }
     }
 
@@ -190,7 +213,7 @@ mod tests {
                 let f = |x: [f64; 3]| 2.5 + 3.0 * x[0] - 7.0 * x[1] + 4.0 * x[2];
                 let (mut worst, mut used, mut near_surface) = (0.0f64, 0, 0);
                 for i in 0..parts.len() {
-                    let Some(w) = mls_weights(&ph, &parts, i) else {
+                    let Some(w) = mls_weights(&ph, &Space::OPEN, &parts, i) else {
                         continue;
                     };
                     used += 1;
@@ -242,8 +265,8 @@ mod tests {
             for p in parts.iter_mut() {
                 p.rho = lin(p.pos);
             }
-            let (rho, used_mls) = density_of(&ph, &parts, i, true);
-            let (shepard, _) = density_of(&ph, &parts, i, false);
+            let (rho, used_mls) = density_of(&ph, &Space::OPEN, &parts, i, true);
+            let (shepard, _) = density_of(&ph, &Space::OPEN, &parts, i, false);
             println!(
                 "{dim}D surface particle: exact {:.6}, MLS {rho:.6}, Shepard {shepard:.6}",
                 lin(parts[i].pos)
@@ -263,7 +286,7 @@ mod tests {
                 p.rho = 1234.5;
             }
             for mls in [false, true] {
-                for rho in filter(&ph, &parts, mls) {
+                for rho in filter(&ph, &Space::OPEN, &parts, mls) {
                     assert!((rho - 1234.5).abs() < 1e-9, "{rho}");
                 }
             }
@@ -277,9 +300,9 @@ mod tests {
             let mut pair = vec![far, far];
             pair[1].pos[0] += 0.5 * ph.h;
             pair[1].rho = 990.0;
-            let (rho, used_mls) = density_of(&ph, &pair[..1], 0, true);
+            let (rho, used_mls) = density_of(&ph, &Space::OPEN, &pair[..1], 0, true);
             assert!(!used_mls && (rho - 1010.0).abs() < 1e-9, "{rho}");
-            let (rho, used_mls) = density_of(&ph, &pair, 0, true);
+            let (rho, used_mls) = density_of(&ph, &Space::OPEN, &pair, 0, true);
             assert!(!used_mls && rho.is_finite() && rho > 990.0 && rho < 1010.0);
         }
     }

@@ -14,7 +14,7 @@ struct Pair<'a> {
 }
 
 impl Pair<'_> {
-    /// (dv/dt, dρ/dt) on fluid particle i from a pressure-carrying neighbour at x_ij.
+    /// (dv/dt, dρ/dt) and de/dt on fluid particle i from a pressure-carrying neighbour at x_ij.
     #[allow(clippy::too_many_arguments)]
     fn rates(
         &self,
@@ -24,7 +24,7 @@ impl Pair<'_> {
         rho_j: f64,
         diffuse: bool,
         rho_ratio: f64,
-    ) -> [f64; 4] {
+    ) -> ([f64; 4], f64) {
         let (ph, m, h) = (self.ph, self.ph.particle_mass, self.ph.h);
         let r2 = dot(x_ij, x_ij);
         let f_ij = kernel::f(ph.kernel, ph.dim, h, r2.sqrt());
@@ -60,7 +60,7 @@ impl Pair<'_> {
         for a in 0..3 {
             acc[a] -= m * p * dw[a];
         }
-        [acc[0], acc[1], acc[2], drho]
+        ([acc[0], acc[1], acc[2], drho], 0.5 * m * p * dot(v_ij, dw))
     }
 }
 
@@ -84,12 +84,17 @@ fn add(a: &mut [f64; 4], b: [f64; 4]) {
 
 /// (dv/dt, dρ/dt) of every particle: fluid gets everything, dynamic walls only dρ/dt from
 /// fluid neighbours, ghosts and repulsive particles nothing.
-pub fn rates(
+pub fn rates(ph: &Physics, walls: &WallParams, space: &Space, parts: &[RefParticle]) -> Vec<[f64; 4]> {
+    rates_and_energy(ph, walls, space, parts).into_iter().map(|(r, _)| r).collect()
+}
+
+/// As [`rates`], with de/dt of the energy equation (0 for every non-fluid particle).
+pub fn rates_and_energy(
     ph: &Physics,
     walls: &WallParams,
     space: &Space,
     parts: &[RefParticle],
-) -> Vec<[f64; 4]> {
+) -> Vec<([f64; 4], f64)> {
     let h = ph.h;
     let pair = Pair {
         ph,
@@ -115,11 +120,12 @@ pub fn rates(
                         r[3] += ph.particle_mass * dot(sub(pi.vel, pj.vel), x_ij.map(|x| x * f_ij));
                     }
                 }
-                return r;
+                return (r, 0.0);
             }
             if pi.kind != FLUID {
-                return r;
+                return (r, 0.0);
             }
+            let mut de = 0.0;
             for (j, pj) in parts.iter().enumerate() {
                 let x_ij = space.sub(pi.pos, pj.pos);
                 let r2 = dot(x_ij, x_ij);
@@ -133,10 +139,9 @@ pub fn rates(
                 }
                 let ghost = pj.kind == GHOST_NO_SLIP || pj.kind == GHOST_FREE_SLIP;
                 let ratio = if ghost { pi.rho / pj.rho } else { 1.0 };
-                add(
-                    &mut r,
-                    pair.rates(pi, x_ij, pj.vel, pj.rho, pj.kind == FLUID, ratio),
-                );
+                let (pr, pe) = pair.rates(pi, x_ij, pj.vel, pj.rho, pj.kind == FLUID, ratio);
+                add(&mut r, pr);
+                de += pe;
             }
             // Mirror images of the fluid across each plane near i, and across pairs of planes
             // (corners).
@@ -167,14 +172,16 @@ pub fn rates(
                     }
                     let x_ig = sub(pi.pos, x_g);
                     if dot(x_ig, x_ig) < support2 {
-                        add(&mut r, pair.rates(pi, x_ig, v_g, pj.rho, true, 1.0));
+                        let (pr, pe) = pair.rates(pi, x_ig, v_g, pj.rho, true, 1.0);
+                        add(&mut r, pr);
+                        de += pe;
                     }
                 }
             }
             for a in 0..3 {
                 r[a] += ph.gravity[a];
             }
-            r
+            (r, de)
         })
         .collect()
 }

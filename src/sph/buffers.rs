@@ -30,6 +30,10 @@ pub struct ParticleBuffers {
     pub probes: wgpu::Buffer,
     pub probe_out: wgpu::Buffer,
     pub mirror_planes: wgpu::Buffer,
+    /// (e, de/dt) per particle, 2 parities, and the new de/dt: one element each when the
+    /// energy equation is off.
+    pub energy: [wgpu::Buffer; 2],
+    pub energy_rate: wgpu::Buffer,
 }
 
 /// Stand-in so a run without probes still binds a valid buffer.
@@ -54,6 +58,7 @@ impl ParticleBuffers {
         init: &InitialParticles,
         probes: &[ProbeDef],
         planes: &[MirrorPlane],
+        energy: bool,
     ) -> Self {
         let n = init.pos.len() as u32;
         let vec4 = 16 * n as u64;
@@ -105,6 +110,8 @@ impl ParticleBuffers {
                 },
             ),
             probe_out: storage(device, "probe out", 4 * probes.len().max(1) as u64),
+            energy: [0, 1].map(|k| storage(device, &format!("energy {k}"), if energy { 8 * n as u64 } else { 8 })),
+            energy_rate: storage(device, "energy rate", if energy { 4 * n as u64 } else { 4 }),
             mirror_planes: if planes.is_empty() {
                 storage(
                     device,
@@ -131,7 +138,9 @@ impl ParticleBuffers {
             &self.probes,
             &self.probe_out,
             &self.mirror_planes,
+            &self.energy_rate,
         ];
+        all.extend(self.energy.iter());
         all.extend(
             self.pos
                 .iter()

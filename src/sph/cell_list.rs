@@ -12,6 +12,7 @@ pub struct CellList {
     scatter: Kernel,
     rank_in_cell: Kernel,
     reorder: Kernel,
+    reorder_energy: Option<(Kernel, [wgpu::BindGroup; 2])>,
     scan_blocks: Kernel,
     scan_add: Kernel,
     bind_key: [wgpu::BindGroup; 2],
@@ -30,8 +31,17 @@ impl CellList {
         cells: &ShaderModule,
         scan: &ShaderModule,
         b: &ParticleBuffers,
+        energy: bool,
     ) -> Result<Self> {
         let cell_key = cells.kernel(device, "cell_key")?;
+        let reorder_energy = if energy {
+            let k = cells.kernel(device, "reorder_energy")?;
+            let bufs = |p: usize| [(0, &b.params), (8, &b.local_perm), (18, &b.energy[p]), (19, &b.energy[1 - p])];
+            let binds = [k.bind(device, &bufs(0))?, k.bind(device, &bufs(1))?];
+            Some((k, binds))
+        } else {
+            None
+        };
         let scatter = cells.kernel(device, "scatter")?;
         let rank_in_cell = cells.kernel(device, "rank_in_cell")?;
         let reorder = cells.kernel(device, "reorder")?;
@@ -92,6 +102,7 @@ impl CellList {
             scatter,
             rank_in_cell,
             reorder,
+            reorder_energy,
             scan_blocks,
             scan_add,
             bind_key,
@@ -116,6 +127,9 @@ impl CellList {
         self.scatter.dispatch(pass, &self.bind_scatter, self.n);
         self.rank_in_cell.dispatch(pass, &self.bind_rank, self.n);
         self.reorder.dispatch(pass, &self.bind_reorder[p], self.n);
+        if let Some((k, bind)) = &self.reorder_energy {
+            k.dispatch(pass, &bind[p], self.n);
+        }
     }
 
     fn encode_scan(&self, pass: &mut wgpu::ComputePass<'_>) {

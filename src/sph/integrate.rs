@@ -32,6 +32,8 @@ impl Integrate {
                 (5, &b.rate_sorted),
                 (6, &b.state),
                 (7, &b.cell_start),
+                (8, &b.energy[p]),
+                (9, &b.energy_rate),
             ]
         };
         Ok(Self {

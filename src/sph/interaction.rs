@@ -24,6 +24,7 @@ impl Interaction {
                 (4, &b.cell_start),
                 (5, &b.rate),
                 (6, &b.mirror_planes),
+                (7, &b.energy_rate),
             ]
         };
         let bind = [

@@ -63,6 +63,8 @@ pub struct Particles {
     /// 0 fluid, 1 wall, 15 excluded.
     pub kind: Vec<u32>,
     pub id: Vec<u32>,
+    /// Specific internal energy [J/kg], when the energy equation is on.
+    pub energy: Option<Vec<f32>>,
 }
 
 /// (positions, (v, ρ), code words) as stored on the GPU.
@@ -105,6 +107,7 @@ pub struct Solver {
     density_filter: Option<DensityFilter>,
     ghost: Ghost,
     has_ghosts: bool,
+    energy: bool,
     integrate: Integrate,
     probes: Probes,
     parity: usize,
@@ -183,6 +186,7 @@ impl Solver {
                 KernelKind::WendlandC2 => 1,
             },
             viscosity,
+            energy: ph.energy,
         };
         let mut pos = Vec::with_capacity(n);
         let mut velrho = Vec::with_capacity(n);
@@ -215,6 +219,7 @@ impl Solver {
             },
             &defs,
             &planes,
+            ph.energy,
         );
         let module = |pass| ShaderModule::new(&device, pass, cfg);
         let cell_list = CellList::new(
@@ -222,6 +227,7 @@ impl Solver {
             &module(Pass::CellList)?,
             &module(Pass::PrefixScan)?,
             &buffers,
+            ph.energy,
         )?;
         let interaction = Interaction::new(&device, &module(Pass::Interaction)?, &buffers)?;
         let ghost = Ghost::new(&device, &module(Pass::Ghost)?, &buffers)?;
@@ -241,6 +247,7 @@ impl Solver {
             interaction,
             density_filter,
             ghost,
+            energy: ph.energy,
             has_ghosts: sc
                 .particles
                 .iter()
@@ -559,6 +566,12 @@ impl Solver {
         )
     }
 
+    /// Test hook: de/dt of the last evaluation (energy equation on), in GPU order.
+    #[doc(hidden)]
+    pub fn read_energy_rates(&self) -> Result<Vec<f32>> {
+        read(&self.device, &self.queue, &self.buffers.energy_rate, self.buffers.n as usize)
+    }
+
     /// Slot starts of the last sort (slots + 2 entries).
     pub fn read_cell_start(&self) -> Result<Vec<u32>> {
         read(
@@ -572,6 +585,11 @@ impl Solver {
     /// All particles in world coordinates, sorted by id.
     pub fn read_particles(&self) -> Result<Particles> {
         let (pos, velrho, code) = self.read_raw()?;
+        let energy: Option<Vec<[f32; 2]>> = if self.energy {
+            Some(read(&self.device, &self.queue, &self.buffers.energy[self.parity], pos.len())?)
+        } else {
+            None
+        };
         let mut order: Vec<usize> = (0..pos.len()).collect();
         order.sort_unstable_by_key(|&i| code[i] & ID_MASK);
         let b = self.params.tait_b as f64;
@@ -587,6 +605,9 @@ impl Solver {
                 .push((b * ((v[3] as f64 / rho0).powf(gamma) - 1.0)) as f32);
             out.kind.push(code[i] >> KIND_SHIFT);
             out.id.push(code[i] & ID_MASK);
+            if let Some(e) = &energy {
+                out.energy.get_or_insert_with(Vec::new).push(e[i][0]);
+            }
         }
         Ok(out)
     }

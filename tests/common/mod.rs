@@ -34,6 +34,7 @@ pub fn physics(dim: u32, dx: f64, c0: f64) -> Physics {
         delta_sph: 0.1,
         particle_mass: 1000.0 * dx.powi(dim as i32),
         density_filter: DensityFilter::None,
+        energy: false,
     }
 }
 
