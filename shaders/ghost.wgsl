@@ -2,12 +2,13 @@
 // inside walls and never move relative to their solid; each step their pressure and velocity
 // are interpolated from the fluid with a corrected kernel W^I (Shepard here; MLS where the case
 // asks for it and the moment matrix is well conditioned):
-//   P_g = Σ_j P_j W^I_gj V_j,   no-slip v_g = 2 v_wall − Σ_j v_j W^I_gj V_j (walls at rest: v_wall = 0).
+//   P_g = Σ_j P_j W^I_gj V_j,   no-slip v_g = 2 v_wall − Σ_j v_j W^I_gj V_j (walls at rest: v_wall = 0),
+// the latter applied in the viscous terms (interaction.wgsl); continuity sees v_wall.
 // Hydrostatic correction (as in Adami, Hu & Adams 2012, eq. 27): each fluid pressure is carried
 // to the ghost along gravity before it is interpolated, P_j + ρ_j g·(x_g − x_j), so a ghost below
 // the fluid sees the hydrostatic increase (g points down) and a hydrostatic field is exact.
-// Free-slip keeps the tangential part of the interpolated velocity and reverses its normal part,
-// the normal being the direction from the ghost towards the fluid, n ∝ Σ_j (x_j − x_g) W_gj V_j.
+// Free-slip ghosts use the interpolated velocity itself in the viscous terms (no tangential
+// shear from the wall).
 // Only fluid particles count (the interpolation domain of fixed-wall ghosts). Fallbacks: MLS →
 // Shepard where the moment matrix is ill-conditioned; no fluid in reach → P_g = 0, v_g = v_wall.
 // ρ_g follows from P_g by the inverse Tait equation, so the interaction pass sees P_g.
@@ -40,7 +41,6 @@ fn ghost_interpolate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     var m_vx = vec4<f32>(0.0);
     var m_vy = vec4<f32>(0.0);
     var m_vz = vec4<f32>(0.0);
-    var toward = vec3<f32>(0.0);
     var slots: array<u32, 27>;
     let n_slots = neighbour_slots(cell_of(pg), &slots);
     for (var s = 0u; s < n_slots; s++) {
@@ -61,7 +61,6 @@ fn ghost_interpolate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
             m_vx += vr.x * wv * basis;
             m_vy += vr.y * wv * basis;
             m_vz += vr.z * wv * basis;
-            toward -= x_gj * wv;
         }
     }
     let volume = a[0][0];
@@ -79,11 +78,8 @@ fn ghost_interpolate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
         p = dot(beta, m_p);
         v = vec3<f32>(dot(beta, m_vx), dot(beta, m_vy), dot(beta, m_vz));
     }
-    var v_g = -v;
-    if (kind == KIND_GHOST_FREE_SLIP) {
-        let len = length(toward);
-        let n = select(vec3<f32>(0.0), toward / len, len > 0.0);
-        v_g = v - 2.0 * dot(v, n) * n;
-    }
-    velrho[g] = vec4<f32>(v_g, density_of(p));
+    // The interpolated fluid velocity is stored; the interaction makes the no-slip ghost
+    // velocity 2 v_wall − v (v_wall = 0) from it for the viscous terms, and uses the wall's own
+    // velocity in continuity.
+    velrho[g] = vec4<f32>(v, density_of(p));
 }

@@ -17,6 +17,7 @@
 // (e, de/dt of the last evaluation) and the new de/dt, when ENERGY.
 @group(0) @binding(8) var<storage, read_write> energy: array<vec2<f32>>;
 @group(0) @binding(9) var<storage, read> energy_rate: array<f32>;
+@group(0) @binding(10) var<storage, read> mirror_planes: array<MirrorPlane>;
 
 var<workgroup> wg_speed: array<f32, WG>;
 var<workgroup> wg_accel: array<f32, WG>;
@@ -46,9 +47,21 @@ fn predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     let vr = velrho[i];
     let r = rate[i];
     if (kind == KIND_FLUID) {
-        let moved = move_by(pos[i], dt * vr.xyz + 0.5 * dt * dt * r.xyz);
+        var moved = move_by(pos[i], dt * vr.xyz + 0.5 * dt * dt * r.xyz);
+        var v = vr.xyz + dt * r.xyz;
+        // Mirror walls cannot be crossed: a particle that would cross one (where the pressure
+        // near a thin, fast layer is ~0 the images do not push back) is reflected specularly,
+        // position and normal velocity, which is what the image method models.
+        for (var k = 0u; k < params.n_mirror_planes; k++) {
+            let plane = mirror_planes[k];
+            let d = dot(domain_pos(moved.pos) - plane.point, plane.normal);
+            if (d < 0.0) {
+                moved = move_by(moved.pos, -2.0 * d * plane.normal);
+                v = reflect_vec(v, plane.normal);
+            }
+        }
         pos[i] = moved.pos;
-        velrho[i] = vec4<f32>(vr.xyz + dt * r.xyz, vr.w + dt * r.w);
+        velrho[i] = vec4<f32>(v, vr.w + dt * r.w);
         if (ENERGY) {
             energy[i].x += dt * energy[i].y;
         }

@@ -16,20 +16,13 @@
 //   enter the sums like fluid; repulsive particles exert only the Lennard-Jones force
 //   D((r0/r)^12 − (r0/r)^4) x_ij/r² for r < r0 (Monaghan 1994, eq. 3.2); mirror planes add, for
 //   each fluid j near the image of i, the ghost x_g = 2x_w − x_j with p_g = p_j, ρ_g = ρ_j and
-//   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip); near a corner
-//   also the double image across both planes.
+//   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip), the latter in
+//   the viscous terms only; near a corner also the double image across both planes.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
 // get nothing.
 // Energy (the seed's eq. 3 with σ = −P I, when ENERGY): de_i/dt = ½ Σ_j m_j (P_i/ρ_i² + P_j/ρ_j²
 //   + Π_ij) v_ij·∇_i W_ij (Monaghan 1992, eq. 2.19 with the artificial-viscosity heating);
 //   laminar viscous heating is not included.
-
-struct MirrorPlane {
-    point: vec3<f32>,
-    no_slip: u32,
-    normal: vec3<f32>,
-    pad: u32,
-}
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;
@@ -52,9 +45,14 @@ struct PairRates {
 }
 
 // Contribution to fluid particle i of a pressure-carrying neighbour j (fluid, dynamic wall,
-// ghost or mirror image) at x_ij = x_i − x_j.
-fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_j: vec3<f32>, rho_j: f32, diffuse: bool, rho_ratio: f32) -> PairRates {
-    let v_ij = pi.v - v_j;
+// ghost or mirror image) at x_ij = x_i − x_j. A wall neighbour has two velocities: `v_cont`
+// for continuity and pressure work (the wall's own, free-slip for mirror images) and `v_visc`
+// for the viscous terms (the no-slip or free-slip ghost velocity), as in Adami, Hu & Adams
+// (2012); with the no-slip velocity in continuity too, a fast tangential surge drains the
+// density next to the wall and sucks fluid through it.
+fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_cont: vec3<f32>, v_visc: vec3<f32>, rho_j: f32, diffuse: bool, rho_ratio: f32) -> PairRates {
+    let v_ij = pi.v - v_cont;
+    let w_ij = pi.v - v_visc;
     let f_ij = kernel_f(sqrt(r2) / params.h);
     let dw_ij = x_ij * f_ij;
     var drho = params.mass * dot(v_ij, dw_ij) * rho_ratio;
@@ -64,20 +62,20 @@ fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_j: vec3<f32>, rho_j: f32
     var acc = vec3<f32>(0.0);
     var pi_ij = 0.0;
     if (VISCOSITY == 0u) {
-        let vx = dot(v_ij, x_ij);
+        let vx = dot(w_ij, x_ij);
         if (vx < 0.0) {
             let mu = params.h * vx / (r2 + params.eta2);
             pi_ij = -params.alpha * params.c0 * mu / (0.5 * (pi.rho + rho_j));
         }
     } else {
-        acc += params.mass * 4.0 * params.nu * r2 * f_ij / ((pi.rho + rho_j) * (r2 + params.eta2)) * v_ij;
+        acc += params.mass * 4.0 * params.nu * r2 * f_ij / ((pi.rho + rho_j) * (r2 + params.eta2)) * w_ij;
     }
     let p_over_rho2_j = pressure_of(rho_j) / (rho_j * rho_j);
-    let pressure_term = pi.p_over_rho2 + p_over_rho2_j + pi_ij;
-    acc -= params.mass * pressure_term * dw_ij;
+    let pressure_term = pi.p_over_rho2 + p_over_rho2_j;
+    acc -= params.mass * (pressure_term + pi_ij) * dw_ij;
     var de = 0.0;
     if (ENERGY) {
-        de = 0.5 * params.mass * pressure_term * dot(v_ij, dw_ij);
+        de = 0.5 * params.mass * (pressure_term * dot(v_ij, dw_ij) + pi_ij * dot(w_ij, dw_ij));
     }
     return PairRates(vec4<f32>(acc, drho), de);
 }
@@ -95,14 +93,6 @@ fn repulsion(x_ij: vec3<f32>, r2: f32) -> vec3<f32> {
 }
 
 const NO_PLANE: u32 = 0xFFFFFFFFu;
-
-fn reflect_vec(v: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    return v - 2.0 * dot(v, n) * n;
-}
-
-fn reflect_point(x: vec3<f32>, plane: MirrorPlane) -> vec3<f32> {
-    return x - 2.0 * dot(x - plane.point, plane.normal) * plane.normal;
-}
 
 // Velocity of a ghost across `plane`: normal part reversed (free-slip) or all (no-slip).
 fn ghost_velocity(v: vec3<f32>, plane: MirrorPlane) -> vec3<f32> {
@@ -132,14 +122,17 @@ fn image_rates(pi: Particle, image: vec3<f32>, k1: u32, k2: u32) -> PairRates {
                 continue;
             }
             var x_ig = x;
-            var v_g = velrho[j].xyz;
+            var v_cont = velrho[j].xyz;
+            var v_visc = v_cont;
             if (double) {
                 x_ig = reflect_vec(x_ig, p2.normal);
-                v_g = ghost_velocity(v_g, p2);
+                v_cont = reflect_vec(v_cont, p2.normal);
+                v_visc = ghost_velocity(v_visc, p2);
             }
             x_ig = reflect_vec(x_ig, p1.normal);
-            v_g = ghost_velocity(v_g, p1);
-            let pr = pair_rates(pi, x_ig, r2, v_g, velrho[j].w, true, 1.0);
+            v_cont = reflect_vec(v_cont, p1.normal);
+            v_visc = ghost_velocity(v_visc, p1);
+            let pr = pair_rates(pi, x_ig, r2, v_cont, v_visc, velrho[j].w, true, 1.0);
             out.rate += pr.rate;
             out.de += pr.de;
         }
@@ -220,7 +213,15 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             }
             let vr_j = velrho[j];
             let ghost = is_ghost(kind_j);
-            let pr = pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.w, kind_j == KIND_FLUID, select(1.0, pi.rho / vr_j.w, ghost));
+            // A ghost stores the fluid velocity interpolated at its position (ghost.wgsl):
+            // continuity sees the wall at rest, viscosity the no-slip or free-slip ghost.
+            var v_cont = vr_j.xyz;
+            var v_visc = vr_j.xyz;
+            if (ghost) {
+                v_cont = vec3<f32>(0.0);
+                v_visc = select(vr_j.xyz, -vr_j.xyz, kind_j == KIND_GHOST_NO_SLIP);
+            }
+            let pr = pair_rates(pi, x_ij, r2, v_cont, v_visc, vr_j.w, kind_j == KIND_FLUID, select(1.0, pi.rho / vr_j.w, ghost));
             r += pr.rate;
             de += pr.de;
         }

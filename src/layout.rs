@@ -224,7 +224,12 @@ mod tests {
                 for kernel in [0, 1] {
                     for viscosity in [0, 1] {
                         for energy in [false, true] {
-                            let cfg = ShaderConfig { dim, kernel, viscosity, energy };
+                            let cfg = ShaderConfig {
+                                dim,
+                                kernel,
+                                viscosity,
+                                energy,
+                            };
                             parse(&compose(pass, cfg), pass.name()).unwrap();
                         }
                     }

@@ -32,7 +32,11 @@ fn series_matches_the_data_file() {
     for line in text.lines().filter(|l| !l.starts_with('#')).skip(1) {
         let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
         for (k, t) in times.iter().enumerate() {
-            assert!((exact(v[0], *t) - v[k + 1]).abs() < 1e-6, "y {} t {t}", v[0]);
+            assert!(
+                (exact(v[0], *t) - v[k + 1]).abs() < 1e-6,
+                "y {} t {t}",
+                v[0]
+            );
         }
         rows += 1;
     }
@@ -55,7 +59,12 @@ fn poiseuille(walls: Walls, times: &[f64]) -> Vec<f64> {
     let lx = 0.5;
     let mut parts: Vec<Particle> = lattice(2, dx, [0.0; 3], [lx, D, 0.0])
         .into_iter()
-        .map(|p| Particle { pos: p, vel: [0.0; 3], rho: 1.0, kind: Kind::Fluid })
+        .map(|p| Particle {
+            pos: p,
+            vel: [0.0; 3],
+            rho: 1.0,
+            kind: Kind::Fluid,
+        })
         .collect();
     let mut planes = Vec::new();
     match walls {
@@ -64,15 +73,31 @@ fn poiseuille(walls: Walls, times: &[f64]) -> Vec<f64> {
                 .into_iter()
                 .chain(lattice(2, dx, [0.0, D, 0.0], [lx, D + 3.0 * dx, 0.0]))
             {
-                parts.push(Particle { pos: layer, vel: [0.0; 3], rho: 1.0, kind: Kind::GhostNoSlip });
+                parts.push(Particle {
+                    pos: layer,
+                    vel: [0.0; 3],
+                    rho: 1.0,
+                    kind: Kind::GhostNoSlip,
+                });
             }
         }
         Walls::Mirror => {
-            planes.push(MirrorPlane { point: [0.0; 3], normal: [0.0, 1.0, 0.0], no_slip: true });
-            planes.push(MirrorPlane { point: [0.0, D, 0.0], normal: [0.0, -1.0, 0.0], no_slip: true });
+            planes.push(MirrorPlane {
+                point: [0.0; 3],
+                normal: [0.0, 1.0, 0.0],
+                no_slip: true,
+            });
+            planes.push(MirrorPlane {
+                point: [0.0, D, 0.0],
+                normal: [0.0, -1.0, 0.0],
+                no_slip: true,
+            });
         }
     }
-    let domain = Domain { min: [0.0, -0.2, 0.0], max: [lx, D + 0.2, 0.0] };
+    let domain = Domain {
+        min: [0.0, -0.2, 0.0],
+        max: [lx, D + 0.2, 0.0],
+    };
     let mut sc = scenario(ph, parts, domain, vec![]);
     sc.periodic = [true, false, false];
     sc.walls.mirror_planes = planes;
@@ -90,7 +115,10 @@ fn poiseuille(walls: Walls, times: &[f64]) -> Vec<f64> {
                 let u = exact(x[1], t);
                 num += (v[0] as f64 - u).powi(2);
                 den += u * u;
-                assert!(x[1] > 0.0 && x[1] < D, "fluid particle left the channel: {x:?}");
+                assert!(
+                    x[1] > 0.0 && x[1] < D,
+                    "fluid particle left the channel: {x:?}"
+                );
             }
         }
         errors.push((num / den).sqrt());
@@ -101,7 +129,15 @@ fn poiseuille(walls: Walls, times: &[f64]) -> Vec<f64> {
 const TIMES: [f64; 3] = [0.002, 0.005, 0.01];
 
 fn check(name: &str, errors: &[f64]) {
-    println!("Poiseuille, {name}: L2 error {}", TIMES.iter().zip(errors).map(|(t, e)| format!("t = {t}: {:.2} %", 100.0 * e)).collect::<Vec<_>>().join(", "));
+    println!(
+        "Poiseuille, {name}: L2 error {}",
+        TIMES
+            .iter()
+            .zip(errors)
+            .map(|(t, e)| format!("t = {t}: {:.2} %", 100.0 * e))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
     for e in errors {
         assert!(*e < 0.05, "L2 error {:.2} % above 5 %", 100.0 * e);
     }
@@ -109,12 +145,18 @@ fn check(name: &str, errors: &[f64]) {
 
 #[test]
 fn poiseuille_fixed_ghost_mls() {
-    check("fixed_ghost MLS", &poiseuille(Walls::Ghost(GhostCorrection::Mls), &TIMES));
+    check(
+        "fixed_ghost MLS",
+        &poiseuille(Walls::Ghost(GhostCorrection::Mls), &TIMES),
+    );
 }
 
 #[test]
 fn poiseuille_fixed_ghost_shepard() {
-    check("fixed_ghost Shepard", &poiseuille(Walls::Ghost(GhostCorrection::Shepard), &TIMES));
+    check(
+        "fixed_ghost Shepard",
+        &poiseuille(Walls::Ghost(GhostCorrection::Shepard), &TIMES),
+    );
 }
 
 #[test]

@@ -18,7 +18,11 @@ fn block(dim: u32, seed: u64, jitter: f64) -> Scenario {
     ph.viscosity = Viscosity::Artificial { alpha: 0.1 };
     let mut rng = Rng(seed);
     let max = if dim == 2 { [0.5, 0.5, 0.0] } else { [0.4; 3] };
-    let min = if dim == 2 { [0.3, 0.3, 0.0] } else { [0.3, 0.3, 0.3] };
+    let min = if dim == 2 {
+        [0.3, 0.3, 0.0]
+    } else {
+        [0.3, 0.3, 0.3]
+    };
     let parts = lattice(dim, dx, min, max)
         .into_iter()
         .map(|p| {
@@ -28,11 +32,24 @@ fn block(dim: u32, seed: u64, jitter: f64) -> Scenario {
                 pos[a] += rng.range(-jitter, jitter) * dx;
                 vel[a] = rng.range(-0.3, 0.3);
             }
-            Particle { pos, vel, rho: 1000.0 * (1.0 + rng.range(0.0, 0.01)), kind: Kind::Fluid }
+            Particle {
+                pos,
+                vel,
+                rho: 1000.0 * (1.0 + rng.range(0.0, 0.01)),
+                kind: Kind::Fluid,
+            }
         })
         .collect();
     let dmax = if dim == 2 { [0.8, 0.8, 0.0] } else { [0.7; 3] };
-    scenario(ph, parts, Domain { min: [0.0; 3], max: dmax }, vec![])
+    scenario(
+        ph,
+        parts,
+        Domain {
+            min: [0.0; 3],
+            max: dmax,
+        },
+        vec![],
+    )
 }
 
 #[test]
@@ -54,7 +71,12 @@ fn energy_rate_matches_reference() {
             .collect();
         solver.rerun_interaction(false).unwrap();
         let gpu_de = solver.read_energy_rates().unwrap();
-        let cpu = reference::interaction::rates_and_energy(&sc.physics, &sc.walls, &reference::Space::of(&sc), &parts);
+        let cpu = reference::interaction::rates_and_energy(
+            &sc.physics,
+            &sc.walls,
+            &reference::Space::of(&sc),
+            &parts,
+        );
         let rms = (cpu.iter().map(|(_, e)| e * e).sum::<f64>() / cpu.len() as f64).sqrt();
         let worst = gpu_de
             .iter()
@@ -78,7 +100,11 @@ fn kinetic_plus_internal_energy_is_conserved() {
         let total = |s: &Solver| {
             let p = s.read_particles().unwrap();
             let e = p.energy.as_ref().expect("energy output");
-            let kin: f64 = p.vel.iter().map(|v| 0.5 * m * v.iter().map(|x| (*x as f64).powi(2)).sum::<f64>()).sum();
+            let kin: f64 = p
+                .vel
+                .iter()
+                .map(|v| 0.5 * m * v.iter().map(|x| (*x as f64).powi(2)).sum::<f64>())
+                .sum();
             let int: f64 = e.iter().map(|x| m * *x as f64).sum();
             (kin, int)
         };
@@ -91,7 +117,14 @@ fn kinetic_plus_internal_energy_is_conserved() {
         }
         let (kin, int) = total(&solver);
         println!("{dim}D: kinetic {k0:.4e} -> {kin:.4e} J, internal {i0:.1e} -> {int:.4e} J, worst drift {:.2e} of the initial kinetic energy, {} steps", worst, solver.steps());
-        assert!(int.abs() > 1e-3 * k0, "the energy equation must exchange energy");
-        assert!(worst < 0.01, "total energy drifted by {:.2} %", 100.0 * worst);
+        assert!(
+            int.abs() > 1e-3 * k0,
+            "the energy equation must exchange energy"
+        );
+        assert!(
+            worst < 0.01,
+            "total energy drifted by {:.2} %",
+            100.0 * worst
+        );
     }
 }

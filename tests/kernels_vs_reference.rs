@@ -173,7 +173,12 @@ fn interaction_matches_reference() {
         let solver = Solver::new(gpu(), &sc).unwrap();
         let (parts, _) = gpu_particles(&solver);
         let gpu_rates = solver.rerun_interaction(true).unwrap();
-        let cpu = reference::interaction::rates(&sc.physics, &sc.walls, &reference::Space::of(&sc), &parts);
+        let cpu = reference::interaction::rates(
+            &sc.physics,
+            &sc.walls,
+            &reference::Space::of(&sc),
+            &parts,
+        );
         let e_acc = rel_err(&gpu_rates, &cpu, 0..3);
         let e_rho = rel_err(&gpu_rates, &cpu, 3..4);
         println!(
@@ -207,7 +212,8 @@ fn one_step_matches_reference() {
             .zip(&rates0)
             .map(|(p, r)| reference::integrate::predict(ph, p, *r, dt))
             .collect();
-        let rates1 = reference::interaction::rates(ph, &sc.walls, &reference::Space::of(&sc), &predicted);
+        let rates1 =
+            reference::interaction::rates(ph, &sc.walls, &reference::Space::of(&sc), &predicted);
         let after_cpu: Vec<RefParticle> = predicted
             .iter()
             .zip(rates1.iter().zip(&rates0))

@@ -72,33 +72,68 @@ fn report(name: &str, o: &Outcome) {
 
 #[test]
 fn fixed_ghost_mls_no_slip() {
-    let o = hydrostatic(&["tank.wall=\"fixed_ghost\"", "walls.ghost_correction=\"mls\""]);
+    let o = hydrostatic(&[
+        "tank.wall=\"fixed_ghost\"",
+        "walls.ghost_correction=\"mls\"",
+    ]);
     report("fixed_ghost (MLS, no-slip)", &o);
-    assert!(o.error.abs() < 0.02, "pressure error {:.2} %", 100.0 * o.error);
-    assert!(o.margin > 0.0 && o.excluded == 0, "penetration: {}", o.margin);
+    assert!(
+        o.error.abs() < 0.02,
+        "pressure error {:.2} %",
+        100.0 * o.error
+    );
+    assert!(
+        o.margin > 0.0 && o.excluded == 0,
+        "penetration: {}",
+        o.margin
+    );
 }
 
 #[test]
 fn fixed_ghost_shepard_free_slip() {
-    let o = hydrostatic(&["tank.wall=\"fixed_ghost\"", "tank.slip=\"free_slip\"", "walls.ghost_correction=\"shepard\""]);
+    let o = hydrostatic(&[
+        "tank.wall=\"fixed_ghost\"",
+        "tank.slip=\"free_slip\"",
+        "walls.ghost_correction=\"shepard\"",
+    ]);
     report("fixed_ghost (Shepard, free-slip)", &o);
-    assert!(o.error.abs() < 0.02, "pressure error {:.2} %", 100.0 * o.error);
-    assert!(o.margin > 0.0 && o.excluded == 0, "penetration: {}", o.margin);
+    assert!(
+        o.error.abs() < 0.02,
+        "pressure error {:.2} %",
+        100.0 * o.error
+    );
+    assert!(
+        o.margin > 0.0 && o.excluded == 0,
+        "penetration: {}",
+        o.margin
+    );
 }
 
 #[test]
 fn mirror_free_slip() {
     let o = hydrostatic(&["tank.wall=\"mirror\"", "tank.slip=\"free_slip\""]);
     report("mirror (free-slip)", &o);
-    assert!(o.error.abs() < 0.02, "pressure error {:.2} %", 100.0 * o.error);
-    assert!(o.margin > 0.0 && o.excluded == 0, "penetration: {}", o.margin);
+    assert!(
+        o.error.abs() < 0.02,
+        "pressure error {:.2} %",
+        100.0 * o.error
+    );
+    assert!(
+        o.margin > 0.0 && o.excluded == 0,
+        "penetration: {}",
+        o.margin
+    );
 }
 
 #[test]
 fn dynamic_boundary() {
     let o = hydrostatic(&[]);
     report("dynamic", &o);
-    assert!(o.error.abs() < 0.02, "pressure error {:.2} %", 100.0 * o.error);
+    assert!(
+        o.error.abs() < 0.02,
+        "pressure error {:.2} %",
+        100.0 * o.error
+    );
     assert_eq!(o.excluded, 0);
 }
 
@@ -114,5 +149,9 @@ fn repulsive_holds_the_water() {
 fn repulsive_pressure_within_2_percent() {
     let o = hydrostatic(&["tank.wall=\"repulsive\""]);
     report("repulsive (Lennard-Jones)", &o);
-    assert!(o.error.abs() < 0.02, "pressure error {:.2} %", 100.0 * o.error);
+    assert!(
+        o.error.abs() < 0.02,
+        "pressure error {:.2} %",
+        100.0 * o.error
+    );
 }

@@ -69,8 +69,16 @@ fn wall_scenario(dim: u32, correction: GhostCorrection, seed: u64) -> Scenario {
     let mut right = [0.0; 3];
     right[0] = o + L;
     sc.walls.mirror_planes = vec![
-        MirrorPlane { point, normal, no_slip: false },
-        MirrorPlane { point: right, normal: [-1.0, 0.0, 0.0], no_slip: true },
+        MirrorPlane {
+            point,
+            normal,
+            no_slip: false,
+        },
+        MirrorPlane {
+            point: right,
+            normal: [-1.0, 0.0, 0.0],
+            no_slip: true,
+        },
     ];
     sc
 }
@@ -97,7 +105,12 @@ fn ghosts_repulsion_and_mirrors_match_reference() {
             let solver = Solver::new(gpu(), &sc).unwrap();
             let gpu_parts = gpu_particles(&solver);
             // Ghost values: the reference interpolates from the GPU's fluid.
-            let cpu_parts = reference::ghost::interpolate(&sc.physics, &sc.walls, &reference::Space::of(&sc), &gpu_parts);
+            let cpu_parts = reference::ghost::interpolate(
+                &sc.physics,
+                &sc.walls,
+                &reference::Space::of(&sc),
+                &gpu_parts,
+            );
             let mut ghosts = 0;
             let (mut ev, mut er) = (0.0f64, 0.0f64);
             for (g, c) in gpu_parts.iter().zip(&cpu_parts) {
@@ -105,7 +118,12 @@ fn ghosts_repulsion_and_mirrors_match_reference() {
                 // the threshold: those few are left out of the comparison.
                 let ratio = reference::ghost::min_pivot_ratio(
                     sc.physics.dim as usize,
-                    reference::ghost::moment_matrix(&sc.physics, &reference::Space::of(&sc), &gpu_parts, g.pos),
+                    reference::ghost::moment_matrix(
+                        &sc.physics,
+                        &reference::Space::of(&sc),
+                        &gpu_parts,
+                        g.pos,
+                    ),
                 );
                 let borderline = correction == GhostCorrection::Mls
                     && (ratio / reference::ghost::MLS_MIN_PIVOT - 1.0).abs() < 0.1;
@@ -121,7 +139,12 @@ fn ghosts_repulsion_and_mirrors_match_reference() {
             }
             // Rates: the reference evaluates on the GPU's own ghost values.
             let gpu_rates = solver.rerun_interaction(true).unwrap();
-            let cpu_rates = reference::interaction::rates(&sc.physics, &sc.walls, &reference::Space::of(&sc), &gpu_parts);
+            let cpu_rates = reference::interaction::rates(
+                &sc.physics,
+                &sc.walls,
+                &reference::Space::of(&sc),
+                &gpu_parts,
+            );
             let rms = (cpu_rates
                 .iter()
                 .map(|r| r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
@@ -174,7 +197,8 @@ fn mls_ghosts_extrapolate_a_linear_pressure_exactly() {
             let mut worst: f64 = 0.0;
             let mut checked = 0;
             for g in parts.iter().filter(|p| p.kind == reference::GHOST_NO_SLIP) {
-                let a = reference::ghost::moment_matrix(&ph, &reference::Space::OPEN, &parts, g.pos);
+                let a =
+                    reference::ghost::moment_matrix(&ph, &reference::Space::OPEN, &parts, g.pos);
                 if reference::ghost::min_pivot_ratio(dim as usize, a)
                     < 1.2 * reference::ghost::MLS_MIN_PIVOT
                 {
@@ -239,4 +263,54 @@ fn lonely_ghosts_stay_finite() {
         );
     }
     assert_eq!(p.rho[0], 1000.0, "no fluid in reach: P = 0, ρ = ρ0");
+}
+
+/// A lone fluid particle thrown at a mirror floor (no pressure from images: it has no
+/// neighbours) bounces back instead of crossing it.
+#[test]
+fn mirror_planes_cannot_be_crossed() {
+    let dx = 0.02;
+    let ph = physics(2, dx, 15.0);
+    let parts = vec![Particle {
+        pos: [0.3, 0.05, 0.0],
+        vel: [0.5, -2.0, 0.0],
+        rho: 1000.0,
+        kind: Kind::Fluid,
+    }];
+    let mut sc = scenario(
+        ph,
+        parts,
+        Domain {
+            min: [0.0, -0.1, 0.0],
+            max: [1.0, 1.0, 0.0],
+        },
+        vec![],
+    );
+    sc.walls.mirror_planes = vec![MirrorPlane {
+        point: [0.0; 3],
+        normal: [0.0, 1.0, 0.0],
+        no_slip: false,
+    }];
+    let walls = sc.walls.clone();
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    let mut min_y = f64::MAX;
+    for k in 1..=20 {
+        solver.advance_to(0.005 * k as f64).unwrap();
+        let p = solver.read_particles().unwrap();
+        min_y = min_y.min(p.pos[0][1]);
+    }
+    let p = solver.read_particles().unwrap();
+    println!("lowest y {min_y}, final velocity {:?}", p.vel[0]);
+    assert!(min_y >= 0.0, "crossed the mirror plane: y = {min_y}");
+    assert!(p.vel[0][1] > 0.0 || p.pos[0][1] > 0.05, "must have bounced");
+    // The reference reflection agrees on a crossing particle.
+    let crossing = reference::RefParticle {
+        pos: [0.3, -0.01, 0.0],
+        vel: [0.5, -2.0, 0.0],
+        rho: 1000.0,
+        kind: 0,
+    };
+    let r = reference::integrate::reflect_at_mirrors(&walls, &crossing);
+    assert_eq!(r.pos, [0.3, 0.01, 0.0]);
+    assert_eq!(r.vel, [0.5, 2.0, 0.0]);
 }

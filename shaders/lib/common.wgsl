@@ -204,6 +204,24 @@ fn neighbour_slots(c: vec3<i32>, slots: ptr<function, array<u32, 27>>) -> u32 {
     return n;
 }
 
+// ---- mirror planes ---------------------------------------------------------------------
+
+// A straight wall with mirrored ghosts; `point` in domain coordinates, `normal` into the fluid.
+struct MirrorPlane {
+    point: vec3<f32>,
+    no_slip: u32,
+    normal: vec3<f32>,
+    pad: u32,
+}
+
+fn reflect_vec(v: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    return v - 2.0 * dot(v, n) * n;
+}
+
+fn reflect_point(x: vec3<f32>, plane: MirrorPlane) -> vec3<f32> {
+    return x - 2.0 * dot(x - plane.point, plane.normal) * plane.normal;
+}
+
 // ---- smoothing kernels (support 2h, q = r/h) ---------------------------------------------
 
 // W(r) for q in [0, 2].

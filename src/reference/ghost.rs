@@ -118,7 +118,6 @@ pub fn interpolate(
             let mut a = [[0.0; 4]; 4];
             let mut m_p = [0.0; 4];
             let mut m_v = [[0.0; 4]; 3];
-            let mut toward = [0.0; 3];
             for j in parts.iter().filter(|p| p.kind == FLUID) {
                 let x = space.sub(g.pos, j.pos);
                 let r2 = dot(x, x);
@@ -137,9 +136,6 @@ pub fn interpolate(
                         m_v[k][r] += j.vel[k] * wv * b[r];
                     }
                 }
-                for k in 0..3 {
-                    toward[k] -= x[k] * wv;
-                }
             }
             let (mut p, mut v) = (0.0, [0.0; 3]);
             if a[0][0] > 1e-6 {
@@ -153,18 +149,9 @@ pub fn interpolate(
                 p = d4(m_p);
                 v = [d4(m_v[0]), d4(m_v[1]), d4(m_v[2])];
             }
+            // The interpolated fluid velocity; interaction.rs makes the ghost velocities.
             let mut out = *g;
-            out.vel = v.map(|x| -x);
-            if g.kind == GHOST_FREE_SLIP {
-                let len = dot(toward, toward).sqrt();
-                let n = if len > 0.0 {
-                    toward.map(|x| x / len)
-                } else {
-                    [0.0; 3]
-                };
-                let vn = dot(v, n);
-                out.vel = [0, 1, 2].map(|k| v[k] - 2.0 * vn * n[k]);
-            }
+            out.vel = v;
             out.rho = ph.rho0 * (1.0 + p / ph.tait_b()).max(0.5).powf(1.0 / ph.gamma);
             out
         })

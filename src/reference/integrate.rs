@@ -18,6 +18,27 @@ pub fn predict(ph: &Physics, p: &RefParticle, rate: [f64; 4], dt: f64) -> RefPar
     out
 }
 
+/// After the predictor: a fluid particle that crossed a mirror plane is reflected back,
+/// position and normal velocity (as `predict` in integrate.wgsl).
+pub fn reflect_at_mirrors(walls: &crate::scenario::WallParams, p: &RefParticle) -> RefParticle {
+    let mut out = *p;
+    if p.kind != FLUID {
+        return out;
+    }
+    for plane in &walls.mirror_planes {
+        let n = plane.normal;
+        let d: f64 = (0..3).map(|a| (out.pos[a] - plane.point[a]) * n[a]).sum();
+        if d < 0.0 {
+            let vn: f64 = (0..3).map(|a| out.vel[a] * n[a]).sum();
+            for a in 0..3 {
+                out.pos[a] -= 2.0 * d * n[a];
+                out.vel[a] -= 2.0 * vn * n[a];
+            }
+        }
+    }
+    out
+}
+
 /// v_{n+1} = v* + ½dt (a_{n+1} − a_n), likewise ρ (walls: only ρ, ≥ ρ0).
 pub fn correct(
     ph: &Physics,

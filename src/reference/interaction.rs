@@ -1,8 +1,8 @@
 //! Twin of shaders/interaction.wgsl, brute force over all pairs (no cell list), f64.
 
 use super::{
-    dot, kernel, laminar_nu, pressure, sub, RefParticle, Space, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP,
-    REPULSIVE, WALL,
+    dot, kernel, laminar_nu, pressure, sub, RefParticle, Space, FLUID, GHOST_FREE_SLIP,
+    GHOST_NO_SLIP, REPULSIVE, WALL,
 };
 use crate::scenario::{MirrorPlane, Physics, Viscosity, WallParams};
 
@@ -14,13 +14,15 @@ struct Pair<'a> {
 }
 
 impl Pair<'_> {
-    /// (dv/dt, dρ/dt) and de/dt on fluid particle i from a pressure-carrying neighbour at x_ij.
+    /// (dv/dt, dρ/dt) and de/dt on fluid particle i from a pressure-carrying neighbour at x_ij
+    /// whose velocity is `v_cont` in continuity and pressure work, `v_visc` in viscosity.
     #[allow(clippy::too_many_arguments)]
     fn rates(
         &self,
         pi: &RefParticle,
         x_ij: [f64; 3],
-        v_j: [f64; 3],
+        v_cont: [f64; 3],
+        v_visc: [f64; 3],
         rho_j: f64,
         diffuse: bool,
         rho_ratio: f64,
@@ -29,7 +31,8 @@ impl Pair<'_> {
         let r2 = dot(x_ij, x_ij);
         let f_ij = kernel::f(ph.kernel, ph.dim, h, r2.sqrt());
         let dw = x_ij.map(|x| x * f_ij);
-        let v_ij = sub(pi.vel, v_j);
+        let v_ij = sub(pi.vel, v_cont);
+        let w_ij = sub(pi.vel, v_visc);
         let mut drho = m * dot(v_ij, dw) * rho_ratio;
         if diffuse {
             drho += ph.delta_sph * h * ph.c0 * 2.0 * (pi.rho - rho_j) * f_ij * r2
@@ -41,7 +44,7 @@ impl Pair<'_> {
         let mut pi_ij = 0.0;
         match self.nu {
             None => {
-                let vx = dot(v_ij, x_ij);
+                let vx = dot(w_ij, x_ij);
                 if vx < 0.0 {
                     let mu = h * vx / (r2 + self.eta2);
                     pi_ij = -self.alpha * ph.c0 * mu / (0.5 * (pi.rho + rho_j));
@@ -50,17 +53,16 @@ impl Pair<'_> {
             Some(nu) => {
                 let c = m * 4.0 * nu * r2 * f_ij / ((pi.rho + rho_j) * (r2 + self.eta2));
                 for a in 0..3 {
-                    acc[a] += c * v_ij[a];
+                    acc[a] += c * w_ij[a];
                 }
             }
         }
-        let p = pressure(ph, pi.rho) / (pi.rho * pi.rho)
-            + pressure(ph, rho_j) / (rho_j * rho_j)
-            + pi_ij;
+        let p = pressure(ph, pi.rho) / (pi.rho * pi.rho) + pressure(ph, rho_j) / (rho_j * rho_j);
         for a in 0..3 {
-            acc[a] -= m * p * dw[a];
+            acc[a] -= m * (p + pi_ij) * dw[a];
         }
-        ([acc[0], acc[1], acc[2], drho], 0.5 * m * p * dot(v_ij, dw))
+        let de = 0.5 * m * (p * dot(v_ij, dw) + pi_ij * dot(w_ij, dw));
+        ([acc[0], acc[1], acc[2], drho], de)
     }
 }
 
@@ -84,8 +86,16 @@ fn add(a: &mut [f64; 4], b: [f64; 4]) {
 
 /// (dv/dt, dρ/dt) of every particle: fluid gets everything, dynamic walls only dρ/dt from
 /// fluid neighbours, ghosts and repulsive particles nothing.
-pub fn rates(ph: &Physics, walls: &WallParams, space: &Space, parts: &[RefParticle]) -> Vec<[f64; 4]> {
-    rates_and_energy(ph, walls, space, parts).into_iter().map(|(r, _)| r).collect()
+pub fn rates(
+    ph: &Physics,
+    walls: &WallParams,
+    space: &Space,
+    parts: &[RefParticle],
+) -> Vec<[f64; 4]> {
+    rates_and_energy(ph, walls, space, parts)
+        .into_iter()
+        .map(|(r, _)| r)
+        .collect()
 }
 
 /// As [`rates`], with de/dt of the energy equation (0 for every non-fluid particle).
@@ -139,7 +149,15 @@ pub fn rates_and_energy(
                 }
                 let ghost = pj.kind == GHOST_NO_SLIP || pj.kind == GHOST_FREE_SLIP;
                 let ratio = if ghost { pi.rho / pj.rho } else { 1.0 };
-                let (pr, pe) = pair.rates(pi, x_ij, pj.vel, pj.rho, pj.kind == FLUID, ratio);
+                // Ghosts hold the interpolated fluid velocity: the wall (at rest) in continuity,
+                // the no-slip or free-slip ghost velocity in viscosity.
+                let (v_cont, v_visc) = match pj.kind {
+                    GHOST_NO_SLIP => ([0.0; 3], pj.vel.map(|v| -v)),
+                    GHOST_FREE_SLIP => ([0.0; 3], pj.vel),
+                    _ => (pj.vel, pj.vel),
+                };
+                let (pr, pe) =
+                    pair.rates(pi, x_ij, v_cont, v_visc, pj.rho, pj.kind == FLUID, ratio);
                 add(&mut r, pr);
                 de += pe;
             }
@@ -158,21 +176,25 @@ pub fn rates_and_energy(
             }
             for chain in chains {
                 for pj in parts.iter().filter(|p| p.kind == FLUID) {
-                    let (mut x_g, mut v_g) = (pj.pos, pj.vel);
+                    let (mut x_g, mut v_cont, mut v_visc) = (pj.pos, pj.vel, pj.vel);
+                    let reflect = |v: [f64; 3], n: [f64; 3]| {
+                        let vn = dot(v, n);
+                        [0, 1, 2].map(|a| v[a] - 2.0 * vn * n[a])
+                    };
                     for plane in chain.iter().rev() {
                         let n = plane.normal;
                         let d = dot(sub(x_g, plane.point), n);
                         x_g = [0, 1, 2].map(|a| x_g[a] - 2.0 * d * n[a]);
-                        let vn = dot(v_g, n);
-                        v_g = if plane.no_slip {
-                            v_g.map(|v| -v)
+                        v_cont = reflect(v_cont, n);
+                        v_visc = if plane.no_slip {
+                            v_visc.map(|v| -v)
                         } else {
-                            [0, 1, 2].map(|a| v_g[a] - 2.0 * vn * n[a])
+                            reflect(v_visc, n)
                         };
                     }
                     let x_ig = sub(pi.pos, x_g);
                     if dot(x_ig, x_ig) < support2 {
-                        let (pr, pe) = pair.rates(pi, x_ig, v_g, pj.rho, true, 1.0);
+                        let (pr, pe) = pair.rates(pi, x_ig, v_cont, v_visc, pj.rho, true, 1.0);
                         add(&mut r, pr);
                         de += pe;
                     }

@@ -110,7 +110,13 @@ impl ParticleBuffers {
                 },
             ),
             probe_out: storage(device, "probe out", 4 * probes.len().max(1) as u64),
-            energy: [0, 1].map(|k| storage(device, &format!("energy {k}"), if energy { 8 * n as u64 } else { 8 })),
+            energy: [0, 1].map(|k| {
+                storage(
+                    device,
+                    &format!("energy {k}"),
+                    if energy { 8 * n as u64 } else { 8 },
+                )
+            }),
             energy_rate: storage(device, "energy rate", if energy { 4 * n as u64 } else { 4 }),
             mirror_planes: if planes.is_empty() {
                 storage(

@@ -36,7 +36,14 @@ impl CellList {
         let cell_key = cells.kernel(device, "cell_key")?;
         let reorder_energy = if energy {
             let k = cells.kernel(device, "reorder_energy")?;
-            let bufs = |p: usize| [(0, &b.params), (8, &b.local_perm), (18, &b.energy[p]), (19, &b.energy[1 - p])];
+            let bufs = |p: usize| {
+                [
+                    (0, &b.params),
+                    (8, &b.local_perm),
+                    (18, &b.energy[p]),
+                    (19, &b.energy[1 - p]),
+                ]
+            };
             let binds = [k.bind(device, &bufs(0))?, k.bind(device, &bufs(1))?];
             Some((k, binds))
         } else {

@@ -34,6 +34,7 @@ impl Integrate {
                 (7, &b.cell_start),
                 (8, &b.energy[p]),
                 (9, &b.energy_rate),
+                (10, &b.mirror_planes),
             ]
         };
         Ok(Self {

@@ -569,7 +569,12 @@ impl Solver {
     /// Test hook: de/dt of the last evaluation (energy equation on), in GPU order.
     #[doc(hidden)]
     pub fn read_energy_rates(&self) -> Result<Vec<f32>> {
-        read(&self.device, &self.queue, &self.buffers.energy_rate, self.buffers.n as usize)
+        read(
+            &self.device,
+            &self.queue,
+            &self.buffers.energy_rate,
+            self.buffers.n as usize,
+        )
     }
 
     /// Slot starts of the last sort (slots + 2 entries).
@@ -586,7 +591,12 @@ impl Solver {
     pub fn read_particles(&self) -> Result<Particles> {
         let (pos, velrho, code) = self.read_raw()?;
         let energy: Option<Vec<[f32; 2]>> = if self.energy {
-            Some(read(&self.device, &self.queue, &self.buffers.energy[self.parity], pos.len())?)
+            Some(read(
+                &self.device,
+                &self.queue,
+                &self.buffers.energy[self.parity],
+                pos.len(),
+            )?)
         } else {
             None
         };
