@@ -14,7 +14,8 @@
 // Walls, by kind of the neighbour j of a fluid particle:
 //   dynamic boundary particles (Crespo et al. 2007) and fixed ghosts (values set by ghost.wgsl)
 //   enter the sums like fluid; repulsive particles exert only the Lennard-Jones force
-//   D((r0/r)^12 − (r0/r)^4) x_ij/r² for r < r0 (Monaghan 1994, eq. 3.2); mirror planes add, for
+//   D((r0/r)^12 − (r0/r)^4) x_ij/r² for r < r0 (Monaghan 1994, eq. 3.2), or the smooth
+//   Monaghan & Kajtar (2009) force; mirror planes add, for
 //   each fluid j near the image of i, the ghost x_g = 2x_w − x_j with p_g = p_j, ρ_g = ρ_j and
 //   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip), the latter in
 //   the viscous terms only; near a corner also the double image across both planes.
@@ -80,8 +81,19 @@ fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_cont: vec3<f32>, v_visc:
     return PairRates(vec4<f32>(acc, drho), de);
 }
 
-// Lennard-Jones repulsion of a boundary particle at x_ij (Monaghan 1994).
+// Force (per unit mass) of a repulsive boundary particle at x_ij: Lennard-Jones (Monaghan 1994)
+// or Monaghan & Kajtar (2009, eq. 3.1 with equal masses): (K/β) x/r² Φ(r/h), Φ the Wendland C4
+// shape (1.77/32)(1 + 5q/2 + 2q²)(2 − q)^5, q < 2.
 fn repulsion(x_ij: vec3<f32>, r2: f32) -> vec3<f32> {
+    if (params.repulsive_form == 1u) {
+        let q = sqrt(r2) / params.h;
+        if (q >= 2.0 || r2 <= 0.0) {
+            return vec3<f32>(0.0);
+        }
+        let t = 2.0 - q;
+        let phi = 1.77 / 32.0 * (1.0 + 2.5 * q + 2.0 * q * q) * t * t * t * t * t;
+        return params.repulsive_k_over_beta * phi / r2 * x_ij;
+    }
     let r0 = params.repulsive_r0;
     if (r2 >= r0 * r0 || r2 <= 0.0) {
         return vec3<f32>(0.0);

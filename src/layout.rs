@@ -34,6 +34,9 @@ pub struct Params {
     pub ghost_mls: u32,
     pub repulsive_d: f32,
     pub repulsive_r0: f32,
+    pub repulsive_form: u32,
+    pub repulsive_k_over_beta: f32,
+    pub pad: [u32; 2],
 }
 
 /// Mirrors `SimState` in shaders/lib/common.wgsl.
@@ -173,7 +176,9 @@ mod tests {
                 n_mirror_planes,
                 ghost_mls,
                 repulsive_d,
-                repulsive_r0
+                repulsive_r0,
+                repulsive_form,
+                repulsive_k_over_beta
             ]
         );
     }

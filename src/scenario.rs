@@ -162,7 +162,22 @@ pub struct WallParams {
     pub repulsive_d: f64,
     /// Lennard-Jones cut-off r0 [m] (the initial particle spacing).
     pub repulsive_r0: f64,
+    pub repulsive_form: RepulsiveForm,
+    /// Monaghan & Kajtar strength K [m²/s²] (their static tank: g·D, D the water depth).
+    pub repulsive_k: f64,
+    /// Monaghan & Kajtar β: fluid spacing over boundary-particle spacing.
+    pub repulsive_beta: f64,
     pub mirror_planes: Vec<MirrorPlane>,
+}
+
+/// The force law of repulsive boundary particles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RepulsiveForm {
+    /// Monaghan (1994): D((r0/r)^12 − (r0/r)^4) x/r² for r < r0.
+    LennardJones,
+    /// Monaghan & Kajtar (2009): (K/β) x/r² Φ(r/h) 2m_b/(m_a+m_b), Φ the Wendland C4 shape
+    /// with Φ(0) = 1.77; smooth along the wall.
+    MonaghanKajtar,
 }
 
 impl WallParams {
@@ -172,6 +187,9 @@ impl WallParams {
             ghost_correction: GhostCorrection::Mls,
             repulsive_d: 5.0 * gravity * height,
             repulsive_r0: dx,
+            repulsive_form: RepulsiveForm::LennardJones,
+            repulsive_k: gravity * height,
+            repulsive_beta: 1.0,
             mirror_planes: Vec::new(),
         }
     }

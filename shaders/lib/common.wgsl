@@ -35,6 +35,10 @@ struct Params {
     ghost_mls: u32,             // 1: ghosts interpolate with MLS, 0: Shepard
     repulsive_d: f32,           // Lennard-Jones D [m²/s²] (Monaghan 1994)
     repulsive_r0: f32,          // Lennard-Jones cut-off r0 [m]
+    repulsive_form: u32,        // 0 Lennard-Jones (Monaghan 1994), 1 Monaghan & Kajtar (2009)
+    repulsive_k_over_beta: f32, // Monaghan & Kajtar K/β [m²/s²]
+    pad0: u32,
+    pad1: u32,
 }
 
 // Time-stepping state that lives on the GPU; read back once per batch of steps.

@@ -357,6 +357,11 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
     if let Some(r0) = case.walls.repulsive_r0 {
         walls.repulsive_r0 = r0;
     }
+    walls.repulsive_form = case.walls.repulsive_form;
+    if let Some(k) = case.walls.repulsive_k {
+        walls.repulsive_k = k;
+    }
+    walls.repulsive_beta = case.walls.repulsive_beta;
     walls.mirror_planes = mirror_planes;
     Ok(Scenario {
         name: case.name,

@@ -138,6 +138,16 @@ pub(super) struct RawWalls {
     pub ghost_correction: Option<GhostCorrectionName>,
     pub repulsive_d_m2_s2: Option<f64>,
     pub repulsive_r0_m: Option<f64>,
+    pub repulsive_form: Option<RepulsiveFormName>,
+    pub repulsive_k_m2_s2: Option<f64>,
+    pub repulsive_beta: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum RepulsiveFormName {
+    LennardJones,
+    MonaghanKajtar,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -423,6 +433,21 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "walls.repulsive_r0_m",
         "the Lennard-Jones cut-off r0 of repulsive walls in metres",
         "repulsive_r0_m = 0.01",
+    ),
+    f(
+        "walls.repulsive_form",
+        "the repulsive force law: lennard_jones or monaghan_kajtar",
+        "repulsive_form = \"monaghan_kajtar\"",
+    ),
+    f(
+        "walls.repulsive_k_m2_s2",
+        "the Monaghan & Kajtar strength K of repulsive walls in m²/s²",
+        "repulsive_k_m2_s2 = 4.9",
+    ),
+    f(
+        "walls.repulsive_beta",
+        "the Monaghan & Kajtar ratio of fluid to boundary-particle spacing",
+        "repulsive_beta = 1.0",
     ),
     f(
         "probe",

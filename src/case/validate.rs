@@ -2,13 +2,15 @@
 //! options that go together, defaults. Produces a [`Case`] in SI with 3-component vectors.
 //! Geometric checks that need several fields at once live in `build.rs`.
 
-use crate::scenario::{DensityFilter, GhostCorrection, KernelKind, Probe, TimeControl, Viscosity};
+use crate::scenario::{
+    DensityFilter, GhostCorrection, KernelKind, Probe, RepulsiveForm, TimeControl, Viscosity,
+};
 
 use super::error::CaseError;
 use super::locate::Ctx;
 use super::schema::{
-    DensityFilterName, GhostCorrectionName, KernelName, RawCase, RawPhysics, SlipName,
-    ViscosityName, WallName,
+    DensityFilterName, GhostCorrectionName, KernelName, RawCase, RawPhysics, RepulsiveFormName,
+    SlipName, ViscosityName, WallName,
 };
 
 /// An axis-aligned box (3 components; in 2D the third is 0).
@@ -53,6 +55,10 @@ pub(super) struct WallSettings {
     pub repulsive_d: Option<f64>,
     /// Lennard-Jones cut-off r0 [m]; default dx.
     pub repulsive_r0: Option<f64>,
+    pub repulsive_form: RepulsiveForm,
+    /// Monaghan & Kajtar K [m²/s²]; default |g| H.
+    pub repulsive_k: Option<f64>,
+    pub repulsive_beta: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -463,6 +469,9 @@ pub(super) fn validate(
             ghost_correction: GhostCorrection::Mls,
             repulsive_d: None,
             repulsive_r0: None,
+            repulsive_form: RepulsiveForm::LennardJones,
+            repulsive_k: None,
+            repulsive_beta: 1.0,
         },
         Some(w) => WallSettings {
             ghost_correction: match w.ghost_correction.unwrap_or(GhostCorrectionName::Mls) {
@@ -495,6 +504,31 @@ pub(super) fn validate(
                     )
                 })
                 .transpose()?,
+            repulsive_form: match w.repulsive_form.unwrap_or(RepulsiveFormName::LennardJones) {
+                RepulsiveFormName::LennardJones => RepulsiveForm::LennardJones,
+                RepulsiveFormName::MonaghanKajtar => RepulsiveForm::MonaghanKajtar,
+            },
+            repulsive_k: w
+                .repulsive_k_m2_s2
+                .map(|k| {
+                    number(
+                        ctx,
+                        "walls.repulsive_k_m2_s2",
+                        k,
+                        Bound::Positive,
+                        "the Monaghan & Kajtar strength K of repulsive walls in m²/s²",
+                        "use about |g| H, e.g. 4.9 for 0.5 m of water, or remove it for that default",
+                    )
+                })
+                .transpose()?,
+            repulsive_beta: number(
+                ctx,
+                "walls.repulsive_beta",
+                w.repulsive_beta.unwrap_or(1.0),
+                Bound::Closed(0.1, 10.0),
+                "the ratio of fluid to boundary-particle spacing",
+                "use 1 for boundary particles on the fluid lattice (as wgsph builds them)",
+            )?,
         },
     };
     let domain = match &raw.domain {

@@ -4,7 +4,7 @@ use super::{
     dot, kernel, laminar_nu, pressure, sub, RefParticle, Space, FLUID, GHOST_FREE_SLIP,
     GHOST_NO_SLIP, REPULSIVE, WALL,
 };
-use crate::scenario::{MirrorPlane, Physics, Viscosity, WallParams};
+use crate::scenario::{MirrorPlane, Physics, RepulsiveForm, Viscosity, WallParams};
 
 struct Pair<'a> {
     ph: &'a Physics,
@@ -66,15 +66,32 @@ impl Pair<'_> {
     }
 }
 
-/// Lennard-Jones repulsion D((r0/r)^12 − (r0/r)^4) x/r² for r < r0 (Monaghan 1994).
-pub fn repulsion(walls: &WallParams, x_ij: [f64; 3]) -> [f64; 3] {
+/// Force per unit mass of a repulsive boundary particle at x_ij: Lennard-Jones
+/// D((r0/r)^12 − (r0/r)^4) x/r² for r < r0 (Monaghan 1994), or Monaghan & Kajtar (2009)
+/// (K/β) x/r² Φ(r/h) with Φ(q) = (1.77/32)(1 + 5q/2 + 2q²)(2 − q)^5 for q < 2.
+pub fn repulsion(ph: &Physics, walls: &WallParams, x_ij: [f64; 3]) -> [f64; 3] {
     let r2 = dot(x_ij, x_ij);
-    let r0 = walls.repulsive_r0;
-    if r2 >= r0 * r0 || r2 <= 0.0 {
+    if r2 <= 0.0 {
         return [0.0; 3];
     }
-    let q2 = r0 * r0 / r2;
-    let f = walls.repulsive_d * (q2.powi(6) - q2.powi(2)) / r2;
+    let f = match walls.repulsive_form {
+        RepulsiveForm::MonaghanKajtar => {
+            let q = r2.sqrt() / ph.h;
+            if q >= 2.0 {
+                return [0.0; 3];
+            }
+            let phi = 1.77 / 32.0 * (1.0 + 2.5 * q + 2.0 * q * q) * (2.0 - q).powi(5);
+            walls.repulsive_k / walls.repulsive_beta * phi / r2
+        }
+        RepulsiveForm::LennardJones => {
+            let r0 = walls.repulsive_r0;
+            if r2 >= r0 * r0 {
+                return [0.0; 3];
+            }
+            let q2 = r0 * r0 / r2;
+            walls.repulsive_d * (q2.powi(6) - q2.powi(2)) / r2
+        }
+    };
     x_ij.map(|x| f * x)
 }
 
@@ -143,7 +160,7 @@ pub fn rates_and_energy(
                     continue;
                 }
                 if pj.kind == REPULSIVE {
-                    let f = repulsion(walls, x_ij);
+                    let f = repulsion(ph, walls, x_ij);
                     add(&mut r, [f[0], f[1], f[2], 0.0]);
                     continue;
                 }

@@ -20,7 +20,7 @@ use crate::gpu::GpuContext;
 use crate::layout::{
     pack_block, unpack_block, Params, Pos, SimState, ID_MASK, KIND_EXCLUDED, KIND_SHIFT,
 };
-use crate::scenario::{GhostCorrection, KernelKind, Kind, Scenario, Viscosity};
+use crate::scenario::{GhostCorrection, KernelKind, Kind, RepulsiveForm, Scenario, Viscosity};
 use buffers::{InitialParticles, ParticleBuffers};
 use cell_list::CellList;
 use density_filter::DensityFilter;
@@ -178,6 +178,9 @@ impl Solver {
             ghost_mls: (sc.walls.ghost_correction == GhostCorrection::Mls) as u32,
             repulsive_d: sc.walls.repulsive_d as f32,
             repulsive_r0: sc.walls.repulsive_r0 as f32,
+            repulsive_form: (sc.walls.repulsive_form == RepulsiveForm::MonaghanKajtar) as u32,
+            repulsive_k_over_beta: (sc.walls.repulsive_k / sc.walls.repulsive_beta) as f32,
+            pad: [0; 2],
         };
         let cfg = ShaderConfig {
             dim: ph.dim,

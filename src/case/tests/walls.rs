@@ -206,6 +206,36 @@ fn walls_table_defaults_and_overrides() {
 }
 
 #[test]
+fn monaghan_kajtar_repulsion_settings() {
+    use crate::scenario::RepulsiveForm;
+    let s = hydrostatic(&[]);
+    assert_eq!(s.walls.repulsive_form, RepulsiveForm::LennardJones);
+    assert!(
+        (s.walls.repulsive_k - 9.81 * 0.5).abs() < 1e-9,
+        "default K = |g| H"
+    );
+    assert_eq!(s.walls.repulsive_beta, 1.0);
+    let s = hydrostatic(&[
+        "walls.repulsive_form=monaghan_kajtar",
+        "walls.repulsive_k_m2_s2=3.5",
+        "walls.repulsive_beta=2",
+    ]);
+    assert_eq!(s.walls.repulsive_form, RepulsiveForm::MonaghanKajtar);
+    assert_eq!(s.walls.repulsive_k, 3.5);
+    assert_eq!(s.walls.repulsive_beta, 2.0);
+    for (set, field) in [
+        ("walls.repulsive_k_m2_s2=-1", "walls.repulsive_k_m2_s2"),
+        ("walls.repulsive_beta=0", "walls.repulsive_beta"),
+        ("walls.repulsive_form=\"soft\"", "walls.repulsive_form"),
+    ] {
+        let e = crate::case::load_str(HYDROSTATIC, "w.toml", &[set.to_string()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(field), "{set}: {e}");
+    }
+}
+
+#[test]
 fn wall_errors_name_line_and_field() {
     let tank_with = |extra: &str| {
         base_with(
