@@ -6,7 +6,6 @@
 mod common;
 use common::*;
 use std::path::Path;
-use wgsph::layout::{unpack_block, KIND_SHIFT};
 use wgsph::reference::{self, RefParticle};
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
@@ -18,21 +17,6 @@ const MODES: [DensityFilter; 2] = [
 
 fn is_mls(m: DensityFilter) -> bool {
     matches!(m, DensityFilter::Mls { .. })
-}
-
-/// GPU arrays (current order) as reference particles, in world coordinates.
-fn gpu_particles(s: &Solver) -> Vec<RefParticle> {
-    let (pos, velrho, code) = s.read_raw().unwrap();
-    pos.iter()
-        .zip(&velrho)
-        .zip(&code)
-        .map(|((p, v), c)| RefParticle {
-            pos: s.grid.to_world(p.off, unpack_block(p.block)),
-            vel: [v[0] as f64, v[1] as f64, v[2] as f64],
-            rho: v[3] as f64,
-            kind: c >> KIND_SHIFT,
-        })
-        .collect()
 }
 
 /// Densities of the current arrays (GPU order).

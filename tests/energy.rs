@@ -4,8 +4,7 @@
 
 mod common;
 use common::*;
-use wgsph::layout::{unpack_block, KIND_SHIFT};
-use wgsph::reference::{self, RefParticle};
+use wgsph::reference;
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
 
@@ -57,18 +56,7 @@ fn energy_rate_matches_reference() {
     for dim in [2, 3] {
         let sc = block(dim, 3 + dim as u64, 0.2);
         let solver = Solver::new(gpu(), &sc).unwrap();
-        let (pos, velrho, code) = solver.read_raw().unwrap();
-        let parts: Vec<RefParticle> = pos
-            .iter()
-            .zip(&velrho)
-            .zip(&code)
-            .map(|((p, v), c)| RefParticle {
-                pos: solver.grid.to_world(p.off, unpack_block(p.block)),
-                vel: [v[0] as f64, v[1] as f64, v[2] as f64],
-                rho: v[3] as f64,
-                kind: c >> KIND_SHIFT,
-            })
-            .collect();
+        let parts = gpu_particles(&solver);
         solver.rerun_interaction(false).unwrap();
         let gpu_de = solver.read_energy_rates().unwrap();
         let cpu = reference::interaction::rates_and_energy(

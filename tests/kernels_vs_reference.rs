@@ -3,7 +3,7 @@
 
 mod common;
 use common::*;
-use wgsph::layout::{unpack_block, ID_MASK, KIND_SHIFT};
+use wgsph::layout::ID_MASK;
 use wgsph::reference::{self, RefParticle};
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
@@ -100,23 +100,6 @@ fn setups() -> Vec<Setup> {
     v
 }
 
-/// GPU arrays (current order) as reference particles, in world coordinates.
-fn gpu_particles(s: &Solver) -> (Vec<RefParticle>, Vec<u32>) {
-    let (pos, velrho, code) = s.read_raw().unwrap();
-    let parts = pos
-        .iter()
-        .zip(&velrho)
-        .zip(&code)
-        .map(|((p, v), c)| RefParticle {
-            pos: s.grid.to_world(p.off, unpack_block(p.block)),
-            vel: [v[0] as f64, v[1] as f64, v[2] as f64],
-            rho: v[3] as f64,
-            kind: c >> KIND_SHIFT,
-        })
-        .collect();
-    (parts, code)
-}
-
 /// max_i |gpu_i − cpu_i| / rms(cpu) over the components `comps`; NaN fails.
 fn rel_err(gpu: &[[f32; 4]], cpu: &[[f64; 4]], comps: std::ops::Range<usize>) -> f64 {
     let mut sq = 0.0;
@@ -171,7 +154,7 @@ fn interaction_matches_reference() {
     for s in setups() {
         let sc = random_scenario(&s);
         let solver = Solver::new(gpu(), &sc).unwrap();
-        let (parts, _) = gpu_particles(&solver);
+        let (parts, _) = gpu_particles_and_codes(&solver);
         let gpu_rates = solver.rerun_interaction(true).unwrap();
         let cpu = reference::interaction::rates(
             &sc.physics,
@@ -195,7 +178,7 @@ fn one_step_matches_reference() {
     for s in setups() {
         let sc = random_scenario(&s);
         let mut solver = Solver::new(gpu(), &sc).unwrap();
-        let (before, code0) = gpu_particles(&solver);
+        let (before, code0) = gpu_particles_and_codes(&solver);
         let rates0: Vec<[f64; 4]> = solver
             .read_rates()
             .unwrap()
@@ -220,7 +203,7 @@ fn one_step_matches_reference() {
             .map(|(p, (r1, r0))| reference::integrate::correct(ph, p, *r1, *r0, dt))
             .collect();
         // GPU, matched by id.
-        let (after_gpu, code1) = gpu_particles(&solver);
+        let (after_gpu, code1) = gpu_particles_and_codes(&solver);
         let mut by_id = vec![0usize; after_gpu.len()];
         for (k, c) in code1.iter().enumerate() {
             by_id[(c & ID_MASK) as usize] = k;
@@ -301,7 +284,7 @@ fn probes_match_reference() {
             },
         ];
         let solver = Solver::new(gpu(), &sc).unwrap();
-        let (parts, _) = gpu_particles(&solver);
+        let (parts, _) = gpu_particles_and_codes(&solver);
         let gpu_values = solver.sample_probes().unwrap();
         let ph = &sc.physics;
         let top = s.domain;

@@ -3,8 +3,7 @@
 
 mod common;
 use common::*;
-use wgsph::layout::{unpack_block, KIND_SHIFT};
-use wgsph::reference::{self, RefParticle};
+use wgsph::reference;
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
 
@@ -81,20 +80,6 @@ fn wall_scenario(dim: u32, correction: GhostCorrection, seed: u64) -> Scenario {
         },
     ];
     sc
-}
-
-fn gpu_particles(s: &Solver) -> Vec<RefParticle> {
-    let (pos, velrho, code) = s.read_raw().unwrap();
-    pos.iter()
-        .zip(&velrho)
-        .zip(&code)
-        .map(|((p, v), c)| RefParticle {
-            pos: s.grid.to_world(p.off, unpack_block(p.block)),
-            vel: [v[0] as f64, v[1] as f64, v[2] as f64],
-            rho: v[3] as f64,
-            kind: c >> KIND_SHIFT,
-        })
-        .collect()
 }
 
 #[test]

@@ -4,7 +4,10 @@
 use std::sync::OnceLock;
 
 use wgsph::gpu::{AdapterChoice, GpuContext};
+use wgsph::layout::{unpack_block, KIND_SHIFT};
+use wgsph::reference::RefParticle;
 use wgsph::scenario::*;
+use wgsph::sph::Solver;
 
 /// The adapter for tests: WGSPH_ADAPTER if set, else auto (lavapipe in CI). A missing adapter
 /// is a failure, not a skip.
@@ -105,4 +108,27 @@ impl Rng {
     pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.next_f64()
     }
+}
+
+/// The GPU arrays (current, cell order) as reference particles in world coordinates, with the
+/// code words (kind and id) in the same order.
+pub fn gpu_particles_and_codes(s: &Solver) -> (Vec<RefParticle>, Vec<u32>) {
+    let (pos, velrho, code) = s.read_raw().unwrap();
+    let parts = pos
+        .iter()
+        .zip(&velrho)
+        .zip(&code)
+        .map(|((p, v), c)| RefParticle {
+            pos: s.grid.to_world(p.off, unpack_block(p.block)),
+            vel: [v[0] as f64, v[1] as f64, v[2] as f64],
+            rho: v[3] as f64,
+            kind: c >> KIND_SHIFT,
+        })
+        .collect();
+    (parts, code)
+}
+
+/// The GPU arrays as reference particles (see `gpu_particles_and_codes`).
+pub fn gpu_particles(s: &Solver) -> Vec<RefParticle> {
+    gpu_particles_and_codes(s).0
 }
