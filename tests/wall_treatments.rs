@@ -165,3 +165,55 @@ fn repulsive_pressure_within_2_percent() {
         100.0 * o.error
     );
 }
+
+/// Every treatment (and both density filters) runs in 3D from the shipped case file: the
+/// SPHERIC Test 2 geometry, coarse, a few hundred steps' worth of time.
+#[test]
+fn every_treatment_runs_in_3d_from_the_case_file() {
+    for set in [
+        vec!["tank.wall=\"dynamic\""],
+        vec![
+            "tank.wall=\"fixed_ghost\"",
+            "obstacle[0].wall=\"fixed_ghost\"",
+            "physics.density_filter=\"mls\"",
+        ],
+        vec![
+            "tank.wall=\"mirror\"",
+            "tank.slip=\"free_slip\"",
+            "physics.density_filter=\"shepard\"",
+        ],
+        vec![
+            "tank.wall=\"repulsive\"",
+            "obstacle[0].wall=\"repulsive\"",
+            "walls.repulsive_form=\"monaghan_kajtar\"",
+        ],
+    ] {
+        let mut all = vec!["particles.dx_m=0.06", "time.end_s=0.05"];
+        all.extend(set.iter());
+        let all: Vec<String> = all.iter().map(|s| s.to_string()).collect();
+        let sc = wgsph::case::load(Path::new("cases/dam_break_3d.toml"), &all).unwrap();
+        assert_eq!(sc.physics.dim, 3);
+        let mut solver = Solver::new(gpu(), &sc).unwrap();
+        solver.advance_to(0.05).unwrap();
+        let p = solver.read_particles().unwrap();
+        println!(
+            "3D {set:?}: {} particles, {} steps, excluded {}",
+            p.pos.len(),
+            solver.steps(),
+            solver.excluded()
+        );
+        assert_eq!(solver.excluded(), 0, "{set:?}");
+        assert!(
+            p.pos.iter().all(|x| x.iter().all(|v| v.is_finite())),
+            "{set:?}"
+        );
+        assert!(
+            solver
+                .sample_probes()
+                .unwrap()
+                .iter()
+                .all(|v| v.is_finite()),
+            "{set:?}"
+        );
+    }
+}
