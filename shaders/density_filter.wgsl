@@ -52,9 +52,10 @@ fn filter_density(i: u32, mls: bool) -> f32 {
     var sum_mw = 0.0;  // Σ m_j W_ij
     var sum_wv = 0.0;  // Σ W_ij V_j
     var a = mls_zero();
+    var m_mw = vec4<f32>(0.0);  // Σ m_j W_ij [1, x_ij/h]: Σ m_j W^MLS_ij = β·m_mw
     var slots: array<u32, 27>;
     let n_slots = neighbour_slots(cell_of(p_i), &slots);
-    // First pass: the Shepard sums and the MLS moment matrix.
+    // One pass: the Shepard sums, the MLS moment matrix and the first moments of m W.
     for (var s = 0u; s < n_slots; s++) {
         for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
             if (j != i && !counts(code_kind(code[j]))) {
@@ -71,6 +72,7 @@ fn filter_density(i: u32, mls: bool) -> f32 {
             sum_wv += wv;
             if (mls) {
                 a = mls_add(a, x_ij, wv);
+                m_mw += params.mass * w * mls_basis(x_ij);
             }
         }
     }
@@ -82,21 +84,8 @@ fn filter_density(i: u32, mls: bool) -> f32 {
     if (mls) {
         let sol = mls_solve(a);
         if (sol.ok) {
-            // Second pass: Σ m_j W_ij (β0 + β·x_ij/h).
-            var rho_mls = 0.0;
-            for (var s = 0u; s < n_slots; s++) {
-                for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
-                    if (j != i && !counts(code_kind(code[j]))) {
-                        continue;
-                    }
-                    let x_ij = rel_pos(p_i, pos[j]);
-                    let r2 = dot(x_ij, x_ij);
-                    if (r2 >= support2) {
-                        continue;
-                    }
-                    rho_mls += params.mass * kernel_w(sqrt(r2) / params.h) * mls_weight(sol.beta, x_ij);
-                }
-            }
+            // Σ m_j W_ij (β0 + β·x_ij/h), from the moments (no second neighbour pass).
+            let rho_mls = dot(sol.beta, m_mw);
             if (positive_finite(rho_mls)) {
                 rho = rho_mls;
             }
