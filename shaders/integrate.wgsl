@@ -104,7 +104,8 @@ fn correct(
         } else if (kind == KIND_WALL) {
             let rho = wall_density(vr.w + half_dt * (r.w - rate_old[i].w));
             velrho[i].w = rho;
-            speed = sound_speed_of(rho);
+            // Moving walls (bodies) count with their speed.
+            speed = sound_speed_of(rho) + length(vr.xyz);
         }
     }
     // Workgroup max, then one atomic per workgroup (max is order-independent: deterministic).

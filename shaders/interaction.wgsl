@@ -20,7 +20,11 @@
 //   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip), the latter in
 //   the viscous terms only; near a corner also the double image across both planes.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
-// get nothing.
+// get nothing. Particles of moving bodies (dynamic boundary particles too) also get the force
+// per unit mass of their fluid neighbours, −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (the
+// opposite of what the fluid receives from them), and a contact force from boundary particles
+// of other bodies and of the fixed walls (the repulsive law above, Monaghan 1994): bodies.wgsl
+// sums both into the body's force and torque.
 // Energy (the seed's eq. 3 with σ = −P I, when ENERGY): de_i/dt = ½ Σ_j m_j (P_i/ρ_i² + P_j/ρ_j²
 //   + Π_ij) v_ij·∇_i W_ij (Monaghan 1992, eq. 2.19 with the artificial-viscosity heating);
 //   laminar viscous heating is not included.
@@ -32,6 +36,7 @@
 @group(0) @binding(5) var<storage, read_write> rate: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read> mirror_planes: array<MirrorPlane>;
 @group(0) @binding(7) var<storage, read_write> energy_rate: array<f32>;
+@group(0) @binding(8) var<storage, read> body_particles: array<BodyParticle>;
 
 // The state of particle i that every pair term needs.
 struct Particle {
@@ -105,6 +110,13 @@ fn repulsion(x_ij: vec3<f32>, r2: f32) -> vec3<f32> {
 }
 
 const NO_PLANE: u32 = 0xFFFFFFFFu;
+const NO_BODY: u32 = 0xFFFFFFFFu;
+
+// Whether boundary particle `id_j` belongs to a fixed wall or to a body other than `body_i`
+// (contact between a body and itself is not a thing).
+fn other_solid(body_i: u32, id_j: u32) -> bool {
+    return !is_body_particle(id_j) || body_particles[id_j - params.body_id_base].body != body_i;
+}
 
 // Velocity of a ghost across `plane`: normal part reversed (free-slip) or all (no-slip).
 fn ghost_velocity(v: vec3<f32>, plane: MirrorPlane) -> vec3<f32> {
@@ -193,6 +205,11 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         return;
     }
     let fluid_i = kind_i == KIND_FLUID;
+    let id_i = code[i] & ID_MASK;
+    var body_i = NO_BODY;
+    if (!fluid_i && is_body_particle(id_i)) {
+        body_i = body_particles[id_i - params.body_id_base].body;
+    }
     let p_i = pos[i];
     let pi = Particle(velrho[i].xyz, velrho[i].w, pressure_of(velrho[i].w) / (velrho[i].w * velrho[i].w));
     let support2 = 4.0 * params.h * params.h;
@@ -212,10 +229,16 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             }
             let kind_j = code_kind(code[j]);
             if (!fluid_i) {
-                // Dynamic wall particle: continuity with fluid neighbours only.
                 if (kind_j == KIND_FLUID) {
                     let vr_j = velrho[j];
-                    r.w += params.mass * dot(pi.v - vr_j.xyz, x_ij * kernel_f(sqrt(r2) / params.h));
+                    if (body_i == NO_BODY) {
+                        // Fixed dynamic wall particle: continuity only.
+                        r.w += params.mass * dot(pi.v - vr_j.xyz, x_ij * kernel_f(sqrt(r2) / params.h));
+                    } else {
+                        r += pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, false, 1.0).rate;
+                    }
+                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && other_solid(body_i, code[j] & ID_MASK)) {
+                    r += vec4<f32>(repulsion(x_ij, r2), 0.0);
                 }
                 continue;
             }

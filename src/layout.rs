@@ -36,7 +36,9 @@ pub struct Params {
     pub repulsive_r0: f32,
     pub repulsive_form: u32,
     pub repulsive_k_over_beta: f32,
-    pub pad: [u32; 2],
+    /// Id of the first body particle (bodies' particles come last); n_particles without bodies.
+    pub body_id_base: u32,
+    pub n_body_particles: u32,
 }
 
 /// Mirrors `SimState` in shaders/lib/common.wgsl.
@@ -83,6 +85,34 @@ pub struct MirrorPlane {
     /// Unit normal into the fluid.
     pub normal: [f32; 3],
     pub pad: u32,
+}
+
+/// Mirrors `BodyParticle` in shaders/lib/common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct BodyParticle {
+    /// Offset from the body's centre of mass at t = 0 [m].
+    pub r: [f32; 3],
+    pub body: u32,
+}
+
+/// Mirrors `BodyMotion` in shaders/bodies.wgsl: a body's rigid motion for one step.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct BodyMotion {
+    /// Centre of mass: offset in its block and packed block (as `Pos`).
+    pub center_off: [f32; 3],
+    pub center_block: u32,
+    /// Columns of the rotation from the body's orientation at t = 0 (WGSL mat3x3, padded).
+    pub rotation: [[f32; 4]; 3],
+    pub velocity: [f32; 3],
+    /// First body-particle index (id − body_id_base) of the body.
+    pub first: u32,
+    pub omega: [f32; 3],
+    pub count: u32,
+    /// First workgroup of the body in `body_force`.
+    pub first_group: u32,
+    pub pad: [u32; 3],
 }
 
 pub const KIND_SHIFT: u32 = 28;
@@ -178,7 +208,9 @@ mod tests {
                 repulsive_d,
                 repulsive_r0,
                 repulsive_form,
-                repulsive_k_over_beta
+                repulsive_k_over_beta,
+                body_id_base,
+                n_body_particles
             ]
         );
     }
@@ -212,6 +244,26 @@ mod tests {
             "MirrorPlane",
             MirrorPlane,
             [point, no_slip, normal]
+        );
+    }
+
+    #[test]
+    fn body_structs_match_wgsl() {
+        check_layout!(Pass::Bodies, "BodyParticle", BodyParticle, [r, body]);
+        check_layout!(
+            Pass::Bodies,
+            "BodyMotion",
+            BodyMotion,
+            [
+                center_off,
+                center_block,
+                rotation,
+                velocity,
+                first,
+                omega,
+                count,
+                first_group
+            ]
         );
     }
 

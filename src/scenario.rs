@@ -207,6 +207,62 @@ pub struct Scenario {
     /// Periodic axes: a particle leaving the domain through one face re-enters through the
     /// opposite one, and neighbours are found across it (minimum image).
     pub periodic: [bool; 3],
+    /// Moving solids (rigid bodies, moving tanks). Their particles come last in `particles`,
+    /// body after body.
+    pub bodies: Vec<Body>,
+}
+
+/// A rigid set of boundary particles that moves as one: a free body (floating box, falling
+/// cylinder) or a prescribed one (a moving tank, a paddle).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    pub name: String,
+    /// Its particles: `particles[range]` of the scenario (ids are indices).
+    pub particles: std::ops::Range<usize>,
+    /// Mass [kg] (per metre of depth in 2D).
+    pub mass: f64,
+    /// Centre of mass at t = 0 [m].
+    pub center: [f64; 3],
+    /// Inertia tensor about the centre of mass at t = 0, world axes [kg m²] (2D: only zz is used).
+    pub inertia: [[f64; 3]; 3],
+    pub motion: Motion,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Motion {
+    /// Moves under the fluid's force and torque, gravity and contact, from this initial
+    /// velocity of its centre of mass and angular velocity (world axes; 2D: only z).
+    Free { velocity: [f64; 3], omega: [f64; 3] },
+    /// Follows a given law whatever the forces: x(t) = pivot + d(t) + R(θ(t) about `axis`)(x0 − pivot).
+    Prescribed(Prescribed),
+}
+
+/// A prescribed rigid motion: a displacement d(t) and a rotation θ(t) about a fixed axis
+/// through `pivot` (the pivot moves with d).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prescribed {
+    pub pivot: [f64; 3],
+    /// Unit rotation axis (2D: z).
+    pub axis: [f64; 3],
+    pub law: MotionLaw,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum MotionLaw {
+    /// d(t) = a_d sin(ωt + φ), θ(t) = a_θ sin(ωt + φ).
+    Sine {
+        translation: [f64; 3],
+        angle: f64,
+        omega: f64,
+        phase: f64,
+    },
+    /// Samples (t, d, θ) of a time series, cubic Hermite between them (slopes by centred
+    /// differences), held constant outside their span.
+    Series {
+        t: Vec<f64>,
+        translation: Vec<[f64; 3]>,
+        angle: Vec<f64>,
+    },
 }
 
 impl Scenario {

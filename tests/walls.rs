@@ -300,6 +300,7 @@ fn mirror_planes_cannot_be_crossed() {
         vel: [0.5, -2.0, 0.0],
         rho: 1000.0,
         kind: 0,
+        body: None,
     };
     let r = reference::integrate::reflect_at_mirrors(&walls, &crossing);
     assert_eq!(r.pos, [0.3, 0.01, 0.0]);

@@ -37,8 +37,9 @@ struct Params {
     repulsive_r0: f32,          // Lennard-Jones cut-off r0 [m]
     repulsive_form: u32,        // 0 Lennard-Jones (Monaghan 1994), 1 Monaghan & Kajtar (2009)
     repulsive_k_over_beta: f32, // Monaghan & Kajtar K/β [m²/s²]
-    pad0: u32,
-    pad1: u32,
+    // Bodies: their particles have the ids body_id_base .. body_id_base + n_body_particles
+    body_id_base: u32,          // n_particles when there are no bodies
+    n_body_particles: u32,
 }
 
 // Time-stepping state that lives on the GPU; read back once per batch of steps.
@@ -74,6 +75,17 @@ const KIND_GHOST_NO_SLIP: u32 = 2u;   // fixed ghost, no-slip
 const KIND_GHOST_FREE_SLIP: u32 = 3u; // fixed ghost, free-slip
 const KIND_REPULSIVE: u32 = 4u;       // repulsive-force boundary particle
 const KIND_EXCLUDED: u32 = 15u;
+
+// A particle of a moving body (rigid or prescribed): where it is in its body's frame.
+// Indexed by id − params.body_id_base. Mirrored by `layout::BodyParticle`.
+struct BodyParticle {
+    r: vec3<f32>,               // offset from the centre of mass at t = 0 [m]
+    body: u32,
+}
+
+fn is_body_particle(id: u32) -> bool {
+    return id >= params.body_id_base;
+}
 
 fn is_ghost(kind: u32) -> bool {
     return kind == KIND_GHOST_NO_SLIP || kind == KIND_GHOST_FREE_SLIP;

@@ -372,6 +372,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
         probes: case.probes,
         walls,
         periodic: [false; 3],
+        bodies: Vec::new(),
     })
 }
 

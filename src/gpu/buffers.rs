@@ -55,17 +55,28 @@ pub fn read<T: Pod>(
     if bytes == 0 {
         return Ok(Vec::new());
     }
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: bytes,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let staging = readback_buffer(device, "readback", bytes);
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
         label: Some("readback"),
     });
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
     queue.submit([encoder.finish()]);
+    Ok(bytemuck::pod_collect_to_vec(&map_read(device, &staging)?))
+}
+
+/// A host-mappable buffer that copies are made into, for [`map_read`].
+pub fn readback_buffer(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(4),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Waits for the GPU and returns the contents of `staging` (a [`readback_buffer`] whose copies
+/// have been submitted); leaves it unmapped for reuse.
+pub fn map_read(device: &wgpu::Device, staging: &wgpu::Buffer) -> Result<Vec<u8>> {
     let (tx, rx) = std::sync::mpsc::channel();
     staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
@@ -80,7 +91,7 @@ pub fn read<T: Pod>(
         .slice(..)
         .get_mapped_range()
         .map_err(|e| anyhow!("reading the mapped buffer failed: {e}"))?;
-    let out = bytemuck::cast_slice::<u8, T>(&view).to_vec();
+    let out = view.to_vec();
     drop(view);
     staging.unmap();
     Ok(out)

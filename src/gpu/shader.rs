@@ -21,10 +21,11 @@ pub enum Pass {
     Probes,
     Ghost,
     DensityFilter,
+    Bodies,
 }
 
 impl Pass {
-    pub const ALL: [Pass; 7] = [
+    pub const ALL: [Pass; 8] = [
         Pass::CellList,
         Pass::PrefixScan,
         Pass::Interaction,
@@ -32,6 +33,7 @@ impl Pass {
         Pass::Probes,
         Pass::Ghost,
         Pass::DensityFilter,
+        Pass::Bodies,
     ];
 
     pub fn name(self) -> &'static str {
@@ -43,6 +45,7 @@ impl Pass {
             Pass::Probes => "probes",
             Pass::Ghost => "ghost",
             Pass::DensityFilter => "density_filter",
+            Pass::Bodies => "bodies",
         }
     }
 
@@ -55,6 +58,7 @@ impl Pass {
             Pass::Probes => include_str!("../../shaders/probes.wgsl"),
             Pass::Ghost => include_str!("../../shaders/ghost.wgsl"),
             Pass::DensityFilter => include_str!("../../shaders/density_filter.wgsl"),
+            Pass::Bodies => include_str!("../../shaders/bodies.wgsl"),
         }
     }
 

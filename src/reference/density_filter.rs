@@ -189,6 +189,7 @@ mod tests {
                         vel: [0.0; 3],
                         rho: 1000.0 * (1.0 + rng.range(-0.02, 0.02)),
                         kind: FLUID,
+                        body: None,
                     });
                 }
             }
@@ -296,6 +297,7 @@ mod tests {
                 vel: [0.0; 3],
                 rho: 1010.0,
                 kind: FLUID,
+                body: None,
             };
             let mut pair = vec![far, far];
             pair[1].pos[0] += 0.5 * ph.h;

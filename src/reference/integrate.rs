@@ -59,18 +59,19 @@ pub fn correct(
     out
 }
 
-/// CFL-limited dt: cfl·min(h / max(c_i + |v_i|), sqrt(h / max|a_i|)), and 0.125 h²/ν (laminar).
+/// CFL-limited dt: cfl·min(h / max(c_i + |v_i|) over fluid and walls, sqrt(h / max|a_i|)), and 0.125 h²/ν (laminar).
 /// `rates` are the rates of the same particles.
 pub fn timestep(ph: &Physics, cfl: f64, parts: &[RefParticle], rates: &[[f64; 4]]) -> f64 {
     let mut max_speed: f64 = 0.0;
     let mut max_accel: f64 = 0.0;
     for (p, r) in parts.iter().zip(rates) {
+        let v = (p.vel[0] * p.vel[0] + p.vel[1] * p.vel[1] + p.vel[2] * p.vel[2]).sqrt();
         if p.kind == FLUID {
-            let v = (p.vel[0] * p.vel[0] + p.vel[1] * p.vel[1] + p.vel[2] * p.vel[2]).sqrt();
             max_speed = max_speed.max(sound_speed(ph, p.rho) + v);
             max_accel = max_accel.max((r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt());
         } else if p.kind == WALL {
-            max_speed = max_speed.max(sound_speed(ph, p.rho));
+            // Moving walls (bodies) count with their speed.
+            max_speed = max_speed.max(sound_speed(ph, p.rho) + v);
         }
     }
     let mut dt = cfl * ph.h / max_speed.max(1e-12);

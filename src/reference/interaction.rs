@@ -1,7 +1,7 @@
 //! Twin of shaders/interaction.wgsl, brute force over all pairs (no cell list), f64.
 
 use super::{
-    dot, kernel, laminar_nu, pressure, sub, RefParticle, Space, FLUID, GHOST_FREE_SLIP,
+    dot, kernel, laminar_nu, pressure, sub, RefParticle, Space, EXCLUDED, FLUID, GHOST_FREE_SLIP,
     GHOST_NO_SLIP, REPULSIVE, WALL,
 };
 use crate::scenario::{MirrorPlane, Physics, RepulsiveForm, Viscosity, WallParams};
@@ -102,7 +102,8 @@ fn add(a: &mut [f64; 4], b: [f64; 4]) {
 }
 
 /// (dv/dt, dρ/dt) of every particle: fluid gets everything, dynamic walls only dρ/dt from
-/// fluid neighbours, ghosts and repulsive particles nothing.
+/// fluid neighbours, ghosts and repulsive particles nothing. Body particles (dynamic walls of a
+/// body) also get the fluid's force and the contact force of other solids' particles.
 pub fn rates(
     ph: &Physics,
     walls: &WallParams,
@@ -142,9 +143,25 @@ pub fn rates_and_energy(
                 for (j, pj) in parts.iter().enumerate() {
                     let x_ij = space.sub(pi.pos, pj.pos);
                     let r2 = dot(x_ij, x_ij);
-                    if j != i && r2 < support2 && pj.kind == FLUID {
-                        let f_ij = kernel::f(ph.kernel, ph.dim, h, r2.sqrt());
-                        r[3] += ph.particle_mass * dot(sub(pi.vel, pj.vel), x_ij.map(|x| x * f_ij));
+                    if j == i || r2 >= support2 {
+                        continue;
+                    }
+                    if pj.kind == FLUID {
+                        if pi.body.is_some() {
+                            // A body particle: the fluid's force on it too.
+                            add(
+                                &mut r,
+                                pair.rates(pi, x_ij, pj.vel, pj.vel, pj.rho, false, 1.0).0,
+                            );
+                        } else {
+                            let f_ij = kernel::f(ph.kernel, ph.dim, h, r2.sqrt());
+                            r[3] +=
+                                ph.particle_mass * dot(sub(pi.vel, pj.vel), x_ij.map(|x| x * f_ij));
+                        }
+                    } else if pi.body.is_some() && pj.kind != EXCLUDED && pj.body != pi.body {
+                        // Contact with a fixed wall or another body.
+                        let f = repulsion(ph, walls, x_ij);
+                        add(&mut r, [f[0], f[1], f[2], 0.0]);
                     }
                 }
                 return (r, 0.0);

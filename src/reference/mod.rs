@@ -4,6 +4,7 @@
 // Component loops written as in the equations read better than iterator chains here.
 #![allow(clippy::needless_range_loop)]
 
+pub mod bodies;
 pub mod cell_list;
 pub mod density_filter;
 pub mod ghost;
@@ -22,6 +23,8 @@ pub struct RefParticle {
     pub rho: f64,
     /// 0 fluid, 1 wall (as in the GPU code word).
     pub kind: u32,
+    /// The moving body the particle belongs to, if any.
+    pub body: Option<u32>,
 }
 
 pub const FLUID: u32 = 0;
@@ -29,6 +32,7 @@ pub const WALL: u32 = 1;
 pub const GHOST_NO_SLIP: u32 = 2;
 pub const GHOST_FREE_SLIP: u32 = 3;
 pub const REPULSIVE: u32 = 4;
+pub const EXCLUDED: u32 = crate::layout::KIND_EXCLUDED;
 
 /// Tait equation of state, P = B((ρ/ρ0)^γ − 1).
 pub fn pressure(ph: &Physics, rho: f64) -> f64 {

@@ -2,7 +2,7 @@
 //! from one into the other); everything else is single.
 
 use crate::gpu::buffers::{storage, storage_init, uniform_init};
-use crate::layout::{MirrorPlane, Params, Pos, ProbeDef, SimState};
+use crate::layout::{BodyParticle, MirrorPlane, Params, Pos, ProbeDef, SimState};
 
 pub struct ParticleBuffers {
     pub n: u32,
@@ -34,6 +34,9 @@ pub struct ParticleBuffers {
     /// energy equation is off.
     pub energy: [wgpu::Buffer; 2],
     pub energy_rate: wgpu::Buffer,
+    /// Body-frame offset and body of every body particle (by id − body_id_base); one dummy
+    /// element without bodies.
+    pub body_particles: wgpu::Buffer,
 }
 
 /// Stand-in so a run without probes still binds a valid buffer.
@@ -48,6 +51,7 @@ pub struct InitialParticles<'a> {
     pub pos: &'a [Pos],
     pub velrho: &'a [[f32; 4]],
     pub code: &'a [u32],
+    pub body_particles: &'a [BodyParticle],
 }
 
 impl ParticleBuffers {
@@ -118,6 +122,15 @@ impl ParticleBuffers {
                 )
             }),
             energy_rate: storage(device, "energy rate", if energy { 4 * n as u64 } else { 4 }),
+            body_particles: if init.body_particles.is_empty() {
+                storage(
+                    device,
+                    "body particles",
+                    std::mem::size_of::<BodyParticle>() as u64,
+                )
+            } else {
+                storage_init(device, "body particles", init.body_particles)
+            },
             mirror_planes: if planes.is_empty() {
                 storage(
                     device,
@@ -145,6 +158,7 @@ impl ParticleBuffers {
             &self.probe_out,
             &self.mirror_planes,
             &self.energy_rate,
+            &self.body_particles,
         ];
         all.extend(self.energy.iter());
         all.extend(

@@ -25,6 +25,7 @@ impl Interaction {
                 (5, &b.rate),
                 (6, &b.mirror_planes),
                 (7, &b.energy_rate),
+                (8, &b.body_particles),
             ]
         };
         let bind = [

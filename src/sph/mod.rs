@@ -2,6 +2,7 @@
 //! predict → cell-list sort → interaction → correct + time step, all on the GPU in one
 //! command encoder; the host reads back a 48-byte state once per batch of steps.
 
+pub mod bodies;
 pub mod buffers;
 pub mod cell_list;
 pub mod density_filter;
@@ -13,7 +14,8 @@ pub mod probes;
 
 use anyhow::{bail, Context, Result};
 
-use crate::gpu::buffers::read;
+use crate::body::BodySet;
+use crate::gpu::buffers::{map_read, read, readback_buffer};
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::shader::{Pass, ShaderConfig};
 use crate::gpu::GpuContext;
@@ -21,6 +23,7 @@ use crate::layout::{
     pack_block, unpack_block, Params, Pos, SimState, ID_MASK, KIND_EXCLUDED, KIND_SHIFT,
 };
 use crate::scenario::{GhostCorrection, KernelKind, Kind, RepulsiveForm, Scenario, Viscosity};
+use bodies::Bodies;
 use buffers::{InitialParticles, ParticleBuffers};
 use cell_list::CellList;
 use density_filter::DensityFilter;
@@ -110,6 +113,9 @@ pub struct Solver {
     energy: bool,
     integrate: Integrate,
     probes: Probes,
+    /// Moving bodies: the GPU part, the host dynamics, and the buffer the state and the
+    /// per-workgroup loads are read back into after every step.
+    bodies: Option<(Bodies, BodySet, wgpu::Buffer)>,
     parity: usize,
     t_base: f64,
     steps: u64,
@@ -144,6 +150,7 @@ impl Solver {
             );
         }
         let grid = Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic)?;
+        let body_id_base = body_id_base(sc)?;
         let (alpha, nu, viscosity) = match ph.viscosity {
             Viscosity::Artificial { alpha } => (alpha, 0.0, 0),
             Viscosity::Laminar { nu } => (0.0, nu, 1),
@@ -180,7 +187,8 @@ impl Solver {
             repulsive_r0: sc.walls.repulsive_r0 as f32,
             repulsive_form: (sc.walls.repulsive_form == RepulsiveForm::MonaghanKajtar) as u32,
             repulsive_k_over_beta: (sc.walls.repulsive_k / sc.walls.repulsive_beta) as f32,
-            pad: [0; 2],
+            body_id_base,
+            n_body_particles: n as u32 - body_id_base,
         };
         let cfg = ShaderConfig {
             dim: ph.dim,
@@ -211,6 +219,7 @@ impl Solver {
         let device = ctx.device.clone();
         let defs = probes::probe_defs(&sc.probes, grid.origin);
         let planes = mirror_planes(sc, grid.origin);
+        let body_particles = bodies::body_particles(sc);
         let buffers = ParticleBuffers::new(
             &device,
             &params,
@@ -219,6 +228,7 @@ impl Solver {
                 pos: &pos,
                 velrho: &velrho,
                 code: &code,
+                body_particles: &body_particles,
             },
             &defs,
             &planes,
@@ -240,6 +250,18 @@ impl Solver {
         };
         let integrate = Integrate::new(&device, &module(Pass::Integrate)?, &buffers)?;
         let probes = Probes::new(&device, &module(Pass::Probes)?, &buffers, &defs)?;
+        let bodies = if sc.bodies.is_empty() {
+            None
+        } else {
+            let gpu = Bodies::new(&device, &module(Pass::Bodies)?, &buffers, sc, body_id_base)?;
+            let staging = readback_buffer(
+                &device,
+                "state and body loads",
+                std::mem::size_of::<SimState>() as u64 + gpu.partials_bytes(),
+            );
+            let host = BodySet::new(&sc.bodies, ph.gravity, ph.dim);
+            Some((gpu, host, staging))
+        };
         let mut solver = Self {
             device,
             queue: ctx.queue.clone(),
@@ -257,6 +279,7 @@ impl Solver {
                 .any(|p| matches!(p.kind, Kind::GhostNoSlip | Kind::GhostFreeSlip)),
             integrate,
             probes,
+            bodies,
             parity: 0,
             t_base: 0.0,
             steps: 0,
@@ -267,10 +290,14 @@ impl Solver {
         };
         // Warm-up: one step with dt = 0 sorts the particles, evaluates the initial rates and
         // chooses the first dt; it moves nothing and is not counted.
-        solver.submit_steps(1);
-        solver.state = solver.read_state()?;
+        solver.take_steps(1)?;
         solver.initial_dt = solver.state.dt_cfl;
         Ok(solver)
+    }
+
+    /// The bodies' host state (poses and last loads), if the case has bodies.
+    pub fn bodies(&self) -> Option<&BodySet> {
+        self.bodies.as_ref().map(|(_, host, _)| host)
     }
 
     pub fn time(&self) -> f64 {
@@ -302,13 +329,54 @@ impl Solver {
         Ok(read::<SimState>(&self.device, &self.queue, &self.buffers.state, 1)?[0])
     }
 
-    /// Records `count` steps into one submission.
-    fn submit_steps(&mut self, count: u32) {
+    /// Takes `count` steps (as the GPU state says: dt 0 once arrived) and reads the state back.
+    /// Without bodies the steps go in one submission; with bodies one at a time, each between
+    /// the host's predictor and corrector of the bodies.
+    fn take_steps(&mut self, count: u32) -> Result<()> {
+        if self.bodies.is_none() {
+            let encoder = self.encode_steps(count);
+            self.queue.submit([encoder.finish()]);
+            self.state = self.read_state()?;
+            return Ok(());
+        }
+        for _ in 0..count {
+            self.step_with_bodies()?;
+        }
+        Ok(())
+    }
+
+    /// One step with bodies: the host predicts every body to t + dt and uploads the poses, the
+    /// GPU steps and sums the loads, the host reads back the state and the loads (the only
+    /// per-step readback) and corrects the bodies.
+    fn step_with_bodies(&mut self) -> Result<()> {
+        let dt = self.state.dt as f64;
+        let t_next = self.time() + dt;
+        let (gpu, host, _) = self.bodies.as_mut().expect("a run with bodies");
+        let poses = host.predict(t_next, dt);
+        gpu.upload(&self.queue, &self.grid, &poses);
+        let mut encoder = self.encode_steps(1);
+        let (gpu, _, staging) = self.bodies.as_ref().expect("a run with bodies");
+        let state_bytes = std::mem::size_of::<SimState>() as u64;
+        encoder.copy_buffer_to_buffer(&self.buffers.state, 0, staging, 0, state_bytes);
+        encoder.copy_buffer_to_buffer(&gpu.partials, 0, staging, state_bytes, gpu.partials_bytes());
+        self.queue.submit([encoder.finish()]);
+        let bytes = map_read(&self.device, staging)?;
+        self.state = bytemuck::pod_read_unaligned(&bytes[..state_bytes as usize]);
+        let partials: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes[state_bytes as usize..]);
+        let loads = gpu.loads(&partials);
+        let (_, host, _) = self.bodies.as_mut().expect("a run with bodies");
+        host.correct(dt, &loads);
+        Ok(())
+    }
+
+    /// Records `count` steps into one command encoder.
+    fn encode_steps(&mut self, count: u32) -> wgpu::CommandEncoder {
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("steps"),
             });
+        let bodies = self.bodies.as_ref().map(|(gpu, _, _)| gpu);
         for _ in 0..count {
             let p = self.parity;
             let q = 1 - p;
@@ -318,11 +386,20 @@ impl Solver {
                 timestamp_writes: None,
             });
             self.integrate.encode_predict(&mut pass, p);
+            if let Some(b) = bodies {
+                b.encode_move(&mut pass, p);
+            }
             self.cell_list.encode(&mut pass, p);
+            if let Some(b) = bodies {
+                b.encode_index(&mut pass, q);
+            }
             if self.has_ghosts {
                 self.ghost.encode(&mut pass, q);
             }
             self.interaction.encode(&mut pass, q);
+            if let Some(b) = bodies {
+                b.encode_force(&mut pass, q);
+            }
             self.integrate.encode_correct(&mut pass, q);
             if let Some(f) = &self.density_filter {
                 f.encode(&mut pass, q);
@@ -330,7 +407,7 @@ impl Solver {
             drop(pass);
             self.parity = q;
         }
-        self.queue.submit([encoder.finish()]);
+        encoder
     }
 
     /// Advances to exactly `t_target` (the last step is shortened to land on it).
@@ -354,8 +431,7 @@ impl Solver {
             let batch =
                 ((left / self.state.dt_cfl.max(1e-30)).ceil() as u32 + 1).clamp(1, MAX_BATCH);
             let before = self.state.steps;
-            self.submit_steps(batch);
-            self.state = self.read_state()?;
+            self.take_steps(batch)?;
             self.steps += (self.state.steps - before) as u64;
             self.check_stability()?;
         }
@@ -376,15 +452,21 @@ impl Solver {
         st.dt = st.dt_cfl;
         self.queue
             .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
+        self.state = st;
         let mut left = count;
         while left > 0 {
             let batch = left.min(MAX_BATCH as u64) as u32;
-            self.submit_steps(batch);
+            if self.bodies.is_some() {
+                self.take_steps(batch)?;
+            } else {
+                // Benchmarks: no readback between batches.
+                let encoder = self.encode_steps(batch);
+                self.queue.submit([encoder.finish()]);
+            }
             left -= batch as u64;
         }
-        let before = st.steps;
         self.state = self.read_state()?;
-        self.steps += (self.state.steps - before) as u64;
+        self.steps += (self.state.steps - st.steps) as u64;
         self.check_stability()
     }
 
@@ -504,6 +586,42 @@ impl Solver {
         self.read_rates()
     }
 
+    /// The body particle `id` belongs to, if any.
+    pub fn body_of_id(&self, id: u32) -> Option<u32> {
+        let (gpu, _, _) = self.bodies.as_ref()?;
+        id.checked_sub(self.params.body_id_base)
+            .and_then(|k| gpu.body_of(k))
+    }
+
+    /// Test hook: re-runs the interaction and the body sums on the current arrays and returns
+    /// each body's force and torque (about the centre of mass of the last uploaded pose).
+    #[doc(hidden)]
+    pub fn rerun_body_loads(&self) -> Result<Vec<crate::body::Load>> {
+        let Some((gpu, _, _)) = &self.bodies else {
+            bail!("the case has no bodies");
+        };
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("body loads"),
+            });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("body loads"),
+            timestamp_writes: None,
+        });
+        self.interaction.encode(&mut pass, self.parity);
+        gpu.encode_force(&mut pass, self.parity);
+        drop(pass);
+        self.queue.submit([encoder.finish()]);
+        let partials: Vec<[f32; 4]> = read(
+            &self.device,
+            &self.queue,
+            &gpu.partials,
+            gpu.partials_bytes() as usize / 16,
+        )?;
+        Ok(gpu.loads(&partials))
+    }
+
     /// Test hook: applies the density filter of the case once to the current arrays (whatever
     /// the step count). With `poison`, the filter's output buffer is first filled with NaN, so a
     /// fluid particle the filter skips gets a NaN density.
@@ -535,14 +653,15 @@ impl Solver {
     /// Test hook: takes exactly one step of `dt` (no clipping) and returns the new state.
     #[doc(hidden)]
     pub fn single_step(&mut self, dt: f32) -> Result<SimState> {
+        self.t_base += self.state.t_rel as f64;
         let mut st = self.state;
         st.t_rel = 0.0;
         st.t_target_rel = f32::MAX;
         st.dt = dt;
         self.queue
             .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
-        self.submit_steps(1);
-        self.state = self.read_state()?;
+        self.state = st;
+        self.take_steps(1)?;
         Ok(self.state)
     }
 
@@ -624,6 +743,29 @@ impl Solver {
         }
         Ok(out)
     }
+}
+
+/// The id of the first body particle: bodies' particles must come last, body after body, in
+/// the scenario's order (the case builder puts them there). Without bodies, the particle count.
+fn body_id_base(sc: &Scenario) -> Result<u32> {
+    let n = sc.particles.len();
+    let base = sc.bodies.first().map_or(n, |b| b.particles.start);
+    let mut next = base;
+    for b in &sc.bodies {
+        if b.particles.start != next || b.particles.is_empty() {
+            bail!(
+                "body '{}' has particles {:?}: bodies need non-empty ranges that follow each \
+                 other up to the last particle",
+                b.name,
+                b.particles
+            );
+        }
+        next = b.particles.end;
+    }
+    if next != n {
+        bail!("the bodies' particles must be the last ones of the scenario");
+    }
+    Ok(base as u32)
 }
 
 /// Kind word of an excluded particle, for callers filtering outputs.

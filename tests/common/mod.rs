@@ -4,7 +4,7 @@
 use std::sync::OnceLock;
 
 use wgsph::gpu::{AdapterChoice, GpuContext};
-use wgsph::layout::{unpack_block, KIND_SHIFT};
+use wgsph::layout::{unpack_block, ID_MASK, KIND_SHIFT};
 use wgsph::reference::RefParticle;
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
@@ -89,6 +89,7 @@ pub fn scenario(
         },
         walls: WallParams::defaults(physics_dx, 0.5, 9.81),
         periodic: [false; 3],
+        bodies: Vec::new(),
         domain,
         particles,
         probes,
@@ -123,6 +124,7 @@ pub fn gpu_particles_and_codes(s: &Solver) -> (Vec<RefParticle>, Vec<u32>) {
             vel: [v[0] as f64, v[1] as f64, v[2] as f64],
             rho: v[3] as f64,
             kind: c >> KIND_SHIFT,
+            body: s.body_of_id(c & ID_MASK),
         })
         .collect();
     (parts, code)

@@ -1,0 +1,117 @@
+// Moving bodies (rigid, free or prescribed). The host integrates each body in f64
+// (src/body/) and uploads its motion for the step; here the GPU
+//   body_move:  places every body particle a at x_a = x_c + R r_a with u_a = u_c + ω × (R r_a)
+//               (the seed's rigid-body kinematics), after the predictor and before the sort;
+//   body_index: after the sort, records where each body particle now is (body_slot);
+//   body_force: after the interaction, sums per workgroup the force m a_a that the fluid (and
+//               contact) exerts on each body particle and its moment (R r_a) × m a_a about the
+//               centre of mass. Each workgroup covers particles of one body only; the host
+//               finishes the sums in f64, in workgroup order (deterministic).
+// Body particles are dynamic boundary particles: the interaction gives them the pressure and
+// viscous force of their fluid neighbours (interaction.wgsl), the opposite of what the fluid
+// receives from them, so momentum is exchanged pairwise.
+
+// A body's rigid motion for the step being taken. Mirrored by `layout::BodyMotion`.
+struct BodyMotion {
+    center_off: vec3<f32>,      // centre of mass, as a Pos: offset in its block
+    center_block: u32,
+    rotation: mat3x3<f32>,      // from the body's orientation at t = 0
+    velocity: vec3<f32>,        // of the centre of mass
+    first: u32,                 // its first body-particle index (id − body_id_base)
+    omega: vec3<f32>,
+    count: u32,                 // its number of particles
+    first_group: u32,           // its first workgroup in body_force
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
+@group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
+@group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> code: array<u32>;
+@group(0) @binding(4) var<storage, read> rate: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> body_particles: array<BodyParticle>;
+@group(0) @binding(6) var<storage, read> bodies: array<BodyMotion>;
+// Index in the particle arrays of body particle k, as of the last sort.
+@group(0) @binding(7) var<storage, read_write> body_slot: array<u32>;
+// Per workgroup of body_force: (force, 0) then (torque, 0).
+@group(0) @binding(8) var<storage, read_write> body_partials: array<vec4<f32>>;
+
+var<workgroup> wg_force: array<vec3<f32>, WG>;
+var<workgroup> wg_torque: array<vec3<f32>, WG>;
+
+@compute @workgroup_size(WG)
+fn body_move(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let k = linear_index(gid, nwg);
+    if (k >= params.n_body_particles) {
+        return;
+    }
+    let i = body_slot[k];
+    if (code_kind(code[i]) == KIND_EXCLUDED) {
+        return;
+    }
+    let bp = body_particles[k];
+    let m = bodies[bp.body];
+    let arm = m.rotation * bp.r;
+    let moved = move_by(Pos(m.center_off, m.center_block), arm);
+    pos[i] = moved.pos;
+    velrho[i] = vec4<f32>(m.velocity + cross(m.omega, arm), velrho[i].w);
+    if (!moved.inside) {
+        code[i] = with_kind(code[i], KIND_EXCLUDED);
+    }
+}
+
+@compute @workgroup_size(WG)
+fn body_index(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles) {
+        return;
+    }
+    let id = code[i] & ID_MASK;
+    if (is_body_particle(id)) {
+        body_slot[id - params.body_id_base] = i;
+    }
+}
+
+@compute @workgroup_size(WG)
+fn body_force(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    let group = wid.x + wid.y * nwg.x;
+    // The body this workgroup belongs to: the last whose first group is not after it.
+    var b = 0u;
+    for (var c = 1u; c < arrayLength(&bodies); c++) {
+        if (bodies[c].first_group <= group) {
+            b = c;
+        }
+    }
+    let m = bodies[b];
+    let local = (group - m.first_group) * WG + li;
+    var force = vec3<f32>(0.0);
+    var torque = vec3<f32>(0.0);
+    if (local < m.count) {
+        let k = m.first + local;
+        let i = body_slot[k];
+        if (code_kind(code[i]) != KIND_EXCLUDED) {
+            force = params.mass * rate[i].xyz;
+            torque = cross(m.rotation * body_particles[k].r, force);
+        }
+    }
+    // Tree reduction in a fixed order: the same input gives the same sums.
+    wg_force[li] = force;
+    wg_torque[li] = torque;
+    workgroupBarrier();
+    for (var s = WG / 2u; s > 0u; s >>= 1u) {
+        if (li < s) {
+            wg_force[li] += wg_force[li + s];
+            wg_torque[li] += wg_torque[li + s];
+        }
+        workgroupBarrier();
+    }
+    if (li == 0u) {
+        body_partials[2u * group] = vec4<f32>(wg_force[0], 0.0);
+        body_partials[2u * group + 1u] = vec4<f32>(wg_torque[0], 0.0);
+    }
+}

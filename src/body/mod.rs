@@ -1,0 +1,154 @@
+//! Host side of moving solids: prescribed motion laws ([`motion`]) and rigid-body dynamics
+//! ([`dynamics`]), in f64. The GPU moves the body particles from the poses computed here and
+//! sums the fluid's force and torque per body (`src/sph/bodies.rs`); only those small per-body
+//! arrays cross the bus each step.
+
+pub mod dynamics;
+pub mod motion;
+
+use glam::{DQuat, DVec3};
+
+use crate::scenario::{Body, Motion, Prescribed};
+use dynamics::RigidBody;
+
+/// Where a body is and how it moves at one instant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pose {
+    /// Centre of mass [m].
+    pub center: DVec3,
+    /// Rotation from the body's orientation at t = 0.
+    pub rotation: DQuat,
+    /// Velocity of the centre of mass [m/s].
+    pub velocity: DVec3,
+    /// Angular velocity, world axes [rad/s].
+    pub omega: DVec3,
+}
+
+impl Pose {
+    /// Velocity of the material point at `x` (u = u_c + ω × (x − x_c)).
+    pub fn velocity_at(&self, x: DVec3) -> DVec3 {
+        self.velocity + self.omega.cross(x - self.center)
+    }
+
+    /// Rotation angle about z (2D bodies), in (−π, π].
+    pub fn angle_z(&self) -> f64 {
+        let (axis, angle) = self.rotation.to_axis_angle();
+        if axis.z < 0.0 {
+            -angle
+        } else {
+            angle
+        }
+    }
+}
+
+/// The force and torque (about the centre of mass) that the fluid and contacts exert on a
+/// body, as summed on the GPU; gravity is not included.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Load {
+    pub force: DVec3,
+    pub torque: DVec3,
+}
+
+enum State {
+    Free(RigidBody),
+    Prescribed {
+        law: Prescribed,
+        center0: DVec3,
+        pose: Pose,
+    },
+}
+
+/// Every body of a run, stepped with the fluid's predictor–corrector.
+pub struct BodySet {
+    states: Vec<State>,
+    loads: Vec<Load>,
+    gravity: DVec3,
+    /// 2D: poses are kept exactly in the z = 0 plane (a rounding-level z would put particles
+    /// outside a 2D domain, whose z extent is 0).
+    planar: bool,
+}
+
+impl BodySet {
+    pub fn new(bodies: &[Body], gravity: [f64; 3], dim: u32) -> Self {
+        let states = bodies
+            .iter()
+            .map(|b| {
+                let center0 = DVec3::from_array(b.center);
+                match &b.motion {
+                    Motion::Free { velocity, omega } => {
+                        State::Free(RigidBody::new(b, *velocity, *omega, dim == 2))
+                    }
+                    Motion::Prescribed(law) => State::Prescribed {
+                        pose: law.pose(center0, 0.0),
+                        law: law.clone(),
+                        center0,
+                    },
+                }
+            })
+            .collect();
+        Self {
+            states,
+            loads: vec![Load::default(); bodies.len()],
+            gravity: DVec3::from_array(gravity),
+            planar: dim == 2,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.states.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.states.is_empty()
+    }
+
+    /// Predictor: every body moved to `t_next = t + dt` (free bodies with their last
+    /// acceleration, prescribed ones by their law). Returns the poses the step evaluates at.
+    pub fn predict(&mut self, t_next: f64, dt: f64) -> Vec<Pose> {
+        let planar = self.planar;
+        self.states
+            .iter_mut()
+            .map(|s| {
+                let pose = match s {
+                    State::Free(b) => {
+                        b.predict(dt);
+                        &mut b.pose
+                    }
+                    State::Prescribed { law, center0, pose } => {
+                        *pose = law.pose(*center0, t_next);
+                        pose
+                    }
+                };
+                if planar {
+                    pose.center.z = 0.0;
+                    pose.velocity.z = 0.0;
+                    pose.omega = DVec3::new(0.0, 0.0, pose.omega.z);
+                }
+                *pose
+            })
+            .collect()
+    }
+
+    /// Corrector with the loads evaluated at the predicted poses.
+    pub fn correct(&mut self, dt: f64, loads: &[Load]) {
+        for ((s, load), last) in self.states.iter_mut().zip(loads).zip(&mut self.loads) {
+            if let State::Free(b) = s {
+                b.correct(dt, *load, self.gravity);
+            }
+            *last = *load;
+        }
+    }
+
+    /// The current pose of body `k`.
+    pub fn pose(&self, k: usize) -> Pose {
+        match &self.states[k] {
+            State::Free(b) => b.pose,
+            State::Prescribed { pose, .. } => *pose,
+        }
+    }
+
+    /// The load of the last evaluation on body `k`.
+    pub fn load(&self, k: usize) -> Load {
+        self.loads[k]
+    }
+}

@@ -1,0 +1,177 @@
+//! Moving bodies on the GPU (shaders/bodies.wgsl): places body particles from the poses the
+//! host computes (src/body/), tracks where the sort puts them, and sums their force and torque
+//! per workgroup for the host to finish in f64.
+
+use anyhow::Result;
+use glam::{DMat3, DVec3};
+
+use super::buffers::ParticleBuffers;
+use super::grid::Grid;
+use crate::body::{Load, Pose};
+use crate::gpu::buffers::{storage, storage_init};
+use crate::gpu::kernel::ShaderModule;
+use crate::gpu::shader::WORKGROUP_SIZE;
+use crate::gpu::Kernel;
+use crate::layout::{pack_block, BodyMotion, BodyParticle};
+use crate::scenario::Scenario;
+
+/// Body-frame offsets of the bodies' particles (index = id − first body id).
+pub fn body_particles(sc: &Scenario) -> Vec<BodyParticle> {
+    let mut out = Vec::new();
+    for (k, b) in sc.bodies.iter().enumerate() {
+        for p in &sc.particles[b.particles.clone()] {
+            out.push(BodyParticle {
+                r: [0, 1, 2].map(|a| (p.pos[a] - b.center[a]) as f32),
+                body: k as u32,
+            });
+        }
+    }
+    out
+}
+
+pub struct Bodies {
+    /// The per-body table; `first`, `count` and `first_group` never change.
+    motions: Vec<BodyMotion>,
+    motion_buf: wgpu::Buffer,
+    pub partials: wgpu::Buffer,
+    /// Workgroups of `body_force` (each covers particles of one body).
+    groups: u32,
+    body_move: Kernel,
+    body_index: Kernel,
+    body_force: Kernel,
+    bind_move: [wgpu::BindGroup; 2],
+    bind_index: [wgpu::BindGroup; 2],
+    bind_force: [wgpu::BindGroup; 2],
+    n_body: u32,
+    n: u32,
+}
+
+impl Bodies {
+    pub fn new(
+        device: &wgpu::Device,
+        module: &ShaderModule,
+        b: &ParticleBuffers,
+        sc: &Scenario,
+        first_id: u32,
+    ) -> Result<Self> {
+        let mut motions = Vec::with_capacity(sc.bodies.len());
+        let mut groups = 0;
+        for body in &sc.bodies {
+            let count = body.particles.len() as u32;
+            motions.push(BodyMotion {
+                first: body.particles.start as u32 - first_id,
+                count,
+                first_group: groups,
+                ..Default::default()
+            });
+            groups += count.div_ceil(WORKGROUP_SIZE).max(1);
+        }
+        let n_body = (sc.particles.len() as u32) - first_id;
+        // The particles start in id order.
+        let slots: Vec<u32> = (first_id..first_id + n_body).collect();
+        let motion_buf = storage_init(device, "body motions", &motions);
+        let body_slot = storage_init(device, "body slots", &slots);
+        let partials = storage(device, "body partials", Self::partials_bytes_for(groups));
+        let body_move = module.kernel(device, "body_move")?;
+        let body_index = module.kernel(device, "body_index")?;
+        let body_force = module.kernel(device, "body_force")?;
+        let bufs = |p: usize| {
+            [
+                (0, &b.params),
+                (1, &b.pos[p]),
+                (2, &b.velrho[p]),
+                (3, &b.code[p]),
+                (4, &b.rate),
+                (5, &b.body_particles),
+                (6, &motion_buf),
+                (7, &body_slot),
+                (8, &partials),
+            ]
+        };
+        let bind = |k: &Kernel| -> Result<[wgpu::BindGroup; 2]> {
+            Ok([k.bind(device, &bufs(0))?, k.bind(device, &bufs(1))?])
+        };
+        Ok(Self {
+            bind_move: bind(&body_move)?,
+            bind_index: bind(&body_index)?,
+            bind_force: bind(&body_force)?,
+            motions,
+            motion_buf,
+            partials,
+            groups,
+            body_move,
+            body_index,
+            body_force,
+            n_body,
+            n: b.n,
+        })
+    }
+
+    fn partials_bytes_for(groups: u32) -> u64 {
+        32 * groups as u64
+    }
+
+    /// Size of the per-workgroup (force, torque) array, the only per-step readback.
+    pub fn partials_bytes(&self) -> u64 {
+        Self::partials_bytes_for(self.groups)
+    }
+
+    /// Uploads the poses of the step about to be taken (one per body, in order).
+    pub fn upload(&mut self, queue: &wgpu::Queue, grid: &Grid, poses: &[Pose]) {
+        for (m, pose) in self.motions.iter_mut().zip(poses) {
+            let (off, block) = grid.to_block(pose.center.to_array());
+            let r = DMat3::from_quat(pose.rotation);
+            m.center_off = off;
+            m.center_block = pack_block(block);
+            m.rotation = [r.x_axis, r.y_axis, r.z_axis].map(|c| {
+                let c = c.as_vec3();
+                [c.x, c.y, c.z, 0.0]
+            });
+            m.velocity = pose.velocity.as_vec3().to_array();
+            m.omega = pose.omega.as_vec3().to_array();
+        }
+        queue.write_buffer(&self.motion_buf, 0, bytemuck::cast_slice(&self.motions));
+    }
+
+    /// Moves the body particles of parity `p` (after the predictor, before the sort).
+    pub fn encode_move(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.body_move
+            .dispatch(pass, &self.bind_move[p], self.n_body);
+    }
+
+    /// Records where the sort put each body particle (parity `p`, after the sort).
+    pub fn encode_index(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.body_index.dispatch(pass, &self.bind_index[p], self.n);
+    }
+
+    /// Per-workgroup force and torque sums of parity `p` (after the interaction).
+    pub fn encode_force(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.body_force
+            .dispatch_groups(pass, &self.bind_force[p], self.groups);
+    }
+
+    /// The body of body particle `k` (id − first body id).
+    pub fn body_of(&self, k: u32) -> Option<u32> {
+        self.motions
+            .iter()
+            .position(|m| (m.first..m.first + m.count).contains(&k))
+            .map(|b| b as u32)
+    }
+
+    /// Each body's force and torque: its workgroups' partial sums added in f64, in order.
+    pub fn loads(&self, partials: &[[f32; 4]]) -> Vec<Load> {
+        let mut out = vec![Load::default(); self.motions.len()];
+        for (k, m) in self.motions.iter().enumerate() {
+            let end = self
+                .motions
+                .get(k + 1)
+                .map_or(self.groups, |next| next.first_group);
+            for g in m.first_group..end {
+                let (f, t) = (partials[2 * g as usize], partials[2 * g as usize + 1]);
+                out[k].force += DVec3::new(f[0] as f64, f[1] as f64, f[2] as f64);
+                out[k].torque += DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64);
+            }
+        }
+        out
+    }
+}
