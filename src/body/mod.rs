@@ -49,6 +49,79 @@ pub struct Load {
     pub torque: DVec3,
 }
 
+/// Column names of a body's CSV (`probes/body_<name>.csv`, after `t_s`): the centre of mass,
+/// the rotation (2D: angle; 3D: quaternion), their rates, and the fluid + contact load
+/// (gravity excluded).
+pub fn csv_columns(dim: u32) -> Vec<String> {
+    let cols: &[&str] = if dim == 2 {
+        &[
+            "x_m",
+            "y_m",
+            "angle_deg",
+            "vx_m_s",
+            "vy_m_s",
+            "omega_rad_s",
+            "fx_n",
+            "fy_n",
+            "torque_nm",
+        ]
+    } else {
+        &[
+            "x_m",
+            "y_m",
+            "z_m",
+            "qw",
+            "qx",
+            "qy",
+            "qz",
+            "vx_m_s",
+            "vy_m_s",
+            "vz_m_s",
+            "omega_x_rad_s",
+            "omega_y_rad_s",
+            "omega_z_rad_s",
+            "fx_n",
+            "fy_n",
+            "fz_n",
+            "tx_nm",
+            "ty_nm",
+            "tz_nm",
+        ]
+    };
+    cols.iter().map(|c| c.to_string()).collect()
+}
+
+/// One CSV row of a body, in the order of [`csv_columns`]. 2D forces and torques are per
+/// metre of depth.
+pub fn csv_row(pose: &Pose, load: &Load, dim: u32) -> Vec<f64> {
+    let (c, v, w, f, t) = (
+        pose.center,
+        pose.velocity,
+        pose.omega,
+        load.force,
+        load.torque,
+    );
+    if dim == 2 {
+        vec![
+            c.x,
+            c.y,
+            pose.angle_z().to_degrees(),
+            v.x,
+            v.y,
+            w.z,
+            f.x,
+            f.y,
+            t.z,
+        ]
+    } else {
+        let q = pose.rotation;
+        vec![
+            c.x, c.y, c.z, q.w, q.x, q.y, q.z, v.x, v.y, v.z, w.x, w.y, w.z, f.x, f.y, f.z, t.x,
+            t.y, t.z,
+        ]
+    }
+}
+
 enum State {
     Free(RigidBody),
     Prescribed {

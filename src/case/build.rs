@@ -5,9 +5,10 @@
 use std::collections::HashSet;
 
 use crate::scenario::{
-    Domain, Kind, MirrorPlane, Particle, Physics, ProbeKind, Scenario, WallParams,
+    Body, Domain, Kind, MirrorPlane, Motion, Particle, Physics, ProbeKind, Scenario, WallParams,
 };
 
+use super::bodies::Shape;
 use super::error::CaseError;
 use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
 use super::locate::Ctx;
@@ -42,17 +43,17 @@ fn fmt_count(n: f64) -> String {
 pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
     let (dim, dx) = (case.dim, case.dx);
     let v = dim - 1;
-    let layers = case.tank.map_or(3, |t| t.layers as i64);
+    let layers = case.tank.as_ref().map_or(3, |t| t.layers as i64);
     // Particle layers of the tank wall: `layers` for dynamic and fixed-ghost walls, the one
     // nearest the fluid for repulsive walls, none for mirror planes.
-    let wall_layers = case.tank.map_or(layers, |t| match t.wall {
+    let wall_layers = case.tank.as_ref().map_or(layers, |t| match t.wall {
         Treatment::Dynamic | Treatment::FixedGhost { .. } => layers,
         Treatment::Repulsive => 1,
         Treatment::Mirror { .. } => 0,
     });
 
     // Tank cells along each axis.
-    let tank = match case.tank {
+    let tank = match &case.tank {
         None => None,
         Some(t) => {
             let mut n = [1.0; 3];
@@ -117,7 +118,10 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
 
     // The global lattice, continued by walls and obstacles.
     let lat = Lattice {
-        origin: case.tank.map_or(case.blocks[0].bx.min, |t| t.inner.min),
+        origin: case
+            .tank
+            .as_ref()
+            .map_or(case.blocks[0].bx.min, |t| t.inner.min),
         dx,
         dim,
     };
@@ -134,7 +138,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
     let wall_of = |n: [f64; 3]| TankWall {
         n: n.map(|c| c.min(1e15) as i64),
         layers: wall_layers,
-        open_top: case.tank.is_none_or(|t| t.open_top),
+        open_top: case.tank.as_ref().is_none_or(|t| t.open_top),
         dim,
     };
     let tank_n = tank.map_or(0.0, |(_, n)| wall_of(n).count());
@@ -151,9 +155,14 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
             }
         })
         .sum();
-    let total = fluid_n + tank_n + obstacle_n;
+    let body_n: f64 = case
+        .bodies
+        .iter()
+        .map(|b| b.shape.measure(dim) / dx.powi(dim as i32))
+        .sum();
+    let total = fluid_n + tank_n + obstacle_n + body_n;
     if total.is_nan() || total > MAX_PARTICLES {
-        return Err(ctx.err("particles.dx_m", Some(format!("{dx}")), format!("the case would create about {} particles ({} fluid, {} wall), more than the limit of 200 million", fmt_count(total), fmt_count(fluid_n), fmt_count(tank_n + obstacle_n)), format!("increase particles.dx_m (the count scales as 1/dx^{dim}) or shrink the geometry")));
+        return Err(ctx.err("particles.dx_m", Some(format!("{dx}")), format!("the case would create about {} particles ({} fluid, {} wall, {} body), more than the limit of 200 million", fmt_count(total), fmt_count(fluid_n), fmt_count(tank_n + obstacle_n), fmt_count(body_n)), format!("increase particles.dx_m (the count scales as 1/dx^{dim}) or shrink the geometry")));
     }
     let wall = tank.map(|(_, n)| wall_of(n));
 
@@ -164,7 +173,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
     let c0 = match case.sound {
         Sound::Speed(c) => c,
         Sound::Coef(k) => {
-            let floor = |b: &Aabb| case.tank.map_or(b.min[v], |t| t.inner.min[v]);
+            let floor = |b: &Aabb| case.tank.as_ref().map_or(b.min[v], |t| t.inner.min[v]);
             let depth = case
                 .blocks
                 .iter()
@@ -224,7 +233,10 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
                 })
                 .sum();
             point_inside(p, user, dim) || d2 < (dx * (1.0 - 1e-6)).powi(2)
-        })
+        }) || case
+            .bodies
+            .iter()
+            .any(|b| b.shape.signed_distance(p, dim) < 0.5 * dx * (1.0 - 1e-6))
     };
     let mut particles = Vec::with_capacity(total as usize);
     for (b, n) in case.blocks.iter().zip(&block_cells) {
@@ -253,7 +265,10 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
             None => case.rho0,
         }
     };
-    // Mirror walls have no particles (their TankWall has no layers).
+    // Mirror walls have no particles (their TankWall has no layers). A moving tank's walls and
+    // obstacles become the body "tank", after every fixed particle.
+    let tank_moves = case.tank.as_ref().is_some_and(|t| t.motion.is_some());
+    let mut tank_particles = Vec::new();
     let mut push_wall = |pos: [f64; 3], t: Treatment| {
         let (kind, rho) = match t {
             Treatment::Dynamic => (Kind::Wall, wall_rho(pos)),
@@ -265,14 +280,19 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
                 (Kind::GhostFreeSlip, wall_rho(pos))
             }
         };
-        particles.push(Particle {
+        let p = Particle {
             pos,
             vel: [0.0; 3],
             rho,
             kind,
-        })
+        };
+        if tank_moves {
+            tank_particles.push(p);
+        } else {
+            particles.push(p);
+        }
     };
-    if let (Some(w), Some(t)) = (&wall, case.tank) {
+    if let (Some(w), Some(t)) = (&wall, case.tank.as_ref()) {
         w.indices()
             .into_iter()
             .for_each(|i| push_wall(lat.pos(i), t.wall));
@@ -295,7 +315,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
     // Mirror planes on every face of the tank's inner box on the lattice (origin + n dx), the
     // lid only when the top is closed; normals point into the fluid.
     let mut mirror_planes = Vec::new();
-    if let (Some(w), Some(t)) = (&wall, case.tank) {
+    if let (Some(w), Some(t)) = (&wall, case.tank.as_ref()) {
         if let Treatment::Mirror { no_slip } = t.wall {
             for a in 0..dim {
                 let mut normal = [0.0; 3];
@@ -318,6 +338,56 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
                 });
             }
         }
+    }
+
+    let mut bodies = Vec::with_capacity(case.bodies.len() + 1);
+    if let (Some(t), Some(motion)) = (
+        &case.tank,
+        case.tank.as_ref().and_then(|t| t.motion.clone()),
+    ) {
+        let start = particles.len();
+        particles.append(&mut tank_particles);
+        bodies.push(Body {
+            name: "tank".into(),
+            particles: start..particles.len(),
+            mass: 0.0,
+            center: [0, 1, 2].map(|a| 0.5 * (t.inner.min[a] + t.inner.max[a])),
+            inertia: [[0.0; 3]; 3],
+            motion,
+        });
+    }
+    for spec in &case.bodies {
+        let start = particles.len();
+        let center = spec.shape.center();
+        for pos in spec.shape.points(dx, dim, spec.layers) {
+            let vel = match &spec.motion {
+                Motion::Free { velocity, omega } => {
+                    let r = [0, 1, 2].map(|a| pos[a] - center[a]);
+                    [
+                        velocity[0] + omega[1] * r[2] - omega[2] * r[1],
+                        velocity[1] + omega[2] * r[0] - omega[0] * r[2],
+                        velocity[2] + omega[0] * r[1] - omega[1] * r[0],
+                    ]
+                }
+                // The prescribed motion sets the velocity from the first step on.
+                Motion::Prescribed(_) => [0.0; 3],
+            };
+            particles.push(Particle {
+                pos,
+                vel,
+                rho: wall_rho(pos),
+                kind: Kind::Wall,
+            });
+        }
+        let mass = spec.mass.unwrap_or(0.0);
+        bodies.push(Body {
+            name: spec.name.clone(),
+            particles: start..particles.len(),
+            mass,
+            center,
+            inertia: spec.shape.inertia(dim, mass),
+            motion: spec.motion.clone(),
+        });
     }
 
     if let Some(p) = particles.iter().find(|p| !p.rho.is_finite()) {
@@ -372,7 +442,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
         probes: case.probes,
         walls,
         periodic: [false; 3],
-        bodies: Vec::new(),
+        bodies,
     })
 }
 
@@ -393,7 +463,28 @@ fn domain(
             min[a] = lat.origin[a] + lo as f64 * dx;
             max[a] = lat.origin[a] + hi as f64 * dx;
         }
-        solid.push(Aabb { min, max });
+        let mut b = Aabb { min, max };
+        if let Some(m) = case.tank.as_ref().and_then(|t| t.motion.as_ref()) {
+            b = swept(&b, m, case.time.end_s, dim);
+        }
+        solid.push(b);
+    }
+    // Bodies, each at its start position (a free body's later path is the user's business).
+    let n_fixed = solid.len();
+    for body in &case.bodies {
+        let c = body.shape.center();
+        let reach = match body.shape {
+            Shape::Box(b) => [0, 1, 2].map(|a| 0.5 * (b.max[a] - b.min[a])),
+            Shape::Ball { radius, .. } => [radius; 3],
+        };
+        let mut b = Aabb {
+            min: [0, 1, 2].map(|a| if a < dim { c[a] - reach[a] } else { 0.0 }),
+            max: [0, 1, 2].map(|a| if a < dim { c[a] + reach[a] } else { 0.0 }),
+        };
+        if let Motion::Prescribed(_) = body.motion {
+            b = swept(&b, &body.motion, case.time.end_s, dim);
+        }
+        solid.push(b);
     }
     let d = match case.domain {
         Some(d) => d,
@@ -409,7 +500,7 @@ fn domain(
                     d.max[a] = d.max[a].max(b.max[a]);
                 }
             }
-            let open = case.tank.is_none_or(|t| t.open_top);
+            let open = case.tank.as_ref().is_none_or(|t| t.open_top);
             if open {
                 // Room above for splashes: the tank's (or the fluid's) height.
                 d.max[v] += match wall {
@@ -444,8 +535,10 @@ fn domain(
         if let Some(a) = inside(b, &d, dim) {
             let path = if i < case.obstacles.len() {
                 format!("obstacle[{i}]")
-            } else {
+            } else if i < n_fixed {
                 "tank".to_string()
+            } else {
+                format!("body[{}]", i - n_fixed)
             };
             return Err(ctx.err(
                 &path,
@@ -479,6 +572,41 @@ fn domain(
         min: d.min,
         max: d.max,
     })
+}
+
+/// The bounding box of `b` moved by a prescribed `motion` over [0, end_s] (sampled finely; a
+/// free motion leaves it as it is).
+fn swept(b: &Aabb, motion: &Motion, end_s: f64, dim: usize) -> Aabb {
+    let Motion::Prescribed(law) = motion else {
+        return *b;
+    };
+    let mut out = *b;
+    let corners: Vec<glam::DVec3> = (0..1 << dim)
+        .map(|k: usize| {
+            glam::DVec3::from_array([0, 1, 2].map(|a| {
+                if a >= dim {
+                    0.0
+                } else if k >> a & 1 == 1 {
+                    b.max[a]
+                } else {
+                    b.min[a]
+                }
+            }))
+        })
+        .collect();
+    const SAMPLES: usize = 2000;
+    for s in 0..=SAMPLES {
+        let t = end_s * s as f64 / SAMPLES as f64;
+        for &c in &corners {
+            // A corner moves as a body whose centre it is.
+            let x = law.pose(c, t).center;
+            for a in 0..dim {
+                out.min[a] = out.min[a].min(x[a]);
+                out.max[a] = out.max[a].max(x[a]);
+            }
+        }
+    }
+    out
 }
 
 /// Height of the fluid from its lowest to its highest particle (+ dx), the H of the default

@@ -6,6 +6,7 @@
 //! field (`validate.rs`) → check the geometry and build the particles (`build.rs`). Every error
 //! names the file, the line, the field's dotted path, what is wrong and a fix.
 
+mod bodies;
 mod build;
 mod diagnose;
 mod error;
@@ -88,6 +89,7 @@ pub fn load_str(text: &str, file_name: &str, overrides: &[String]) -> Result<Sce
     let stem = Path::new(file_name)
         .file_stem()
         .map_or_else(|| "case".to_string(), |s| s.to_string_lossy().into_owned());
-    let case = validate::validate(&ctx, &raw, &stem)?;
+    let case_dir = Path::new(file_name).parent().unwrap_or(Path::new("."));
+    let case = validate::validate(&ctx, &raw, &stem, case_dir)?;
     build::build(&ctx, case)
 }

@@ -22,6 +22,8 @@ pub(super) struct RawCase {
     pub walls: Option<RawWalls>,
     #[serde(default)]
     pub probe: Vec<RawProbe>,
+    #[serde(default)]
+    pub body: Vec<RawBody>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -89,6 +91,56 @@ pub(super) struct RawTank {
     pub open_top: Option<bool>,
     pub wall: Option<WallName>,
     pub slip: Option<SlipName>,
+    pub motion: Option<RawMotion>,
+}
+
+/// A moving solid: `[[body]]` (`docs/cases.md`, "Bodies").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawBody {
+    pub name: String,
+    pub shape: ShapeName,
+    pub min_m: Option<Vec<f64>>,
+    pub max_m: Option<Vec<f64>>,
+    pub center_m: Option<Vec<f64>>,
+    pub radius_m: Option<f64>,
+    pub density_kg_m3: Option<f64>,
+    pub mass_kg: Option<f64>,
+    pub layers: Option<i64>,
+    pub wall: Option<WallName>,
+    pub motion: Option<RawMotion>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum ShapeName {
+    Box,
+    Circle,
+    Sphere,
+}
+
+/// How a body or the tank moves: `[body.motion]`, `[tank.motion]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawMotion {
+    pub kind: MotionName,
+    pub velocity_m_s: Option<Vec<f64>>,
+    pub angular_velocity_rad_s: Option<Vec<f64>>,
+    pub pivot_m: Option<Vec<f64>>,
+    pub axis: Option<Vec<f64>>,
+    pub translation_m: Option<Vec<f64>>,
+    pub rotation_deg: Option<f64>,
+    pub period_s: Option<f64>,
+    pub phase_deg: Option<f64>,
+    pub file: Option<String>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum MotionName {
+    Free,
+    Sine,
+    Series,
 }
 
 /// Wall treatment of the tank or of an obstacle (`docs/cases.md`, "Wall treatments").
@@ -466,6 +518,126 @@ pub(super) const FIELDS: &[FieldHelp] = &[
     ),
     f("probe[].kind", "the probe kind", "kind = \"pressure\""),
     f(
+        "tank.motion",
+        "the [tank.motion] table",
+        "[tank.motion] with kind = \"sine\"",
+    ),
+    f(
+        "body",
+        "a list of [[body]] tables",
+        "[[body]] with name, shape and its size",
+    ),
+    f(
+        "body[]",
+        "a [[body]] table",
+        "[[body]] with name, shape and its size",
+    ),
+    f(
+        "body[].name",
+        "the body name, letters, digits, _ and -",
+        "name = \"box\"",
+    ),
+    f(
+        "body[].shape",
+        "the body shape: box, circle (2D) or sphere (3D)",
+        "shape = \"box\"",
+    ),
+    f(
+        "body[].min_m",
+        "the lower corner of a box body in metres",
+        "min_m = [0.4, 0.2]",
+    ),
+    f(
+        "body[].max_m",
+        "the upper corner of a box body in metres",
+        "max_m = [0.6, 0.3]",
+    ),
+    f(
+        "body[].center_m",
+        "the centre of a circle or sphere body in metres",
+        "center_m = [0.5, 0.4]",
+    ),
+    f(
+        "body[].radius_m",
+        "the radius of a circle or sphere body in metres",
+        "radius_m = 0.055",
+    ),
+    f(
+        "body[].density_kg_m3",
+        "the body density in kg/m³",
+        "density_kg_m3 = 500.0",
+    ),
+    f(
+        "body[].mass_kg",
+        "the body mass in kg (per metre of depth in 2D)",
+        "mass_kg = 4.75",
+    ),
+    f(
+        "body[].layers",
+        "the particle layers under the body surface, 1 to 64",
+        "layers = 3",
+    ),
+    f(
+        "body[].wall",
+        "the body's wall treatment (dynamic)",
+        "wall = \"dynamic\"",
+    ),
+    f(
+        "body[].motion",
+        "the [body.motion] table",
+        "[body.motion] with kind = \"free\"",
+    ),
+    f(
+        "motion.kind",
+        "the motion: free (bodies only), sine or series",
+        "kind = \"sine\"",
+    ),
+    f(
+        "motion.velocity_m_s",
+        "the initial velocity of a free body's centre in m/s",
+        "velocity_m_s = [0.0, -2.955]",
+    ),
+    f(
+        "motion.angular_velocity_rad_s",
+        "the initial angular velocity of a free body in rad/s: [w_z] in 2D, [w_x, w_y, w_z] in 3D",
+        "angular_velocity_rad_s = [0.0]",
+    ),
+    f(
+        "motion.pivot_m",
+        "the point the prescribed rotation turns about, in metres",
+        "pivot_m = [0.46, 0.0]",
+    ),
+    f(
+        "motion.axis",
+        "the rotation axis of a prescribed motion (3D only; 2D turns about z)",
+        "axis = [0.0, 1.0, 0.0]",
+    ),
+    f(
+        "motion.translation_m",
+        "the amplitude of the sinusoidal displacement in metres",
+        "translation_m = [0.05, 0.0]",
+    ),
+    f(
+        "motion.rotation_deg",
+        "the amplitude of the sinusoidal rotation in degrees",
+        "rotation_deg = 4.0",
+    ),
+    f(
+        "motion.period_s",
+        "the period of the sinusoidal motion in seconds",
+        "period_s = 3.14159",
+    ),
+    f(
+        "motion.phase_deg",
+        "the phase of the sinusoidal motion in degrees",
+        "phase_deg = 0.0",
+    ),
+    f(
+        "motion.file",
+        "the CSV of the motion time series (t_s, dx_m, dy_m[, dz_m], angle_deg), relative to the case file",
+        "file = \"excitation.csv\"",
+    ),
+    f(
         "probe[].point_m",
         "the sampling point of a pressure probe",
         "point_m = [0.5, 0.05]",
@@ -493,7 +665,8 @@ impl FieldHelp {
         let value = self.example.split_once('=').map_or("", |(_, v)| v.trim());
         match self.path {
             "dimension" | "tank.layers" | "physics.density_filter_every" => "an integer",
-            "fluid_block" | "obstacle" | "probe" => "an array of tables",
+            "fluid_block" | "obstacle" | "probe" | "body" => "an array of tables",
+            "body[].layers" => "an integer",
             _ if self.example.starts_with('[') => "a table",
             _ if value.starts_with('"') => "a string",
             _ if value.starts_with('[') => "an array of numbers",
@@ -521,5 +694,13 @@ pub(super) fn help(path: &str) -> Option<&'static FieldHelp> {
             _ => generic.push(c),
         }
     }
-    FIELDS.iter().find(|h| h.path == generic)
+    // The fields of a motion table are the same under the tank and under every body.
+    let shared = generic
+        .find("motion.")
+        .map_or("", |i| &generic[i..])
+        .to_string();
+    FIELDS
+        .iter()
+        .find(|h| h.path == generic)
+        .or_else(|| FIELDS.iter().find(|h| h.path == shared))
 }

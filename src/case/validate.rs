@@ -26,12 +26,14 @@ pub(super) enum Sound {
     Coef(f64),
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub(super) struct Tank {
     pub inner: Aabb,
     pub layers: u32,
     pub open_top: bool,
     pub wall: Treatment,
+    /// A prescribed motion (the tank and its obstacles move together); `None`: fixed.
+    pub motion: Option<crate::scenario::Motion>,
 }
 
 /// The wall treatment of the tank or of an obstacle (`docs/cases.md`, "Wall treatments").
@@ -92,11 +94,12 @@ pub(super) struct Case {
     pub domain: Option<Aabb>,
     pub walls: WallSettings,
     pub probes: Vec<Probe>,
+    pub bodies: Vec<super::bodies::BodySpec>,
 }
 
 /// Allowed range of a number.
 #[derive(Clone, Copy)]
-enum Bound {
+pub(super) enum Bound {
     /// > 0
     Positive,
     /// [lo, hi]
@@ -105,7 +108,7 @@ enum Bound {
     OpenClosed(f64, f64),
 }
 
-fn number(
+pub(super) fn number(
     ctx: &Ctx<'_>,
     path: &str,
     v: f64,
@@ -173,7 +176,7 @@ pub(super) fn vector(
 }
 
 /// A box from `{path}.min_m` / `{path}.max_m` with min < max on every axis.
-fn aabb(
+pub(super) fn aabb(
     ctx: &Ctx<'_>,
     path: &str,
     min: &[f64],
@@ -215,6 +218,7 @@ pub(super) fn validate(
     ctx: &Ctx<'_>,
     raw: &RawCase,
     default_name: &str,
+    case_dir: &std::path::Path,
 ) -> Result<Case, CaseError> {
     let dim = match raw.dimension {
         2 => 2,
@@ -417,11 +421,34 @@ pub(super) fn validate(
                 ));
             }
             let wall = treatment(ctx, "tank", tk.wall, tk.slip)?;
+            let motion = match &tk.motion {
+                None => None,
+                Some(m) => {
+                    if wall != Treatment::Dynamic {
+                        return Err(ctx.err(
+                            "tank.motion",
+                            None,
+                            "a moving tank needs dynamic boundary particles; moving mirror, \
+                             fixed-ghost and repulsive walls are not implemented yet",
+                            "set tank.wall = \"dynamic\", or remove [tank.motion]",
+                        ));
+                    }
+                    Some(super::bodies::motion(
+                        ctx,
+                        "tank.motion",
+                        m,
+                        dim,
+                        false,
+                        case_dir,
+                    )?)
+                }
+            };
             Some(Tank {
                 inner,
                 layers: layers as u32,
                 open_top: tk.open_top.unwrap_or(true),
                 wall,
+                motion,
             })
         }
     };
@@ -549,6 +576,8 @@ pub(super) fn validate(
         probes.push(probe);
     }
 
+    let bodies = super::bodies::validate(ctx, &raw.body, dim, case_dir)?;
+
     Ok(Case {
         name,
         dim,
@@ -571,6 +600,7 @@ pub(super) fn validate(
         domain,
         walls,
         probes,
+        bodies,
     })
 }
 

@@ -223,6 +223,15 @@ impl OutputDir {
         ProbeWriter::create(&self.dir.join(PROBES_DIR), names_and_columns)
     }
 
+    /// Creates DIR/probes/<name>.csv files with several value columns each (`t_s,<columns>`),
+    /// e.g. the bodies' motion and loads; rows are added with [`ProbeWriter::record_rows`].
+    pub fn table_writer(
+        &self,
+        tables: &[(String, Vec<String>)],
+    ) -> Result<ProbeWriter, OutputError> {
+        ProbeWriter::create_tables(&self.dir.join(PROBES_DIR), tables)
+    }
+
     /// Writes DIR/run.json atomically (pretty-printed; non-finite numbers become `null`).
     pub fn write_run_summary(&self, summary: &RunSummary) -> Result<(), OutputError> {
         run_summary::write_run_summary(&self.dir.join(RUN_SUMMARY_FILE), summary)

@@ -8,6 +8,8 @@ use super::{fmt_f64, write_atomic, OutputError};
 
 struct ProbeFile {
     path: PathBuf,
+    /// Value columns after `t_s`.
+    columns: usize,
     /// Full CSV text (header + every recorded row), kept in memory and rewritten on flush.
     text: String,
 }
@@ -35,9 +37,22 @@ impl ProbeWriter {
         dir: &Path,
         names_and_columns: &[(String, String)],
     ) -> Result<Self, OutputError> {
+        let tables: Vec<(String, Vec<String>)> = names_and_columns
+            .iter()
+            .map(|(n, c)| (n.clone(), vec![c.clone()]))
+            .collect();
+        Self::create_tables(dir, &tables)
+    }
+
+    /// As [`create`](ProbeWriter::create) with several value columns per file
+    /// (`t_s,<c1>,<c2>,...`), filled by [`record_rows`](ProbeWriter::record_rows).
+    pub(crate) fn create_tables(
+        dir: &Path,
+        tables: &[(String, Vec<String>)],
+    ) -> Result<Self, OutputError> {
         let mut seen = HashSet::new();
-        let mut files = Vec::with_capacity(names_and_columns.len());
-        for (name, column) in names_and_columns {
+        let mut files = Vec::with_capacity(tables.len());
+        for (name, columns) in tables {
             let bad = |reason| OutputError::ProbeName {
                 dir: dir.to_path_buf(),
                 name: name.clone(),
@@ -49,7 +64,11 @@ impl ProbeWriter {
             if name.contains(['/', '\\', '\0', '\n', '\r']) {
                 return Err(bad("contains a path separator or control character"));
             }
-            if column.is_empty() || column.contains([',', '"', '\n', '\r']) {
+            if columns.is_empty()
+                || columns
+                    .iter()
+                    .any(|c| c.is_empty() || c.contains([',', '"', '\n', '\r']))
+            {
                 return Err(bad(
                     "its column name is empty or contains ',', '\"' or a line break",
                 ));
@@ -59,7 +78,8 @@ impl ProbeWriter {
             }
             files.push(ProbeFile {
                 path: dir.join(format!("{name}.csv")),
-                text: format!("t_s,{column}\n"),
+                columns: columns.len(),
+                text: format!("t_s,{}\n", columns.join(",")),
             });
         }
         let mut w = ProbeWriter {
@@ -101,9 +121,32 @@ impl ProbeWriter {
                 got: values.len(),
             });
         }
-        for (f, &v) in self.files.iter_mut().zip(values) {
+        let rows: Vec<Vec<f64>> = values.iter().map(|&v| vec![v]).collect();
+        self.record_rows(t_s, &rows)
+    }
+
+    /// Records one row `t,v1,v2,...` per file; `rows[k]` must have file k's column count.
+    pub fn record_rows(&mut self, t_s: f64, rows: &[Vec<f64>]) -> Result<(), OutputError> {
+        let shape_ok = rows.len() == self.files.len()
+            && self
+                .files
+                .iter()
+                .zip(rows)
+                .all(|(f, r)| r.len() == f.columns);
+        if !shape_ok {
+            return Err(OutputError::ProbeCount {
+                dir: self.dir.clone(),
+                expected: self.files.iter().map(|f| f.columns).sum(),
+                got: rows.iter().map(Vec::len).sum(),
+            });
+        }
+        for (f, row) in self.files.iter_mut().zip(rows) {
             // Writing into a String cannot fail.
-            let _ = writeln!(f.text, "{},{}", fmt_f64(t_s), fmt_f64(v));
+            let _ = write!(f.text, "{}", fmt_f64(t_s));
+            for &v in row {
+                let _ = write!(f.text, ",{}", fmt_f64(v));
+            }
+            f.text.push('\n');
         }
         self.rows += 1;
         self.dirty = true;

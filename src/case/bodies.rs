@@ -1,0 +1,687 @@
+//! Moving solids in case files: `[[body]]` tables and `[tank.motion]`. Field checks, the
+//! motion laws (sine, or a CSV time series read relative to the case file), the bodies'
+//! particles and their mass properties (from the shape, not from the particles, so a body can
+//! be a shell of a few particle layers).
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use crate::scenario::{Motion, MotionLaw, Prescribed};
+
+use super::error::CaseError;
+use super::locate::Ctx;
+use super::schema::{MotionName, RawBody, RawMotion, ShapeName, WallName};
+use super::validate::{aabb, number, vector, Aabb, Bound};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Shape {
+    Box(Aabb),
+    /// A circle (2D) or a sphere (3D).
+    Ball {
+        center: [f64; 3],
+        radius: f64,
+    },
+}
+
+#[derive(Debug, Clone)]
+pub(super) struct BodySpec {
+    pub name: String,
+    pub shape: Shape,
+    /// Mass [kg] (per metre in 2D); `None` for prescribed bodies given neither mass nor density.
+    pub mass: Option<f64>,
+    /// Particle layers under the surface; `None`: the whole body.
+    pub layers: Option<u32>,
+    pub motion: Motion,
+}
+
+fn file_safe(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
+pub(super) fn validate(
+    ctx: &Ctx<'_>,
+    raw: &[RawBody],
+    dim: usize,
+    case_dir: &Path,
+) -> Result<Vec<BodySpec>, CaseError> {
+    let mut out: Vec<BodySpec> = Vec::with_capacity(raw.len());
+    for (i, b) in raw.iter().enumerate() {
+        let path = format!("body[{i}]");
+        if !file_safe(&b.name) || b.name == "tank" {
+            return Err(ctx.err(
+                &format!("{path}.name"),
+                Some(format!("{:?}", b.name)),
+                "must be made of letters, digits, `_` and `-` (it becomes the file name \
+                 probes/body_<name>.csv) and must not be \"tank\" (the moving tank's name)",
+                "use a name like \"box\" or \"cylinder\"",
+            ));
+        }
+        if let Some(j) = out.iter().position(|o| o.name == b.name) {
+            return Err(ctx.err(
+                &format!("{path}.name"),
+                Some(format!("{:?}", b.name)),
+                format!("body[{j}] already has this name"),
+                "give every body a different name",
+            ));
+        }
+        if let Some(w) = b.wall.filter(|w| *w != WallName::Dynamic) {
+            return Err(ctx.err(
+                &format!("{path}.wall"),
+                Some(format!("\"{}\"", w.as_str())),
+                "bodies are made of dynamic boundary particles; fixed-ghost, repulsive and \
+                 mirror bodies are not implemented yet",
+                "use wall = \"dynamic\" (or remove the field)",
+            ));
+        }
+        let shape = shape(ctx, &path, b, dim)?;
+        let mass = match (b.density_kg_m3, b.mass_kg) {
+            (Some(_), Some(_)) => {
+                return Err(ctx.err(
+                    &format!("{path}.mass_kg"),
+                    None,
+                    "density_kg_m3 and mass_kg are both given",
+                    "keep only one of them",
+                ))
+            }
+            (Some(d), None) => Some(
+                number(
+                    ctx,
+                    &format!("{path}.density_kg_m3"),
+                    d,
+                    Bound::Positive,
+                    "the body density in kg/m³",
+                    "give a positive density, e.g. 500.0",
+                )? * shape.measure(dim),
+            ),
+            (None, Some(m)) => Some(number(
+                ctx,
+                &format!("{path}.mass_kg"),
+                m,
+                Bound::Positive,
+                "the body mass in kg (per metre of depth in 2D)",
+                "give a positive mass",
+            )?),
+            (None, None) => None,
+        };
+        let layers = match b.layers {
+            None => None,
+            Some(l) if (1..=64).contains(&l) => Some(l as u32),
+            Some(l) => {
+                return Err(ctx.err(
+                    &format!("{path}.layers"),
+                    Some(l.to_string()),
+                    "must be between 1 and 64 (particle layers under the surface)",
+                    "use 3 or more (the kernel support is 2h), or remove it to fill the body",
+                ))
+            }
+        };
+        let motion_path = format!("{path}.motion");
+        let motion = match &b.motion {
+            None => Motion::Free {
+                velocity: [0.0; 3],
+                omega: [0.0; 3],
+            },
+            Some(m) => motion(ctx, &motion_path, m, dim, true, case_dir)?,
+        };
+        if matches!(motion, Motion::Free { .. }) && mass.is_none() {
+            return Err(ctx.err(
+                &path,
+                None,
+                "a free body needs its mass: give density_kg_m3 or mass_kg",
+                "add density_kg_m3 = 500.0 (or mass_kg)",
+            ));
+        }
+        out.push(BodySpec {
+            name: b.name.clone(),
+            shape,
+            mass,
+            layers,
+            motion,
+        });
+    }
+    Ok(out)
+}
+
+fn shape(ctx: &Ctx<'_>, path: &str, b: &RawBody, dim: usize) -> Result<Shape, CaseError> {
+    let (name, needs): (&str, &[&str]) = match b.shape {
+        ShapeName::Box => ("box", &["min_m", "max_m"]),
+        ShapeName::Circle => ("circle", &["center_m", "radius_m"]),
+        ShapeName::Sphere => ("sphere", &["center_m", "radius_m"]),
+    };
+    let given = [
+        ("min_m", b.min_m.is_some()),
+        ("max_m", b.max_m.is_some()),
+        ("center_m", b.center_m.is_some()),
+        ("radius_m", b.radius_m.is_some()),
+    ];
+    for (field, present) in given {
+        if present != needs.contains(&field) {
+            return Err(ctx.err(
+                &format!("{path}.{field}"),
+                None,
+                if present {
+                    format!("is not used by a {name} body")
+                } else {
+                    format!("is required for a {name} body")
+                },
+                format!("a {name} body takes {}", needs.join(" and ")),
+            ));
+        }
+    }
+    match (b.shape, dim) {
+        (ShapeName::Circle, 3) | (ShapeName::Sphere, 2) => {
+            return Err(ctx.err(
+                &format!("{path}.shape"),
+                Some(format!("\"{name}\"")),
+                format!("is not a {dim}D shape"),
+                if dim == 2 {
+                    "use shape = \"circle\" (or \"box\") in 2D"
+                } else {
+                    "use shape = \"sphere\" (or \"box\") in 3D"
+                },
+            ))
+        }
+        _ => {}
+    }
+    Ok(match (&b.min_m, &b.max_m, &b.center_m, b.radius_m) {
+        (Some(lo), Some(hi), _, _) => Shape::Box(aabb(ctx, path, lo, hi, dim, "the body")?),
+        (_, _, Some(c), Some(r)) => Shape::Ball {
+            center: vector(
+                ctx,
+                &format!("{path}.center_m"),
+                c,
+                dim,
+                "the centre in metres",
+            )?,
+            radius: number(
+                ctx,
+                &format!("{path}.radius_m"),
+                r,
+                Bound::Positive,
+                "the radius in metres",
+                "give a positive radius",
+            )?,
+        },
+        _ => unreachable!("fields checked above"),
+    })
+}
+
+/// A `[... .motion]` table; `allow_free` for bodies (the tank can only be prescribed).
+pub(super) fn motion(
+    ctx: &Ctx<'_>,
+    path: &str,
+    m: &RawMotion,
+    dim: usize,
+    allow_free: bool,
+    case_dir: &Path,
+) -> Result<Motion, CaseError> {
+    let needs: &[&str] = match m.kind {
+        MotionName::Free => &["velocity_m_s", "angular_velocity_rad_s"],
+        MotionName::Sine => &[
+            "pivot_m",
+            "axis",
+            "translation_m",
+            "rotation_deg",
+            "period_s",
+            "phase_deg",
+        ],
+        MotionName::Series => &["pivot_m", "axis", "file"],
+    };
+    let kind = match m.kind {
+        MotionName::Free => "free",
+        MotionName::Sine => "sine",
+        MotionName::Series => "series",
+    };
+    let given = [
+        ("velocity_m_s", m.velocity_m_s.is_some()),
+        ("angular_velocity_rad_s", m.angular_velocity_rad_s.is_some()),
+        ("pivot_m", m.pivot_m.is_some()),
+        ("axis", m.axis.is_some()),
+        ("translation_m", m.translation_m.is_some()),
+        ("rotation_deg", m.rotation_deg.is_some()),
+        ("period_s", m.period_s.is_some()),
+        ("phase_deg", m.phase_deg.is_some()),
+        ("file", m.file.is_some()),
+    ];
+    for (field, present) in given {
+        if present && !needs.contains(&field) {
+            return Err(ctx.err(
+                &format!("{path}.{field}"),
+                None,
+                format!("is not used by a {kind} motion"),
+                format!("a {kind} motion takes {}", needs.join(", ")),
+            ));
+        }
+    }
+    if m.kind == MotionName::Free {
+        if !allow_free {
+            return Err(ctx.err(
+                &format!("{path}.kind"),
+                Some("\"free\"".into()),
+                "the tank cannot move freely",
+                "use kind = \"sine\" or \"series\"",
+            ));
+        }
+        let velocity = match &m.velocity_m_s {
+            Some(v) => vector(
+                ctx,
+                &format!("{path}.velocity_m_s"),
+                v,
+                dim,
+                "the initial velocity in m/s",
+            )?,
+            None => [0.0; 3],
+        };
+        let omega = match &m.angular_velocity_rad_s {
+            None => [0.0; 3],
+            Some(w) if dim == 2 && w.len() == 1 && w[0].is_finite() => [0.0, 0.0, w[0]],
+            Some(w) if dim == 3 => vector(
+                ctx,
+                &format!("{path}.angular_velocity_rad_s"),
+                w,
+                3,
+                "the initial angular velocity in rad/s",
+            )?,
+            Some(w) => {
+                return Err(ctx.err(
+                    &format!("{path}.angular_velocity_rad_s"),
+                    Some(format!("{w:?}")),
+                    "in 2D is one finite number in a list, the rate about z",
+                    "write angular_velocity_rad_s = [0.0]",
+                ))
+            }
+        };
+        return Ok(Motion::Free { velocity, omega });
+    }
+    let pivot = match &m.pivot_m {
+        Some(p) => vector(
+            ctx,
+            &format!("{path}.pivot_m"),
+            p,
+            dim,
+            "the rotation pivot in metres",
+        )?,
+        None => [0.0; 3],
+    };
+    let axis = match &m.axis {
+        Some(_) if dim == 2 => {
+            return Err(ctx.err(
+                &format!("{path}.axis"),
+                None,
+                "is only used in 3D (2D motions turn about z)",
+                "remove axis",
+            ))
+        }
+        None => [0.0, 0.0, 1.0],
+        Some(a) => {
+            let a = vector(ctx, &format!("{path}.axis"), a, 3, "the rotation axis")?;
+            let len = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+            if len == 0.0 {
+                return Err(ctx.err(
+                    &format!("{path}.axis"),
+                    None,
+                    "is the zero vector",
+                    "give the rotation axis, e.g. [0.0, 1.0, 0.0]",
+                ));
+            }
+            a.map(|c| c / len)
+        }
+    };
+    let law = if m.kind == MotionName::Sine {
+        let Some(period) = m.period_s else {
+            return Err(ctx.err(
+                &format!("{path}.period_s"),
+                None,
+                "is required for a sine motion",
+                "add period_s = 3.14159 (for example)",
+            ));
+        };
+        let period = number(
+            ctx,
+            &format!("{path}.period_s"),
+            period,
+            Bound::Positive,
+            "the period in seconds",
+            "give a positive period",
+        )?;
+        let translation = match &m.translation_m {
+            Some(t) => vector(
+                ctx,
+                &format!("{path}.translation_m"),
+                t,
+                dim,
+                "the displacement amplitude in metres",
+            )?,
+            None => [0.0; 3],
+        };
+        let angle = number(
+            ctx,
+            &format!("{path}.rotation_deg"),
+            m.rotation_deg.unwrap_or(0.0),
+            Bound::Closed(-180.0, 180.0),
+            "the rotation amplitude in degrees",
+            "give an amplitude between -180 and 180 degrees",
+        )?;
+        let phase = number(
+            ctx,
+            &format!("{path}.phase_deg"),
+            m.phase_deg.unwrap_or(0.0),
+            Bound::Closed(-360.0, 360.0),
+            "the phase in degrees",
+            "give a phase between -360 and 360 degrees",
+        )?;
+        MotionLaw::Sine {
+            translation,
+            angle: angle.to_radians(),
+            omega: 2.0 * PI / period,
+            phase: phase.to_radians(),
+        }
+    } else {
+        let Some(file) = &m.file else {
+            return Err(ctx.err(
+                &format!("{path}.file"),
+                None,
+                "is required for a series motion",
+                "add file = \"excitation.csv\" (t_s, dx_m, dy_m[, dz_m], angle_deg)",
+            ));
+        };
+        series(ctx, &format!("{path}.file"), file, dim, case_dir)?
+    };
+    Ok(Motion::Prescribed(Prescribed { pivot, axis, law }))
+}
+
+/// A motion time series: a CSV with `#` comments, an optional header line, and rows
+/// `t_s, dx_m, dy_m[, dz_m], angle_deg` (t strictly increasing).
+fn series(
+    ctx: &Ctx<'_>,
+    path: &str,
+    file: &str,
+    dim: usize,
+    case_dir: &Path,
+) -> Result<MotionLaw, CaseError> {
+    let full = case_dir.join(file);
+    let text = std::fs::read_to_string(&full).map_err(|e| {
+        ctx.err(
+            path,
+            Some(format!("{file:?}")),
+            format!("cannot read {}: {e}", full.display()),
+            "give the path of the CSV relative to the case file",
+        )
+    })?;
+    let columns = dim + 2;
+    let (mut t, mut translation, mut angle) = (Vec::new(), Vec::new(), Vec::new());
+    for (n, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
+        let bad = |problem: String| {
+            ctx.err(
+                path,
+                Some(format!("{file:?}")),
+                format!("{} line {}: {problem}", full.display(), n + 1),
+                format!(
+                    "write rows of {columns} numbers: t_s, dx_m, dy_m{}, angle_deg, with t increasing",
+                    if dim == 3 { ", dz_m" } else { "" }
+                ),
+            )
+        };
+        let values = match values {
+            Ok(v) => v,
+            // A header line (before any data) is skipped.
+            Err(_) if t.is_empty() => continue,
+            Err(_) => return Err(bad(format!("{line:?} is not {columns} numbers"))),
+        };
+        if values.len() != columns || values.iter().any(|v| !v.is_finite()) {
+            return Err(bad(format!("{line:?} is not {columns} finite numbers")));
+        }
+        if t.last().is_some_and(|&last| values[0] <= last) {
+            return Err(bad(format!("t = {} does not increase", values[0])));
+        }
+        t.push(values[0]);
+        let mut d = [0.0; 3];
+        d[..dim].copy_from_slice(&values[1..=dim]);
+        translation.push(d);
+        angle.push(values[dim + 1].to_radians());
+    }
+    if t.is_empty() {
+        return Err(ctx.err(
+            path,
+            Some(format!("{file:?}")),
+            format!("{} has no data rows", full.display()),
+            "add rows t_s, dx_m, dy_m[, dz_m], angle_deg",
+        ));
+    }
+    Ok(MotionLaw::Series {
+        t,
+        translation,
+        angle,
+    })
+}
+
+impl Shape {
+    /// Area (2D) or volume (3D).
+    pub(super) fn measure(&self, dim: usize) -> f64 {
+        match *self {
+            Shape::Box(b) => (0..dim).map(|a| b.max[a] - b.min[a]).product(),
+            Shape::Ball { radius, .. } if dim == 2 => PI * radius * radius,
+            Shape::Ball { radius, .. } => 4.0 / 3.0 * PI * radius.powi(3),
+        }
+    }
+
+    pub(super) fn center(&self) -> [f64; 3] {
+        match *self {
+            Shape::Box(b) => [0, 1, 2].map(|a| 0.5 * (b.min[a] + b.max[a])),
+            Shape::Ball { center, .. } => center,
+        }
+    }
+
+    /// Inertia tensor about the centre of a uniform body of `mass`.
+    pub(super) fn inertia(&self, dim: usize, mass: f64) -> [[f64; 3]; 3] {
+        let diag = match *self {
+            Shape::Box(b) => {
+                let s = [0, 1, 2].map(|a| if a < dim { b.max[a] - b.min[a] } else { 0.0 });
+                let sq = s.map(|x| x * x);
+                [
+                    mass * (sq[1] + sq[2]) / 12.0,
+                    mass * (sq[0] + sq[2]) / 12.0,
+                    mass * (sq[0] + sq[1]) / 12.0,
+                ]
+            }
+            Shape::Ball { radius, .. } if dim == 2 => {
+                let r2 = radius * radius;
+                [mass * r2 / 4.0, mass * r2 / 4.0, mass * r2 / 2.0]
+            }
+            Shape::Ball { radius, .. } => [0.4 * mass * radius * radius; 3],
+        };
+        [
+            [diag[0], 0.0, 0.0],
+            [0.0, diag[1], 0.0],
+            [0.0, 0.0, diag[2]],
+        ]
+    }
+
+    /// Distance from `p` to the shape's surface, negative inside.
+    pub(super) fn signed_distance(&self, p: [f64; 3], dim: usize) -> f64 {
+        match *self {
+            Shape::Box(b) => {
+                let d: Vec<f64> = (0..dim)
+                    .map(|a| (b.min[a] - p[a]).max(p[a] - b.max[a]))
+                    .collect();
+                let outside = d.iter().map(|x| x.max(0.0).powi(2)).sum::<f64>().sqrt();
+                let inside = d.iter().cloned().fold(f64::MIN, f64::max).min(0.0);
+                outside + inside
+            }
+            Shape::Ball { center, radius } => {
+                (0..dim)
+                    .map(|a| (p[a] - center[a]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+                    - radius
+            }
+        }
+    }
+
+    /// The body's particles at spacing `dx`: a box on its own cell-centred lattice, a circle
+    /// as concentric rings (a smooth surface), a sphere on a lattice through its centre; only
+    /// the outer `layers` when given.
+    pub(super) fn points(&self, dx: f64, dim: usize, layers: Option<u32>) -> Vec<[f64; 3]> {
+        let depth = layers.map_or(f64::MAX, |l| l as f64 * dx);
+        let mut out = Vec::new();
+        match *self {
+            Shape::Box(b) => {
+                let n = [0, 1, 2].map(|a| {
+                    if a < dim {
+                        ((b.max[a] - b.min[a]) / dx).round().max(1.0) as i64
+                    } else {
+                        1
+                    }
+                });
+                let step = [0, 1, 2].map(|a| {
+                    if a < dim {
+                        (b.max[a] - b.min[a]) / n[a] as f64
+                    } else {
+                        0.0
+                    }
+                });
+                for i in 0..n[0] {
+                    for j in 0..n[1] {
+                        for k in 0..n[2] {
+                            let idx = [i, j, k];
+                            let p = [0, 1, 2].map(|a| {
+                                if a < dim {
+                                    b.min[a] + (idx[a] as f64 + 0.5) * step[a]
+                                } else {
+                                    0.0
+                                }
+                            });
+                            if -self.signed_distance(p, dim) < depth {
+                                out.push(p);
+                            }
+                        }
+                    }
+                }
+            }
+            Shape::Ball { center, radius } if dim == 2 => {
+                let mut r = radius - 0.5 * dx;
+                let mut ring = 0;
+                while r > 0.25 * dx && radius - r < depth {
+                    let n = ((2.0 * PI * r / dx).round() as usize).max(3);
+                    let shift = if ring % 2 == 0 { 0.0 } else { 0.5 };
+                    for j in 0..n {
+                        let a = 2.0 * PI * (j as f64 + shift) / n as f64;
+                        out.push([center[0] + r * a.cos(), center[1] + r * a.sin(), 0.0]);
+                    }
+                    r -= dx;
+                    ring += 1;
+                }
+                if r > -0.75 * dx && radius - r < depth + dx {
+                    out.push(center);
+                }
+            }
+            Shape::Ball { center, radius } => {
+                let n = (radius / dx).ceil() as i64;
+                for i in -n..=n {
+                    for j in -n..=n {
+                        for k in -n..=n {
+                            let p = [
+                                center[0] + i as f64 * dx,
+                                center[1] + j as f64 * dx,
+                                center[2] + k as f64 * dx,
+                            ];
+                            let d = -self.signed_distance(p, dim);
+                            if d >= 0.5 * dx - 1e-9 * dx && d < depth + 0.5 * dx {
+                                out.push(p);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shell_and_filled_boxes() {
+        let b = Shape::Box(Aabb {
+            min: [0.0, 0.0, 0.0],
+            max: [0.1, 0.06, 0.0],
+        });
+        assert_eq!(b.points(0.01, 2, None).len(), 60);
+        // Two layers: everything but the inner 6 x 2.
+        assert_eq!(b.points(0.01, 2, Some(2)).len(), 60 - 12);
+        assert!((b.measure(2) - 0.006).abs() < 1e-15);
+        assert!((b.signed_distance([0.05, 0.03, 0.0], 2) + 0.03).abs() < 1e-15);
+        assert!((b.signed_distance([0.13, 0.1, 0.0], 2) - 0.05).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_circle_of_rings_fills_its_area() {
+        let c = Shape::Ball {
+            center: [0.3, 0.4, 0.0],
+            radius: 0.055,
+        };
+        let dx = 0.005;
+        let pts = c.points(dx, 2, None);
+        let area = pts.len() as f64 * dx * dx;
+        assert!(
+            (area / c.measure(2) - 1.0).abs() < 0.05,
+            "{} particles",
+            pts.len()
+        );
+        // Outer ring half a spacing inside the surface.
+        let outer = pts
+            .iter()
+            .map(|p| c.signed_distance(*p, 2))
+            .fold(f64::MIN, f64::max);
+        assert!((outer + 0.5 * dx).abs() < 1e-12);
+        // Mean is the centre.
+        let mean = [0, 1].map(|a| pts.iter().map(|p| p[a]).sum::<f64>() / pts.len() as f64);
+        assert!((mean[0] - 0.3).abs() < 1e-3 * dx && (mean[1] - 0.4).abs() < 1e-3 * dx);
+    }
+
+    #[test]
+    fn a_sphere_fills_its_volume() {
+        let s = Shape::Ball {
+            center: [0.0; 3],
+            radius: 0.1,
+        };
+        let dx = 0.01;
+        let n = s.points(dx, 3, None).len() as f64;
+        // Centres fill the ball of radius R − dx/2 (the surface stays dx/2 beyond them).
+        let inner = Shape::Ball {
+            center: [0.0; 3],
+            radius: 0.1 - 0.5 * dx,
+        };
+        assert!(
+            (n * dx.powi(3) / inner.measure(3) - 1.0).abs() < 0.05,
+            "{n}"
+        );
+        assert!(s.points(dx, 3, Some(2)).len() < n as usize);
+    }
+
+    #[test]
+    fn inertia_of_a_square_and_a_disc() {
+        let b = Shape::Box(Aabb {
+            min: [0.0; 3],
+            max: [0.2, 0.1, 0.0],
+        });
+        let i = b.inertia(2, 3.0);
+        assert!((i[2][2] - 3.0 * (0.04 + 0.01) / 12.0).abs() < 1e-15);
+        let d = Shape::Ball {
+            center: [0.0; 3],
+            radius: 0.5,
+        };
+        assert!((d.inertia(2, 2.0)[2][2] - 0.25).abs() < 1e-15);
+    }
+}
