@@ -1,4 +1,4 @@
-//! The `wgsph` command: run a case, list adapters, benchmark.
+//! The `wgsph` command: run a case, plot a run, list adapters, benchmark.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -9,6 +9,8 @@ use clap::{Parser, Subcommand};
 
 use wgsph::gpu::context::list_adapters;
 use wgsph::gpu::{AdapterChoice, GpuContext};
+use wgsph::plot::snapshot::SnapshotField;
+use wgsph::run::RunOptions;
 
 #[derive(Parser)]
 #[command(
@@ -36,6 +38,13 @@ enum Command {
         /// Override a case field, e.g. --set particles.dx_m=0.005 (repeatable).
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         set: Vec<String>,
+        /// Also draw every particle output as DIR/snapshots/NNNNNN.png (3D: the x-z slice
+        /// through the middle of the domain).
+        #[arg(long)]
+        snapshots: bool,
+        /// Colour of the fluid in the snapshots (default: pressure).
+        #[arg(long, value_name = "pressure|speed", requires = "snapshots")]
+        snapshot_field: Option<SnapshotField>,
     },
     /// Plot every probe time series of a finished run as PNG (DIR/plots/<probe>.png).
     Plot {
@@ -96,11 +105,21 @@ fn context(choice: Option<AdapterChoice>) -> Result<GpuContext> {
 
 fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Run { case, out, set } => {
+        Command::Run {
+            case,
+            out,
+            set,
+            snapshots,
+            snapshot_field,
+        } => {
             let sc = wgsph::case::load(&case, &set)?;
             let ctx = context(cli.adapter)?;
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
-            let report = wgsph::run::run(&ctx, &sc, &dir, &mut |line| println!("{line}"))?;
+            let options = RunOptions {
+                snapshot_png: snapshots.then(|| snapshot_field.unwrap_or_default()),
+            };
+            let report =
+                wgsph::run::run(&ctx, &sc, &dir, &options, &mut |line| println!("{line}"))?;
             let s = &report.summary;
             println!(
                 "{}: {} steps to t = {:.4} s in {:.1} s wall ({:.3e} particle-steps/s); outputs in {}",

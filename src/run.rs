@@ -1,5 +1,6 @@
-//! Running a scenario to its end with outputs: particle snapshots at every output time, probe
-//! samples at every probe time, run.json at the end (also when the run stops early).
+//! Running a scenario to its end with outputs: particle snapshots (VTU, and PNG when asked for)
+//! at every output time, probe samples at every probe time, run.json at the end (also when the
+//! run stops early).
 
 use std::path::Path;
 use std::time::Instant;
@@ -7,7 +8,8 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 
 use crate::gpu::GpuContext;
-use crate::output::{OutputDir, RunSummary, Snapshot};
+use crate::output::{OutputDir, RunSummary, Snapshot, SNAPSHOTS_DIR};
+use crate::plot::snapshot::{SnapshotField, SnapshotView};
 use crate::scenario::{Kind, ProbeKind, Scenario};
 use crate::sph::Solver;
 
@@ -20,6 +22,13 @@ pub fn probe_column(kind: &ProbeKind) -> &'static str {
     }
 }
 
+/// Optional outputs of a run.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Also draw every particle snapshot as DIR/snapshots/NNNNNN.png, coloured by this field.
+    pub snapshot_png: Option<SnapshotField>,
+}
+
 /// What a finished (or stopped) run reports.
 pub struct RunReport {
     pub summary: RunSummary,
@@ -27,22 +36,42 @@ pub struct RunReport {
     pub stopped: Option<anyhow::Error>,
 }
 
-pub fn write_snapshot(out: &mut OutputDir, solver: &Solver) -> Result<()> {
-    let p = solver.read_particles()?;
-    out.write_snapshot(&Snapshot {
-        time_s: solver.time(),
-        pos: &p.pos,
-        vel: &p.vel,
-        rho: &p.rho,
-        pressure: &p.pressure,
-        kind: &p.kind,
-        id: &p.id,
-        extra: &match &p.energy {
+/// Particle outputs at an output time: the VTU snapshot and, when asked for, its PNG (drawn
+/// from the same read-back).
+struct ParticleOutputs {
+    out: OutputDir,
+    png: Option<SnapshotView>,
+}
+
+impl ParticleOutputs {
+    fn write(&mut self, solver: &Solver) -> Result<()> {
+        let p = solver.read_particles()?;
+        let extra = match &p.energy {
             Some(e) => vec![("energy", e.as_slice())],
             None => vec![],
-        },
-    })?;
-    Ok(())
+        };
+        let snap = Snapshot {
+            time_s: solver.time(),
+            pos: &p.pos,
+            vel: &p.vel,
+            rho: &p.rho,
+            pressure: &p.pressure,
+            kind: &p.kind,
+            id: &p.id,
+            extra: &extra,
+        };
+        let index = self.out.snapshot_count();
+        self.out.write_snapshot(&snap)?;
+        if let Some(view) = &self.png {
+            let path = self
+                .out
+                .path()
+                .join(SNAPSHOTS_DIR)
+                .join(format!("{index:06}.png"));
+            view.write_png(&path, &snap)?;
+        }
+        Ok(())
+    }
 }
 
 /// Sample times of a series with interval `every` up to `end` (inclusive, `end` always last).
@@ -56,15 +85,26 @@ pub fn run(
     ctx: &GpuContext,
     sc: &Scenario,
     dir: &Path,
+    options: &RunOptions,
     log: &mut dyn FnMut(&str),
 ) -> Result<RunReport> {
-    let mut out = OutputDir::create(dir)?;
+    let out = OutputDir::create(dir)?;
+    let png = match options.snapshot_png {
+        Some(field) => {
+            let pngs = dir.join(SNAPSHOTS_DIR);
+            std::fs::create_dir_all(&pngs)
+                .with_context(|| format!("cannot create {}", pngs.display()))?;
+            Some(SnapshotView::for_scenario(sc, field)?)
+        }
+        None => None,
+    };
     let names: Vec<(String, String)> = sc
         .probes
         .iter()
         .map(|p| (p.name.clone(), probe_column(&p.kind).to_string()))
         .collect();
     let mut probes = out.probe_writer(&names)?;
+    let mut outputs = ParticleOutputs { out, png };
     let mut solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
     log(&format!(
         "{}: {} particles ({} fluid, {} wall) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
@@ -76,7 +116,7 @@ pub fn run(
         solver.gpu_bytes() as f64 / sc.particles.len() as f64,
         solver.dt()
     ));
-    write_snapshot(&mut out, &solver)?;
+    outputs.write(&solver)?;
     if !sc.probes.is_empty() {
         probes.record(0.0, &solver.sample_probes()?)?;
     }
@@ -97,7 +137,7 @@ pub fn run(
             probes.record(solver.time(), &solver.sample_probes()?)?;
         }
         if solver.time() >= next_output - 1e-9 * every_out {
-            write_snapshot(&mut out, &solver)?;
+            outputs.write(&solver)?;
             probes.flush()?;
             let wall = started.elapsed().as_secs_f64();
             log(&format!(
@@ -127,13 +167,13 @@ pub fn run(
         wall_time_s: wall,
         particle_steps_per_s: solver.steps() as f64 * n / wall.max(1e-9),
         gpu_bytes_per_particle: solver.gpu_bytes() as f64 / n,
-        outputs: out.snapshot_count() as u64,
+        outputs: outputs.out.snapshot_count() as u64,
         status: match &stopped {
             None => "completed".into(),
             Some(e) => format!("stopped: {e:#}"),
         },
     };
-    out.write_run_summary(&summary)?;
+    outputs.out.write_run_summary(&summary)?;
     Ok(RunReport { summary, stopped })
 }
 
