@@ -3,8 +3,10 @@
 pub mod case;
 pub mod gpu;
 pub mod layout;
+pub mod logging;
 pub mod output;
 pub mod plot;
+pub mod progress;
 pub mod reference;
 pub mod run;
 pub mod scenario;

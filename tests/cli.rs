@@ -63,8 +63,8 @@ fn run_writes_snapshots_probes_and_summary() {
 }
 
 /// Runs `wgsph run cases/hydrostatic_2d.toml` to t = 0.04 s with outputs every 0.02 s, output
-/// captured; returns (output, out dir).
-fn run_hydrostatic(name: &str, args: &[&str]) -> (std::process::Output, PathBuf) {
+/// captured (so off a terminal), RUST_LOG set to `rust_log`; returns (output, out dir).
+fn run_hydrostatic(name: &str, rust_log: &str, args: &[&str]) -> (std::process::Output, PathBuf) {
     let out = temp_dir(name);
     let o = wgsph()
         .args(["run", "cases/hydrostatic_2d.toml"])
@@ -77,6 +77,7 @@ fn run_hydrostatic(name: &str, args: &[&str]) -> (std::process::Output, PathBuf)
         .arg("--out")
         .arg(&out)
         .args(args)
+        .env("RUST_LOG", rust_log)
         .output()
         .unwrap();
     assert!(
@@ -89,9 +90,20 @@ fn run_hydrostatic(name: &str, args: &[&str]) -> (std::process::Output, PathBuf)
 }
 
 #[test]
-fn snapshots_are_pngs_one_per_output() {
-    let (o, out) = run_hydrostatic("pngs", &["--snapshots"]);
-    assert!(String::from_utf8_lossy(&o.stdout).contains("completed: "));
+fn snapshots_are_pngs_and_log_lines_go_to_stderr_off_a_terminal() {
+    let (o, out) = run_hydrostatic("pngs", "wgsph=debug", &["--snapshots"]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    // The set-up line, the first progress line (later ones come every 10 s of wall time) and,
+    // with RUST_LOG=wgsph=debug, one line per output.
+    for line in [
+        "INFO ] hydrostatic_2d: 1598 particles",
+        "INFO ] t = 0.0100/0.04 s (25 %)",
+        "particle-steps/s",
+        "DEBUG] output 2 at t = 0.0400 s",
+    ] {
+        assert!(stderr.contains(line), "{line:?} not in stderr:\n{stderr}");
+    }
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("completed: "));
     // One PNG per VTU, all the same size, and nothing else (no temporary file).
     let mut names: Vec<String> = std::fs::read_dir(out.join("snapshots"))
         .unwrap()
@@ -114,6 +126,25 @@ fn snapshots_are_pngs_one_per_output() {
     assert!(sizes[0].0 > 400 && sizes[0].1 > 400, "{sizes:?}");
     assert!(sizes.iter().all(|s| *s == sizes[0]), "{sizes:?}");
     assert!(out.join("particles/particles_000002.vtu").is_file());
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn quiet_prints_nothing_but_errors() {
+    // --quiet wins over RUST_LOG.
+    let (o, out) = run_hydrostatic("quiet", "debug", &["--quiet"]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    for word in ["INFO", "DEBUG", "WARN", "t = "] {
+        assert!(!stderr.contains(word), "{word:?} in stderr:\n{stderr}");
+    }
+    let summary = std::fs::read_to_string(out.join("run.json")).unwrap();
+    assert!(summary.contains("\"completed\""));
+    assert!(!out.join("snapshots").exists());
     std::fs::remove_dir_all(&out).unwrap();
 }
 
