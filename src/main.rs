@@ -1,14 +1,19 @@
-//! The `wgsph` command: run a case, list adapters, benchmark.
+//! The `wgsph` command: run a case, plot a run, list adapters, benchmark.
 
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
+use indicatif::MultiProgress;
 
 use wgsph::gpu::context::list_adapters;
 use wgsph::gpu::{AdapterChoice, GpuContext};
+use wgsph::plot::snapshot::SnapshotField;
+use wgsph::progress::{LogLines, Progress, ProgressBarView};
+use wgsph::run::RunOptions;
 
 #[derive(Parser)]
 #[command(
@@ -26,7 +31,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a case file and write outputs (VTU series, probe CSVs, run.json).
+    /// Run a case file and write outputs (VTU series, probe CSVs, run.json), showing progress
+    /// (a bar on a terminal, else a log line about every 10 s on stderr).
     Run {
         /// The case file (TOML), e.g. cases/dam_break_2d.toml.
         case: PathBuf,
@@ -36,6 +42,17 @@ enum Command {
         /// Override a case field, e.g. --set particles.dx_m=0.005 (repeatable).
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         set: Vec<String>,
+        /// Also draw every particle output as DIR/snapshots/NNNNNN.png (3D: the x-z slice
+        /// through the middle of the domain).
+        #[arg(long)]
+        snapshots: bool,
+        /// Colour of the fluid in the snapshots (default: pressure).
+        #[arg(long, value_name = "pressure|speed", requires = "snapshots")]
+        snapshot_field: Option<SnapshotField>,
+        /// Print only errors: no progress, no summary line. Otherwise RUST_LOG sets the log
+        /// levels (default: warn,wgsph=info).
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Plot every probe time series of a finished run as PNG (DIR/plots/<probe>.png).
     Plot {
@@ -81,7 +98,11 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match run(cli) {
+    let quiet = matches!(cli.command, Command::Run { quiet: true, .. });
+    let bars = MultiProgress::new();
+    // Fails only if a logger is already set, which nothing else in the process does.
+    let _ = wgsph::logging::init(quiet, bars.clone());
+    match run(cli, &bars) {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
@@ -94,13 +115,40 @@ fn context(choice: Option<AdapterChoice>) -> Result<GpuContext> {
     GpuContext::new(AdapterChoice::resolve(choice)?)
 }
 
-fn run(cli: Cli) -> Result<ExitCode> {
+/// A bar when stderr is a terminal (and not `--quiet`), else plain log lines.
+fn progress(quiet: bool, bars: &MultiProgress) -> Box<dyn Progress> {
+    if !quiet && std::io::stderr().is_terminal() {
+        Box::new(ProgressBarView::new(bars))
+    } else {
+        Box::new(LogLines::default())
+    }
+}
+
+fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
     match cli.command {
-        Command::Run { case, out, set } => {
+        Command::Run {
+            case,
+            out,
+            set,
+            snapshots,
+            snapshot_field,
+            quiet,
+        } => {
             let sc = wgsph::case::load(&case, &set)?;
             let ctx = context(cli.adapter)?;
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
-            let report = wgsph::run::run(&ctx, &sc, &dir, &mut |line| println!("{line}"))?;
+            let options = RunOptions {
+                snapshot_png: snapshots.then(|| snapshot_field.unwrap_or_default()),
+            };
+            let report = wgsph::run::run(&ctx, &sc, &dir, &options, &mut *progress(quiet, bars))?;
+            let code = if report.stopped.is_some() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::SUCCESS
+            };
+            if quiet {
+                return Ok(code);
+            }
             let s = &report.summary;
             println!(
                 "{}: {} steps to t = {:.4} s in {:.1} s wall ({:.3e} particle-steps/s); outputs in {}",
@@ -111,11 +159,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 s.particle_steps_per_s,
                 dir.display()
             );
-            Ok(if report.stopped.is_some() {
-                ExitCode::from(2)
-            } else {
-                ExitCode::SUCCESS
-            })
+            Ok(code)
         }
         Command::Plot {
             dir,

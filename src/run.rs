@@ -1,5 +1,6 @@
-//! Running a scenario to its end with outputs: particle snapshots at every output time, probe
-//! samples at every probe time, run.json at the end (also when the run stops early).
+//! Running a scenario to its end with outputs: particle snapshots (VTU, and PNG when asked for)
+//! at every output time, probe samples at every probe time, run.json at the end (also when the
+//! run stops early). Progress is reported once per probe interval to a [`Progress`].
 
 use std::path::Path;
 use std::time::Instant;
@@ -7,7 +8,9 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 
 use crate::gpu::GpuContext;
-use crate::output::{OutputDir, RunSummary, Snapshot};
+use crate::output::{OutputDir, RunSummary, Snapshot, SNAPSHOTS_DIR};
+use crate::plot::snapshot::{SnapshotField, SnapshotView};
+use crate::progress::{Progress, RunStatus};
 use crate::scenario::{Kind, ProbeKind, Scenario};
 use crate::sph::Solver;
 
@@ -20,6 +23,13 @@ pub fn probe_column(kind: &ProbeKind) -> &'static str {
     }
 }
 
+/// Optional outputs of a run.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Also draw every particle snapshot as DIR/snapshots/NNNNNN.png, coloured by this field.
+    pub snapshot_png: Option<SnapshotField>,
+}
+
 /// What a finished (or stopped) run reports.
 pub struct RunReport {
     pub summary: RunSummary,
@@ -27,22 +37,42 @@ pub struct RunReport {
     pub stopped: Option<anyhow::Error>,
 }
 
-pub fn write_snapshot(out: &mut OutputDir, solver: &Solver) -> Result<()> {
-    let p = solver.read_particles()?;
-    out.write_snapshot(&Snapshot {
-        time_s: solver.time(),
-        pos: &p.pos,
-        vel: &p.vel,
-        rho: &p.rho,
-        pressure: &p.pressure,
-        kind: &p.kind,
-        id: &p.id,
-        extra: &match &p.energy {
+/// Particle outputs at an output time: the VTU snapshot and, when asked for, its PNG (drawn
+/// from the same read-back).
+struct ParticleOutputs {
+    out: OutputDir,
+    png: Option<SnapshotView>,
+}
+
+impl ParticleOutputs {
+    fn write(&mut self, solver: &Solver) -> Result<()> {
+        let p = solver.read_particles()?;
+        let extra = match &p.energy {
             Some(e) => vec![("energy", e.as_slice())],
             None => vec![],
-        },
-    })?;
-    Ok(())
+        };
+        let snap = Snapshot {
+            time_s: solver.time(),
+            pos: &p.pos,
+            vel: &p.vel,
+            rho: &p.rho,
+            pressure: &p.pressure,
+            kind: &p.kind,
+            id: &p.id,
+            extra: &extra,
+        };
+        let index = self.out.snapshot_count();
+        self.out.write_snapshot(&snap)?;
+        if let Some(view) = &self.png {
+            let path = self
+                .out
+                .path()
+                .join(SNAPSHOTS_DIR)
+                .join(format!("{index:06}.png"));
+            view.write_png(&path, &snap)?;
+        }
+        Ok(())
+    }
 }
 
 /// Sample times of a series with interval `every` up to `end` (inclusive, `end` always last).
@@ -51,22 +81,33 @@ fn schedule(every: f64, end: f64) -> impl Iterator<Item = f64> {
     (1..=n).map(move |k| (k as f64 * every).min(end))
 }
 
-/// Runs `sc` on `ctx`, writing into `dir`. `log` receives one line per output.
+/// Runs `sc` on `ctx`, writing into `dir`; `progress` hears once per probe interval.
 pub fn run(
     ctx: &GpuContext,
     sc: &Scenario,
     dir: &Path,
-    log: &mut dyn FnMut(&str),
+    options: &RunOptions,
+    progress: &mut dyn Progress,
 ) -> Result<RunReport> {
-    let mut out = OutputDir::create(dir)?;
+    let out = OutputDir::create(dir)?;
+    let png = match options.snapshot_png {
+        Some(field) => {
+            let pngs = dir.join(SNAPSHOTS_DIR);
+            std::fs::create_dir_all(&pngs)
+                .with_context(|| format!("cannot create {}", pngs.display()))?;
+            Some(SnapshotView::for_scenario(sc, field)?)
+        }
+        None => None,
+    };
     let names: Vec<(String, String)> = sc
         .probes
         .iter()
         .map(|p| (p.name.clone(), probe_column(&p.kind).to_string()))
         .collect();
     let mut probes = out.probe_writer(&names)?;
+    let mut outputs = ParticleOutputs { out, png };
     let mut solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
-    log(&format!(
+    log::info!(
         "{}: {} particles ({} fluid, {} wall) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
         sc.name,
         sc.particles.len(),
@@ -75,21 +116,27 @@ pub fn run(
         ctx.describe(),
         solver.gpu_bytes() as f64 / sc.particles.len() as f64,
         solver.dt()
-    ));
-    write_snapshot(&mut out, &solver)?;
+    );
+    outputs.write(&solver)?;
     if !sc.probes.is_empty() {
         probes.record(0.0, &solver.sample_probes()?)?;
     }
     let started = Instant::now();
+    let status = |solver: &Solver, outputs: &ParticleOutputs| RunStatus {
+        time_s: solver.time(),
+        end_s: sc.time.end_s,
+        dt_s: solver.dt(),
+        steps: solver.steps(),
+        particles: sc.particles.len() as u64,
+        excluded: solver.excluded(),
+        outputs: outputs.out.snapshot_count(),
+        wall_s: started.elapsed().as_secs_f64(),
+    };
     let every_out = sc.time.output_every_s;
     let mut next_output = every_out.min(sc.time.end_s);
     let mut stopped = None;
     for t in schedule(sc.time.probe_every_s, sc.time.end_s) {
         if let Err(e) = solver.advance_to(t) {
-            log(&format!(
-                "stopped: {e:#}; outputs up to t = {:.6} s are kept",
-                next_output - every_out
-            ));
             stopped = Some(e);
             break;
         }
@@ -97,22 +144,26 @@ pub fn run(
             probes.record(solver.time(), &solver.sample_probes()?)?;
         }
         if solver.time() >= next_output - 1e-9 * every_out {
-            write_snapshot(&mut out, &solver)?;
+            outputs.write(&solver)?;
             probes.flush()?;
-            let wall = started.elapsed().as_secs_f64();
-            log(&format!(
-                "t = {:.4} s  steps {}  dt {:.3e} s  excluded {}  {:.3e} particle-steps/s",
-                solver.time(),
-                solver.steps(),
-                solver.dt(),
-                solver.excluded(),
-                solver.steps() as f64 * sc.particles.len() as f64 / wall.max(1e-9)
-            ));
+            log::debug!(
+                "output {} at t = {:.4} s",
+                outputs.out.snapshot_count() - 1,
+                solver.time()
+            );
             next_output = (next_output + every_out).min(sc.time.end_s);
         }
+        progress.update(&status(&solver, &outputs));
     }
     probes.flush()?;
-    let wall = started.elapsed().as_secs_f64();
+    let end = status(&solver, &outputs);
+    progress.finish(&end);
+    if let Some(e) = &stopped {
+        log::error!(
+            "stopped: {e:#}; outputs up to t = {:.6} s are kept",
+            next_output - every_out
+        );
+    }
     let n = sc.particles.len() as f64;
     let summary = RunSummary {
         case: sc.name.clone(),
@@ -121,19 +172,19 @@ pub fn run(
         dimension: sc.physics.dim,
         particles_fluid: sc.count(Kind::Fluid) as u64,
         particles_wall: sc.count(Kind::Wall) as u64,
-        particles_excluded: solver.excluded(),
-        steps: solver.steps(),
-        simulated_time_s: solver.time(),
-        wall_time_s: wall,
-        particle_steps_per_s: solver.steps() as f64 * n / wall.max(1e-9),
+        particles_excluded: end.excluded,
+        steps: end.steps,
+        simulated_time_s: end.time_s,
+        wall_time_s: end.wall_s,
+        particle_steps_per_s: end.particle_steps_per_s(),
         gpu_bytes_per_particle: solver.gpu_bytes() as f64 / n,
-        outputs: out.snapshot_count() as u64,
+        outputs: end.outputs as u64,
         status: match &stopped {
             None => "completed".into(),
             Some(e) => format!("stopped: {e:#}"),
         },
     };
-    out.write_run_summary(&summary)?;
+    outputs.out.write_run_summary(&summary)?;
     Ok(RunReport { summary, stopped })
 }
 

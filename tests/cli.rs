@@ -62,6 +62,112 @@ fn run_writes_snapshots_probes_and_summary() {
     std::fs::remove_dir_all(&out).unwrap();
 }
 
+/// Runs `wgsph run cases/hydrostatic_2d.toml` to t = 0.04 s with outputs every 0.02 s, output
+/// captured (so off a terminal), RUST_LOG set to `rust_log`; returns (output, out dir).
+fn run_hydrostatic(name: &str, rust_log: &str, args: &[&str]) -> (std::process::Output, PathBuf) {
+    let out = temp_dir(name);
+    let o = wgsph()
+        .args(["run", "cases/hydrostatic_2d.toml"])
+        .args([
+            "--set",
+            "time.end_s=0.04",
+            "--set",
+            "time.output_every_s=0.02",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .args(args)
+        .env("RUST_LOG", rust_log)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    (o, out)
+}
+
+#[test]
+fn snapshots_are_pngs_and_log_lines_go_to_stderr_off_a_terminal() {
+    let (o, out) = run_hydrostatic("pngs", "wgsph=debug", &["--snapshots"]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    // The set-up line, the first progress line (later ones come every 10 s of wall time) and,
+    // with RUST_LOG=wgsph=debug, one line per output.
+    for line in [
+        "INFO ] hydrostatic_2d: 1598 particles",
+        "INFO ] t = 0.0100/0.04 s (25 %)",
+        "particle-steps/s",
+        "DEBUG] output 2 at t = 0.0400 s",
+    ] {
+        assert!(stderr.contains(line), "{line:?} not in stderr:\n{stderr}");
+    }
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("completed: "));
+    // One PNG per VTU, all the same size, and nothing else (no temporary file).
+    let mut names: Vec<String> = std::fs::read_dir(out.join("snapshots"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["000000.png", "000001.png", "000002.png"]);
+    let sizes: Vec<(u32, u32)> = names
+        .iter()
+        .map(|n| {
+            let file = std::fs::File::open(out.join("snapshots").join(n)).unwrap();
+            let info = png::Decoder::new(std::io::BufReader::new(file))
+                .read_info()
+                .unwrap()
+                .info()
+                .clone();
+            (info.width, info.height)
+        })
+        .collect();
+    assert!(sizes[0].0 > 400 && sizes[0].1 > 400, "{sizes:?}");
+    assert!(sizes.iter().all(|s| *s == sizes[0]), "{sizes:?}");
+    assert!(out.join("particles/particles_000002.vtu").is_file());
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn quiet_prints_nothing_but_errors() {
+    // --quiet wins over RUST_LOG.
+    let (o, out) = run_hydrostatic("quiet", "debug", &["--quiet"]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    for word in ["INFO", "DEBUG", "WARN", "t = "] {
+        assert!(!stderr.contains(word), "{word:?} in stderr:\n{stderr}");
+    }
+    let summary = std::fs::read_to_string(out.join("run.json")).unwrap();
+    assert!(summary.contains("\"completed\""));
+    assert!(!out.join("snapshots").exists());
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn snapshot_field_needs_snapshots_and_a_known_field() {
+    for (args, word) in [
+        (&["--snapshot-field", "speed"][..], "--snapshots"),
+        (
+            &["--snapshots", "--snapshot-field", "density"][..],
+            "pressure or speed",
+        ),
+    ] {
+        let o = wgsph()
+            .args(["run", "cases/hydrostatic_2d.toml"])
+            .args(args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(word), "{args:?}: {stderr}");
+    }
+}
+
 /// Writes `text` as a case file and runs it; returns (exit code, stderr).
 fn run_bad(name: &str, text: &str) -> (i32, String) {
     let dir = temp_dir(name);

@@ -36,7 +36,14 @@ fn unstable_run_stops_with_step_time_and_keeps_outputs() {
     sc.time.probe_every_s = 0.01;
     let dir = std::env::temp_dir().join(format!("wgsph-unstable-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let report = wgsph::run::run(gpu(), &sc, &dir, &mut |l| println!("{l}")).unwrap();
+    let report = wgsph::run::run(
+        gpu(),
+        &sc,
+        &dir,
+        &Default::default(),
+        &mut wgsph::progress::LogLines::default(),
+    )
+    .unwrap();
     let err = report.stopped.expect("the run must stop");
     let msg = format!("{err:#}");
     println!("{msg}");

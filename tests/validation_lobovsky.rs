@@ -70,7 +70,14 @@ fn run_to(t_end: f64, tag: &str, set: &[&str]) -> Outcome {
     let sc = wgsph::case::load(Path::new("cases/dam_break_lobovsky_2d.toml"), &set).unwrap();
     let dir = std::env::temp_dir().join(format!("wgsph-lobovsky-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let report = wgsph::run::run(gpu(), &sc, &dir, &mut |l| println!("{l}")).unwrap();
+    let report = wgsph::run::run(
+        gpu(),
+        &sc,
+        &dir,
+        &Default::default(),
+        &mut wgsph::progress::LogLines::default(),
+    )
+    .unwrap();
     assert!(report.stopped.is_none(), "{}", report.summary.status);
     assert_eq!(report.summary.particles_excluded, 0);
 

@@ -14,6 +14,7 @@
 //! DIR/particles/particles_000000.vtu    one file per snapshot, raw appended binary
 //! DIR/probes/<name>.csv                 "t_s,<column>" time series per probe
 //! DIR/run.json                          run summary
+//! DIR/snapshots/NNNNNN.png              with --snapshots: a picture of each particle snapshot
 //! ```
 
 mod atomic;
@@ -36,6 +37,8 @@ pub const PVD_FILE: &str = "particles.pvd";
 pub const PARTICLES_DIR: &str = "particles";
 /// Name of the probe folder inside the output directory.
 pub const PROBES_DIR: &str = "probes";
+/// Name of the folder of snapshot pictures (`NNNNNN.png`, the index of the `.vtu`).
+pub const SNAPSHOTS_DIR: &str = "snapshots";
 /// Name of the run summary file inside the output directory.
 pub const RUN_SUMMARY_FILE: &str = "run.json";
 

@@ -10,6 +10,8 @@
 //! Text is drawn with the embedded DejaVu Sans (`assets/fonts/`, Bitstream Vera licence) through
 //! plotters' pure-Rust `ab_glyph` path: no system font or library is needed.
 
+pub mod snapshot;
+
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -28,7 +30,7 @@ pub const ERRORS_FILE: &str = "errors.csv";
 const WIDTH: u32 = 900;
 const HEIGHT: u32 = 540;
 
-static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// A two-column CSV: the header's column names and the rows.
 #[derive(Clone, Debug, PartialEq)]
@@ -623,13 +625,18 @@ fn render_png(
         Ok(())
     };
     draw(&mut buf).map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
+    write_png(path, (WIDTH, HEIGHT), &buf)
+}
+
+/// Writes an 8-bit RGB buffer of `size` pixels to `path` as PNG, atomically.
+fn write_png(path: &Path, size: (u32, u32), rgb: &[u8]) -> Result<()> {
     write_atomic(path, |w| {
-        let mut enc = png::Encoder::new(w, WIDTH, HEIGHT);
+        let mut enc = png::Encoder::new(w, size.0, size.1);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
         let mut writer = enc.write_header().map_err(std::io::Error::other)?;
         writer
-            .write_image_data(&buf)
+            .write_image_data(rgb)
             .map_err(std::io::Error::other)?;
         writer.finish().map_err(std::io::Error::other)
     })?;
