@@ -7,8 +7,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 
+use crate::body;
 use crate::gpu::GpuContext;
-use crate::output::{OutputDir, RunSummary, Snapshot, SNAPSHOTS_DIR};
+use crate::output::{OutputDir, ProbeWriter, RunSummary, Snapshot, SNAPSHOTS_DIR};
 use crate::plot::snapshot::{SnapshotField, SnapshotView};
 use crate::progress::{Progress, RunStatus};
 use crate::scenario::{Kind, ProbeKind, Scenario};
@@ -75,6 +76,36 @@ impl ParticleOutputs {
     }
 }
 
+/// The bodies' CSVs (`probes/body_<name>.csv`), one row per probe time.
+struct BodyOutputs {
+    csv: ProbeWriter,
+    dim: u32,
+}
+
+impl BodyOutputs {
+    fn new(out: &OutputDir, sc: &Scenario) -> Result<Self> {
+        let tables: Vec<(String, Vec<String>)> = sc
+            .bodies
+            .iter()
+            .map(|b| (format!("body_{}", b.name), body::csv_columns(sc.physics.dim)))
+            .collect();
+        Ok(Self {
+            csv: out.table_writer(&tables)?,
+            dim: sc.physics.dim,
+        })
+    }
+
+    fn record(&mut self, solver: &Solver) -> Result<()> {
+        if let Some(set) = solver.bodies() {
+            let rows: Vec<Vec<f64>> = (0..set.len())
+                .map(|k| body::csv_row(&set.pose(k), &set.load(k), self.dim))
+                .collect();
+            self.csv.record_rows(solver.time(), &rows)?;
+        }
+        Ok(())
+    }
+}
+
 /// Sample times of a series with interval `every` up to `end` (inclusive, `end` always last).
 fn schedule(every: f64, end: f64) -> impl Iterator<Item = f64> {
     let n = (end / every - 1e-9).ceil().max(0.0) as u64;
@@ -105,6 +136,7 @@ pub fn run(
         .map(|p| (p.name.clone(), probe_column(&p.kind).to_string()))
         .collect();
     let mut probes = out.probe_writer(&names)?;
+    let mut bodies = BodyOutputs::new(&out, sc)?;
     let mut outputs = ParticleOutputs { out, png };
     let mut solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
     log::info!(
@@ -121,6 +153,7 @@ pub fn run(
     if !sc.probes.is_empty() {
         probes.record(0.0, &solver.sample_probes()?)?;
     }
+    bodies.record(&solver)?;
     let started = Instant::now();
     let status = |solver: &Solver, outputs: &ParticleOutputs| RunStatus {
         time_s: solver.time(),
@@ -143,9 +176,11 @@ pub fn run(
         if !sc.probes.is_empty() {
             probes.record(solver.time(), &solver.sample_probes()?)?;
         }
+        bodies.record(&solver)?;
         if solver.time() >= next_output - 1e-9 * every_out {
             outputs.write(&solver)?;
             probes.flush()?;
+            bodies.csv.flush()?;
             log::debug!(
                 "output {} at t = {:.4} s",
                 outputs.out.snapshot_count() - 1,
@@ -156,6 +191,7 @@ pub fn run(
         progress.update(&status(&solver, &outputs));
     }
     probes.flush()?;
+    bodies.csv.flush()?;
     let end = status(&solver, &outputs);
     progress.finish(&end);
     if let Some(e) = &stopped {
