@@ -87,7 +87,12 @@ impl BodyOutputs {
         let tables: Vec<(String, Vec<String>)> = sc
             .bodies
             .iter()
-            .map(|b| (format!("body_{}", b.name), body::csv_columns(sc.physics.dim)))
+            .map(|b| {
+                (
+                    format!("body_{}", b.name),
+                    body::csv_columns(sc.physics.dim),
+                )
+            })
             .collect();
         Ok(Self {
             csv: out.table_writer(&tables)?,

@@ -39,7 +39,10 @@ fn sample(sc: &Scenario, every: f64, end: f64) -> Vec<(f64, [f64; 3], f64)> {
 fn floating_draft(dx: &str, end: f64, from: f64) -> f64 {
     let sc = load(
         "cases/floating_box_2d.toml",
-        &[&format!("particles.dx_m={dx}"), &format!("time.end_s={end}")],
+        &[
+            &format!("particles.dx_m={dx}"),
+            &format!("time.end_s={end}"),
+        ],
     );
     let s = sample(&sc, 0.01, end);
     let late: Vec<f64> = s
@@ -59,7 +62,10 @@ fn floating_box_settles_near_the_archimedes_draft_coarse() {
     // the fine test).
     let d = floating_draft("0.02", 2.0, 1.0);
     let err = d / ARCHIMEDES_DRAFT - 1.0;
-    println!("dx = 0.02: mean draft {d:.4} m over 1-2 s, {:+.1} %", 100.0 * err);
+    println!(
+        "dx = 0.02: mean draft {d:.4} m over 1-2 s, {:+.1} %",
+        100.0 * err
+    );
     assert!(err.abs() < 0.25, "draft error {err}");
 }
 
@@ -68,7 +74,10 @@ fn floating_box_settles_near_the_archimedes_draft_coarse() {
 fn floating_box_draft_within_2_percent_fine() {
     let d = floating_draft("0.01", 3.0, 1.5);
     let err = d / ARCHIMEDES_DRAFT - 1.0;
-    println!("dx = 0.01: mean draft {d:.4} m over 1.5-3 s, {:+.2} %", 100.0 * err);
+    println!(
+        "dx = 0.01: mean draft {d:.4} m over 1.5-3 s, {:+.2} %",
+        100.0 * err
+    );
     assert!(err.abs() < 0.02, "draft error {err}");
 }
 
@@ -116,7 +125,7 @@ fn water_entry_error(density: &str, dx: &str) -> f64 {
         "tests/data/water_entry_cylinder_rho{density}_greenhow_lin.csv"
     )))
     .unwrap();
-    let t_end = reference.points.last().unwrap().0 * (d / g as f64).sqrt();
+    let t_end = reference.points.last().unwrap().0 * (d / g).sqrt();
     let sc = load(
         "cases/water_entry_cylinder_2d.toml",
         &[

@@ -570,8 +570,14 @@ impl Shape {
             Shape::Ball { center, radius } if dim == 2 => {
                 let mut r = radius - 0.5 * dx;
                 let mut ring = 0;
-                while r > 0.25 * dx && radius - r < depth {
-                    let n = ((2.0 * PI * r / dx).round() as usize).max(3);
+                while r > 0.0 && radius - r < depth {
+                    if r * 3f64.sqrt() < dx {
+                        // No room for a ring of three: one particle at the centre.
+                        out.push(center);
+                        break;
+                    }
+                    // As many as fit with a chord of at least dx.
+                    let n = ((PI / (0.5 * dx / r).asin()).floor() as usize).max(3);
                     let shift = if ring % 2 == 0 { 0.0 } else { 0.5 };
                     for j in 0..n {
                         let a = 2.0 * PI * (j as f64 + shift) / n as f64;
@@ -579,9 +585,6 @@ impl Shape {
                     }
                     r -= dx;
                     ring += 1;
-                }
-                if r > -0.75 * dx && radius - r < depth + dx {
-                    out.push(center);
                 }
             }
             Shape::Ball { center, radius } => {

@@ -3,7 +3,7 @@
 use std::collections::HashMap;
 
 use super::*;
-use crate::scenario::{Kind, Particle, ProbeKind, Viscosity};
+use crate::scenario::{Kind, Motion, Particle, ProbeKind, Viscosity};
 
 const HYDROSTATIC: &str = include_str!("../../cases/hydrostatic_2d.toml");
 const DAM_2D: &str = include_str!("../../cases/dam_break_2d.toml");
@@ -961,3 +961,93 @@ fn nothing_panics_on_hostile_values() {
 mod walls;
 
 mod density_filter;
+
+// ---------------------------------------------------------------- bodies and moving tanks
+
+const FLOATING: &str = include_str!("../../cases/floating_box_2d.toml");
+const WATER_ENTRY: &str = include_str!("../../cases/water_entry_cylinder_2d.toml");
+
+#[test]
+fn body_cases_build_with_bodies_last() {
+    for (text, name, mass) in [
+        (FLOATING, "box", 500.0 * 0.2 * 0.1),
+        (
+            WATER_ENTRY,
+            "cylinder",
+            500.0 * std::f64::consts::PI * 0.055 * 0.055,
+        ),
+    ] {
+        let s = load_str(text, "c.toml", &[]).unwrap();
+        check_invariants(&s);
+        assert_eq!(s.bodies.len(), 1);
+        let b = &s.bodies[0];
+        assert_eq!(b.name, name);
+        assert_eq!(b.particles.end, s.particles.len());
+        assert!((b.mass - mass).abs() < 1e-12 * mass, "{} vs {mass}", b.mass);
+        // No fluid within half a spacing of the body's particles' volumes.
+        let dx = s.physics.dx;
+        for p in s.particles.iter().filter(|p| p.kind == Kind::Fluid) {
+            for q in &s.particles[b.particles.clone()] {
+                let d2: f64 = (0..2).map(|a| (p.pos[a] - q.pos[a]).powi(2)).sum();
+                assert!(
+                    d2 > (0.99 * dx).powi(2),
+                    "fluid at {:?} too near {:?}",
+                    p.pos,
+                    q.pos
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_moving_tank_becomes_the_last_body_and_widens_the_domain() {
+    let text = format!(
+        "{BASE}\n[tank.motion]\nkind = \"sine\"\npivot_m = [0.5, 0.0]\nrotation_deg = 4.0\nperiod_s = 3.14159\n"
+    );
+    let moving = load_str(&text, "c.toml", &[]).unwrap();
+    let fixed = load_str(BASE, "c.toml", &[]).unwrap();
+    assert_eq!(moving.bodies.len(), 1);
+    let tank = &moving.bodies[0];
+    assert_eq!(tank.name, "tank");
+    assert_eq!(tank.particles.len(), fixed.count(Kind::Wall));
+    assert!(moving.domain.max[1] > fixed.domain.max[1]);
+    assert!(matches!(tank.motion, Motion::Prescribed(_)));
+}
+
+#[test]
+fn bad_bodies_and_motions_are_refused() {
+    let with_body = |body: &str| format!("{BASE}\n[[body]]\nname = \"b\"\n{body}\n");
+    assert_err(
+        &with_body(
+            "shape = \"sphere\"\ncenter_m = [0.5, 0.5]\nradius_m = 0.05\ndensity_kg_m3 = 500.0",
+        ),
+        &[],
+        None,
+        &["body[0].shape", "2D"],
+    );
+    assert_err(
+        &with_body("shape = \"box\"\nmin_m = [0.4, 0.4]\nmax_m = [0.5, 0.5]"),
+        &[],
+        None,
+        &["body[0]", "mass"],
+    );
+    assert_err(
+        &with_body("shape = \"circle\"\ncenter_m = [0.5, 0.5]\nradius_m = 0.05\nmass_kg = 1.0\nwall = \"mirror\""),
+        &[],
+        None,
+        &["body[0].wall", "dynamic"],
+    );
+    assert_err(
+        &with_body("shape = \"circle\"\ncenter_m = [0.5, 0.5]\nradius_m = 0.05\nmass_kg = 1.0\n[body.motion]\nkind = \"series\"\nfile = \"no_such.csv\""),
+        &[],
+        None,
+        &["body[0].motion.file", "no_such.csv"],
+    );
+    assert_err(
+        &format!("{BASE}\n[tank.motion]\nkind = \"free\"\n"),
+        &[],
+        None,
+        &["tank.motion.kind", "sine"],
+    );
+}
