@@ -120,7 +120,7 @@ fn a_neutrally_buoyant_box_stays_put() {
 /// Penetration (y0 − y_c)/D of the water-entry case against Greenhow & Lin at each reference
 /// time: the largest relative error.
 fn water_entry_error(density: &str, dx: &str) -> f64 {
-    let (d, g, y0) = (0.11, 9.81, 0.355);
+    let (d, g, y0): (f64, f64, f64) = (0.11, 9.81, 0.355);
     let reference = read_csv(Path::new(&format!(
         "tests/data/water_entry_cylinder_rho{density}_greenhow_lin.csv"
     )))
