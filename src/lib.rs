@@ -2,6 +2,7 @@
 
 pub mod body;
 pub mod case;
+pub mod checkpoint;
 pub mod gpu;
 pub mod layout;
 pub mod logging;

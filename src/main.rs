@@ -3,17 +3,20 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::MultiProgress;
 
+use wgsph::checkpoint::{CaseSource, Checkpoint, CHECKPOINT_FILE};
 use wgsph::gpu::context::list_adapters;
 use wgsph::gpu::{AdapterChoice, GpuContext};
 use wgsph::plot::snapshot::SnapshotField;
 use wgsph::progress::{LogLines, Progress, ProgressBarView};
-use wgsph::run::RunOptions;
+use wgsph::run::{CheckpointPolicy, RunOptions, RunReport};
 
 #[derive(Parser)]
 #[command(
@@ -49,8 +52,29 @@ enum Command {
         /// Colour of the fluid in the snapshots (default: pressure).
         #[arg(long, value_name = "pressure|speed", requires = "snapshots")]
         snapshot_field: Option<SnapshotField>,
+        /// Checkpoint (DIR/checkpoint.bin) every so many simulated seconds (0.5 or 0.5s) or
+        /// wall minutes (10min), or 'never'. Default: 30min. Ctrl-C and SIGTERM always write
+        /// one and stop; `wgsph resume DIR` continues.
+        #[arg(long, value_name = "SECONDS|MINUTESmin|never")]
+        checkpoint_every: Option<CheckpointPolicy>,
         /// Print only errors: no progress, no summary line. Otherwise RUST_LOG sets the log
         /// levels (default: warn,wgsph=info).
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Continue a run from its checkpoint (DIR/checkpoint.bin) with the case file and
+    /// overrides it started with; on the same adapter the result is bit-identical to an
+    /// uninterrupted run.
+    Resume {
+        /// The run's output directory.
+        dir: PathBuf,
+        /// Change the time control, e.g. --set time.end_s=2 to run longer (repeatable; the
+        /// particles, physics, walls, probes and bodies must stay as they were).
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        set: Vec<String>,
+        /// As for `run` (default: the run's own policy is not stored; 30min).
+        #[arg(long, value_name = "SECONDS|MINUTESmin|never")]
+        checkpoint_every: Option<CheckpointPolicy>,
         #[arg(long, short)]
         quiet: bool,
     },
@@ -98,7 +122,10 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let quiet = matches!(cli.command, Command::Run { quiet: true, .. });
+    let quiet = matches!(
+        cli.command,
+        Command::Run { quiet: true, .. } | Command::Resume { quiet: true, .. }
+    );
     let bars = MultiProgress::new();
     // Fails only if a logger is already set, which nothing else in the process does.
     let _ = wgsph::logging::init(quiet, bars.clone());
@@ -124,6 +151,46 @@ fn progress(quiet: bool, bars: &MultiProgress) -> Box<dyn Progress> {
     }
 }
 
+/// A flag set by Ctrl-C or SIGTERM: the run writes a checkpoint at the next probe time and
+/// stops. A second signal ends the process at once.
+fn interrupt_flag() -> Result<Arc<AtomicBool>> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let seen = flag.clone();
+    ctrlc::set_handler(move || {
+        if seen.swap(true, Ordering::Relaxed) {
+            std::process::exit(130);
+        }
+        eprintln!("interrupt: writing a checkpoint at the next probe time, then stopping");
+    })
+    .context("installing the Ctrl-C handler")?;
+    Ok(flag)
+}
+
+/// Exit status of a run: 0 completed, 2 stopped (unstable or GPU failure), 130 interrupted.
+/// Prints the summary line unless quiet.
+fn finish(report: &RunReport, dir: &std::path::Path, quiet: bool) -> ExitCode {
+    let code = if report.stopped.is_some() {
+        ExitCode::from(2)
+    } else if report.interrupted_at_s.is_some() {
+        ExitCode::from(130)
+    } else {
+        ExitCode::SUCCESS
+    };
+    if !quiet {
+        let s = &report.summary;
+        println!(
+            "{}: {} steps to t = {:.4} s in {:.1} s wall ({:.3e} particle-steps/s); outputs in {}",
+            s.status,
+            s.steps,
+            s.simulated_time_s,
+            s.wall_time_s,
+            s.particle_steps_per_s,
+            dir.display()
+        );
+    }
+    code
+}
+
 fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
     match cli.command {
         Command::Run {
@@ -132,6 +199,7 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             set,
             snapshots,
             snapshot_field,
+            checkpoint_every,
             quiet,
         } => {
             let sc = wgsph::case::load(&case, &set)?;
@@ -139,27 +207,52 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
             let options = RunOptions {
                 snapshot_png: snapshots.then(|| snapshot_field.unwrap_or_default()),
+                checkpoint: checkpoint_every.unwrap_or_else(CheckpointPolicy::default_for_runs),
+                source: Some(CaseSource {
+                    path: std::path::absolute(&case)
+                        .with_context(|| format!("resolving {}", case.display()))?,
+                    overrides: set,
+                }),
+                interrupt: Some(interrupt_flag()?),
+                halt_at_s: None,
             };
             let report = wgsph::run::run(&ctx, &sc, &dir, &options, &mut *progress(quiet, bars))?;
-            let code = if report.stopped.is_some() {
-                ExitCode::from(2)
-            } else {
-                ExitCode::SUCCESS
+            Ok(finish(&report, &dir, quiet))
+        }
+        Command::Resume {
+            dir,
+            set,
+            checkpoint_every,
+            quiet,
+        } => {
+            let ck = Checkpoint::read(&dir.join(CHECKPOINT_FILE))?;
+            let Some(source) = ck.source.clone() else {
+                anyhow::bail!(
+                    "{} does not record its case file (it was written through the library): \
+                     resume it with wgsph::run::resume",
+                    dir.join(CHECKPOINT_FILE).display()
+                );
             };
-            if quiet {
-                return Ok(code);
-            }
-            let s = &report.summary;
-            println!(
-                "{}: {} steps to t = {:.4} s in {:.1} s wall ({:.3e} particle-steps/s); outputs in {}",
-                s.status,
-                s.steps,
-                s.simulated_time_s,
-                s.wall_time_s,
-                s.particle_steps_per_s,
-                dir.display()
-            );
-            Ok(code)
+            let overrides: Vec<String> = source.overrides.iter().chain(&set).cloned().collect();
+            let sc = wgsph::case::load(&source.path, &overrides)?;
+            let ctx = context(cli.adapter)?;
+            let options = RunOptions {
+                snapshot_png: ck
+                    .snapshot_field
+                    .as_deref()
+                    .map(|f| f.parse().map_err(anyhow::Error::msg))
+                    .transpose()?,
+                checkpoint: checkpoint_every.unwrap_or_else(CheckpointPolicy::default_for_runs),
+                source: Some(CaseSource {
+                    path: source.path,
+                    overrides,
+                }),
+                interrupt: Some(interrupt_flag()?),
+                halt_at_s: None,
+            };
+            let report =
+                wgsph::run::resume(&ctx, &sc, &dir, &options, &mut *progress(quiet, bars))?;
+            Ok(finish(&report, &dir, quiet))
         }
         Command::Plot {
             dir,
@@ -222,6 +315,11 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                     limits.max_buffer_size >> 20,
                     limits.max_storage_buffers_per_shader_stage,
                     limits.max_compute_workgroups_per_dimension
+                );
+                let cap = wgsph::sph::capacity(&limits);
+                println!(
+                    "  fits at most {} particles (bound by {})",
+                    cap.particles, cap.bound_by
                 );
             }
             let choice = AdapterChoice::resolve(cli.adapter)?;

@@ -3,17 +3,20 @@
 //! run stops early). Progress is reported once per probe interval to a [`Progress`].
 
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 
 use crate::body;
+use crate::checkpoint::{fingerprint, CaseSource, Checkpoint, OutputState, CHECKPOINT_FILE};
 use crate::gpu::GpuContext;
 use crate::output::{OutputDir, ProbeWriter, RunSummary, Snapshot, SNAPSHOTS_DIR};
 use crate::plot::snapshot::{SnapshotField, SnapshotView};
 use crate::progress::{Progress, RunStatus};
 use crate::scenario::{Kind, ProbeKind, Scenario};
-use crate::sph::Solver;
+use crate::sph::{check_capacity, Solver};
 
 /// Column name of a probe's CSV.
 pub fn probe_column(kind: &ProbeKind) -> &'static str {
@@ -24,18 +27,83 @@ pub fn probe_column(kind: &ProbeKind) -> &'static str {
     }
 }
 
-/// Optional outputs of a run.
+/// When a run writes its checkpoint (`DIR/checkpoint.bin`, the last one replacing the one
+/// before). Checkpoints are taken at probe times, the first one at or after each due time; an
+/// interrupt (Ctrl-C, SIGTERM) always writes one.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CheckpointPolicy {
+    /// Every so many simulated seconds.
+    pub every_sim_s: Option<f64>,
+    /// Every so many wall-clock seconds.
+    pub every_wall_s: Option<f64>,
+}
+
+impl CheckpointPolicy {
+    /// What `wgsph run` does without `--checkpoint-every`: every 30 wall minutes.
+    pub fn default_for_runs() -> Self {
+        Self {
+            every_sim_s: None,
+            every_wall_s: Some(30.0 * 60.0),
+        }
+    }
+}
+
+impl std::str::FromStr for CheckpointPolicy {
+    type Err = anyhow::Error;
+
+    /// `0.5` or `0.5s`: every 0.5 simulated seconds; `10min`: every 10 wall minutes;
+    /// `never`: only on interrupts.
+    fn from_str(text: &str) -> Result<Self> {
+        let t = text.trim();
+        let number = |s: &str| -> Result<f64> {
+            match s.trim().parse::<f64>() {
+                Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+                _ => anyhow::bail!(
+                    "--checkpoint-every '{text}': give a positive number of simulated seconds \
+                     (0.5 or 0.5s), of wall minutes (10min), or 'never'"
+                ),
+            }
+        };
+        Ok(if t == "never" {
+            Self::default()
+        } else if let Some(m) = t.strip_suffix("min") {
+            Self {
+                every_sim_s: None,
+                every_wall_s: Some(60.0 * number(m)?),
+            }
+        } else {
+            Self {
+                every_sim_s: Some(number(t.strip_suffix('s').unwrap_or(t))?),
+                every_wall_s: None,
+            }
+        })
+    }
+}
+
+/// Options of a run beyond its case.
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
     /// Also draw every particle snapshot as DIR/snapshots/NNNNNN.png, coloured by this field.
     pub snapshot_png: Option<SnapshotField>,
+    pub checkpoint: CheckpointPolicy,
+    /// The case file and overrides, recorded in checkpoints for `wgsph resume`.
+    pub source: Option<CaseSource>,
+    /// Set (by a signal handler) to stop at the next probe time with a checkpoint.
+    pub interrupt: Option<Arc<AtomicBool>>,
+    /// Stop with a checkpoint at the first probe time at or after this simulated time, as if
+    /// interrupted (batch jobs with a time limit split a run this way; so do the tests).
+    pub halt_at_s: Option<f64>,
 }
 
 /// What a finished (or stopped) run reports.
 pub struct RunReport {
     pub summary: RunSummary,
-    /// Set when the run stopped before its end (instability); outputs up to then are kept.
+    /// Set when the run stopped before its end (instability, GPU failure); outputs up to then
+    /// and the last checkpoint are kept.
     pub stopped: Option<anyhow::Error>,
+    /// Set when the run stopped on request (interrupt, `halt_at_s`) with a checkpoint at this
+    /// simulated time; `wgsph resume` continues it.
+    pub interrupted_at_s: Option<f64>,
 }
 
 /// Particle outputs at an output time: the VTU snapshot and, when asked for, its PNG (drawn
@@ -125,113 +193,333 @@ pub fn run(
     options: &RunOptions,
     progress: &mut dyn Progress,
 ) -> Result<RunReport> {
-    let out = OutputDir::create(dir)?;
-    let png = match options.snapshot_png {
-        Some(field) => {
-            let pngs = dir.join(SNAPSHOTS_DIR);
-            std::fs::create_dir_all(&pngs)
-                .with_context(|| format!("cannot create {}", pngs.display()))?;
-            Some(SnapshotView::for_scenario(sc, field)?)
-        }
-        None => None,
-    };
-    let names: Vec<(String, String)> = sc
-        .probes
-        .iter()
-        .map(|p| (p.name.clone(), probe_column(&p.kind).to_string()))
-        .collect();
-    let mut probes = out.probe_writer(&names)?;
-    let mut bodies = BodyOutputs::new(&out, sc)?;
-    let mut outputs = ParticleOutputs { out, png };
-    let mut solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
-    log::info!(
-        "{}: {} particles ({} fluid, {} wall) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
-        sc.name,
-        sc.particles.len(),
-        sc.count(Kind::Fluid),
-        sc.count(Kind::Wall),
-        ctx.describe(),
-        solver.gpu_bytes() as f64 / sc.particles.len() as f64,
-        solver.dt()
-    );
-    outputs.write(&solver)?;
+    check_capacity(ctx, sc.particles.len())?;
+    let mut runner = Runner::create(ctx, sc, dir, options)?;
+    runner.outputs.write(&runner.solver)?;
     if !sc.probes.is_empty() {
-        probes.record(0.0, &solver.sample_probes()?)?;
+        runner.probes.record(0.0, &runner.solver.sample_probes()?)?;
     }
-    bodies.record(&solver)?;
-    let started = Instant::now();
-    let status = |solver: &Solver, outputs: &ParticleOutputs| RunStatus {
-        time_s: solver.time(),
-        end_s: sc.time.end_s,
-        dt_s: solver.dt(),
-        steps: solver.steps(),
-        particles: sc.particles.len() as u64,
-        excluded: solver.excluded(),
-        outputs: outputs.out.snapshot_count(),
-        wall_s: started.elapsed().as_secs_f64(),
-    };
-    let every_out = sc.time.output_every_s;
-    let mut next_output = every_out.min(sc.time.end_s);
-    let mut stopped = None;
-    for t in schedule(sc.time.probe_every_s, sc.time.end_s) {
-        if let Err(e) = solver.advance_to(t) {
-            stopped = Some(e);
-            break;
-        }
-        if !sc.probes.is_empty() {
-            probes.record(solver.time(), &solver.sample_probes()?)?;
-        }
-        bodies.record(&solver)?;
-        if solver.time() >= next_output - 1e-9 * every_out {
-            outputs.write(&solver)?;
-            probes.flush()?;
-            bodies.csv.flush()?;
-            log::debug!(
-                "output {} at t = {:.4} s",
-                outputs.out.snapshot_count() - 1,
-                solver.time()
-            );
-            next_output = (next_output + every_out).min(sc.time.end_s);
-        }
-        progress.update(&status(&solver, &outputs));
-    }
-    probes.flush()?;
-    bodies.csv.flush()?;
-    let end = status(&solver, &outputs);
-    progress.finish(&end);
-    if let Some(e) = &stopped {
-        log::error!(
-            "stopped: {e:#}; outputs up to t = {:.6} s are kept",
-            next_output - every_out
+    runner.bodies.record(&runner.solver)?;
+    runner.go(progress)
+}
+
+/// Continues the run in `dir` from its checkpoint. `sc` must be the scenario the run was built
+/// from (checked by its fingerprint), except for its time control: a later `time.end_s`
+/// extends the run, other intervals apply from the checkpoint on. On the same adapter the
+/// continued run is bit-identical to an uninterrupted one.
+pub fn resume(
+    ctx: &GpuContext,
+    sc: &Scenario,
+    dir: &Path,
+    options: &RunOptions,
+    progress: &mut dyn Progress,
+) -> Result<RunReport> {
+    let path = dir.join(CHECKPOINT_FILE);
+    let ck = Checkpoint::read(&path)?;
+    if ck.fingerprint != fingerprint(sc) {
+        bail!(
+            "{} was written by a different case than '{}' (particles, physics, walls, probes or \
+             bodies differ); resume with the case file and --set overrides the run started with",
+            path.display(),
+            sc.name
         );
     }
-    let n = sc.particles.len() as f64;
-    let summary = RunSummary {
-        case: sc.name.clone(),
-        adapter: ctx.info.name.clone(),
-        backend: format!("{:?}", ctx.info.backend),
-        dimension: sc.physics.dim,
-        particles_fluid: sc.count(Kind::Fluid) as u64,
-        particles_wall: sc.count(Kind::Wall) as u64,
-        particles_excluded: end.excluded,
-        steps: end.steps,
-        simulated_time_s: end.time_s,
-        wall_time_s: end.wall_s,
-        particle_steps_per_s: end.particle_steps_per_s(),
-        gpu_bytes_per_particle: solver.gpu_bytes() as f64 / n,
-        outputs: end.outputs as u64,
-        status: match &stopped {
-            None => "completed".into(),
-            Some(e) => format!("stopped: {e:#}"),
-        },
-    };
-    outputs.out.write_run_summary(&summary)?;
-    Ok(RunReport { summary, stopped })
+    if ck.adapter != ctx.info.name {
+        log::warn!(
+            "resuming on '{}' a run checkpointed on '{}': it continues, but not bit-identically",
+            ctx.info.name,
+            ck.adapter
+        );
+    }
+    check_capacity(ctx, sc.particles.len())?;
+    let mut runner = Runner::create(ctx, sc, dir, options)?;
+    runner
+        .solver
+        .restore_state(&ck.solver)
+        .context("restoring the checkpoint")?;
+    let o = ck.outputs;
+    runner.outputs.out.resume_series(o.snapshots)?;
+    runner.probes.restore(&o.probe_tables)?;
+    runner.bodies.csv.restore(&o.body_tables)?;
+    runner.next_output = o.next_output_s;
+    runner.wall_before = o.wall_s;
+    runner.last_checkpoint = Some(ck.time_s);
+    runner.next_checkpoint_sim = options
+        .checkpoint
+        .every_sim_s
+        .map(|every| ck.time_s + every);
+    log::info!(
+        "{}: resuming from t = {:.6} s (step {}) in {}",
+        sc.name,
+        ck.time_s,
+        runner.solver.steps(),
+        dir.display()
+    );
+    runner.go(progress)
+}
+
+/// A run in progress: the solver, its outputs and the schedule of outputs and checkpoints.
+struct Runner<'a> {
+    ctx: &'a GpuContext,
+    sc: &'a Scenario,
+    options: &'a RunOptions,
+    solver: Solver,
+    probes: ProbeWriter,
+    bodies: BodyOutputs,
+    outputs: ParticleOutputs,
+    next_output: f64,
+    next_checkpoint_sim: Option<f64>,
+    /// Wall time spent before this process (resumed runs).
+    wall_before: f64,
+    started: Instant,
+    last_checkpoint_wall: Instant,
+    /// Simulated time of the last checkpoint written (or resumed from).
+    last_checkpoint: Option<f64>,
+}
+
+impl<'a> Runner<'a> {
+    /// Creates the output writers and the solver (at t = 0).
+    fn create(
+        ctx: &'a GpuContext,
+        sc: &'a Scenario,
+        dir: &Path,
+        options: &'a RunOptions,
+    ) -> Result<Self> {
+        let out = OutputDir::create(dir)?;
+        let png = match options.snapshot_png {
+            Some(field) => {
+                let pngs = dir.join(SNAPSHOTS_DIR);
+                std::fs::create_dir_all(&pngs)
+                    .with_context(|| format!("cannot create {}", pngs.display()))?;
+                Some(SnapshotView::for_scenario(sc, field)?)
+            }
+            None => None,
+        };
+        let names: Vec<(String, String)> = sc
+            .probes
+            .iter()
+            .map(|p| (p.name.clone(), probe_column(&p.kind).to_string()))
+            .collect();
+        let probes = out.probe_writer(&names)?;
+        let bodies = BodyOutputs::new(&out, sc)?;
+        let solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
+        log::info!(
+            "{}: {} particles ({} fluid, {} wall) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
+            sc.name,
+            sc.particles.len(),
+            sc.count(Kind::Fluid),
+            sc.count(Kind::Wall),
+            ctx.describe(),
+            solver.gpu_bytes() as f64 / sc.particles.len() as f64,
+            solver.dt()
+        );
+        Ok(Self {
+            ctx,
+            sc,
+            options,
+            solver,
+            probes,
+            bodies,
+            outputs: ParticleOutputs { out, png },
+            next_output: sc.time.output_every_s.min(sc.time.end_s),
+            next_checkpoint_sim: options.checkpoint.every_sim_s,
+            wall_before: 0.0,
+            started: Instant::now(),
+            last_checkpoint_wall: Instant::now(),
+            last_checkpoint: None,
+        })
+    }
+
+    fn status(&self) -> RunStatus {
+        RunStatus {
+            time_s: self.solver.time(),
+            end_s: self.sc.time.end_s,
+            dt_s: self.solver.dt(),
+            steps: self.solver.steps(),
+            particles: self.sc.particles.len() as u64,
+            excluded: self.solver.excluded(),
+            outputs: self.outputs.out.snapshot_count(),
+            wall_s: self.wall_before + self.started.elapsed().as_secs_f64(),
+        }
+    }
+
+    /// Steps from the solver's time to the end, recording outputs, probes and checkpoints.
+    fn go(mut self, progress: &mut dyn Progress) -> Result<RunReport> {
+        let sc = self.sc;
+        let t0 = self.solver.time();
+        let mut stopped = None;
+        let mut interrupted_at_s = None;
+        for t in schedule(sc.time.probe_every_s, sc.time.end_s).filter(|&t| t > t0) {
+            // Any failure from here on (instability, GPU failure, a full disk) ends the run
+            // with what was written so far and the last checkpoint kept.
+            match self.probe_interval(t) {
+                Err(e) => {
+                    stopped = Some(e);
+                    break;
+                }
+                Ok(halt) => {
+                    progress.update(&self.status());
+                    if halt {
+                        interrupted_at_s = Some(self.solver.time());
+                        break;
+                    }
+                }
+            }
+        }
+        self.probes.flush()?;
+        self.bodies.csv.flush()?;
+        let end = self.status();
+        progress.finish(&end);
+        let resume_hint = match self.last_checkpoint {
+            Some(t) => format!(
+                "; the last checkpoint (t = {t:.6} s) is kept: continue with `wgsph resume {}`",
+                self.outputs.out.path().display()
+            ),
+            None => String::new(),
+        };
+        if let Some(e) = &stopped {
+            log::error!(
+                "stopped: {e:#}; outputs up to t = {:.6} s are kept{resume_hint}",
+                self.outputs.out.snapshots().last().map_or(0.0, |(t, _)| *t)
+            );
+        }
+        if let Some(t) = interrupted_at_s {
+            log::warn!("interrupted at t = {t:.6} s{resume_hint}");
+        }
+        let n = sc.particles.len() as f64;
+        let summary = RunSummary {
+            case: sc.name.clone(),
+            adapter: self.ctx.info.name.clone(),
+            backend: format!("{:?}", self.ctx.info.backend),
+            dimension: sc.physics.dim,
+            particles_fluid: sc.count(Kind::Fluid) as u64,
+            particles_wall: sc.count(Kind::Wall) as u64,
+            particles_excluded: end.excluded,
+            steps: end.steps,
+            simulated_time_s: end.time_s,
+            wall_time_s: end.wall_s,
+            particle_steps_per_s: end.particle_steps_per_s(),
+            gpu_bytes_per_particle: self.solver.gpu_bytes() as f64 / n,
+            outputs: end.outputs as u64,
+            status: match (&stopped, interrupted_at_s) {
+                (Some(e), _) => format!("stopped: {e:#}{resume_hint}"),
+                (None, Some(_)) => format!("interrupted{resume_hint}"),
+                (None, None) => "completed".into(),
+            },
+        };
+        self.outputs.out.write_run_summary(&summary)?;
+        Ok(RunReport {
+            summary,
+            stopped,
+            interrupted_at_s,
+        })
+    }
+
+    /// Advances to the probe time `t` and writes what is due there: probe rows, particle
+    /// outputs, a checkpoint. True when the run must stop here on request (with a checkpoint).
+    fn probe_interval(&mut self, t: f64) -> Result<bool> {
+        let sc = self.sc;
+        let every_out = sc.time.output_every_s;
+        self.solver.advance_to(t)?;
+        if !sc.probes.is_empty() {
+            self.probes
+                .record(self.solver.time(), &self.solver.sample_probes()?)?;
+        }
+        self.bodies.record(&self.solver)?;
+        if self.solver.time() >= self.next_output - 1e-9 * every_out {
+            self.outputs.write(&self.solver)?;
+            self.probes.flush()?;
+            self.bodies.csv.flush()?;
+            log::debug!(
+                "output {} at t = {:.4} s",
+                self.outputs.out.snapshot_count() - 1,
+                self.solver.time()
+            );
+            self.next_output = (self.next_output + every_out).min(sc.time.end_s);
+        }
+        let halt = self.interrupted()
+            || self
+                .options
+                .halt_at_s
+                .is_some_and(|h| self.solver.time() >= h - 1e-12 * sc.time.end_s);
+        let end = self.solver.time() >= sc.time.end_s;
+        if !end && (halt || self.checkpoint_due()) {
+            self.write_checkpoint()?;
+        }
+        Ok(halt && !end)
+    }
+
+    fn interrupted(&self) -> bool {
+        self.options
+            .interrupt
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+
+    fn checkpoint_due(&mut self) -> bool {
+        let t = self.solver.time();
+        let policy = self.options.checkpoint;
+        let mut due = false;
+        if let (Some(next), Some(every)) = (self.next_checkpoint_sim, policy.every_sim_s) {
+            if t >= next - 1e-9 * every {
+                due = true;
+                // The next one is due a full interval after this probe time.
+                self.next_checkpoint_sim = Some(t + every);
+            }
+        }
+        if let Some(every) = policy.every_wall_s {
+            due |= self.last_checkpoint_wall.elapsed().as_secs_f64() >= every;
+        }
+        due
+    }
+
+    /// Writes DIR/checkpoint.bin with the solver state and the outputs so far, after making
+    /// the outputs durable (so the files on disk match the checkpoint).
+    fn write_checkpoint(&mut self) -> Result<()> {
+        self.probes.flush()?;
+        self.bodies.csv.flush()?;
+        let ck = Checkpoint {
+            case_name: self.sc.name.clone(),
+            fingerprint: fingerprint(self.sc),
+            source: self.options.source.clone(),
+            snapshot_field: self.options.snapshot_png.map(|f| f.to_string()),
+            adapter: self.ctx.info.name.clone(),
+            time_s: self.solver.time(),
+            outputs: OutputState {
+                next_output_s: self.next_output,
+                snapshots: self.outputs.out.snapshots().to_vec(),
+                probe_tables: self.probes.texts(),
+                body_tables: self.bodies.csv.texts(),
+                wall_s: self.wall_before + self.started.elapsed().as_secs_f64(),
+            },
+            solver: self.solver.save_state()?,
+        };
+        let path = self.outputs.out.path().join(CHECKPOINT_FILE);
+        ck.write(&path)?;
+        self.last_checkpoint = Some(ck.time_s);
+        self.last_checkpoint_wall = Instant::now();
+        log::debug!("checkpoint at t = {:.6} s", ck.time_s);
+        Ok(())
+    }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::schedule;
+    use super::{schedule, CheckpointPolicy};
+
+    #[test]
+    fn checkpoint_policy_parses_simulated_and_wall_intervals() {
+        let p = |s: &str| s.parse::<CheckpointPolicy>();
+        assert_eq!(p("0.5").unwrap().every_sim_s, Some(0.5));
+        assert_eq!(p("0.25s").unwrap().every_sim_s, Some(0.25));
+        let wall = p("10min").unwrap();
+        assert_eq!((wall.every_sim_s, wall.every_wall_s), (None, Some(600.0)));
+        assert_eq!(p("never").unwrap(), CheckpointPolicy::default());
+        for bad in ["", "0", "-1s", "nan", "tenmin", "1h"] {
+            let e = p(bad).unwrap_err().to_string();
+            assert!(e.contains("--checkpoint-every"), "{bad}: {e}");
+        }
+    }
 
     #[test]
     fn schedule_ends_exactly_at_end() {

@@ -19,8 +19,8 @@ pub struct RigidBody {
     inertia0: DMat3,
     pub pose: Pose,
     /// Linear and angular accelerations of the last evaluation.
-    accel: DVec3,
-    alpha: DVec3,
+    pub(super) accel: DVec3,
+    pub(super) alpha: DVec3,
     /// Rotation about z only (2D).
     planar: bool,
 }

@@ -224,4 +224,72 @@ impl BodySet {
     pub fn load(&self, k: usize) -> Load {
         self.loads[k]
     }
+
+    /// Everything that outlives a step, as [`SAVED_PER_BODY`] numbers per body, for
+    /// checkpoints: pose, accelerations (free bodies; zero for prescribed ones) and last load.
+    pub fn save(&self) -> Vec<f64> {
+        let mut out = Vec::with_capacity(SAVED_PER_BODY * self.len());
+        for (s, load) in self.states.iter().zip(&self.loads) {
+            let (pose, accel, alpha) = match s {
+                State::Free(b) => (b.pose, b.accel, b.alpha),
+                State::Prescribed { pose, .. } => (*pose, DVec3::ZERO, DVec3::ZERO),
+            };
+            out.extend(pose.center.to_array());
+            out.extend(pose.rotation.to_array());
+            for v in [
+                pose.velocity,
+                pose.omega,
+                accel,
+                alpha,
+                load.force,
+                load.torque,
+            ] {
+                out.extend(v.to_array());
+            }
+        }
+        out
+    }
+
+    /// Puts back what [`save`](Self::save) gave, for the same bodies.
+    pub fn restore(&mut self, saved: &[f64]) -> anyhow::Result<()> {
+        if saved.len() != SAVED_PER_BODY * self.len() {
+            anyhow::bail!(
+                "the saved state has {} numbers for the bodies; this case's {} bodies need {}",
+                saved.len(),
+                self.len(),
+                SAVED_PER_BODY * self.len()
+            );
+        }
+        for ((s, load), v) in self
+            .states
+            .iter_mut()
+            .zip(&mut self.loads)
+            .zip(saved.chunks_exact(SAVED_PER_BODY))
+        {
+            let vec3 = |k: usize| DVec3::new(v[k], v[k + 1], v[k + 2]);
+            let pose = Pose {
+                center: vec3(0),
+                rotation: DQuat::from_xyzw(v[3], v[4], v[5], v[6]),
+                velocity: vec3(7),
+                omega: vec3(10),
+            };
+            match s {
+                State::Free(b) => {
+                    b.pose = pose;
+                    b.accel = vec3(13);
+                    b.alpha = vec3(16);
+                }
+                State::Prescribed { pose: p, .. } => *p = pose,
+            }
+            *load = Load {
+                force: vec3(19),
+                torque: vec3(22),
+            };
+        }
+        Ok(())
+    }
 }
+
+/// Numbers per body in [`BodySet::save`]: centre 3, quaternion 4, velocity 3, ω 3,
+/// accelerations 3 + 3, force 3, torque 3.
+pub const SAVED_PER_BODY: usize = 25;

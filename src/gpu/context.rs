@@ -5,6 +5,7 @@
 
 use std::fmt;
 use std::str::FromStr;
+use std::sync::{Arc, Mutex};
 
 use anyhow::{anyhow, bail, Context, Result};
 
@@ -76,7 +77,80 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     pub info: wgpu::AdapterInfo,
     pub limits: wgpu::Limits,
+    /// The first error the device reported outside an error scope (out of memory, device
+    /// lost, validation); see [`GpuFaults`].
+    pub faults: GpuFaults,
 }
+
+/// The first asynchronous GPU failure of a device: out-of-memory and validation errors that no
+/// error scope caught, and device loss. wgpu's default handler panics on these; a run must
+/// instead stop with a message and keep its last checkpoint, so the handlers only record the
+/// failure here and the solver checks it after every submission it waits for.
+#[derive(Clone, Default)]
+pub struct GpuFaults(Arc<Mutex<Faults>>);
+
+#[derive(Default)]
+struct Faults {
+    /// Why the device was lost, if it was: the root cause of whatever failed around it.
+    lost: Option<String>,
+    /// The first error no scope caught.
+    first: Option<String>,
+}
+
+impl GpuFaults {
+    /// Installs the recording handlers on `device`.
+    fn watch(&self, device: &wgpu::Device) {
+        let errors = self.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            let what = match &e {
+                wgpu::Error::OutOfMemory { .. } => "the GPU ran out of memory",
+                wgpu::Error::Validation { .. } => "a GPU command was rejected",
+                wgpu::Error::Internal { .. } => "the GPU driver failed",
+            };
+            errors.record(format!("{what}: {e}"));
+        }));
+        let lost = self.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            let what = format!("the GPU device was lost ({reason:?}): {message}");
+            log::error!("{what}");
+            lost.lock().lost.get_or_insert(what);
+        });
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Faults> {
+        self.0.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Keeps the first failure (later ones are usually consequences of it).
+    pub fn record(&self, what: String) {
+        let mut f = self.lock();
+        if f.first.is_none() {
+            log::error!("{what}");
+            f.first = Some(what);
+        }
+    }
+
+    /// The failure to report, if any: the device loss when there was one (commands on a lost
+    /// device fail first, but the loss is the cause), else the first error.
+    pub fn first(&self) -> Option<String> {
+        let f = self.lock();
+        f.lost.clone().or_else(|| f.first.clone())
+    }
+
+    /// Err with the failure to report, if any.
+    pub fn check(&self) -> Result<()> {
+        match self.first() {
+            Some(what) => Err(GpuFailure(what).into()),
+            None => Ok(()),
+        }
+    }
+}
+
+/// A run cannot go on because the GPU failed (out of memory, device lost); the message says
+/// what the driver reported.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct GpuFailure(pub String);
 
 /// Storage buffers one kernel binds at most (the reorder pass: 9); see shaders/cell_list.wgsl.
 pub const STORAGE_BUFFERS_PER_STAGE: u32 = 10;
@@ -98,6 +172,15 @@ pub fn list_adapters() -> Vec<(wgpu::AdapterInfo, wgpu::Limits)> {
 
 impl GpuContext {
     pub fn new(choice: AdapterChoice) -> Result<Self> {
+        Self::with_limits(choice, |_| {})
+    }
+
+    /// As [`new`](Self::new), with the device's limits lowered by `restrict` (tests use this to
+    /// stand for a smaller GPU).
+    pub fn with_limits(
+        choice: AdapterChoice,
+        restrict: impl FnOnce(&mut wgpu::Limits),
+    ) -> Result<Self> {
         let instance = instance();
         let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::PRIMARY));
         adapters.retain(|a| match choice {
@@ -129,13 +212,14 @@ impl GpuContext {
         }
         // Ask for what the adapter can give: particle arrays are as large as the binding and
         // buffer limits allow; the solver checks its own needs against these.
-        let limits = wgpu::Limits {
+        let mut limits = wgpu::Limits {
             max_storage_buffers_per_shader_stage: STORAGE_BUFFERS_PER_STAGE,
             max_storage_buffer_binding_size: have.max_storage_buffer_binding_size,
             max_buffer_size: have.max_buffer_size,
             max_compute_workgroups_per_dimension: have.max_compute_workgroups_per_dimension,
             ..wgpu::Limits::default()
         };
+        restrict(&mut limits);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("wgsph"),
             required_features: wgpu::Features::empty(),
@@ -145,11 +229,14 @@ impl GpuContext {
             trace: wgpu::Trace::Off,
         }))
         .with_context(|| format!("requesting a device from adapter '{}'", info.name))?;
+        let faults = GpuFaults::default();
+        faults.watch(&device);
         Ok(Self {
             device,
             queue,
             info,
             limits,
+            faults,
         })
     }
 

@@ -16,6 +16,24 @@ pub(crate) fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
+/// Removes the temporary files ([`temp_path`] names) in `dir` that a killed run left behind
+/// (best effort: a file that cannot be removed stays).
+pub(crate) fn remove_stale_temps(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let is_temp = name
+            .to_str()
+            .and_then(|n| n.rsplit_once(".tmp-"))
+            .is_some_and(|(_, pid)| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
+        if is_temp && e.file_type().is_ok_and(|t| t.is_file()) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
 /// Writes a file atomically: `write` fills a buffered writer on `<path>.tmp-<pid>` (same folder),
 /// which is then flushed, fsynced and renamed onto `path`; finally the folder is fsynced (best
 /// effort) so the rename itself is durable. If anything fails — including the closure returning

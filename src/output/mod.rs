@@ -78,6 +78,9 @@ pub enum OutputError {
         expected: usize,
         got: usize,
     },
+    /// A run cannot be resumed into this output (the checkpoint and the files disagree).
+    #[error("cannot resume into {}: {reason}", path.display())]
+    Resume { path: PathBuf, reason: String },
     /// A probe name cannot be used as a file name (empty, path separator, duplicate, ...).
     #[error("invalid probe name {name:?} in {}: {reason}", dir.display())]
     ProbeName {
@@ -166,7 +169,8 @@ pub struct OutputDir {
 }
 
 impl OutputDir {
-    /// Creates DIR, DIR/particles, DIR/probes (existing folders are fine). Errors name the path.
+    /// Creates DIR, DIR/particles, DIR/probes (existing folders are fine) and removes the
+    /// temporary files a killed run may have left in them. Errors name the path.
     pub fn create(dir: &Path) -> Result<Self, OutputError> {
         for d in [
             dir.to_path_buf(),
@@ -174,7 +178,9 @@ impl OutputDir {
             dir.join(PROBES_DIR),
         ] {
             std::fs::create_dir_all(&d).map_err(|e| OutputError::io("create directory", &d, e))?;
+            atomic::remove_stale_temps(&d);
         }
+        atomic::remove_stale_temps(&dir.join(SNAPSHOTS_DIR));
         Ok(OutputDir {
             dir: dir.to_path_buf(),
             snapshots: Vec::new(),
@@ -214,6 +220,27 @@ impl OutputDir {
         let pvd_path = self.pvd_path();
         write_atomic(&pvd_path, |w| pvd::write_pvd(w, &self.snapshots))?;
         Ok(vtu_path)
+    }
+
+    /// The (time, relative path) of every snapshot written so far.
+    pub fn snapshots(&self) -> &[(f64, String)] {
+        &self.snapshots
+    }
+
+    /// Resuming a run: the series is what the checkpoint lists (snapshots a killed run wrote
+    /// after its checkpoint are dropped from the `.pvd` and overwritten by the resumed run).
+    pub fn resume_series(&mut self, snapshots: Vec<(f64, String)>) -> Result<(), OutputError> {
+        for (_, rel) in &snapshots {
+            let file = self.dir.join(rel);
+            if !file.is_file() {
+                return Err(OutputError::Resume {
+                    path: file,
+                    reason: "a snapshot the checkpoint lists is missing".into(),
+                });
+            }
+        }
+        self.snapshots = snapshots;
+        write_atomic(&self.pvd_path(), |w| pvd::write_pvd(w, &self.snapshots))
     }
 
     /// Creates one CSV per probe at DIR/probes/<name>.csv with header `t_s,<column>` (written

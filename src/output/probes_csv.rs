@@ -153,6 +153,42 @@ impl ProbeWriter {
         Ok(())
     }
 
+    /// The full text of every file (header and rows recorded so far), for checkpoints.
+    pub fn texts(&self) -> Vec<String> {
+        self.files.iter().map(|f| f.text.clone()).collect()
+    }
+
+    /// Resuming a run: replaces the rows with `texts` (what [`texts`](Self::texts) gave for the
+    /// same files) and rewrites the files, dropping rows a killed run wrote after its
+    /// checkpoint.
+    pub fn restore(&mut self, texts: &[String]) -> Result<(), OutputError> {
+        if texts.len() != self.files.len() {
+            return Err(OutputError::Resume {
+                path: self.dir.clone(),
+                reason: format!(
+                    "the checkpoint has {} tables, the case {}",
+                    texts.len(),
+                    self.files.len()
+                ),
+            });
+        }
+        for (f, text) in self.files.iter().zip(texts) {
+            let header = f.text.lines().next().unwrap_or_default();
+            if text.lines().next() != Some(header) || !text.ends_with('\n') {
+                return Err(OutputError::Resume {
+                    path: f.path.clone(),
+                    reason: format!("the checkpoint's table does not start with '{header}'"),
+                });
+            }
+        }
+        for (f, text) in self.files.iter_mut().zip(texts) {
+            f.text = text.clone();
+        }
+        self.rows = texts.first().map_or(0, |t| t.lines().count() - 1);
+        self.dirty = true;
+        self.flush()
+    }
+
     /// Makes the recorded rows durable by atomically rewriting every CSV (no-op when nothing was
     /// recorded since the last successful flush).
     pub fn flush(&mut self) -> Result<(), OutputError> {

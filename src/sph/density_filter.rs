@@ -6,7 +6,7 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 use super::buffers::ParticleBuffers;
-use crate::gpu::buffers::STORAGE;
+use crate::gpu::buffers::{read, STORAGE};
 use crate::gpu::kernel::{fold_groups, ShaderModule};
 use crate::gpu::shader::WORKGROUP_SIZE;
 use crate::gpu::Kernel;
@@ -31,8 +31,13 @@ pub struct DensityFilter {
     bind_apply: [wgpu::BindGroup; 2],
     /// Indirect dispatch arguments written by the gate.
     args: wgpu::Buffer,
+    /// [`FilterCtl`]: its `last` outlives a step, so checkpoints save it.
+    ctl: wgpu::Buffer,
     n: u32,
 }
+
+/// Byte offset of `FilterCtl::last`.
+const LAST_OFFSET: u64 = std::mem::offset_of!(FilterCtl, last) as u64;
 
 impl DensityFilter {
     /// The filter of `mode`, or None for `Mode::None`.
@@ -93,6 +98,7 @@ impl DensityFilter {
             filter,
             apply,
             args,
+            ctl,
             n: b.n,
         }))
     }
@@ -109,6 +115,17 @@ impl DensityFilter {
             pass.set_bind_group(0, &bind[p], &[]);
             pass.dispatch_workgroups_indirect(&self.args, 0);
         }
+    }
+
+    /// The GPU step count of the last filtering (0: none yet). Waits for the GPU.
+    pub fn last_applied(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<u32> {
+        let ctl: Vec<FilterCtl> = read(device, queue, &self.ctl, 1)?;
+        Ok(ctl[0].last)
+    }
+
+    /// Sets the step count of the last filtering (restoring a checkpoint).
+    pub fn set_last_applied(&self, queue: &wgpu::Queue, last: u32) {
+        queue.write_buffer(&self.ctl, LAST_OFFSET, bytemuck::bytes_of(&last));
     }
 
     /// Filters the arrays of parity `p` now, whatever the step (test hook).

@@ -11,11 +11,13 @@ pub mod grid;
 pub mod integrate;
 pub mod interaction;
 pub mod probes;
+pub mod state;
 
 use anyhow::{bail, Context, Result};
 
 use crate::body::BodySet;
 use crate::gpu::buffers::{map_read, read, readback_buffer};
+use crate::gpu::context::GpuFaults;
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::shader::{Pass, ShaderConfig};
 use crate::gpu::GpuContext;
@@ -98,9 +100,72 @@ pub fn kernel_norm(kernel: KernelKind, dim: u32, h: f64) -> f64 {
     }
 }
 
+/// How many particles fit an adapter, and the limit that binds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Capacity {
+    pub particles: u64,
+    /// The binding limit: a wgpu limit's name, or the particle id's width.
+    pub bound_by: &'static str,
+    /// That limit's value (bytes for the wgpu limits).
+    pub limit: u64,
+}
+
+/// Bytes of the largest per-particle array (positions, (v, ρ), rates: 16 bytes a particle);
+/// every other per-particle array is smaller, and the hash grid has at most 2 slots of 4 bytes
+/// a particle.
+const LARGEST_ARRAY_BYTES_PER_PARTICLE: u64 = 16;
+
+/// The most particles a device with `limits` can run: each per-particle array must fit one
+/// storage binding and one buffer, and ids have 28 bits.
+pub fn capacity(limits: &wgpu::Limits) -> Capacity {
+    let per = LARGEST_ARRAY_BYTES_PER_PARTICLE;
+    [
+        Capacity {
+            particles: limits.max_storage_buffer_binding_size / per,
+            bound_by: "max_storage_buffer_binding_size",
+            limit: limits.max_storage_buffer_binding_size,
+        },
+        Capacity {
+            particles: limits.max_buffer_size / per,
+            bound_by: "max_buffer_size",
+            limit: limits.max_buffer_size,
+        },
+        Capacity {
+            particles: ID_MASK as u64,
+            bound_by: "the 28-bit particle id",
+            limit: ID_MASK as u64,
+        },
+    ]
+    .into_iter()
+    .min_by_key(|c| c.particles)
+    .expect("three candidates")
+}
+
+/// Fails, saying how many fit and which limit binds, when `n` particles do not fit `ctx`'s
+/// device. Runs call this before they create anything.
+pub fn check_capacity(ctx: &GpuContext, n: usize) -> Result<()> {
+    let cap = capacity(&ctx.limits);
+    if n as u64 > cap.particles {
+        let limit = if cap.bound_by.starts_with("max_") {
+            format!("{} = {} MiB", cap.bound_by, cap.limit >> 20)
+        } else {
+            cap.bound_by.to_string()
+        };
+        bail!(
+            "the case has {n} particles but adapter '{}' fits at most {}: its {limit} holds              {} particles of {LARGEST_ARRAY_BYTES_PER_PARTICLE} bytes per array. Use a coarser              particles.dx_m (the count scales as dx^-dim) or a GPU with larger limits              (`wgsph info` lists them)",
+            ctx.info.name,
+            cap.particles,
+            cap.particles
+        );
+    }
+    Ok(())
+}
+
 pub struct Solver {
     device: wgpu::Device,
     queue: wgpu::Queue,
+    /// Asynchronous GPU failures (out of memory, device lost), checked after every wait.
+    faults: GpuFaults,
     pub grid: Grid,
     pub params: Params,
     buffers: ParticleBuffers,
@@ -133,22 +198,7 @@ impl Solver {
         if n == 0 {
             bail!("the case has no particles");
         }
-        if n > ID_MASK as usize {
-            bail!(
-                "{n} particles: at most {} fit the 28-bit particle id",
-                ID_MASK
-            );
-        }
-        let max_binding = ctx.limits.max_storage_buffer_binding_size;
-        let fit = max_binding / 16;
-        if n as u64 > fit {
-            bail!(
-                "{n} particles do not fit adapter '{}': its largest storage binding is {} MiB, \
-                 which holds {fit} particles (16 bytes each per array)",
-                ctx.info.name,
-                max_binding >> 20
-            );
-        }
+        check_capacity(ctx, n)?;
         let grid = Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic)?;
         let body_id_base = body_id_base(sc)?;
         let (alpha, nu, viscosity) = match ph.viscosity {
@@ -217,6 +267,9 @@ impl Solver {
             code.push(((p.kind as u32) << KIND_SHIFT) | id as u32);
         }
         let device = ctx.device.clone();
+        // Allocation failures are caught here to name what was being allocated; later ones
+        // reach `faults`.
+        let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let defs = probes::probe_defs(&sc.probes, grid.origin);
         let planes = mirror_planes(sc, grid.origin);
         let body_particles = bodies::body_particles(sc);
@@ -262,9 +315,19 @@ impl Solver {
             let host = BodySet::new(&sc.bodies, ph.gravity, ph.dim);
             Some((gpu, host, staging))
         };
+        if let Some(e) = pollster::block_on(oom.pop()) {
+            bail!(
+                "the GPU ran out of memory allocating the buffers of {n} particles ({} MiB, \
+                 {:.0} bytes a particle): use a coarser particles.dx_m or a GPU with more \
+                 memory ({e})",
+                buffers.bytes() >> 20,
+                buffers.bytes() as f64 / n as f64
+            );
+        }
         let mut solver = Self {
             device,
             queue: ctx.queue.clone(),
+            faults: ctx.faults.clone(),
             grid,
             params,
             buffers,
@@ -326,7 +389,16 @@ impl Solver {
     }
 
     fn read_state(&self) -> Result<SimState> {
-        Ok(read::<SimState>(&self.device, &self.queue, &self.buffers.state, 1)?[0])
+        let state = read::<SimState>(&self.device, &self.queue, &self.buffers.state, 1);
+        // A lost device fails the wait; say why rather than how.
+        self.faults.check()?;
+        Ok(state?[0])
+    }
+
+    /// Test hook: destroys the device, as a driver reset or an unplugged GPU would.
+    #[doc(hidden)]
+    pub fn lose_device(&self) {
+        self.device.destroy();
     }
 
     /// Takes `count` steps (as the GPU state says: dt 0 once arrived) and reads the state back.
@@ -337,7 +409,7 @@ impl Solver {
             let encoder = self.encode_steps(count);
             self.queue.submit([encoder.finish()]);
             self.state = self.read_state()?;
-            return Ok(());
+            return self.faults.check();
         }
         for _ in 0..count {
             self.step_with_bodies()?;
@@ -366,7 +438,7 @@ impl Solver {
         let loads = gpu.loads(&partials);
         let (_, host, _) = self.bodies.as_mut().expect("a run with bodies");
         host.correct(dt, &loads);
-        Ok(())
+        self.faults.check()
     }
 
     /// Records `count` steps into one command encoder.

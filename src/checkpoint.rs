@@ -1,0 +1,387 @@
+//! Checkpoint files: `DIR/checkpoint.bin`, the last state a run can resume from.
+//!
+//! Layout (little-endian): the magic `WGSPHCKP`, a format version (u32), the length of a JSON
+//! header (u64), the header, the binary sections it lists (particle arrays, straight from the
+//! GPU), and an FNV-1a 64 checksum of everything before it. The header holds the scalars as
+//! bit patterns (exact), the output series so far (snapshot list, probe CSV texts) and where
+//! the case came from. The file is written to a temporary name and renamed into place like
+//! every output, so a run killed while checkpointing keeps the previous checkpoint.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+
+use crate::layout::{Pos, SimState};
+use crate::output::write_atomic;
+use crate::scenario::Scenario;
+use crate::sph::state::SolverState;
+
+/// Name of the checkpoint file inside the output directory.
+pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
+const MAGIC: &[u8; 8] = b"WGSPHCKP";
+const FORMAT: u32 = 1;
+
+/// The case file and `--set` overrides a run was started with, so `wgsph resume` can rebuild
+/// the scenario.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CaseSource {
+    pub path: PathBuf,
+    pub overrides: Vec<String>,
+}
+
+/// Where a run's outputs stood when the checkpoint was taken.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct OutputState {
+    /// Simulated time of the next particle output.
+    pub next_output_s: f64,
+    /// (time, relative path) of every particle snapshot written.
+    pub snapshots: Vec<(f64, String)>,
+    /// Full text of every probe CSV, then of every body CSV.
+    pub probe_tables: Vec<String>,
+    pub body_tables: Vec<String>,
+    /// Wall time spent so far [s].
+    pub wall_s: f64,
+}
+
+/// Everything needed to continue a run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checkpoint {
+    pub case_name: String,
+    /// [`fingerprint`] of the scenario the run was built from.
+    pub fingerprint: u64,
+    pub source: Option<CaseSource>,
+    /// The colour field of PNG snapshots (`--snapshots`), if the run draws them.
+    pub snapshot_field: Option<String>,
+    /// The adapter the state was computed on (bit-identity holds on the same adapter only).
+    pub adapter: String,
+    pub time_s: f64,
+    pub outputs: OutputState,
+    pub solver: SolverState,
+}
+
+#[derive(Serialize, Deserialize)]
+struct Header {
+    format: u32,
+    case_name: String,
+    fingerprint: String,
+    source: Option<CaseSource>,
+    snapshot_field: Option<String>,
+    adapter: String,
+    /// For people reading the header; `time_bits` is what resumes.
+    time_s: f64,
+    time_bits: u64,
+    wall_s: f64,
+    next_output_bits: u64,
+    snapshots: Vec<(u64, String)>,
+    probe_tables: Vec<String>,
+    body_tables: Vec<String>,
+    parity: u32,
+    t_base_bits: u64,
+    steps: u64,
+    initial_dt_bits: u32,
+    filter_last: u32,
+    body_bits: Vec<u64>,
+    /// (name, bytes) of the binary sections, in file order.
+    sections: Vec<(String, u64)>,
+}
+
+/// FNV-1a 64: a checksum without a dependency; enough to tell a damaged file or a different
+/// case, not an adversary.
+#[derive(Clone, Copy)]
+pub struct Fnv(u64);
+
+impl Default for Fnv {
+    fn default() -> Self {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv {
+    pub fn update(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+
+    pub fn finish(self) -> u64 {
+        self.0
+    }
+}
+
+/// A hash of what a run's state depends on: the particles as built (positions, velocities,
+/// densities, kinds), the physics, walls, domain, probes and bodies. Time control is left
+/// out, so a resumed run may be given a later end time.
+pub fn fingerprint(sc: &Scenario) -> u64 {
+    let mut h = Fnv::default();
+    let settings = format!(
+        "{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+        sc.name, sc.physics, sc.domain, sc.walls, sc.periodic, sc.probes, sc.bodies
+    );
+    h.update(settings.as_bytes());
+    for p in &sc.particles {
+        for x in p.pos.iter().chain(&p.vel).chain([&p.rho]) {
+            h.update(&x.to_bits().to_le_bytes());
+        }
+        h.update(&[p.kind as u8]);
+    }
+    h.finish()
+}
+
+impl Checkpoint {
+    /// Writes the checkpoint to `path` atomically.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let s = &self.solver;
+        let mut sections: Vec<(&str, &[u8])> = vec![
+            ("sim", bytemuck::bytes_of(&s.sim)),
+            ("pos", bytemuck::cast_slice(&s.pos)),
+            ("velrho", bytemuck::cast_slice(&s.velrho)),
+            ("code", bytemuck::cast_slice(&s.code)),
+            ("rate", bytemuck::cast_slice(&s.rate)),
+        ];
+        if let Some(e) = &s.energy {
+            sections.push(("energy", bytemuck::cast_slice(e)));
+        }
+        let o = &self.outputs;
+        let header = Header {
+            format: FORMAT,
+            case_name: self.case_name.clone(),
+            fingerprint: format!("{:016x}", self.fingerprint),
+            source: self.source.clone(),
+            snapshot_field: self.snapshot_field.clone(),
+            adapter: self.adapter.clone(),
+            time_s: self.time_s,
+            time_bits: self.time_s.to_bits(),
+            wall_s: o.wall_s,
+            next_output_bits: o.next_output_s.to_bits(),
+            snapshots: o
+                .snapshots
+                .iter()
+                .map(|(t, f)| (t.to_bits(), f.clone()))
+                .collect(),
+            probe_tables: o.probe_tables.clone(),
+            body_tables: o.body_tables.clone(),
+            parity: s.parity,
+            t_base_bits: s.t_base.to_bits(),
+            steps: s.steps,
+            initial_dt_bits: s.initial_dt.to_bits(),
+            filter_last: s.filter_last,
+            body_bits: s.bodies.iter().map(|x| x.to_bits()).collect(),
+            sections: sections
+                .iter()
+                .map(|(n, b)| (n.to_string(), b.len() as u64))
+                .collect(),
+        };
+        let json = serde_json::to_vec(&header).context("encoding the checkpoint header")?;
+        write_atomic(path, |w| {
+            let mut sum = Fnv::default();
+            let mut put = |w: &mut dyn Write, bytes: &[u8]| {
+                sum.update(bytes);
+                w.write_all(bytes)
+            };
+            put(w, MAGIC)?;
+            put(w, &FORMAT.to_le_bytes())?;
+            put(w, &(json.len() as u64).to_le_bytes())?;
+            put(w, &json)?;
+            for (_, bytes) in &sections {
+                put(w, bytes)?;
+            }
+            w.write_all(&sum.finish().to_le_bytes())
+        })?;
+        Ok(())
+    }
+
+    /// Reads a checkpoint, checking its magic, version, checksum and section sizes.
+    pub fn read(path: &Path) -> Result<Self> {
+        let bytes = std::fs::read(path)
+            .with_context(|| format!("cannot read the checkpoint {}", path.display()))?;
+        Self::decode(&bytes).with_context(|| format!("checkpoint {}", path.display()))
+    }
+
+    fn decode(bytes: &[u8]) -> Result<Self> {
+        if bytes.len() < 28 || &bytes[..8] != MAGIC {
+            bail!("not a wgsph checkpoint (no WGSPHCKP magic)");
+        }
+        let (body, tail) = bytes.split_at(bytes.len() - 8);
+        let mut sum = Fnv::default();
+        sum.update(body);
+        if sum.finish().to_le_bytes() != tail {
+            bail!("damaged: its checksum does not match its content");
+        }
+        let format = u32::from_le_bytes(body[8..12].try_into().expect("4 bytes"));
+        if format != FORMAT {
+            bail!("format {format}; this wgsph reads format {FORMAT}");
+        }
+        let json_len = u64::from_le_bytes(body[12..20].try_into().expect("8 bytes")) as usize;
+        let json = body
+            .get(20..20usize.saturating_add(json_len))
+            .context("truncated header")?;
+        let h: Header = serde_json::from_slice(json).context("bad header")?;
+        let mut rest = &body[20 + json_len..];
+        let mut section = |name: &str| -> Result<&[u8]> {
+            let (_, len) = h
+                .sections
+                .iter()
+                .find(|(n, _)| n == name)
+                .with_context(|| format!("no '{name}' section"))?;
+            let len = *len as usize;
+            if rest.len() < len {
+                bail!("section '{name}' is truncated");
+            }
+            let (mine, more) = rest.split_at(len);
+            rest = more;
+            Ok(mine)
+        };
+        let sim: SimState = pod_one(section("sim")?, "sim")?;
+        let pos: Vec<Pos> = pod_vec(section("pos")?, "pos")?;
+        let velrho: Vec<[f32; 4]> = pod_vec(section("velrho")?, "velrho")?;
+        let code: Vec<u32> = pod_vec(section("code")?, "code")?;
+        let rate: Vec<[f32; 4]> = pod_vec(section("rate")?, "rate")?;
+        let energy = if h.sections.iter().any(|(n, _)| n == "energy") {
+            Some(pod_vec::<[f32; 2]>(section("energy")?, "energy")?)
+        } else {
+            None
+        };
+        let fingerprint = u64::from_str_radix(&h.fingerprint, 16).context("bad fingerprint")?;
+        Ok(Checkpoint {
+            case_name: h.case_name,
+            fingerprint,
+            source: h.source,
+            snapshot_field: h.snapshot_field,
+            adapter: h.adapter,
+            time_s: f64::from_bits(h.time_bits),
+            outputs: OutputState {
+                next_output_s: f64::from_bits(h.next_output_bits),
+                snapshots: h
+                    .snapshots
+                    .into_iter()
+                    .map(|(t, f)| (f64::from_bits(t), f))
+                    .collect(),
+                probe_tables: h.probe_tables,
+                body_tables: h.body_tables,
+                wall_s: h.wall_s,
+            },
+            solver: SolverState {
+                parity: h.parity,
+                t_base: f64::from_bits(h.t_base_bits),
+                steps: h.steps,
+                initial_dt: f32::from_bits(h.initial_dt_bits),
+                sim,
+                filter_last: h.filter_last,
+                pos,
+                velrho,
+                code,
+                rate,
+                energy,
+                bodies: h.body_bits.into_iter().map(f64::from_bits).collect(),
+            },
+        })
+    }
+}
+
+fn pod_vec<T: bytemuck::Pod>(bytes: &[u8], name: &str) -> Result<Vec<T>> {
+    if !bytes.len().is_multiple_of(std::mem::size_of::<T>()) {
+        bail!(
+            "section '{name}' has {} bytes, not whole elements",
+            bytes.len()
+        );
+    }
+    Ok(bytemuck::pod_collect_to_vec(bytes))
+}
+
+fn pod_one<T: bytemuck::Pod>(bytes: &[u8], name: &str) -> Result<T> {
+    if bytes.len() != std::mem::size_of::<T>() {
+        bail!("section '{name}' has {} bytes", bytes.len());
+    }
+    Ok(bytemuck::pod_read_unaligned(bytes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Checkpoint {
+        let n = 5;
+        Checkpoint {
+            case_name: "c".into(),
+            fingerprint: 0x0123_4567_89ab_cdef,
+            source: Some(CaseSource {
+                path: "/cases/a.toml".into(),
+                overrides: vec!["time.end_s=1".into()],
+            }),
+            snapshot_field: Some("speed".into()),
+            adapter: "llvmpipe".into(),
+            time_s: 0.1 + 0.2,
+            outputs: OutputState {
+                next_output_s: 1.0 / 3.0,
+                snapshots: vec![(0.0, "particles/particles_000000.vtu".into())],
+                probe_tables: vec!["t_s,pressure_pa\n0,1.5\n".into()],
+                body_tables: vec![],
+                wall_s: 12.5,
+            },
+            solver: SolverState {
+                parity: 1,
+                t_base: 0.3,
+                steps: 1234,
+                initial_dt: 1e-4,
+                sim: SimState {
+                    t_rel: 1e-7,
+                    dt: 2e-4,
+                    steps: 77,
+                    ..Default::default()
+                },
+                filter_last: 60,
+                pos: (0..n)
+                    .map(|i| Pos {
+                        off: [i as f32 * 0.1, -0.0, f32::MIN_POSITIVE],
+                        block: i,
+                    })
+                    .collect(),
+                velrho: (0..n).map(|i| [i as f32, 1.0, 2.0, 1000.5]).collect(),
+                code: (0..n).rev().collect(),
+                rate: (0..n).map(|i| [0.5, i as f32, -3.0, 1e-9]).collect(),
+                energy: Some((0..n).map(|i| [i as f32, 7.0]).collect()),
+                bodies: vec![1.0 / 7.0; crate::body::SAVED_PER_BODY],
+            },
+        }
+    }
+
+    fn temp(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("wgsph-ckp-{}-{tag}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d.join(CHECKPOINT_FILE)
+    }
+
+    #[test]
+    fn round_trips_exactly() {
+        let path = temp("roundtrip");
+        let c = sample();
+        c.write(&path).unwrap();
+        assert_eq!(Checkpoint::read(&path).unwrap(), c);
+        let mut no_energy = c.clone();
+        no_energy.solver.energy = None;
+        no_energy.write(&path).unwrap();
+        assert_eq!(Checkpoint::read(&path).unwrap(), no_energy);
+    }
+
+    #[test]
+    fn truncated_or_damaged_files_are_refused() {
+        let path = temp("damaged");
+        sample().write(&path).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        for cut in [0, 7, 20, bytes.len() / 2, bytes.len() - 1] {
+            std::fs::write(&path, &bytes[..cut]).unwrap();
+            let e = format!("{:#}", Checkpoint::read(&path).unwrap_err());
+            assert!(e.contains("checkpoint"), "{e}");
+        }
+        let mut flipped = bytes.clone();
+        let k = flipped.len() - 20;
+        flipped[k] ^= 1;
+        std::fs::write(&path, &flipped).unwrap();
+        let e = format!("{:#}", Checkpoint::read(&path).unwrap_err());
+        assert!(e.contains("checksum"), "{e}");
+    }
+}

@@ -1,0 +1,385 @@
+//! Restart and crash safety: a run split by a checkpoint and resumed is bit-identical to an
+//! uninterrupted one (fluid with density filter and energy equation; a floating body); a real
+//! run killed with SIGKILL leaves only complete files behind and resumes from its last
+//! checkpoint to the same result; Ctrl-C (SIGINT) checkpoints and stops; a lost GPU device and
+//! a case too large for the adapter give clear errors instead of panics.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use common::gpu;
+use wgsph::progress::LogLines;
+use wgsph::run::RunOptions;
+use wgsph::scenario::Scenario;
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("wgsph-restart-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn load(case: &str, set: &[&str]) -> Scenario {
+    let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+    wgsph::case::load(Path::new(case), &set).unwrap()
+}
+
+/// Every file of a run's outputs that must match between two runs: the snapshots, the probe
+/// and body CSVs (run.json differs by its wall times, the checkpoint by its history).
+fn result_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    for sub in ["particles", "probes"] {
+        let mut names: Vec<_> = std::fs::read_dir(dir.join(sub))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        for n in names {
+            let rel = format!("{sub}/{n}");
+            out.push((rel.clone(), std::fs::read(dir.join(&rel)).unwrap()));
+        }
+    }
+    out.push((
+        "particles.pvd".into(),
+        std::fs::read(dir.join("particles.pvd")).unwrap(),
+    ));
+    out
+}
+
+fn assert_same_results(a: &Path, b: &Path) {
+    let (fa, fb) = (result_files(a), result_files(b));
+    let names = |f: &[(String, Vec<u8>)]| f.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&fa), names(&fb), "the runs wrote different files");
+    for ((name, x), (_, y)) in fa.iter().zip(&fb) {
+        assert!(
+            x == y,
+            "{name} differs between the uninterrupted and the resumed run"
+        );
+    }
+}
+
+fn steps(dir: &Path) -> u64 {
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap();
+    s["steps"].as_u64().unwrap()
+}
+
+/// Runs `sc` once straight through and once halted at `halt` and resumed; every output must be
+/// the same bytes.
+fn split_run_matches(tag: &str, sc: &Scenario, halt: f64) {
+    let straight = temp_dir(&format!("{tag}-straight"));
+    let split = temp_dir(&format!("{tag}-split"));
+    let opts = RunOptions::default();
+    let a = wgsph::run::run(gpu(), sc, &straight, &opts, &mut LogLines::default()).unwrap();
+    assert!(a.stopped.is_none() && a.interrupted_at_s.is_none());
+    let halted = RunOptions {
+        halt_at_s: Some(halt),
+        ..RunOptions::default()
+    };
+    let b = wgsph::run::run(gpu(), sc, &split, &halted, &mut LogLines::default()).unwrap();
+    let t_halt = b.interrupted_at_s.expect("the split run halts");
+    assert!((t_halt - halt).abs() < 1e-9, "halted at {t_halt}");
+    assert!(
+        b.summary.status.starts_with("interrupted"),
+        "{}",
+        b.summary.status
+    );
+    let first_half = b.summary.steps;
+    let c = wgsph::run::resume(gpu(), sc, &split, &opts, &mut LogLines::default()).unwrap();
+    assert!(c.stopped.is_none() && c.interrupted_at_s.is_none());
+    println!(
+        "{tag}: {} steps straight; {first_half} + {} split",
+        a.summary.steps,
+        c.summary.steps - first_half
+    );
+    assert!(first_half > 100 && c.summary.steps > first_half + 100);
+    assert_eq!(steps(&straight), steps(&split));
+    assert_same_results(&straight, &split);
+}
+
+#[test]
+fn resume_is_bit_identical_for_a_dam_break_with_filter_and_energy() {
+    let sc = load(
+        "cases/dam_break_2d.toml",
+        &[
+            "particles.dx_m=0.0146",
+            "physics.density_filter=\"shepard\"",
+            "physics.density_filter_every=7",
+            "physics.energy=true",
+            "time.end_s=0.2",
+            "time.output_every_s=0.05",
+            "time.probe_every_s=0.01",
+        ],
+    );
+    split_run_matches("dam-break", &sc, 0.1);
+}
+
+#[test]
+fn resume_is_bit_identical_for_a_floating_body() {
+    let sc = load(
+        "cases/floating_box_2d.toml",
+        &[
+            "particles.dx_m=0.02",
+            "time.end_s=0.16",
+            "time.output_every_s=0.04",
+            "time.probe_every_s=0.01",
+        ],
+    );
+    split_run_matches("floating-box", &sc, 0.07);
+}
+
+fn wgsph() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_wgsph"))
+}
+
+/// The CLI case of the process tests: a coarse dam break, checkpoints every 0.02 s.
+const CLI_CASE: [&str; 10] = [
+    "cases/dam_break_2d.toml",
+    "--set",
+    "particles.dx_m=0.0146",
+    "--set",
+    "time.end_s=0.4",
+    "--set",
+    "time.output_every_s=0.02",
+    "--set",
+    "time.probe_every_s=0.01",
+    "--quiet",
+];
+
+/// The uninterrupted CLI run every process test compares with.
+fn reference_run() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = temp_dir("cli-reference");
+        let o = wgsph()
+            .arg("run")
+            .args(CLI_CASE)
+            .args(["--checkpoint-every", "never", "--out"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        dir
+    })
+}
+
+/// Starts the CLI run into `dir` with a checkpoint every 0.02 s.
+fn spawn_run(dir: &Path) -> std::process::Child {
+    wgsph()
+        .arg("run")
+        .args(CLI_CASE)
+        .args(["--checkpoint-every", "0.02s", "--out"])
+        .arg(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap()
+}
+
+/// Waits until `dir` has a checkpoint and `more` further snapshots beyond the first.
+fn wait_for_checkpoint(dir: &Path, child: &mut std::process::Child) {
+    let start = Instant::now();
+    while !dir.join("checkpoint.bin").is_file()
+        || !dir.join("particles/particles_000002.vtu").is_file()
+    {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended before a checkpoint"
+        );
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no checkpoint after 2 min"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// The files a killed run left: every snapshot the .pvd lists is the reference run's snapshot
+/// of the same index, byte for byte (complete, never truncated), and every CSV is a prefix of
+/// the reference CSV ending at a line end.
+fn assert_consistent_prefix(dir: &Path, reference: &Path) {
+    let pvd = std::fs::read_to_string(dir.join("particles.pvd")).unwrap();
+    let listed: Vec<&str> = pvd
+        .split("file=\"")
+        .skip(1)
+        .map(|s| s.split('"').next().unwrap())
+        .collect();
+    assert!(!listed.is_empty());
+    for f in &listed {
+        let got = std::fs::read(dir.join(f)).unwrap();
+        let want = std::fs::read(reference.join(f)).unwrap();
+        assert!(
+            got == want,
+            "{f}: listed by particles.pvd but not the complete snapshot"
+        );
+    }
+    for e in std::fs::read_dir(dir.join("probes")).unwrap() {
+        let e = e.unwrap();
+        let name = e.file_name().into_string().unwrap();
+        if name.contains(".csv.tmp-") {
+            continue; // killed while rewriting this CSV: not referenced, removed on resume
+        }
+        assert!(name.ends_with(".csv"), "stray file probes/{name}");
+        let got = std::fs::read_to_string(e.path()).unwrap();
+        let want = std::fs::read_to_string(reference.join("probes").join(&name)).unwrap();
+        assert!(
+            got.ends_with('\n') && want.starts_with(&got),
+            "probes/{name} is not a clean prefix"
+        );
+    }
+}
+
+fn resume_cli(dir: &Path) {
+    let o = wgsph()
+        .args(["resume", "--quiet"])
+        .arg(dir)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "resume failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+#[test]
+fn a_run_killed_with_sigkill_leaves_complete_files_and_resumes_to_the_same_result() {
+    let reference = reference_run();
+    for (k, extra_ms) in [0u64, 150].into_iter().enumerate() {
+        let dir = temp_dir(&format!("sigkill-{k}"));
+        let mut child = spawn_run(&dir);
+        wait_for_checkpoint(&dir, &mut child);
+        std::thread::sleep(Duration::from_millis(extra_ms));
+        child.kill().unwrap(); // SIGKILL on Unix
+        child.wait().unwrap();
+        assert_consistent_prefix(&dir, reference);
+        resume_cli(&dir);
+        // result_files() lists every file: no temporary file is left after the resume.
+        assert_same_results(reference, &dir);
+        assert_eq!(steps(reference), steps(&dir));
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn ctrl_c_writes_a_checkpoint_and_stops_then_resume_completes() {
+    let reference = reference_run();
+    let dir = temp_dir("sigint");
+    let mut child = spawn_run(&dir);
+    wait_for_checkpoint(&dir, &mut child);
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "exit status after Ctrl-C");
+    let summary = std::fs::read_to_string(dir.join("run.json")).unwrap();
+    assert!(
+        summary.contains("interrupted") && summary.contains("wgsph resume"),
+        "{summary}"
+    );
+    // The checkpoint is the one taken when the run stopped, not an earlier periodic one.
+    let json: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    let ck = wgsph::checkpoint::Checkpoint::read(&dir.join("checkpoint.bin")).unwrap();
+    assert_eq!(ck.time_s, json["simulated_time_s"].as_f64().unwrap());
+    assert_eq!(ck.solver.steps, json["steps"].as_u64().unwrap());
+    assert_consistent_prefix(&dir, reference);
+    resume_cli(&dir);
+    assert_same_results(reference, &dir);
+}
+
+#[test]
+fn resume_refuses_a_different_case() {
+    let sc = load(
+        "cases/hydrostatic_2d.toml",
+        &["time.end_s=0.05", "time.probe_every_s=0.01"],
+    );
+    let dir = temp_dir("other-case");
+    let halted = RunOptions {
+        halt_at_s: Some(0.02),
+        ..RunOptions::default()
+    };
+    wgsph::run::run(gpu(), &sc, &dir, &halted, &mut LogLines::default()).unwrap();
+    let other = load(
+        "cases/hydrostatic_2d.toml",
+        &["time.end_s=0.05", "particles.dx_m=0.025"],
+    );
+    let e = wgsph::run::resume(
+        gpu(),
+        &other,
+        &dir,
+        &RunOptions::default(),
+        &mut LogLines::default(),
+    )
+    .err()
+    .expect("a different case must be refused");
+    let msg = format!("{e:#}");
+    assert!(
+        msg.contains("different case") && msg.contains("checkpoint.bin"),
+        "{msg}"
+    );
+    // A later end time is the same case: it extends the run.
+    let longer = load(
+        "cases/hydrostatic_2d.toml",
+        &["time.end_s=0.08", "time.probe_every_s=0.01"],
+    );
+    let r = wgsph::run::resume(
+        gpu(),
+        &longer,
+        &dir,
+        &RunOptions::default(),
+        &mut LogLines::default(),
+    )
+    .unwrap();
+    assert!((r.summary.simulated_time_s - 0.08).abs() < 1e-12);
+}
+
+#[test]
+fn a_lost_device_stops_the_solver_with_a_message() {
+    let ctx =
+        wgsph::gpu::GpuContext::new(wgsph::gpu::AdapterChoice::resolve(None).unwrap()).unwrap();
+    let sc = load("cases/hydrostatic_2d.toml", &["time.end_s=0.05"]);
+    let mut solver = wgsph::sph::Solver::new(&ctx, &sc).unwrap();
+    solver.advance_to(0.01).unwrap();
+    solver.lose_device();
+    let e = solver
+        .advance_to(0.02)
+        .expect_err("stepping on a lost device must fail");
+    let msg = format!("{e:#}");
+    println!("{msg}");
+    assert!(msg.contains("device was lost"), "{msg}");
+}
+
+#[test]
+fn a_case_too_large_for_the_adapter_fails_before_the_run_starts() {
+    let ctx = wgsph::gpu::GpuContext::with_limits(
+        wgsph::gpu::AdapterChoice::resolve(None).unwrap(),
+        |l| l.max_storage_buffer_binding_size = 16 * 1000,
+    )
+    .unwrap();
+    let sc = load("cases/hydrostatic_2d.toml", &[]);
+    assert!(sc.particles.len() > 1000);
+    let dir = temp_dir("too-large");
+    let e = wgsph::run::run(
+        &ctx,
+        &sc,
+        &dir,
+        &RunOptions::default(),
+        &mut LogLines::default(),
+    )
+    .err()
+    .expect("the case must not fit");
+    let msg = format!("{e:#}");
+    println!("{msg}");
+    assert!(
+        msg.contains(&format!("{} particles", sc.particles.len()))
+            && msg.contains("fits at most 1000")
+            && msg.contains("max_storage_buffer_binding_size"),
+        "{msg}"
+    );
+    assert!(!dir.exists(), "nothing is written before the check");
+}
