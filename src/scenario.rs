@@ -131,6 +131,9 @@ pub enum ProbeKind {
 pub struct Probe {
     pub name: String,
     pub kind: ProbeKind,
+    /// The body (index into `Scenario::bodies`) the probe moves with, e.g. a pressure
+    /// transducer on a moving tank's wall; its coordinates are given at t = 0.
+    pub body: Option<usize>,
 }
 
 /// How ghost particles interpolate pressure and velocity from the fluid (the kernel W^I).

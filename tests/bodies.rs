@@ -385,3 +385,73 @@ fn a_body_in_free_flight_follows_the_exact_trajectory() {
         assert_eq!(a.vel, b.vel);
     }
 }
+
+/// A probe attached to a moving tank samples where the tank has taken it: at t = T/4 of the
+/// sloshing case's pitch (θ = −4°), an attached pressure probe and a fixed probe placed by hand
+/// at the rotated point read the same pressure; and the attached probe is not where it started.
+#[test]
+fn a_probe_attached_to_the_tank_moves_with_it() {
+    let set: Vec<String> = ["particles.dx_m=0.04", "time.end_s=1"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let mut sc = wgsph::case::load(std::path::Path::new("cases/sloshing_2d.toml"), &set).unwrap();
+    let p2 = sc.probes.iter().find(|p| p.name == "p2").unwrap().clone();
+    assert_eq!(p2.body, Some(0), "p2 is attached to the tank");
+    let ProbeKind::Pressure { point: x0 } = p2.kind else {
+        panic!("p2 is a pressure probe")
+    };
+    // The case's law: θ(t) = 4° sin(2t + π) about the pivot (0.46, 0), no translation.
+    let t1 = std::f64::consts::FRAC_PI_4;
+    let theta = 4f64.to_radians() * (2.0 * t1 + std::f64::consts::PI).sin();
+    let (s, c) = theta.sin_cos();
+    let r = [x0[0] - 0.46, x0[1]];
+    let x1 = [0.46 + c * r[0] - s * r[1], s * r[0] + c * r[1], 0.0];
+    assert!(
+        (x1[1] - x0[1]).abs() > 0.02,
+        "the probe must have moved noticeably"
+    );
+    for (name, point) in [("fixed_at_x1", x1), ("fixed_at_x0", x0)] {
+        sc.probes.push(Probe {
+            name: name.into(),
+            kind: ProbeKind::Pressure { point },
+            body: None,
+        });
+    }
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    solver.advance_to(t1).unwrap();
+    let v = solver.sample_probes().unwrap();
+    let value = |name: &str| v[sc.probes.iter().position(|p| p.name == name).unwrap()];
+    let (attached, at_x1, at_x0) = (value("p2"), value("fixed_at_x1"), value("fixed_at_x0"));
+    println!("attached {attached:.3} Pa, fixed at x1 {at_x1:.3} Pa, fixed at x0 {at_x0:.3} Pa");
+    assert!(
+        (attached - at_x1).abs() <= 1e-4 * at_x1.abs(),
+        "attached {attached} vs fixed at the moved point {at_x1}"
+    );
+    assert!((attached - at_x0).abs() > 0.05 * at_x0.abs());
+}
+
+/// `probe[].body` must name a moving body; the error names the field and the choices.
+#[test]
+fn a_probe_on_an_unknown_body_is_refused() {
+    let dir = std::env::temp_dir().join(format!("wgsph-probe-body-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string("cases/sloshing_2d.toml")
+        .unwrap()
+        .replacen(
+            "point_m = [0.915, 0.17]\nbody = \"tank\"",
+            "point_m = [0.915, 0.17]\nbody = \"lid\"",
+            1,
+        );
+    assert!(text.contains("\"lid\""));
+    let path = dir.join("case.toml");
+    std::fs::write(&path, text).unwrap();
+    let e = match wgsph::case::load(&path, &[]) {
+        Ok(_) => panic!("a probe on an unknown body was accepted"),
+        Err(e) => format!("{e:#}"),
+    };
+    assert!(
+        e.contains("probe[0].body") && e.contains("\"tank\"") && e.contains("case.toml"),
+        "{e}"
+    );
+}

@@ -270,10 +270,12 @@ fn probes_match_reference() {
             Probe {
                 name: "p".into(),
                 kind: ProbeKind::Pressure { point: centre },
+                body: None,
             },
             Probe {
                 name: "h".into(),
                 kind: ProbeKind::Height { base },
+                body: None,
             },
             Probe {
                 name: "f".into(),
@@ -281,6 +283,7 @@ fn probes_match_reference() {
                     origin: [0.01, 0.02, 0.0],
                     axis,
                 },
+                body: None,
             },
         ];
         let solver = Solver::new(gpu(), &sc).unwrap();

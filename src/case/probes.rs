@@ -107,5 +107,7 @@ pub(super) fn probe(ctx: &Ctx<'_>, i: usize, p: &RawProbe, dim: usize) -> Result
     Ok(Probe {
         name: p.name.clone(),
         kind,
+        // Resolved against the bodies once they are known (validate.rs).
+        body: None,
     })
 }

@@ -233,6 +233,8 @@ pub(super) struct RawProbe {
     pub base_m: Option<Vec<f64>>,
     pub origin_m: Option<Vec<f64>>,
     pub axis: Option<Vec<f64>>,
+    /// The body the probe moves with ("tank" for a moving tank).
+    pub body: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -656,6 +658,11 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "probe[].axis",
         "the direction of a front probe",
         "axis = [1.0, 0.0]",
+    ),
+    f(
+        "probe[].body",
+        "the body the probe moves with (\"tank\" for a moving tank)",
+        "body = \"tank\"",
     ),
 ];
 

@@ -577,6 +577,13 @@ pub(super) fn validate(
     }
 
     let bodies = super::bodies::validate(ctx, &raw.body, dim, case_dir)?;
+    let tank_moves = tank.as_ref().is_some_and(|t| t.motion.is_some());
+    for (i, (probe, p)) in probes.iter_mut().zip(&raw.probe).enumerate() {
+        probe.body = match &p.body {
+            None => None,
+            Some(name) => Some(attached_body(ctx, i, name, tank_moves, &bodies)?),
+        };
+    }
 
     Ok(Case {
         name,
@@ -602,6 +609,41 @@ pub(super) fn validate(
         probes,
         bodies,
     })
+}
+
+/// The index in the scenario's bodies (a moving tank first, then `[[body]]` in order) of the
+/// body `probe[i].body` names.
+fn attached_body(
+    ctx: &Ctx<'_>,
+    i: usize,
+    name: &str,
+    tank_moves: bool,
+    bodies: &[super::bodies::BodySpec],
+) -> Result<usize, CaseError> {
+    if name == "tank" && tank_moves {
+        return Ok(0);
+    }
+    if let Some(k) = bodies.iter().position(|b| b.name == name) {
+        return Ok(k + tank_moves as usize);
+    }
+    let mut names: Vec<String> = bodies.iter().map(|b| format!("\"{}\"", b.name)).collect();
+    if tank_moves {
+        names.insert(0, "\"tank\"".into());
+    }
+    Err(ctx.err(
+        &format!("probe[{i}].body"),
+        Some(format!("{name:?}")),
+        if name == "tank" {
+            "the tank does not move (no [tank.motion]), so nothing to attach to".to_string()
+        } else {
+            "no body has this name".to_string()
+        },
+        if names.is_empty() {
+            "remove body: the case has no moving bodies".to_string()
+        } else {
+            format!("use one of {}, or remove body", names.join(", "))
+        },
+    ))
 }
 
 /// `physics.density_filter` with `physics.density_filter_every` (default 30, only with a filter).

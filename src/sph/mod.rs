@@ -178,6 +178,8 @@ pub struct Solver {
     energy: bool,
     integrate: Integrate,
     probes: Probes,
+    /// The case's probes and the bodies' centres at t = 0, when a probe moves with a body.
+    attached_probes: Option<(Vec<crate::scenario::Probe>, Vec<[f64; 3]>)>,
     /// Moving bodies: the GPU part, the host dynamics, and the buffer the state and the
     /// per-workgroup loads are read back into after every step.
     bodies: Option<(Bodies, BodySet, wgpu::Buffer)>,
@@ -342,6 +344,12 @@ impl Solver {
                 .any(|p| matches!(p.kind, Kind::GhostNoSlip | Kind::GhostFreeSlip)),
             integrate,
             probes,
+            attached_probes: sc.probes.iter().any(|p| p.body.is_some()).then(|| {
+                (
+                    sc.probes.clone(),
+                    sc.bodies.iter().map(|b| b.center).collect(),
+                )
+            }),
             bodies,
             parity: 0,
             t_base: 0.0,
@@ -617,6 +625,18 @@ impl Solver {
     pub fn sample_probes(&self) -> Result<Vec<f64>> {
         if self.probes.is_empty() {
             return Ok(Vec::new());
+        }
+        if let (Some((list, centers)), Some(set)) = (&self.attached_probes, self.bodies()) {
+            let placed: Vec<_> = list
+                .iter()
+                .map(|p| match p.body {
+                    Some(k) => probes::moved(p, centers[k], &set.pose(k)),
+                    None => p.clone(),
+                })
+                .collect();
+            let defs = probes::probe_defs(&placed, self.grid.origin);
+            self.queue
+                .write_buffer(&self.buffers.probes, 0, bytemuck::cast_slice(&defs));
         }
         let mut encoder = self
             .device

@@ -3,10 +3,12 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
+use crate::body::Pose;
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::Kernel;
 use crate::layout::ProbeDef;
 use crate::scenario::{Probe, ProbeKind};
+use glam::DVec3;
 
 pub const PROBE_PRESSURE: u32 = 0;
 pub const PROBE_HEIGHT: u32 = 1;
@@ -39,6 +41,29 @@ pub fn probe_defs(probes: &[Probe], origin: [f64; 3]) -> Vec<ProbeDef> {
             }
         })
         .collect()
+}
+
+/// `probe` where its body has taken it: a point given at t = 0 goes to x_c + R (x0 − x_c0)
+/// (x_c0 the body's centre at t = 0, `pose` its current one) and a front's axis turns with R.
+/// A height gauge's line stays vertical in the world frame.
+pub fn moved(probe: &Probe, center0: [f64; 3], pose: &Pose) -> Probe {
+    let c0 = DVec3::from_array(center0);
+    let place =
+        |x: &[f64; 3]| (pose.center + pose.rotation * (DVec3::from_array(*x) - c0)).to_array();
+    let kind = match &probe.kind {
+        ProbeKind::Pressure { point } => ProbeKind::Pressure {
+            point: place(point),
+        },
+        ProbeKind::Height { base } => ProbeKind::Height { base: place(base) },
+        ProbeKind::Front { origin, axis } => ProbeKind::Front {
+            origin: place(origin),
+            axis: (pose.rotation * DVec3::from_array(*axis)).to_array(),
+        },
+    };
+    Probe {
+        kind,
+        ..probe.clone()
+    }
 }
 
 /// Inverse of `ordered_bits` in probes.wgsl; 0 (no fluid at all) gives NaN.
