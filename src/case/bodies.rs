@@ -8,7 +8,7 @@ use std::path::Path;
 
 use crate::scenario::{Motion, MotionLaw, Prescribed};
 
-use super::error::CaseError;
+use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::schema::{MotionName, RawBody, RawMotion, ShapeName, WallName};
 use super::validate::{aabb, number, vector, Aabb, Bound};
@@ -106,6 +106,30 @@ pub(super) fn validate(
             )?),
             (None, None) => None,
         };
+        if let Some(m) = mass {
+            // Density times a large area, or a large mass times a large size, can overflow (or
+            // a tiny density underflow to 0); the rigid-body equations divide by both.
+            let inertia = shape.inertia(dim, m);
+            let used: &[usize] = if dim == 2 { &[2] } else { &[0, 1, 2] };
+            let fine = |x: f64| x.is_finite() && x > 0.0;
+            if !(fine(m) && used.iter().all(|&a| fine(inertia[a][a]))) {
+                let (field, value) = match (b.density_kg_m3, b.mass_kg) {
+                    (Some(d), _) => ("density_kg_m3", d),
+                    (_, m) => ("mass_kg", m.unwrap_or(0.0)),
+                };
+                return Err(ctx.err(
+                    &format!("{path}.{field}"),
+                    Some(num(value)),
+                    format!(
+                        "gives the body a mass of {} kg and moments of inertia {:?} kg m² that \
+                         cannot be computed with",
+                        num(m),
+                        used.iter().map(|&a| num(inertia[a][a])).collect::<Vec<_>>()
+                    ),
+                    "give a realistic density or mass",
+                ));
+            }
+        }
         let layers = match b.layers {
             None => None,
             Some(l) if (1..=64).contains(&l) => Some(l as u32),
@@ -130,7 +154,8 @@ pub(super) fn validate(
             return Err(ctx.err(
                 &path,
                 None,
-                "a free body needs its mass: give density_kg_m3 or mass_kg",
+                "a free body (one without [body.motion], or with kind = \"free\") needs its \
+                 mass: give density_kg_m3 or mass_kg",
                 "add density_kg_m3 = 500.0 (or mass_kg)",
             ));
         }
@@ -277,7 +302,18 @@ pub(super) fn motion(
         };
         let omega = match &m.angular_velocity_rad_s {
             None => [0.0; 3],
-            Some(w) if dim == 2 && w.len() == 1 && w[0].is_finite() => [0.0, 0.0, w[0]],
+            // One component (the length is right): `vector` only checks that it is finite,
+            // naming `angular_velocity_rad_s[0]`.
+            Some(w) if dim == 2 && w.len() == 1 => {
+                let w = vector(
+                    ctx,
+                    &format!("{path}.angular_velocity_rad_s"),
+                    w,
+                    1,
+                    "the initial rate of turn about z in rad/s",
+                )?;
+                [0.0, 0.0, w[0]]
+            }
             Some(w) if dim == 3 => vector(
                 ctx,
                 &format!("{path}.angular_velocity_rad_s"),
@@ -289,7 +325,7 @@ pub(super) fn motion(
                 return Err(ctx.err(
                     &format!("{path}.angular_velocity_rad_s"),
                     Some(format!("{w:?}")),
-                    "in 2D is one finite number in a list, the rate about z",
+                    "in 2D (dimension = 2) is one number in a list, the rate about z",
                     "write angular_velocity_rad_s = [0.0]",
                 ))
             }
@@ -403,6 +439,30 @@ fn series(
     case_dir: &Path,
 ) -> Result<MotionLaw, CaseError> {
     let full = case_dir.join(file);
+    // A file, not a device or a pipe (reading /dev/zero would never end), and of a size that
+    // a series can have.
+    const MAX_BYTES: u64 = 64 << 20;
+    if let Ok(meta) = std::fs::metadata(&full) {
+        let problem = if !meta.is_file() {
+            Some(format!("{} is not a regular file", full.display()))
+        } else if meta.len() > MAX_BYTES {
+            Some(format!(
+                "{} has {} bytes, more than the {MAX_BYTES} a motion series may have",
+                full.display(),
+                meta.len()
+            ))
+        } else {
+            None
+        };
+        if let Some(problem) = problem {
+            return Err(ctx.err(
+                path,
+                Some(format!("{file:?}")),
+                problem,
+                "give the path of a CSV file relative to the case file",
+            ));
+        }
+    }
     let text = std::fs::read_to_string(&full).map_err(|e| {
         ctx.err(
             path,
@@ -471,6 +531,19 @@ impl Shape {
             Shape::Box(b) => (0..dim).map(|a| b.max[a] - b.min[a]).product(),
             Shape::Ball { radius, .. } if dim == 2 => PI * radius * radius,
             Shape::Ball { radius, .. } => 4.0 / 3.0 * PI * radius.powi(3),
+        }
+    }
+
+    /// How many lattice points [`Shape::points`] considers at spacing `dx` (at least as many
+    /// as it returns), for the particle budget.
+    pub(super) fn lattice_size(&self, dx: f64, dim: usize) -> f64 {
+        match *self {
+            Shape::Box(b) => (0..dim)
+                .map(|a| ((b.max[a] - b.min[a]) / dx).round().max(1.0))
+                .product(),
+            // Rings a spacing apart, each with about 2 pi r / dx points.
+            Shape::Ball { radius, .. } if dim == 2 => PI * (radius / dx + 1.0).powi(2),
+            Shape::Ball { radius, .. } => (2.0 * (radius / dx).ceil() + 1.0).powi(3),
         }
     }
 

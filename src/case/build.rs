@@ -1,6 +1,6 @@
 //! From a validated [`Case`] to the [`Scenario`]: geometric checks (blocks inside the tank and
-//! the domain, nothing too thin, probes inside the domain, particle budget), the particle
-//! lattices, the hydrostatic initial density and the default domain.
+//! the domain, nothing too thin, probes inside the domain; the size limits are in `limits.rs`),
+//! the particle lattices, the hydrostatic initial density and the default domain.
 
 use std::collections::HashSet;
 
@@ -9,13 +9,12 @@ use crate::scenario::{
 };
 
 use super::bodies::Shape;
-use super::error::CaseError;
+use super::error::{num, CaseError};
 use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
+use super::limits;
 use super::locate::Ctx;
 use super::validate::{Aabb, Case, Sound, Treatment};
 
-/// Refuse cases with more particles than this.
-pub const MAX_PARTICLES: f64 = 200e6;
 /// Tolerance for "inside" tests of user boxes [m].
 const TOL: f64 = 1e-9;
 const AXES: [&str; 3] = ["x", "y", "z"];
@@ -32,15 +31,7 @@ fn fmt_box(b: &Aabb, dim: usize) -> String {
     format!("{:?} to {:?}", &b.min[..dim], &b.max[..dim])
 }
 
-fn fmt_count(n: f64) -> String {
-    if n < 1e12 {
-        format!("{n:.0}")
-    } else {
-        format!("{n:.2e}")
-    }
-}
-
-pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
+pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Scenario, CaseError> {
     let (dim, dx) = (case.dim, case.dx);
     let v = dim - 1;
     let layers = case.tank.as_ref().map_or(3, |t| t.layers as i64);
@@ -59,14 +50,16 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
             let mut n = [1.0; 3];
             for (a, na) in n.iter_mut().enumerate().take(dim) {
                 *na = cells(t.inner.max[a] - t.inner.min[a], dx);
+                limits::tank_length(ctx, t.inner.max[a] - t.inner.min[a], *na, AXES[a])?;
                 if *na < 1.0 {
                     return Err(ctx.err(
                         "tank.max_m",
                         None,
                         format!(
-                            "the tank is {} m along {}, less than one particle spacing dx = {dx} m",
-                            t.inner.max[a] - t.inner.min[a],
-                            AXES[a]
+                            "the tank is {} m along {}, less than one particle spacing dx = {} m",
+                            num(t.inner.max[a] - t.inner.min[a]),
+                            AXES[a],
+                            num(dx)
                         ),
                         "make the tank larger or particles.dx_m smaller",
                     ));
@@ -95,7 +88,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
             let len = b.bx.max[a] - b.bx.min[a];
             *na = cells(len, dx);
             if *na < 1.0 {
-                return Err(ctx.err(&format!("{path}.max_m"), None, format!("the block is {len} m thick along {}, too thin to hold one particle at dx = {dx} m", AXES[a]), "make the block at least dx thick, or decrease particles.dx_m"));
+                return Err(ctx.err(&format!("{path}.max_m"), None, format!("the block is {} m thick along {}, too thin to hold one particle at dx = {} m", num(len), AXES[a], num(dx)), "make the block at least dx thick, or decrease particles.dx_m"));
             }
         }
         for (j, other) in case.blocks[..i].iter().enumerate() {
@@ -128,42 +121,48 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
     let mut obstacle_ranges = Vec::with_capacity(case.obstacles.len());
     for (i, o) in case.obstacles.iter().enumerate() {
         let Some(r) = lat.range_in(o) else {
-            return Err(ctx.err(&format!("obstacle[{i}].max_m"), None, format!("the obstacle ({}) is too thin to hold one wall particle on the particle lattice (spacing dx = {dx} m)", fmt_box(o, dim)), "make it at least dx thick along every axis, or decrease particles.dx_m"));
+            return Err(ctx.err(&format!("obstacle[{i}].max_m"), None, format!("the obstacle ({}) is too thin to hold one wall particle on the particle lattice (spacing dx = {} m)", fmt_box(o, dim), num(dx)), "make it at least dx thick along every axis, or decrease particles.dx_m"));
         };
         obstacle_ranges.push(r);
     }
 
-    // Particle budget, before anything is allocated.
-    let fluid_n: f64 = block_cells.iter().map(|n| n.iter().product::<f64>()).sum();
+    // Particle budget, before anything is allocated: every part's count (for a body, the
+    // lattice its particles are picked from, so that a long thin box counts its true length).
     let wall_of = |n: [f64; 3]| TankWall {
         n: n.map(|c| c.min(1e15) as i64),
         layers: wall_layers,
         open_top: case.tank.as_ref().is_none_or(|t| t.open_top),
         dim,
     };
-    let tank_n = tank.map_or(0.0, |(_, n)| wall_of(n).count());
-    let obstacle_n: f64 = obstacle_ranges
-        .iter()
-        .zip(&case.obstacle_walls)
-        .map(|((lo, hi), t)| {
-            let n = (0..dim).map(|a| hi[a] - lo[a] + 1.0);
-            let all: f64 = n.clone().product();
-            if *t == Treatment::Repulsive {
-                all - n.map(|c| (c - 2.0).max(0.0)).product::<f64>()
-            } else {
-                all
-            }
-        })
-        .sum();
-    let body_n: f64 = case
-        .bodies
-        .iter()
-        .map(|b| b.shape.measure(dim) / dx.powi(dim as i32))
-        .sum();
-    let total = fluid_n + tank_n + obstacle_n + body_n;
-    if total.is_nan() || total > MAX_PARTICLES {
-        return Err(ctx.err("particles.dx_m", Some(format!("{dx}")), format!("the case would create about {} particles ({} fluid, {} wall, {} body), more than the limit of 200 million", fmt_count(total), fmt_count(fluid_n), fmt_count(tank_n + obstacle_n), fmt_count(body_n)), format!("increase particles.dx_m (the count scales as 1/dx^{dim}) or shrink the geometry")));
+    let mut parts: Vec<(String, f64)> = Vec::new();
+    for (i, n) in block_cells.iter().enumerate() {
+        parts.push((format!("fluid_block[{i}]"), n.iter().product()));
     }
+    let n_fluid_parts = parts.len();
+    if let Some((_, n)) = tank {
+        parts.push(("tank".into(), wall_of(n).count()));
+    }
+    for (i, ((lo, hi), t)) in obstacle_ranges.iter().zip(&case.obstacle_walls).enumerate() {
+        let n = (0..dim).map(|a| hi[a] - lo[a] + 1.0);
+        let all: f64 = n.clone().product();
+        let count = if *t == Treatment::Repulsive {
+            all - n.map(|c| (c - 2.0).max(0.0)).product::<f64>()
+        } else {
+            all
+        };
+        parts.push((format!("obstacle[{i}]"), count));
+    }
+    let n_wall_parts = parts.len();
+    for (i, b) in case.bodies.iter().enumerate() {
+        parts.push((format!("body[{i}]"), b.shape.lattice_size(dx, dim)));
+    }
+    let total = limits::budget(
+        ctx,
+        (dx, dim),
+        &parts,
+        [n_fluid_parts, n_wall_parts],
+        max_particles,
+    )?;
     let wall = tank.map(|(_, n)| wall_of(n));
 
     let domain = domain(ctx, &case, &lat, wall.as_ref())?;
@@ -181,22 +180,31 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
                 .fold(0.0, f64::max);
             let c = k * (g * depth).sqrt();
             if !c.is_finite() || c <= 0.0 {
-                return Err(ctx.err("physics.sound_speed_coef", Some(format!("{k}")), format!("gives c0 = coef * sqrt(|g| * H) = {c} m/s with |g| = {g} m/s² and H = {depth} m"), "give physics.sound_speed_m_s instead"));
+                return Err(ctx.err("physics.sound_speed_coef", Some(num(k)), format!("gives c0 = coef * sqrt(|g| * H) = {} m/s with |g| = {} m/s² (physics.gravity_m_s2) and H = {} m (the deepest fluid block)", num(c), num(g), num(depth)), "give physics.sound_speed_m_s instead"));
             }
             c
         }
     };
+    // The field the speed of sound came from, for the errors below.
+    let (sound_path, sound_value) = match case.sound {
+        Sound::Speed(c) => ("physics.sound_speed_m_s", c),
+        Sound::Coef(k) => ("physics.sound_speed_coef", k),
+    };
     let tait_b = c0 * c0 * case.rho0 / case.gamma;
     if !(tait_b.is_finite() && tait_b > 0.0) {
-        return Err(ctx.err("physics.sound_speed_m_s", Some(format!("{c0}")), format!("gives a Tait stiffness B = c0² rho0 / gamma = {tait_b} Pa that cannot be computed with"), "use a realistic speed of sound, about 10 times the largest flow speed"));
+        return Err(ctx.err(sound_path, Some(num(sound_value)), format!("gives a Tait stiffness B = c0² rho0 / gamma = {} Pa that cannot be computed with (c0 = {} m/s, physics.rho0_kg_m3 = {}, physics.gamma = {})", num(tait_b), num(c0), num(case.rho0), num(case.gamma)), "use a realistic speed of sound, about 10 times the largest flow speed, and a realistic physics.rho0_kg_m3"));
     }
     let mass = case.rho0 * dx.powi(dim as i32);
     if !(mass.is_finite() && mass > 0.0) {
         return Err(ctx.err(
             "particles.dx_m",
-            Some(format!("{dx}")),
+            Some(num(dx)),
             format!(
-                "gives a particle mass rho0 * dx^{dim} = {mass} kg that cannot be computed with"
+                "gives a particle mass physics.rho0_kg_m3 * dx^{dim} = {} * {}^{dim} = {} kg \
+                 that cannot be computed with",
+                num(case.rho0),
+                num(dx),
+                num(mass)
             ),
             "use a spacing and density of realistic size",
         ));
@@ -222,8 +230,9 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
             )
         })
         .collect();
-    let blocked = |p: [f64; 3]| {
-        solids.iter().any(|(user, parts)| {
+    // The obstacle or body that takes the place of a fluid particle at `p`, if any.
+    let blocker = |p: [f64; 3]| {
+        let obstacle = solids.iter().position(|(user, parts)| {
             let d2: f64 = (0..dim)
                 .map(|a| {
                     (parts.min[a] - p[a])
@@ -233,23 +242,52 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
                 })
                 .sum();
             point_inside(p, user, dim) || d2 < (dx * (1.0 - 1e-6)).powi(2)
-        }) || case
-            .bodies
-            .iter()
-            .any(|b| b.shape.signed_distance(p, dim) < 0.5 * dx * (1.0 - 1e-6))
+        });
+        let body = || {
+            case.bodies
+                .iter()
+                .position(|b| b.shape.signed_distance(p, dim) < 0.5 * dx * (1.0 - 1e-6))
+        };
+        match obstacle {
+            Some(i) => Some(("obstacle", i)),
+            None => body().map(|i| ("body", i)),
+        }
     };
     let mut particles = Vec::with_capacity(total as usize);
-    for (b, n) in case.blocks.iter().zip(&block_cells) {
+    for (i, (b, n)) in case.blocks.iter().zip(&block_cells).enumerate() {
         let top = b.bx.max[v];
+        let start = particles.len();
+        let mut first_blocker = None;
         for pos in block_points(b.bx.min, n.map(|c| c as i64), dx, dim) {
-            if !blocked(pos) {
-                particles.push(Particle {
+            match blocker(pos) {
+                None => particles.push(Particle {
                     pos,
                     vel: b.vel,
                     rho: rho_at(top - pos[v]),
                     kind: Kind::Fluid,
-                });
+                }),
+                Some(s) => {
+                    first_blocker.get_or_insert(s);
+                }
             }
+        }
+        if particles.len() == start {
+            // A block wholly inside solids is a mistake, and a case without fluid is empty.
+            let solid = first_blocker.map_or(String::new(), |(kind, j)| format!("{kind}[{j}]"));
+            return Err(ctx.err(
+                &format!("fluid_block[{i}]"),
+                None,
+                format!(
+                    "the block ({}) lies inside {solid}, or within half a spacing of it \
+                     (particles.dx_m / 2 = {} m): none of its particles would be fluid",
+                    fmt_box(&b.bx, dim),
+                    num(0.5 * dx)
+                ),
+                format!(
+                    "move {solid} out of the fluid, remove fluid_block[{i}], or decrease \
+                     particles.dx_m"
+                ),
+            ));
         }
     }
 
@@ -356,10 +394,25 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
             motion,
         });
     }
-    for spec in &case.bodies {
+    for (i, spec) in case.bodies.iter().enumerate() {
         let start = particles.len();
         let center = spec.shape.center();
-        for pos in spec.shape.points(dx, dim, spec.layers) {
+        let points = spec.shape.points(dx, dim, spec.layers);
+        if let (true, Shape::Ball { radius, .. }) = (points.is_empty(), spec.shape) {
+            // Particles sit half a spacing inside the surface: a smaller ball has none, and
+            // a body without particles would feel no fluid.
+            return Err(ctx.err(
+                &format!("body[{i}].radius_m"),
+                Some(num(radius)),
+                format!(
+                    "is less than half a particle spacing (dx / 2 = {} m): the body would have \
+                     no particles",
+                    num(0.5 * dx)
+                ),
+                "make the radius a few particle spacings, or decrease particles.dx_m",
+            ));
+        }
+        for pos in points {
             let vel = match &spec.motion {
                 Motion::Free { velocity, omega } => {
                     let r = [0, 1, 2].map(|a| pos[a] - center[a]);
@@ -392,8 +445,8 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
 
     if let Some(p) = particles.iter().find(|p| !p.rho.is_finite()) {
         return Err(ctx.err(
-            "physics.sound_speed_m_s",
-            Some(format!("{c0}")),
+            sound_path,
+            Some(num(sound_value)),
             format!(
                 "is so small that the hydrostatic start density at {:?} is {}",
                 &p.pos[..dim],
@@ -455,7 +508,14 @@ fn domain(
 ) -> Result<Domain, CaseError> {
     let (dim, dx) = (case.dim, case.dx);
     let v = dim - 1;
-    let mut solid = case.obstacles.clone();
+    // The solids with the field that places each: obstacles, the tank's walls, the bodies (a
+    // prescribed motion's whole path).
+    let mut solid: Vec<(String, Aabb)> = case
+        .obstacles
+        .iter()
+        .enumerate()
+        .map(|(i, o)| (format!("obstacle[{i}]"), *o))
+        .collect();
     if let Some(w) = wall {
         let (mut min, mut max) = ([0.0; 3], [0.0; 3]);
         for a in 0..dim {
@@ -464,14 +524,15 @@ fn domain(
             max[a] = lat.origin[a] + hi as f64 * dx;
         }
         let mut b = Aabb { min, max };
+        let mut path = "tank";
         if let Some(m) = case.tank.as_ref().and_then(|t| t.motion.as_ref()) {
             b = swept(&b, m, case.time.end_s, dim);
+            path = "tank.motion";
         }
-        solid.push(b);
+        solid.push((path.into(), b));
     }
     // Bodies, each at its start position (a free body's later path is the user's business).
-    let n_fixed = solid.len();
-    for body in &case.bodies {
+    for (i, body) in case.bodies.iter().enumerate() {
         let c = body.shape.center();
         let reach = match body.shape {
             Shape::Box(b) => [0, 1, 2].map(|a| 0.5 * (b.max[a] - b.min[a])),
@@ -481,15 +542,17 @@ fn domain(
             min: [0, 1, 2].map(|a| if a < dim { c[a] - reach[a] } else { 0.0 }),
             max: [0, 1, 2].map(|a| if a < dim { c[a] + reach[a] } else { 0.0 }),
         };
+        let mut path = format!("body[{i}]");
         if let Motion::Prescribed(_) = body.motion {
             b = swept(&b, &body.motion, case.time.end_s, dim);
+            path.push_str(".motion");
         }
-        solid.push(b);
+        solid.push((path, b));
     }
     let d = match case.domain {
         Some(d) => d,
         None => {
-            let mut all: Vec<Aabb> = solid.clone();
+            let mut all: Vec<Aabb> = solid.iter().map(|(_, b)| *b).collect();
             if wall.is_none() {
                 all.extend(case.blocks.iter().map(|b| b.bx));
             }
@@ -515,7 +578,23 @@ fn domain(
             d
         }
     };
-    let fix = "enlarge [domain] (or remove it to get the default, which encloses the tank)";
+    // Which bound of [domain] to move, and to where, for a box that leaves it along `a`.
+    let fix = |b: &Aabb, a: usize| {
+        if case.domain.is_none() {
+            return "enlarge [domain] (or remove it to get the default, which encloses the tank)"
+                .to_string();
+        }
+        let (field, side, to) = if b.min[a] < d.min[a] - TOL {
+            ("min_m", "lower", b.min[a])
+        } else {
+            ("max_m", "raise", b.max[a])
+        };
+        format!(
+            "{side} domain.{field}[{a}] to {} or beyond, or remove [domain] to get the \
+             default, which encloses everything",
+            num(to)
+        )
+    };
     for (i, b) in case.blocks.iter().enumerate() {
         if let Some(a) = inside(&b.bx, &d, dim) {
             return Err(ctx.err(
@@ -527,21 +606,14 @@ fn domain(
                     fmt_box(&d, dim),
                     AXES[a]
                 ),
-                fix,
+                fix(&b.bx, a),
             ));
         }
     }
-    for (i, b) in solid.iter().enumerate() {
+    for (path, b) in &solid {
         if let Some(a) = inside(b, &d, dim) {
-            let path = if i < case.obstacles.len() {
-                format!("obstacle[{i}]")
-            } else if i < n_fixed {
-                "tank".to_string()
-            } else {
-                format!("body[{}]", i - n_fixed)
-            };
             return Err(ctx.err(
-                &path,
+                path,
                 None,
                 format!(
                     "its particles ({}) leave the domain ({}) along {} and would be dropped",
@@ -549,7 +621,7 @@ fn domain(
                     fmt_box(&d, dim),
                     AXES[a]
                 ),
-                fix,
+                fix(b, a),
             ));
         }
     }
@@ -560,18 +632,35 @@ fn domain(
             ProbeKind::Front { origin, .. } => ("origin_m", *origin),
         };
         if !point_inside(point, &d, dim) {
+            // Say what the default domain encloses: removing the tank shrinks it to the fluid.
+            let (which, fix) = match (case.domain, &case.tank) {
+                (Some(_), _) => (
+                    "the domain",
+                    "move the probe inside [domain], or enlarge it",
+                ),
+                (None, Some(_)) => (
+                    "the default domain (around the tank, obstacles and bodies)",
+                    "move the probe inside it, or give a [domain] that encloses it",
+                ),
+                (None, None) => (
+                    "the default domain (around the fluid, obstacles and bodies: there is no tank)",
+                    "move the probe inside it, or give a [domain] that encloses it",
+                ),
+            };
             return Err(ctx.err(
                 &format!("probe[{i}].{field}"),
                 Some(format!("{:?}", &point[..dim])),
-                format!("lies outside the domain ({})", fmt_box(&d, dim)),
-                "move the probe inside the domain",
+                format!("lies outside {which} ({})", fmt_box(&d, dim)),
+                fix,
             ));
         }
     }
-    Ok(Domain {
+    let domain = Domain {
         min: d.min,
         max: d.max,
-    })
+    };
+    limits::grid_fits(ctx, case, &domain, &solid)?;
+    Ok(domain)
 }
 
 /// The bounding box of `b` moved by a prescribed `motion` over [0, end_s] (sampled finely; a

@@ -94,3 +94,13 @@ impl From<Diagnostic> for CaseError {
         CaseError::Invalid(Box::new(d))
     }
 }
+
+/// A number as a message writes it: as Rust displays it, but in exponent form when very large
+/// or small (`1e300`, not three hundred digits).
+pub(super) fn num(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-6..1e16).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}

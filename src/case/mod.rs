@@ -11,6 +11,7 @@ mod build;
 mod diagnose;
 mod error;
 mod lattice;
+mod limits;
 mod locate;
 mod overrides;
 mod probes;
@@ -22,8 +23,8 @@ mod tests;
 
 use std::path::Path;
 
-pub use build::MAX_PARTICLES;
 pub use error::{CaseError, Diagnostic};
+pub use limits::MAX_PARTICLES;
 
 use crate::scenario::Scenario;
 use locate::{Ctx, Index};
@@ -42,6 +43,18 @@ pub fn load(path: &Path, overrides: &[String]) -> Result<Scenario, CaseError> {
 /// Builds a case from its text; `file_name` is used in messages and, without a `name` field,
 /// its stem becomes the case name.
 pub fn load_str(text: &str, file_name: &str, overrides: &[String]) -> Result<Scenario, CaseError> {
+    load_str_limited(text, file_name, overrides, MAX_PARTICLES)
+}
+
+/// [`load_str`] with a particle budget of `max_particles` instead of [`MAX_PARTICLES`]: a case
+/// that would create more particles is refused (naming `particles.dx_m`) before any is made.
+/// For tests that build thousands of cases and must stay small and fast (`tests/case_fuzz/`).
+pub fn load_str_limited(
+    text: &str,
+    file_name: &str,
+    overrides: &[String],
+    max_particles: f64,
+) -> Result<Scenario, CaseError> {
     let doc = toml::de::DeTable::parse(text).map_err(|e| diagnose::syntax(file_name, text, &e))?;
     let index = Index::new(text, doc.get_ref());
 
@@ -79,8 +92,16 @@ pub fn load_str(text: &str, file_name: &str, overrides: &[String]) -> Result<Sce
                 "check the --set values",
             )
         })?;
-        let doc = toml::de::DeTable::parse(&edited)
-            .map_err(|e| diagnose::syntax(file_name, &edited, &e))?;
+        // The edit of a valid document is valid TOML; should it not be, the overrides are to
+        // blame, not a line of the file.
+        let doc = toml::de::DeTable::parse(&edited).map_err(|e| {
+            ctx.err(
+                "",
+                None,
+                format!("cannot apply the overrides: {}", e.message().trim()),
+                "check the --set values",
+            )
+        })?;
         (edited.as_str(), Some(Index::new(&edited, doc.get_ref())))
     };
     let raw: RawCase = toml::from_str(de_text)
@@ -91,5 +112,5 @@ pub fn load_str(text: &str, file_name: &str, overrides: &[String]) -> Result<Sce
         .map_or_else(|| "case".to_string(), |s| s.to_string_lossy().into_owned());
     let case_dir = Path::new(file_name).parent().unwrap_or(Path::new("."));
     let case = validate::validate(&ctx, &raw, &stem, case_dir)?;
-    build::build(&ctx, case)
+    build::build(&ctx, case, max_particles)
 }

@@ -9,6 +9,9 @@ use toml::{Table, Value};
 
 use super::error::{CaseError, Diagnostic};
 
+/// Most names and indices in a key; the deepest field, `body[0].motion.pivot_m`, has 4.
+const MAX_KEY_PARTS: usize = 8;
+
 #[derive(Debug, Clone, PartialEq)]
 enum Seg {
     Key(String),
@@ -58,6 +61,18 @@ pub(super) fn parse(file: &str, arg: &str) -> Result<Override, CaseError> {
             "use a dotted field path such as particles.dx_m or probe[0].point_m",
         )
     };
+    // An index picks an entry of the list named just before it; `apply` relies on that (a
+    // list of lists, `probe.0.1`, has no tables to set a field in).
+    let push_index = |segs: &mut Vec<Seg>, i: usize| match segs.last() {
+        None => Err(bad_key("it cannot start with an index")),
+        Some(Seg::Index(_)) => Err(bad_key(
+            "an index must follow the name of a [[...]] list, as in probe[0].name",
+        )),
+        Some(Seg::Key(_)) => {
+            segs.push(Seg::Index(i));
+            Ok(())
+        }
+    };
     let mut segs = Vec::new();
     for part in raw_key.trim().split('.') {
         let (name, index) = match part.split_once('[') {
@@ -77,10 +92,7 @@ pub(super) fn parse(file: &str, arg: &str) -> Result<Override, CaseError> {
         }
         if !name.is_empty() {
             if let Ok(i) = name.parse::<usize>() {
-                if segs.is_empty() {
-                    return Err(bad_key("it cannot start with an index"));
-                }
-                segs.push(Seg::Index(i));
+                push_index(&mut segs, i)?;
             } else if name
                 .chars()
                 .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
@@ -93,14 +105,19 @@ pub(super) fn parse(file: &str, arg: &str) -> Result<Override, CaseError> {
             }
         }
         if let Some(i) = index {
-            if segs.is_empty() {
-                return Err(bad_key("it cannot start with an index"));
-            }
-            segs.push(Seg::Index(i));
+            push_index(&mut segs, i)?;
         }
     }
     if !matches!(segs.last(), Some(Seg::Key(_))) {
         return Err(bad_key("it must end with a field name"));
+    }
+    // `apply` creates the missing tables; thousands of them would overflow the stack when the
+    // document is written out again.
+    if segs.len() > MAX_KEY_PARTS {
+        return Err(bad_key(&format!(
+            "it has {} parts, but no case field is deeper than 4 (body[0].motion.pivot_m)",
+            segs.len()
+        )));
     }
     let mut key = String::new();
     for s in &segs {
@@ -223,8 +240,24 @@ mod tests {
 
     #[test]
     fn rejects_bad_keys() {
+        let deep = format!("{}=1", vec!["a"; 10_000].join("."));
         for bad in [
-            "dx", "=1", "a..b=1", "[0].a=1", "a[x].b=1", "a[0]=1", "a b=1", "0.a=1",
+            "dx",
+            "=1",
+            "a..b=1",
+            "[0].a=1",
+            "a[x].b=1",
+            "a[0]=1",
+            "a b=1",
+            "0.a=1",
+            // Two indices in a row (the fuzz test found that they reached `apply`'s
+            // `unreachable!`).
+            "probe.0.0.a=1",
+            "probe[0].1.a=1",
+            "probe.0[1].a=1",
+            // Thousands of tables made by one --set overflowed the stack (an abort).
+            &deep,
+            "a.b.c.d.e.f.g.h.i=1",
         ] {
             let e = parse("f", bad).unwrap_err().to_string();
             assert!(e.contains("--set"), "{bad}: {e}");

@@ -648,7 +648,11 @@ fn vectors_of_the_wrong_length_are_refused() {
         ),
         &[],
         Some(14),
-        &["tank.min_m", "3 components", "2D case needs 2"],
+        &[
+            "tank.min_m",
+            "3 components",
+            "2D case (dimension = 2) needs 2",
+        ],
     );
     assert_err(
         &base_with("point_m = [0.5, 0.05]", "point_m = []"),
@@ -669,7 +673,11 @@ fn vectors_of_the_wrong_length_are_refused() {
         &base_with("dimension = 2", "dimension = 3"),
         &[],
         Some(14),
-        &["tank.min_m", "2 components", "3D case needs 3"],
+        &[
+            "tank.min_m",
+            "2 components",
+            "3D case (dimension = 3) needs 3",
+        ],
     );
 }
 
@@ -834,7 +842,7 @@ fn geometry_errors() {
         &base_with("point_m = [0.5, 0.05]", "point_m = [0.5, 5.0]"),
         &[],
         Some(24),
-        &["probe[0].point_m", "outside the domain"],
+        &["probe[0].point_m", "outside the default domain"],
     );
     // Fluid outside a given domain, tank walls outside a given domain.
     let with_domain =
@@ -1051,3 +1059,7 @@ fn bad_bodies_and_motions_are_refused() {
         &["tank.motion.kind", "sine"],
     );
 }
+
+// ---------------------------------------------------------------- found by tests/case_fuzz/
+
+mod fuzz_found;

@@ -6,7 +6,7 @@ use crate::scenario::{
     DensityFilter, GhostCorrection, KernelKind, Probe, RepulsiveForm, TimeControl, Viscosity,
 };
 
-use super::error::CaseError;
+use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::schema::{
     DensityFilterName, GhostCorrectionName, KernelName, RawCase, RawPhysics, RepulsiveFormName,
@@ -119,20 +119,26 @@ pub(super) fn number(
     if !v.is_finite() {
         return Err(ctx.err(
             path,
-            Some(format!("{v}")),
+            Some(num(v)),
             format!("must be a finite number ({what})"),
             fix,
         ));
     }
     let (ok, rule) = match bound {
         Bound::Positive => (v > 0.0, "must be > 0".to_string()),
-        Bound::Closed(lo, hi) => (lo <= v && v <= hi, format!("must be in [{lo}, {hi}]")),
-        Bound::OpenClosed(lo, hi) => (lo < v && v <= hi, format!("must be in ({lo}, {hi}]")),
+        Bound::Closed(lo, hi) => (
+            lo <= v && v <= hi,
+            format!("must be in [{}, {}]", num(lo), num(hi)),
+        ),
+        Bound::OpenClosed(lo, hi) => (
+            lo < v && v <= hi,
+            format!("must be in ({}, {}]", num(lo), num(hi)),
+        ),
     };
     if ok {
         Ok(v)
     } else {
-        Err(ctx.err(path, Some(format!("{v}")), format!("{rule} ({what})"), fix))
+        Err(ctx.err(path, Some(num(v)), format!("{rule} ({what})"), fix))
     }
 }
 
@@ -154,7 +160,7 @@ pub(super) fn vector(
             path,
             Some(format!("{v:?}")),
             format!(
-                "has {} components but this {dim}D case needs {dim}: {axes} ({what})",
+                "has {} components but this {dim}D case (dimension = {dim}) needs {dim}: {axes} ({what})",
                 v.len()
             ),
             format!("give {dim} numbers, {axes}"),
@@ -165,7 +171,7 @@ pub(super) fn vector(
         if !c.is_finite() {
             return Err(ctx.err(
                 &format!("{path}[{i}]"),
-                Some(format!("{c}")),
+                Some(num(c)),
                 format!("must be a finite number ({what})"),
                 "give a finite number",
             ));
@@ -205,7 +211,8 @@ pub(super) fn aabb(
                 Some(format!("{max:?}")),
                 format!(
                     "max_m[{a}] = {} is not above min_m[{a}] = {} ({what} would be empty)",
-                    hi[a], lo[a]
+                    num(hi[a]),
+                    num(lo[a])
                 ),
                 "make every component of max_m larger than that of min_m",
             ));
@@ -282,7 +289,19 @@ pub(super) fn validate(
         "use e.g. 1000.0 for water",
     )?;
     let gravity = match &ph.gravity_m_s2 {
-        Some(g) => vector(ctx, "physics.gravity_m_s2", g, dim, "gravity in m/s²")?,
+        Some(g) => {
+            let v = vector(ctx, "physics.gravity_m_s2", g, dim, "gravity in m/s²")?;
+            // Finite components can still have an infinite magnitude |g|.
+            if !v.iter().map(|c| c * c).sum::<f64>().sqrt().is_finite() {
+                return Err(ctx.err(
+                    "physics.gravity_m_s2",
+                    Some(format!("{g:?}")),
+                    "has a magnitude too large to compute with (gravity in m/s²)",
+                    "give the gravity in m/s², e.g. [0.0, -9.81] in 2D",
+                ));
+            }
+            v
+        }
         None => {
             let mut g = [0.0; 3];
             g[dim - 1] = -9.81;
@@ -320,7 +339,7 @@ pub(super) fn validate(
     let viscosity = match ph.viscosity.unwrap_or(ViscosityName::Artificial) {
         ViscosityName::Artificial => {
             if let Some(nu) = ph.nu_m2_s {
-                return Err(ctx.err("physics.nu_m2_s", Some(format!("{nu}")), "is only used with viscosity = \"laminar\", but the viscosity is \"artificial\"", "remove nu_m2_s, or set viscosity = \"laminar\""));
+                return Err(ctx.err("physics.nu_m2_s", Some(num(nu)), "is only used with viscosity = \"laminar\", but the viscosity is \"artificial\"", "remove nu_m2_s, or set viscosity = \"laminar\""));
             }
             let alpha = number(
                 ctx,
@@ -334,7 +353,7 @@ pub(super) fn validate(
         }
         ViscosityName::Laminar => {
             if let Some(a) = ph.alpha {
-                return Err(ctx.err("physics.alpha", Some(format!("{a}")), "is only used with viscosity = \"artificial\", but the viscosity is \"laminar\"", "remove alpha, or set viscosity = \"artificial\""));
+                return Err(ctx.err("physics.alpha", Some(num(a)), "is only used with viscosity = \"artificial\", but the viscosity is \"laminar\"", "remove alpha, or set viscosity = \"artificial\""));
             }
             let Some(nu) = ph.nu_m2_s else {
                 return Err(ctx.err(

@@ -1,0 +1,157 @@
+//! The size limits of a case, checked before any particle is made: the particle budget (the
+//! message names the part with the most), the tank's length in spacings, and the extent of
+//! the solver's neighbour grid. Each refusal names the field that makes the case too large.
+
+use crate::scenario::Domain;
+use crate::sph::grid::Grid;
+
+use super::error::{num, CaseError};
+use super::locate::Ctx;
+use super::validate::{Aabb, Case};
+
+/// Refuse cases with more particles than this.
+pub const MAX_PARTICLES: f64 = 200e6;
+/// Longest tank, in particle spacings along one axis: the neighbour grid takes 2^30 cells of
+/// 2h <= 6 dx along an axis, so a longer tank could never run; its lattice count would also
+/// lose precision (and mirror walls, having no particles, escape the particle budget).
+const MAX_TANK_SPACINGS: f64 = 1e10;
+
+fn fmt_count(n: f64) -> String {
+    // + 0.0 turns the -0 of an empty sum into 0.
+    let n = n + 0.0;
+    if n < 1e12 {
+        format!("{n:.0}")
+    } else {
+        format!("{n:.2e}")
+    }
+}
+
+/// A particle budget for messages: "200 million", or the count itself when smaller.
+fn fmt_limit(n: f64) -> String {
+    if n >= 1e6 && (n / 1e6).fract() == 0.0 {
+        format!("{} million", n / 1e6)
+    } else {
+        fmt_count(n)
+    }
+}
+
+/// The tank's inner box is `len` m, `spacings` dx, along `axis`.
+pub(super) fn tank_length(
+    ctx: &Ctx<'_>,
+    len: f64,
+    spacings: f64,
+    axis: &str,
+) -> Result<(), CaseError> {
+    if spacings <= MAX_TANK_SPACINGS {
+        return Ok(());
+    }
+    Err(ctx.err(
+        "tank.max_m",
+        None,
+        format!(
+            "the tank is {} m along {axis}, {} particle spacings, more than the {} the \
+             solver's neighbour grid can hold",
+            num(len),
+            num(spacings),
+            num(MAX_TANK_SPACINGS)
+        ),
+        "make the tank smaller or particles.dx_m larger",
+    ))
+}
+
+/// The total particle count of `parts` (name, count), which are fluid blocks up to
+/// `ends[0]`, walls up to `ends[1]`, then bodies; refused above `max_particles`.
+pub(super) fn budget(
+    ctx: &Ctx<'_>,
+    (dx, dim): (f64, usize),
+    parts: &[(String, f64)],
+    ends: [usize; 2],
+    max_particles: f64,
+) -> Result<f64, CaseError> {
+    let sum = |r: std::ops::Range<usize>| parts[r].iter().map(|(_, n)| n).sum::<f64>();
+    let (fluid_n, wall_n) = (sum(0..ends[0]), sum(ends[0]..ends[1]));
+    let body_n = sum(ends[1]..parts.len());
+    let total = fluid_n + wall_n + body_n;
+    if !(total.is_nan() || total > max_particles) {
+        return Ok(total);
+    }
+    let (largest, most) = parts
+        .iter()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(("the geometry", 0.0), |(p, n)| (p.as_str(), *n));
+    Err(ctx.err(
+        "particles.dx_m",
+        Some(num(dx)),
+        format!(
+            "the case would create about {} particles ({} fluid, {} wall, {} body; the most, \
+             about {}, in {largest}), more than the limit of {}",
+            fmt_count(total),
+            fmt_count(fluid_n),
+            fmt_count(wall_n),
+            fmt_count(body_n),
+            fmt_count(most),
+            fmt_limit(max_particles)
+        ),
+        format!("increase particles.dx_m (the count scales as 1/dx^{dim}) or shrink {largest}"),
+    ))
+}
+
+/// The solver's neighbour grid (cells 2h wide) must cover the domain; an error names the
+/// given domain, or the part that stretches the default one farthest from the fluid.
+pub(super) fn grid_fits(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    domain: &Domain,
+    solid: &[(String, Aabb)],
+) -> Result<(), CaseError> {
+    let (dim, h) = (case.dim, case.h_over_dx * case.dx);
+    let Err(e) = Grid::new(domain, h, dim as u32, 0, [false; 3]) else {
+        return Ok(());
+    };
+    let extent = |a: usize| domain.max[a] - domain.min[a];
+    let a = (0..dim)
+        .max_by(|&a, &b| extent(a).total_cmp(&extent(b)))
+        .unwrap_or(0);
+    let fluid = 0.5 * (case.blocks[0].bx.min[a] + case.blocks[0].bx.max[a]);
+    let reach = |b: &Aabb| (b.min[a] - fluid).abs().max((b.max[a] - fluid).abs());
+    let (path, fix) = if case.domain.is_some() {
+        let field = if (domain.min[a] - fluid).abs() > (domain.max[a] - fluid).abs() {
+            "domain.min_m"
+        } else {
+            "domain.max_m"
+        };
+        (
+            field.to_string(),
+            "shrink [domain] to where the fluid can go, or increase particles.dx_m".to_string(),
+        )
+    } else {
+        let blocks = case
+            .blocks
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (format!("fluid_block[{i}]"), b.bx));
+        let (path, _) = solid
+            .iter()
+            .cloned()
+            .chain(blocks)
+            .max_by(|x, y| reach(&x.1).total_cmp(&reach(&y.1)))
+            .unwrap_or_else(|| ("fluid_block[0]".into(), case.blocks[0].bx));
+        let fix = format!(
+            "bring {path} closer to the fluid or make it smaller (the default domain encloses \
+             everything), or increase particles.dx_m"
+        );
+        (path, fix)
+    };
+    Err(ctx.err(
+        &path,
+        None,
+        format!(
+            "makes the domain ({:?} to {:?}) too large for the neighbour grid, whose cells are \
+             2h = {} m wide: {e}",
+            &domain.min[..dim],
+            &domain.max[..dim],
+            num(2.0 * h)
+        ),
+        fix,
+    ))
+}

@@ -1,0 +1,280 @@
+//! Property tests of the case loader on hostile input (issue 5, "Bad input"). Every field of
+//! every shipped case (`cases/*.toml`) and of the seeds in `tests/data/case_fuzz/` (which use
+//! the fields no shipped case does) is replaced by zero, negative, NaN, infinite, huge, tiny,
+//! arbitrary and mistyped values, deleted, or joined by an unknown field; vectors get the wrong
+//! length; a `--set` override must do what the same edit of the file does; arbitrary text and
+//! bytes are read as a case file.
+//!
+//! Asserted (`check.rs`): no input panics; a rejected input's message starts with the file's
+//! name, names the field (`names_field`) and gives a fix; what must fail fails, naming the
+//! field's full dotted path (NaN, infinity or a string in a number, a missing required field,
+//! an unknown field, a vector of the wrong length); what must pass passes; an accepted case
+//! builds a sane scenario (`check_sane`).
+//!
+//! CPU only. Each property prints how many inputs it tried. CI runs the `CASES_*` below;
+//! `PROPTEST_CASES=100000 cargo test --release --test case_fuzz` runs longer (every property
+//! then tries that many), `PROPTEST_RNG_SEED=n` repeats a run.
+
+mod check;
+mod doc;
+mod values;
+
+use proptest::prelude::*;
+use proptest::sample::Index;
+use proptest::test_runner::TestCaseError;
+use toml::Value;
+
+use check::{check, check_sane, expectation, load, run, write, Expect};
+use doc::{edit, node_mut, nodes, seeds, tables, vector_len, Node, Seg};
+use values::{any_value, apply, change, gentle_change, number, token};
+
+/// Particle budget of the cases built here, instead of the engine's 200 million: an accepted
+/// mutation (a ten times larger tank, say) stays small and fast, and larger ones exercise the
+/// budget check, which must name `particles.dx_m`. The largest seed (dam_break_3d) has about
+/// 180 thousand particles.
+const MAX_PARTICLES: f64 = 400_000.0;
+
+// Inputs per property in CI (`PROPTEST_CASES` overrides them all).
+const CASES_FIELDS: u32 = 3000;
+const CASES_VECTORS: u32 = 500;
+const CASES_DELETE_ADD: u32 = 1000;
+const CASES_OVERRIDES: u32 = 500;
+const CASES_COMPOUND: u32 = 1000;
+const CASES_TEXT: u32 = 3000;
+
+#[test]
+fn every_seed_builds_and_survives_a_round_trip() {
+    for seed in seeds() {
+        let direct = load(&seed.text, &seed.file, &[]).unwrap();
+        let sc = direct.unwrap_or_else(|e| panic!("{e:#}"));
+        check_sane(&sc).unwrap_or_else(|e| panic!("{}: {e}", seed.file));
+        // The same document written by the toml crate (as every mutation below is).
+        let text = toml::to_string(&seed.doc).unwrap();
+        let again = load(&text, &seed.file, &[]).unwrap().unwrap();
+        assert_eq!(sc, again, "{}", seed.file);
+    }
+}
+
+/// One field of one seed replaced by a hostile number, a mistyped value, a scaled value, or
+/// deleted.
+#[test]
+fn every_field_with_hostile_values() {
+    let strategy = (any::<Index>(), any::<Index>(), change());
+    run("fields", CASES_FIELDS, strategy, |(s, f, change)| {
+        let seed = s.get(seeds());
+        let nodes = nodes(&seed.doc);
+        let node = f.get(&nodes);
+        let new = apply(&change, &node.value);
+        let expect = expectation(seed, node, new.as_ref());
+        let doc = edit(&seed.doc, &node.segs, new);
+        check(seed, &doc, &[], &node.segs, expect, &format!("{change:?}"))
+    });
+}
+
+/// Vector fields with the wrong number of components (of any values) must be refused naming
+/// the field; with the right number of finite numbers they may pass.
+#[test]
+fn vectors_of_every_length() {
+    let strategy = (
+        any::<Index>(),
+        any::<Index>(),
+        prop::collection::vec(number(), 0..7),
+    );
+    run("vectors", CASES_VECTORS, strategy, |(s, f, items)| {
+        let seed = s.get(seeds());
+        let vectors: Vec<Node> = nodes(&seed.doc)
+            .into_iter()
+            .filter(|n| n.value.is_array() && vector_len(&n.path, seed.dim).is_some())
+            .collect();
+        let node = f.get(&vectors);
+        let new = Value::Array(items);
+        let expect = expectation(seed, node, Some(&new));
+        let doc = edit(&seed.doc, &node.segs, Some(new));
+        check(seed, &doc, &[], &node.segs, expect, "a vector")
+    });
+}
+
+/// Deleting a field (required ones must be named as missing) and adding an unknown one to any
+/// table (must be refused, naming it).
+#[test]
+fn deleted_and_unknown_fields() {
+    let strategy = (any::<Index>(), any::<Index>(), any::<bool>(), any_value());
+    run(
+        "delete_add",
+        CASES_DELETE_ADD,
+        strategy,
+        |(s, f, delete, value)| {
+            let seed = s.get(seeds());
+            if delete {
+                let nodes = nodes(&seed.doc);
+                let node = f.get(&nodes);
+                let expect = expectation(seed, node, None);
+                let doc = edit(&seed.doc, &node.segs, None);
+                check(seed, &doc, &[], &node.segs, expect, "deleted")
+            } else {
+                let mut segs = f.get(&tables(&seed.doc)).clone();
+                segs.push(Seg::Key("zz_unknown".into()));
+                let mut root = Value::Table(seed.doc.clone());
+                let (last, parent) = segs.split_last().unwrap();
+                if let (Seg::Key(k), Some(t)) = (last, node_mut(&mut root, parent).as_table_mut()) {
+                    t.insert(k.clone(), value);
+                }
+                let doc = root.as_table().unwrap().clone();
+                check(seed, &doc, &[], &segs, Expect::Reject, "an unknown field")
+            }
+        },
+    );
+}
+
+/// `--set KEY=VALUE` must give what the same edit of the file gives: the same scenario, or an
+/// error about the same field.
+#[test]
+fn overrides_agree_with_editing_the_file() {
+    let strategy = (any::<Index>(), any::<Index>(), any_value());
+    run("overrides", CASES_OVERRIDES, strategy, |(s, f, value)| {
+        let seed = s.get(seeds());
+        // --set addresses fields, not vector components.
+        let fields: Vec<Node> = nodes(&seed.doc)
+            .into_iter()
+            .filter(|n| matches!(n.segs.last(), Some(Seg::Key(_))))
+            .collect();
+        let node = f.get(&fields);
+        let doc = edit(&seed.doc, &node.segs, Some(value.clone()));
+        let Some(text) = write(&doc) else {
+            return Ok(());
+        };
+        let arg = format!("{}={value}", node.path);
+        let edited = load(&text, &seed.file, &[]).map_err(TestCaseError::fail)?;
+        let set = load(&seed.text, &seed.file, std::slice::from_ref(&arg))
+            .map_err(TestCaseError::fail)?;
+        match (&edited, &set) {
+            (Ok(a), Ok(b)) => prop_assert_eq!(a, b, "--set {}", arg),
+            (Err(a), Err(b)) => {
+                prop_assert_eq!(a.field(), b.field(), "--set {}: {:#} / {:#}", arg, a, b);
+                let msg = format!("{b:#}");
+                prop_assert!(
+                    msg.starts_with(&seed.file) && msg.contains("fix: "),
+                    "{}",
+                    msg
+                );
+            }
+            _ => prop_assert!(
+                false,
+                "--set {} gives {:?}, editing the file gives {:?}",
+                arg,
+                set.as_ref()
+                    .map(|_| "a scenario")
+                    .map_err(|e| format!("{e:#}")),
+                edited
+                    .as_ref()
+                    .map(|_| "a scenario")
+                    .map_err(|e| format!("{e:#}"))
+            ),
+        }
+        Ok(())
+    });
+}
+
+/// Several changes at once, anywhere, plus `--set` arguments with arbitrary keys: nothing
+/// panics, a refusal names the file and gives a fix, an acceptance is sane.
+#[test]
+fn compound_changes_and_arbitrary_overrides() {
+    let key = prop_oneof![
+        "[a-z_]{1,8}(\\.[a-z_0-9]{1,8}){0,3}",
+        "(tank|body|probe|fluid_block|obstacle|particles|time)([.\\[][0-9]{1,2}\\]?){0,3}(\\.[a-z_]{1,6}){0,2}",
+        ".{0,16}",
+        // Deep keys: every part becomes a table.
+        (1..300usize).prop_map(|n| vec!["tank"; n].join(".")),
+    ];
+    let set = (key, any_value()).prop_map(|(k, v)| format!("{k}={v}"));
+    let strategy = (
+        any::<Index>(),
+        prop::collection::vec((any::<Index>(), gentle_change()), 1..5),
+        // Mostly none: a random key is an unknown field, refused before the builder.
+        prop_oneof![3 => Just(Vec::new()), 1 => prop::collection::vec(set, 1..3)],
+    );
+    run(
+        "compound",
+        CASES_COMPOUND,
+        strategy,
+        |(s, changes, sets)| {
+            let seed = s.get(seeds());
+            let mut doc = seed.doc.clone();
+            let mut last = Vec::new();
+            for (f, change) in &changes {
+                let nodes = nodes(&doc);
+                if nodes.is_empty() {
+                    break;
+                }
+                let node = f.get(&nodes);
+                doc = edit(&doc, &node.segs, apply(change, &node.value));
+                last = node.segs.clone();
+            }
+            let Some(text) = write(&doc) else {
+                return Ok(());
+            };
+            match load(&text, &seed.file, &sets).map_err(TestCaseError::fail)? {
+                Ok(sc) => check_sane(&sc).map_err(|e| {
+                    TestCaseError::fail(format!("unsound: {e}: --set {sets:?} {last:?}\n{text}"))
+                }),
+                Err(e) => {
+                    let msg = format!("{e:#}");
+                    prop_assert!(
+                        msg.starts_with(&seed.file) && msg.contains("fix: "),
+                        "{}\n--set {:?}\n{}",
+                        msg,
+                        sets,
+                        text
+                    );
+                    Ok(())
+                }
+            }
+        },
+    );
+}
+
+/// Arbitrary text and bytes as a case file: no panic, and an error naming the file with a fix.
+#[test]
+fn arbitrary_text() {
+    let text = prop_oneof![
+        any::<String>(),
+        prop::collection::vec(any::<u8>(), 0..400)
+            .prop_map(|b| String::from_utf8_lossy(&b).into_owned()),
+        prop::collection::vec(token(), 0..80).prop_map(|t| t.concat()),
+        // Deep nesting (the parser has a recursion limit; the loader must not recurse more).
+        (
+            prop::sample::select(vec![("[", "]"), ("{ a = ", "}"), ("[{a=[", "]}]")]),
+            0..3000usize
+        )
+            .prop_map(|((open, close), n)| format!(
+                "dimension = {}{}\n",
+                open.repeat(n),
+                close.repeat(n)
+            )),
+        // A seed with a stray token inserted.
+        (any::<Index>(), any::<Index>(), token()).prop_map(|(s, at, t)| {
+            let text = &s.get(seeds()).text;
+            let mut cut = at.index(text.len() + 1);
+            while !text.is_char_boundary(cut) {
+                cut -= 1;
+            }
+            format!("{}{t}{}", &text[..cut], &text[cut..])
+        }),
+    ];
+    run("text", CASES_TEXT, text, |text| {
+        let file = "fuzz/arbitrary.toml";
+        match load(&text, file, &[]).map_err(TestCaseError::fail)? {
+            Ok(sc) => check_sane(&sc).map_err(TestCaseError::fail),
+            Err(e) => {
+                let msg = format!("{e:#}");
+                prop_assert!(
+                    msg.starts_with(file) && msg.contains("fix: "),
+                    "{}\n{:?}",
+                    msg,
+                    text
+                );
+                Ok(())
+            }
+        }
+    });
+}
