@@ -41,6 +41,9 @@ fn fmt_count(n: f64) -> String {
 }
 
 pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
+    if !case.solids.is_empty() {
+        return super::solids::build_solid_case(ctx, case);
+    }
     let (dim, dx) = (case.dim, case.dx);
     let v = dim - 1;
     let layers = case.tank.as_ref().map_or(3, |t| t.layers as i64);
@@ -443,6 +446,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
         walls,
         periodic: [false; 3],
         bodies,
+        solids: None,
     })
 }
 

@@ -15,6 +15,7 @@ mod locate;
 mod overrides;
 mod probes;
 mod schema;
+mod solids;
 mod validate;
 
 #[cfg(test)]
