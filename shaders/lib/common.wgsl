@@ -60,7 +60,7 @@ struct SimState {
     dt_cfl: f32,                // unclipped CFL step, for reporting
     max_speed_bits: atomic<u32>,  // max over particles of c_i + |v_i| (f32 bits; non-negative)
     max_accel_bits: atomic<u32>,  // max over fluid of |a_i| (f32 bits)
-    nan_count: atomic<u32>,     // fluid particles that became non-finite (cumulative)
+    nan_count: atomic<u32>,     // fluid and solid particles that became non-finite (cumulative)
     excluded: u32,              // particles in the excluded slot at the last sort
     steps: u32,                 // steps taken with dt > 0 since the host's base
     pad0: u32,

@@ -383,7 +383,8 @@ impl Solver {
             steps: 0,
             state: SimState::default(),
             initial_dt: 0.0,
-            n_fluid: sc.count(Kind::Fluid) as u64,
+            // Fluid and free solid particles: the ones that move and can leave the domain.
+            n_fluid: (sc.count(Kind::Fluid) + sc.count(Kind::Solid)) as u64,
             max_excluded_fraction: 0.05,
         };
         // Warm-up: one step with dt = 0 sorts the particles, evaluates the initial rates and
@@ -634,13 +635,13 @@ impl Solver {
         };
         if s.nan_count > 0 {
             return fail(format!(
-                "{} fluid particle(s) became non-finite; reduce time.cfl or check the case",
+                "{} fluid or solid particle(s) became non-finite; reduce time.cfl or check the case",
                 s.nan_count
             ));
         }
         if s.excluded as f64 > self.max_excluded_fraction * self.n_fluid as f64 {
             return fail(format!(
-                "{} of {} fluid particles left the domain (more than {:.0} %)",
+                "{} of {} fluid and solid particles left the domain (more than {:.0} %)",
                 s.excluded,
                 self.n_fluid,
                 100.0 * self.max_excluded_fraction
