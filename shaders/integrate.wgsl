@@ -70,6 +70,17 @@ fn predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         }
     } else if (kind == KIND_WALL) {
         velrho[i].w = wall_density(vr.w + dt * r.w);
+    } else if (kind == KIND_SOLID) {
+        // Elastic solid (rates from elastic.wgsl): the same predictor as the fluid, no walls.
+        let moved = move_by(pos[i], dt * vr.xyz + 0.5 * dt * dt * r.xyz);
+        pos[i] = moved.pos;
+        velrho[i] = vec4<f32>(vr.xyz + dt * r.xyz, vr.w + dt * r.w);
+        if (!moved.inside) {
+            exclude(i);
+        }
+    } else if (kind == KIND_SOLID_CLAMPED) {
+        // Held fixed: density (and stress, elastic.wgsl) only.
+        velrho[i].w = vr.w + dt * r.w;
     }
 }
 
@@ -97,6 +108,20 @@ fn correct(
             if (all_finite(v) && all_finite(r) && v.w > 0.0) {
                 speed = sound_speed_of(v.w) + length(v.xyz);
                 accel = length(r.xyz);
+            } else {
+                atomicAdd(&state.nan_count, 1u);
+                exclude(i);
+            }
+        } else if (is_solid(kind)) {
+            var v = vec4<f32>(vr.xyz, vr.w + half_dt * (r.w - rate_old[i].w));
+            if (kind == KIND_SOLID) {
+                v = vec4<f32>(vr.xyz + half_dt * (r.xyz - rate_old[i].xyz), v.w);
+            }
+            velrho[i] = v;
+            if (all_finite(v) && all_finite(r) && v.w > 0.0) {
+                // The time step sees the solid sound speed c_s = sqrt(K/ρs).
+                speed = sqrt(params.solid_c2) + length(v.xyz);
+                accel = select(0.0, length(r.xyz), kind == KIND_SOLID);
             } else {
                 atomicAdd(&state.nan_count, 1u);
                 exclude(i);

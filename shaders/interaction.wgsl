@@ -19,12 +19,13 @@
 //   each fluid j near the image of i, the ghost x_g = 2x_w − x_j with p_g = p_j, ρ_g = ρ_j and
 //   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip), the latter in
 //   the viscous terms only; near a corner also the double image across both planes.
-// Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
-// get nothing. Particles of moving bodies (dynamic boundary particles too) also get the force
-// per unit mass of their fluid neighbours, −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (the
-// opposite of what the fluid receives from them), and a contact force from boundary particles
-// of other bodies and of the fixed walls (the repulsive law above, Monaghan 1994): bodies.wgsl
-// sums both into the body's force and torque.
+// Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts, repulsive and solid
+// particles get nothing here (solid particles get theirs from elastic.wgsl, which runs next).
+// Particles of moving bodies (dynamic boundary particles too) also get the force per unit mass
+// of their fluid neighbours, −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (the opposite
+// of what the fluid receives from them), and a contact force from boundary particles of other
+// bodies and of the fixed walls (the repulsive law above, Monaghan 1994): bodies.wgsl sums both
+// into the body's force and torque.
 // Energy (the seed's eq. 3 with σ = −P I, when ENERGY): de_i/dt = ½ Σ_j m_j (P_i/ρ_i² + P_j/ρ_j²
 //   + Π_ij) v_ij·∇_i W_ij (Monaghan 1992, eq. 2.19 with the artificial-viscosity heating);
 //   laminar viscous heating is not included.
@@ -237,13 +238,18 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                     } else {
                         r += pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, false, 1.0).rate;
                     }
-                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && other_solid(body_i, code[j] & ID_MASK)) {
+                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && !is_solid(kind_j) && other_solid(body_i, code[j] & ID_MASK)) {
                     r += vec4<f32>(repulsion(x_ij, r2), 0.0);
                 }
                 continue;
             }
             if (kind_j == KIND_REPULSIVE) {
                 r += vec4<f32>(repulsion(x_ij, r2), 0.0);
+                continue;
+            }
+            if (is_solid(kind_j)) {
+                // No fluid–solid coupling yet (elastic.wgsl); the case builder refuses cases
+                // with both.
                 continue;
             }
             let vr_j = velrho[j];

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::layout::{Pos, SimState};
+use crate::layout::{Pos, SimState, SolidState};
 use crate::output::write_atomic;
 use crate::scenario::Scenario;
 use crate::sph::state::SolverState;
@@ -144,6 +144,9 @@ impl Checkpoint {
         if let Some(e) = &s.energy {
             sections.push(("energy", bytemuck::cast_slice(e)));
         }
+        if let Some(solid) = &s.solid {
+            sections.push(("solid", bytemuck::cast_slice(solid)));
+        }
         let o = &self.outputs;
         let header = Header {
             format: FORMAT,
@@ -244,6 +247,11 @@ impl Checkpoint {
         } else {
             None
         };
+        let solid = if h.sections.iter().any(|(n, _)| n == "solid") {
+            Some(pod_vec::<SolidState>(section("solid")?, "solid")?)
+        } else {
+            None
+        };
         let fingerprint = u64::from_str_radix(&h.fingerprint, 16).context("bad fingerprint")?;
         Ok(Checkpoint {
             case_name: h.case_name,
@@ -275,6 +283,7 @@ impl Checkpoint {
                 code,
                 rate,
                 energy,
+                solid,
                 bodies: h.body_bits.into_iter().map(f64::from_bits).collect(),
             },
         })
@@ -343,6 +352,15 @@ mod tests {
                 code: (0..n).rev().collect(),
                 rate: (0..n).map(|i| [0.5, i as f32, -3.0, 1e-9]).collect(),
                 energy: Some((0..n).map(|i| [i as f32, 7.0]).collect()),
+                solid: Some(
+                    (0..n)
+                        .map(|i| SolidState {
+                            tau_a: [i as f32, -1.0, 2.5, 1e3],
+                            body: i,
+                            ..Default::default()
+                        })
+                        .collect(),
+                ),
                 bodies: vec![1.0 / 7.0; crate::body::SAVED_PER_BODY],
             },
         }
@@ -363,6 +381,7 @@ mod tests {
         assert_eq!(Checkpoint::read(&path).unwrap(), c);
         let mut no_energy = c.clone();
         no_energy.solver.energy = None;
+        no_energy.solver.solid = None;
         no_energy.write(&path).unwrap();
         assert_eq!(Checkpoint::read(&path).unwrap(), no_energy);
     }

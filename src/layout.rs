@@ -39,6 +39,36 @@ pub struct Params {
     /// Id of the first body particle (bodies' particles come last); n_particles without bodies.
     pub body_id_base: u32,
     pub n_body_particles: u32,
+    /// Elastic solid (zeros without solids): reference density ρs, c_s², shear modulus μ,
+    /// particle mass, artificial viscosity α, artificial stress ε, 1/W(Δp).
+    pub solid_rho0: f32,
+    pub solid_c2: f32,
+    pub solid_mu: f32,
+    pub solid_mass: f32,
+    pub solid_alpha: f32,
+    pub solid_eps: f32,
+    pub solid_inv_w_dx: f32,
+    pub solid_pad: u32,
+}
+
+/// Mirrors `SolidState` in shaders/lib/common.wgsl: the deviatoric stress τ of a solid particle
+/// (xx, yy, zz, xy | xz, yz) [Pa], its elastic body, and dτ/dt of the last evaluation.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct SolidState {
+    pub tau_a: [f32; 4],
+    pub tau_b: [f32; 3],
+    pub body: u32,
+    pub rate_a: [f32; 4],
+    pub rate_b: [f32; 4],
+}
+
+/// Mirrors `SymRate`: dτ/dt (xx, yy, zz, xy | xz, yz, 0, 0) [Pa/s].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct SymRate {
+    pub a: [f32; 4],
+    pub b: [f32; 4],
 }
 
 /// Mirrors `SimState` in shaders/lib/common.wgsl.
@@ -210,9 +240,27 @@ mod tests {
                 repulsive_form,
                 repulsive_k_over_beta,
                 body_id_base,
-                n_body_particles
+                n_body_particles,
+                solid_rho0,
+                solid_c2,
+                solid_mu,
+                solid_mass,
+                solid_alpha,
+                solid_eps,
+                solid_inv_w_dx
             ]
         );
+    }
+
+    #[test]
+    fn solid_structs_match_wgsl() {
+        check_layout!(
+            Pass::Elastic,
+            "SolidState",
+            SolidState,
+            [tau_a, tau_b, body, rate_a, rate_b]
+        );
+        check_layout!(Pass::Elastic, "SymRate", SymRate, [a, b]);
     }
 
     #[test]

@@ -116,10 +116,19 @@ struct ParticleOutputs {
 impl ParticleOutputs {
     fn write(&mut self, solver: &Solver) -> Result<()> {
         let p = solver.read_particles()?;
-        let extra = match &p.energy {
+        let mut extra = match &p.energy {
             Some(e) => vec![("energy", e.as_slice())],
             None => vec![],
         };
+        // Deviatoric stress components of elastic solids (zero for other particles).
+        let names = ["tau_xx", "tau_yy", "tau_zz", "tau_xy", "tau_xz", "tau_yz"];
+        let tau: Vec<Vec<f32>> = match &p.stress {
+            Some(s) => (0..6).map(|c| s.iter().map(|t| t[c]).collect()).collect(),
+            None => Vec::new(),
+        };
+        for (name, v) in names.iter().zip(&tau) {
+            extra.push((name, v.as_slice()));
+        }
         let snap = Snapshot {
             time_s: solver.time(),
             pos: &p.pos,

@@ -19,11 +19,19 @@ pub enum Kind {
     GhostFreeSlip = 3,
     /// Repulsive-force boundary particle (Monaghan 1994, Lennard-Jones form).
     Repulsive = 4,
+    /// Hypoelastic solid particle (Gray, Monaghan & Swift 2001): moves with its stress.
+    Solid = 5,
+    /// Clamped solid particle: part of its body's stress sums, but held fixed in place.
+    SolidClamped = 6,
 }
 
 impl Kind {
     pub fn is_fluid(self) -> bool {
         self == Kind::Fluid
+    }
+
+    pub fn is_solid(self) -> bool {
+        matches!(self, Kind::Solid | Kind::SolidClamped)
     }
 }
 
@@ -213,6 +221,53 @@ pub struct Scenario {
     /// Moving solids (rigid bodies, moving tanks). Their particles come last in `particles`,
     /// body after body.
     pub bodies: Vec<Body>,
+    /// Elastic bodies, when the case has solid particles.
+    pub solids: Option<Solids>,
+}
+
+/// A linear hypoelastic material (Gray, Monaghan & Swift 2001, section 2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ElasticMaterial {
+    /// Reference density ρs [kg/m³].
+    pub density: f64,
+    /// Young's modulus E [Pa].
+    pub youngs_modulus: f64,
+    /// Poisson ratio ν (below 0.5).
+    pub poisson_ratio: f64,
+    /// Monaghan artificial viscosity α between solid particles (with the solid sound speed).
+    pub alpha: f64,
+    /// Artificial stress ε (Monaghan 2000; Gray, Monaghan & Swift 2001 use 0.3); 0 disables it.
+    pub artificial_stress: f64,
+}
+
+impl ElasticMaterial {
+    /// Shear modulus μ = E / (2(1 + ν)) [Pa].
+    pub fn shear_modulus(&self) -> f64 {
+        self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+    }
+
+    /// Bulk modulus K = E / (3(1 − 2ν)) [Pa].
+    pub fn bulk_modulus(&self) -> f64 {
+        self.youngs_modulus / (3.0 * (1.0 - 2.0 * self.poisson_ratio))
+    }
+
+    /// Solid sound speed c_s = sqrt(K / ρs) [m/s]; the solid's pressure is p = c_s² (ρ − ρs).
+    pub fn sound_speed(&self) -> f64 {
+        (self.bulk_modulus() / self.density).sqrt()
+    }
+}
+
+/// The solid particles of a case: one material, several bodies (solid particles interact only
+/// within their body).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Solids {
+    pub material: ElasticMaterial,
+    /// Elastic body of every particle, indexed like `Scenario::particles` (read for solid
+    /// kinds only).
+    pub body: Vec<u32>,
+    /// Initial deviatoric stress τ (xx, yy, zz, xy, xz, yz) of every particle [Pa] (read for
+    /// solid kinds only).
+    pub tau0: Vec<[f64; 6]>,
 }
 
 /// A rigid set of boundary particles that moves as one: a free body (floating box, falling

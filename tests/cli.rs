@@ -230,3 +230,33 @@ fn bad_case_files_fail_with_file_line_and_field() {
         }
     }
 }
+
+#[test]
+fn a_solid_case_runs_and_writes_the_stress() {
+    let out = temp_dir("plate");
+    let o = wgsph()
+        .args([
+            "run",
+            "cases/oscillating_plate_2d.toml",
+            "--set",
+            "time.end_s=0.01",
+            "--set",
+            "time.output_every_s=0.01",
+            "--quiet",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let vtu = std::fs::read(out.join("particles/particles_000001.vtu")).unwrap();
+    let head = String::from_utf8_lossy(&vtu[..vtu.len().min(4096)]);
+    for name in ["tau_xx", "tau_yy", "tau_xy", "pressure"] {
+        assert!(head.contains(&format!("Name=\"{name}\"")), "{name} missing");
+    }
+}

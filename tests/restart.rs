@@ -131,6 +131,19 @@ fn resume_is_bit_identical_for_a_floating_body() {
     split_run_matches("floating-box", &sc, 0.07);
 }
 
+#[test]
+fn resume_is_bit_identical_for_an_elastic_plate() {
+    let sc = load(
+        "cases/oscillating_plate_2d.toml",
+        &[
+            "time.end_s=0.04",
+            "time.output_every_s=0.01",
+            "time.probe_every_s=0.005",
+        ],
+    );
+    split_run_matches("plate", &sc, 0.02);
+}
+
 fn wgsph() -> Command {
     Command::new(env!("CARGO_BIN_EXE_wgsph"))
 }

@@ -40,6 +40,15 @@ struct Params {
     // Bodies: their particles have the ids body_id_base .. body_id_base + n_body_particles
     body_id_base: u32,          // n_particles when there are no bodies
     n_body_particles: u32,
+    // Elastic solid (Gray, Monaghan & Swift 2001); zeros when the case has no solids
+    solid_rho0: f32,            // reference density ρs [kg/m³]
+    solid_c2: f32,              // c_s² = K/ρs [m²/s²]
+    solid_mu: f32,              // shear modulus μ [Pa]
+    solid_mass: f32,            // solid particle mass [kg]
+    solid_alpha: f32,           // Monaghan artificial viscosity α between solid particles
+    solid_eps: f32,             // artificial stress ε (Monaghan 2000)
+    solid_inv_w_dx: f32,        // 1/W(Δp), Δp the initial spacing
+    solid_pad: u32,
 }
 
 // Time-stepping state that lives on the GPU; read back once per batch of steps.
@@ -51,7 +60,7 @@ struct SimState {
     dt_cfl: f32,                // unclipped CFL step, for reporting
     max_speed_bits: atomic<u32>,  // max over particles of c_i + |v_i| (f32 bits; non-negative)
     max_accel_bits: atomic<u32>,  // max over fluid of |a_i| (f32 bits)
-    nan_count: atomic<u32>,     // fluid particles that became non-finite (cumulative)
+    nan_count: atomic<u32>,     // fluid and solid particles that became non-finite (cumulative)
     excluded: u32,              // particles in the excluded slot at the last sort
     steps: u32,                 // steps taken with dt > 0 since the host's base
     pad0: u32,
@@ -74,6 +83,8 @@ const KIND_WALL: u32 = 1u;            // dynamic boundary particle
 const KIND_GHOST_NO_SLIP: u32 = 2u;   // fixed ghost, no-slip
 const KIND_GHOST_FREE_SLIP: u32 = 3u; // fixed ghost, free-slip
 const KIND_REPULSIVE: u32 = 4u;       // repulsive-force boundary particle
+const KIND_SOLID: u32 = 5u;           // hypoelastic solid particle
+const KIND_SOLID_CLAMPED: u32 = 6u;   // solid particle held fixed (in the stress sums)
 const KIND_EXCLUDED: u32 = 15u;
 
 // A particle of a moving body (rigid or prescribed): where it is in its body's frame.
@@ -85,6 +96,28 @@ struct BodyParticle {
 
 fn is_body_particle(id: u32) -> bool {
     return id >= params.body_id_base;
+}
+
+fn is_solid(kind: u32) -> bool {
+    return kind == KIND_SOLID || kind == KIND_SOLID_CLAMPED;
+}
+
+// Per solid particle, sorted with it: deviatoric stress τ = (xx, yy, zz, xy | xz, yz) [Pa],
+// its elastic body, and dτ/dt of the last evaluation (for the corrector). Mirrored by
+// `layout::SolidState`.
+struct SolidState {
+    tau_a: vec4<f32>,
+    tau_b: vec3<f32>,
+    body: u32,
+    rate_a: vec4<f32>,
+    rate_b: vec4<f32>,
+}
+
+// dτ/dt as written by the elastic pass: (xx, yy, zz, xy | xz, yz, 0, 0). Mirrored by
+// `layout::SymRate`.
+struct SymRate {
+    a: vec4<f32>,
+    b: vec4<f32>,
 }
 
 fn is_ghost(kind: u32) -> bool {

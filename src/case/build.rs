@@ -32,6 +32,9 @@ fn fmt_box(b: &Aabb, dim: usize) -> String {
 }
 
 pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Scenario, CaseError> {
+    if !case.solids.is_empty() {
+        return super::solids::build_solid_case(ctx, case);
+    }
     let (dim, dx) = (case.dim, case.dx);
     let v = dim - 1;
     let layers = case.tank.as_ref().map_or(3, |t| t.layers as i64);
@@ -496,6 +499,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         walls,
         periodic: [false; 3],
         bodies,
+        solids: None,
     })
 }
 

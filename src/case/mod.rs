@@ -16,6 +16,7 @@ mod locate;
 mod overrides;
 mod probes;
 mod schema;
+mod solids;
 mod validate;
 
 #[cfg(test)]

@@ -24,6 +24,43 @@ pub(super) struct RawCase {
     pub probe: Vec<RawProbe>,
     #[serde(default)]
     pub body: Vec<RawBody>,
+    #[serde(default)]
+    pub solid: Vec<RawSolid>,
+}
+
+/// An elastic body: `[[solid]]` (`docs/cases.md`, "Elastic solids").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSolid {
+    pub name: String,
+    pub min_m: Vec<f64>,
+    pub max_m: Vec<f64>,
+    pub density_kg_m3: f64,
+    pub youngs_modulus_pa: f64,
+    pub poisson_ratio: f64,
+    pub alpha: Option<f64>,
+    pub artificial_stress: Option<f64>,
+    pub clamped_min_m: Option<Vec<f64>>,
+    pub clamped_max_m: Option<Vec<f64>>,
+    pub initial_velocity: Option<RawSolidVelocity>,
+}
+
+/// `[solid.initial_velocity]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSolidVelocity {
+    pub kind: SolidVelocityName,
+    pub root_m: Option<Vec<f64>>,
+    pub axis: Option<Vec<f64>>,
+    pub direction: Option<Vec<f64>>,
+    pub length_m: Option<f64>,
+    pub tip_velocity_m_s: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum SolidVelocityName {
+    CantileverMode,
 }
 
 #[derive(Debug, Deserialize)]
@@ -664,6 +701,101 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "the body the probe moves with (\"tank\" for a moving tank)",
         "body = \"tank\"",
     ),
+    f(
+        "solid",
+        "a list of [[solid]] tables",
+        "[[solid]] with name, min_m, max_m and the material",
+    ),
+    f(
+        "solid[]",
+        "a [[solid]] table",
+        "[[solid]] with name, min_m, max_m and the material",
+    ),
+    f(
+        "solid[].name",
+        "the solid's name, letters, digits, _ and -",
+        "name = \"plate\"",
+    ),
+    f(
+        "solid[].min_m",
+        "the solid's lower corner in metres",
+        "min_m = [0.0, 0.0]",
+    ),
+    f(
+        "solid[].max_m",
+        "the solid's upper corner in metres",
+        "max_m = [0.26, 0.02]",
+    ),
+    f(
+        "solid[].density_kg_m3",
+        "the solid's density in kg/m³",
+        "density_kg_m3 = 1000.0",
+    ),
+    f(
+        "solid[].youngs_modulus_pa",
+        "Young's modulus in Pa",
+        "youngs_modulus_pa = 2.0e6",
+    ),
+    f(
+        "solid[].poisson_ratio",
+        "the Poisson ratio, 0 to 0.49",
+        "poisson_ratio = 0.3975",
+    ),
+    f(
+        "solid[].alpha",
+        "the artificial viscosity between solid particles",
+        "alpha = 0.1",
+    ),
+    f(
+        "solid[].artificial_stress",
+        "the artificial stress coefficient epsilon",
+        "artificial_stress = 0.3",
+    ),
+    f(
+        "solid[].clamped_min_m",
+        "the lower corner of the clamped region in metres",
+        "clamped_min_m = [0.0, 0.0]",
+    ),
+    f(
+        "solid[].clamped_max_m",
+        "the upper corner of the clamped region in metres",
+        "clamped_max_m = [0.06, 0.02]",
+    ),
+    f(
+        "solid[].initial_velocity",
+        "the [solid.initial_velocity] table",
+        "[solid.initial_velocity] with kind = \"cantilever_mode\"",
+    ),
+    f(
+        "solid[].initial_velocity.kind",
+        "the initial velocity field: cantilever_mode",
+        "kind = \"cantilever_mode\"",
+    ),
+    f(
+        "solid[].initial_velocity.root_m",
+        "the clamped end of the cantilever in metres",
+        "root_m = [0.06, 0.01]",
+    ),
+    f(
+        "solid[].initial_velocity.axis",
+        "the cantilever's axis, root to tip",
+        "axis = [1.0, 0.0]",
+    ),
+    f(
+        "solid[].initial_velocity.direction",
+        "the direction of the initial velocity",
+        "direction = [0.0, 1.0]",
+    ),
+    f(
+        "solid[].initial_velocity.length_m",
+        "the cantilever's free length in metres",
+        "length_m = 0.2",
+    ),
+    f(
+        "solid[].initial_velocity.tip_velocity_m_s",
+        "the initial tip velocity in m/s",
+        "tip_velocity_m_s = 0.57",
+    ),
 ];
 
 impl FieldHelp {
@@ -672,7 +804,7 @@ impl FieldHelp {
         let value = self.example.split_once('=').map_or("", |(_, v)| v.trim());
         match self.path {
             "dimension" | "tank.layers" | "physics.density_filter_every" => "an integer",
-            "fluid_block" | "obstacle" | "probe" | "body" => "an array of tables",
+            "fluid_block" | "obstacle" | "probe" | "body" | "solid" => "an array of tables",
             "body[].layers" => "an integer",
             _ if self.example.starts_with('[') => "a table",
             _ if value.starts_with('"') => "a string",

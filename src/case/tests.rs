@@ -966,6 +966,7 @@ fn nothing_panics_on_hostile_values() {
     assert!(n > 100);
 }
 
+mod solids;
 mod walls;
 
 mod density_filter;

@@ -95,6 +95,8 @@ pub(super) struct Case {
     pub walls: WallSettings,
     pub probes: Vec<Probe>,
     pub bodies: Vec<super::bodies::BodySpec>,
+    /// Elastic solids; a case has either fluid or solids (no coupling yet).
+    pub solids: Vec<super::solids::SolidSpec>,
 }
 
 /// Allowed range of a number.
@@ -319,6 +321,8 @@ pub(super) fn validate(
         }
         (Some(c), None) => Sound::Speed(number(ctx, "physics.sound_speed_m_s", c, Bound::Positive, "the numerical speed of sound c0 in m/s", "give a positive speed, about 10 times the largest expected flow speed")?),
         (None, Some(k)) => Sound::Coef(number(ctx, "physics.sound_speed_coef", k, Bound::Positive, "c0 = coef * sqrt(|g| * H)", "use e.g. 10.0")?),
+        // A solid-only case has no fluid to give a sound speed to (unused; see solids.rs).
+        (None, None) if raw.fluid_block.is_empty() && !raw.solid.is_empty() => Sound::Speed(1.0),
         (None, None) => {
             return Err(ctx.err(
                 "physics.sound_speed_coef",
@@ -471,11 +475,33 @@ pub(super) fn validate(
             })
         }
     };
-    if raw.fluid_block.is_empty() {
+    let solids = raw
+        .solid
+        .iter()
+        .enumerate()
+        .map(|(i, s)| super::solids::validate_solid(ctx, i, s, dim))
+        .collect::<Result<Vec<_>, _>>()?;
+    if !solids.is_empty() {
+        // No fluid–solid (or wall–solid) coupling yet: solids come alone.
+        let other = [
+            ("fluid_block", !raw.fluid_block.is_empty()),
+            ("tank", raw.tank.is_some()),
+            ("obstacle", !raw.obstacle.is_empty()),
+            ("body", !raw.body.is_empty()),
+        ];
+        if let Some((what, _)) = other.iter().find(|(_, present)| *present) {
+            return Err(ctx.err(
+                what,
+                None,
+                format!("a case with [[solid]] cannot have {what} yet: elastic solids are not coupled to fluid, walls or rigid bodies"),
+                format!("remove {what}, or the [[solid]] tables"),
+            ));
+        }
+    } else if raw.fluid_block.is_empty() {
         return Err(ctx.err(
             "fluid_block",
             None,
-            "no fluid: at least one [[fluid_block]] is required",
+            "no fluid: at least one [[fluid_block]] (or [[solid]]) is required",
             "add a [[fluid_block]] table with min_m and max_m",
         ));
     }
@@ -627,6 +653,7 @@ pub(super) fn validate(
         walls,
         probes,
         bodies,
+        solids,
     })
 }
 

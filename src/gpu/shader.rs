@@ -22,10 +22,11 @@ pub enum Pass {
     Ghost,
     DensityFilter,
     Bodies,
+    Elastic,
 }
 
 impl Pass {
-    pub const ALL: [Pass; 8] = [
+    pub const ALL: [Pass; 9] = [
         Pass::CellList,
         Pass::PrefixScan,
         Pass::Interaction,
@@ -34,6 +35,7 @@ impl Pass {
         Pass::Ghost,
         Pass::DensityFilter,
         Pass::Bodies,
+        Pass::Elastic,
     ];
 
     pub fn name(self) -> &'static str {
@@ -46,6 +48,7 @@ impl Pass {
             Pass::Ghost => "ghost",
             Pass::DensityFilter => "density_filter",
             Pass::Bodies => "bodies",
+            Pass::Elastic => "elastic",
         }
     }
 
@@ -59,6 +62,7 @@ impl Pass {
             Pass::Ghost => include_str!("../../shaders/ghost.wgsl"),
             Pass::DensityFilter => include_str!("../../shaders/density_filter.wgsl"),
             Pass::Bodies => include_str!("../../shaders/bodies.wgsl"),
+            Pass::Elastic => include_str!("../../shaders/elastic.wgsl"),
         }
     }
 

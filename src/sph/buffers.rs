@@ -2,7 +2,9 @@
 //! from one into the other); everything else is single.
 
 use crate::gpu::buffers::{storage, storage_init, uniform_init};
-use crate::layout::{BodyParticle, MirrorPlane, Params, Pos, ProbeDef, SimState};
+use crate::layout::{
+    BodyParticle, MirrorPlane, Params, Pos, ProbeDef, SimState, SolidState, SymRate,
+};
 
 pub struct ParticleBuffers {
     pub n: u32,
@@ -37,6 +39,10 @@ pub struct ParticleBuffers {
     /// Body-frame offset and body of every body particle (by id − body_id_base); one dummy
     /// element without bodies.
     pub body_particles: wgpu::Buffer,
+    /// Deviatoric stress, body and last dτ/dt of solid particles, 2 parities, and the new
+    /// dτ/dt: one element each when the case has no solids.
+    pub solid: [wgpu::Buffer; 2],
+    pub stress_rate: wgpu::Buffer,
 }
 
 /// Stand-in so a run without probes still binds a valid buffer.
@@ -52,6 +58,8 @@ pub struct InitialParticles<'a> {
     pub velrho: &'a [[f32; 4]],
     pub code: &'a [u32],
     pub body_particles: &'a [BodyParticle],
+    /// One per particle when the case has solids, else empty.
+    pub solid: &'a [SolidState],
 }
 
 impl ParticleBuffers {
@@ -122,6 +130,25 @@ impl ParticleBuffers {
                 )
             }),
             energy_rate: storage(device, "energy rate", if energy { 4 * n as u64 } else { 4 }),
+            solid: if init.solid.is_empty() {
+                [0, 1].map(|k| {
+                    storage(
+                        device,
+                        &format!("solid {k}"),
+                        std::mem::size_of::<SolidState>() as u64,
+                    )
+                })
+            } else {
+                [
+                    storage_init(device, "solid 0", init.solid),
+                    storage(device, "solid 1", std::mem::size_of_val(init.solid) as u64),
+                ]
+            },
+            stress_rate: storage(
+                device,
+                "stress rate",
+                (std::mem::size_of::<SymRate>() * init.solid.len().max(1)) as u64,
+            ),
             body_particles: if init.body_particles.is_empty() {
                 storage(
                     device,
@@ -159,8 +186,10 @@ impl ParticleBuffers {
             &self.mirror_planes,
             &self.energy_rate,
             &self.body_particles,
+            &self.stress_rate,
         ];
         all.extend(self.energy.iter());
+        all.extend(self.solid.iter());
         all.extend(
             self.pos
                 .iter()

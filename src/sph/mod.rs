@@ -6,6 +6,7 @@ pub mod bodies;
 pub mod buffers;
 pub mod cell_list;
 pub mod density_filter;
+pub mod elastic;
 pub mod ghost;
 pub mod grid;
 pub mod integrate;
@@ -29,6 +30,7 @@ use bodies::Bodies;
 use buffers::{InitialParticles, ParticleBuffers};
 use cell_list::CellList;
 use density_filter::DensityFilter;
+use elastic::Elastic;
 use ghost::Ghost;
 use grid::Grid;
 use integrate::Integrate;
@@ -70,6 +72,9 @@ pub struct Particles {
     pub id: Vec<u32>,
     /// Specific internal energy [J/kg], when the energy equation is on.
     pub energy: Option<Vec<f32>>,
+    /// Deviatoric stress τ (xx, yy, zz, xy, xz, yz) [Pa], when the case has solids (zeros for
+    /// other particles).
+    pub stress: Option<Vec<[f32; 6]>>,
 }
 
 /// (positions, (v, ρ), code words) as stored on the GPU.
@@ -177,6 +182,8 @@ pub struct Solver {
     has_ghosts: bool,
     energy: bool,
     integrate: Integrate,
+    /// Elastic solid particles, if the case has any.
+    elastic: Option<Elastic>,
     probes: Probes,
     /// The case's probes and the bodies' centres at t = 0, when a probe moves with a body.
     attached_probes: Option<(Vec<crate::scenario::Probe>, Vec<[f64; 3]>)>,
@@ -207,7 +214,7 @@ impl Solver {
             Viscosity::Artificial { alpha } => (alpha, 0.0, 0),
             Viscosity::Laminar { nu } => (0.0, nu, 1),
         };
-        let params = Params {
+        let mut params = Params {
             grid_cells: grid.cells,
             hash_mask: grid.slots - 1,
             block_size: grid.block_size,
@@ -241,7 +248,19 @@ impl Solver {
             repulsive_k_over_beta: (sc.walls.repulsive_k / sc.walls.repulsive_beta) as f32,
             body_id_base,
             n_body_particles: n as u32 - body_id_base,
+            ..Default::default()
         };
+        if let Some(solids) = &sc.solids {
+            let m = &solids.material;
+            params.solid_rho0 = m.density as f32;
+            params.solid_c2 = (m.sound_speed() * m.sound_speed()) as f32;
+            params.solid_mu = m.shear_modulus() as f32;
+            params.solid_mass = (m.density * ph.dx.powi(ph.dim as i32)) as f32;
+            params.solid_alpha = m.alpha as f32;
+            params.solid_eps = m.artificial_stress as f32;
+            params.solid_inv_w_dx =
+                (1.0 / crate::reference::kernel::w(ph.kernel, ph.dim, ph.h, ph.dx)) as f32;
+        }
         let cfg = ShaderConfig {
             dim: ph.dim,
             kernel: match ph.kernel {
@@ -275,6 +294,7 @@ impl Solver {
         let defs = probes::probe_defs(&sc.probes, grid.origin);
         let planes = mirror_planes(sc, grid.origin);
         let body_particles = bodies::body_particles(sc);
+        let solid = solid_states(sc)?;
         let buffers = ParticleBuffers::new(
             &device,
             &params,
@@ -284,6 +304,7 @@ impl Solver {
                 velrho: &velrho,
                 code: &code,
                 body_particles: &body_particles,
+                solid: &solid,
             },
             &defs,
             &planes,
@@ -296,6 +317,7 @@ impl Solver {
             &module(Pass::PrefixScan)?,
             &buffers,
             ph.energy,
+            sc.solids.is_some(),
         )?;
         let interaction = Interaction::new(&device, &module(Pass::Interaction)?, &buffers)?;
         let ghost = Ghost::new(&device, &module(Pass::Ghost)?, &buffers)?;
@@ -304,6 +326,10 @@ impl Solver {
             mode => DensityFilter::new(&device, &module(Pass::DensityFilter)?, &buffers, mode)?,
         };
         let integrate = Integrate::new(&device, &module(Pass::Integrate)?, &buffers)?;
+        let elastic = match sc.solids {
+            Some(_) => Some(Elastic::new(&device, &module(Pass::Elastic)?, &buffers)?),
+            None => None,
+        };
         let probes = Probes::new(&device, &module(Pass::Probes)?, &buffers, &defs)?;
         let bodies = if sc.bodies.is_empty() {
             None
@@ -343,6 +369,7 @@ impl Solver {
                 .iter()
                 .any(|p| matches!(p.kind, Kind::GhostNoSlip | Kind::GhostFreeSlip)),
             integrate,
+            elastic,
             probes,
             attached_probes: sc.probes.iter().any(|p| p.body.is_some()).then(|| {
                 (
@@ -356,7 +383,8 @@ impl Solver {
             steps: 0,
             state: SimState::default(),
             initial_dt: 0.0,
-            n_fluid: sc.count(Kind::Fluid) as u64,
+            // Fluid and free solid particles: the ones that move and can leave the domain.
+            n_fluid: (sc.count(Kind::Fluid) + sc.count(Kind::Solid)) as u64,
             max_excluded_fraction: 0.05,
         };
         // Warm-up: one step with dt = 0 sorts the particles, evaluates the initial rates and
@@ -466,6 +494,9 @@ impl Solver {
                 timestamp_writes: None,
             });
             self.integrate.encode_predict(&mut pass, p);
+            if let Some(e) = &self.elastic {
+                e.encode_predict(&mut pass, p);
+            }
             if let Some(b) = bodies {
                 b.encode_move(&mut pass, p);
             }
@@ -477,6 +508,10 @@ impl Solver {
                 self.ghost.encode(&mut pass, q);
             }
             self.interaction.encode(&mut pass, q);
+            if let Some(e) = &self.elastic {
+                e.encode_rates(&mut pass, q);
+                e.encode_correct(&mut pass, q);
+            }
             if let Some(b) = bodies {
                 b.encode_force(&mut pass, q);
             }
@@ -600,13 +635,13 @@ impl Solver {
         };
         if s.nan_count > 0 {
             return fail(format!(
-                "{} fluid particle(s) became non-finite; reduce time.cfl or check the case",
+                "{} fluid or solid particle(s) became non-finite; reduce time.cfl or check the case",
                 s.nan_count
             ));
         }
         if s.excluded as f64 > self.max_excluded_fraction * self.n_fluid as f64 {
             return fail(format!(
-                "{} of {} fluid particles left the domain (more than {:.0} %)",
+                "{} of {} fluid and solid particles left the domain (more than {:.0} %)",
                 s.excluded,
                 self.n_fluid,
                 100.0 * self.max_excluded_fraction
@@ -654,14 +689,20 @@ impl Solver {
         Ok(self.probes.decode(&raw))
     }
 
-    /// Test hook: re-runs only the interaction pass on the current arrays and returns the rates.
-    /// With `poison`, `rate` is first filled with NaN so an entry the kernel skips cannot pass.
+    /// Test hook: re-runs only the interaction pass (and the elastic rates, with solids) on the
+    /// current arrays and returns the rates. With `poison`, `rate` (and the stress rates) are
+    /// first filled with NaN so an entry the kernel skips cannot pass.
     #[doc(hidden)]
     pub fn rerun_interaction(&self, poison: bool) -> Result<Vec<[f32; 4]>> {
         if poison {
             let nan = vec![f32::NAN; 4 * self.buffers.n as usize];
             self.queue
                 .write_buffer(&self.buffers.rate, 0, bytemuck::cast_slice(&nan));
+            if self.elastic.is_some() {
+                let nan = vec![f32::NAN; 8 * self.buffers.n as usize];
+                self.queue
+                    .write_buffer(&self.buffers.stress_rate, 0, bytemuck::cast_slice(&nan));
+            }
         }
         let mut encoder = self
             .device
@@ -673,9 +714,40 @@ impl Solver {
             timestamp_writes: None,
         });
         self.interaction.encode(&mut pass, self.parity);
+        if let Some(e) = &self.elastic {
+            e.encode_rates(&mut pass, self.parity);
+        }
         drop(pass);
         self.queue.submit([encoder.finish()]);
         self.read_rates()
+    }
+
+    /// Test hook: the solid state (τ, body, last dτ/dt) of the current arrays, GPU order.
+    #[doc(hidden)]
+    pub fn read_solid(&self) -> Result<Vec<crate::layout::SolidState>> {
+        if self.elastic.is_none() {
+            bail!("the case has no solids");
+        }
+        read(
+            &self.device,
+            &self.queue,
+            &self.buffers.solid[self.parity],
+            self.buffers.n as usize,
+        )
+    }
+
+    /// Test hook: dτ/dt of the last evaluation, GPU order.
+    #[doc(hidden)]
+    pub fn read_stress_rates(&self) -> Result<Vec<crate::layout::SymRate>> {
+        if self.elastic.is_none() {
+            bail!("the case has no solids");
+        }
+        read(
+            &self.device,
+            &self.queue,
+            &self.buffers.stress_rate,
+            self.buffers.n as usize,
+        )
     }
 
     /// The body particle `id` belongs to, if any.
@@ -814,6 +886,10 @@ impl Solver {
         } else {
             None
         };
+        let solid = match &self.elastic {
+            Some(_) => Some(self.read_solid()?),
+            None => None,
+        };
         let mut order: Vec<usize> = (0..pos.len()).collect();
         order.sort_unstable_by_key(|&i| code[i] & ID_MASK);
         let b = self.params.tait_b as f64;
@@ -825,12 +901,25 @@ impl Solver {
             let v = velrho[i];
             out.vel.push([v[0], v[1], v[2]]);
             out.rho.push(v[3]);
-            out.pressure
-                .push((b * ((v[3] as f64 / rho0).powf(gamma) - 1.0)) as f32);
-            out.kind.push(code[i] >> KIND_SHIFT);
+            let kind = code[i] >> KIND_SHIFT;
+            if kind == Kind::Solid as u32 || kind == Kind::SolidClamped as u32 {
+                // p = c_s² (ρ − ρs).
+                out.pressure
+                    .push(self.params.solid_c2 * (v[3] - self.params.solid_rho0));
+            } else {
+                out.pressure
+                    .push((b * ((v[3] as f64 / rho0).powf(gamma) - 1.0)) as f32);
+            }
+            out.kind.push(kind);
             out.id.push(code[i] & ID_MASK);
             if let Some(e) = &energy {
                 out.energy.get_or_insert_with(Vec::new).push(e[i][0]);
+            }
+            if let Some(s) = &solid {
+                let (a, b) = (s[i].tau_a, s[i].tau_b);
+                out.stress
+                    .get_or_insert_with(Vec::new)
+                    .push([a[0], a[1], a[2], a[3], b[0], b[1]]);
             }
         }
         Ok(out)
@@ -858,6 +947,35 @@ fn body_id_base(sc: &Scenario) -> Result<u32> {
         bail!("the bodies' particles must be the last ones of the scenario");
     }
     Ok(base as u32)
+}
+
+/// The initial solid state of every particle (τ0, body), or nothing without solids.
+fn solid_states(sc: &Scenario) -> Result<Vec<crate::layout::SolidState>> {
+    let Some(solids) = &sc.solids else {
+        return Ok(Vec::new());
+    };
+    let n = sc.particles.len();
+    if solids.body.len() != n || solids.tau0.len() != n {
+        bail!(
+            "the solids have {} bodies and {} stresses for {n} particles",
+            solids.body.len(),
+            solids.tau0.len()
+        );
+    }
+    if sc.particles.iter().any(|p| p.kind.is_fluid()) {
+        bail!("cases with both fluid and elastic solids are not supported yet (no fluid–solid coupling)");
+    }
+    Ok((0..n)
+        .map(|i| {
+            let t = solids.tau0[i].map(|x| x as f32);
+            crate::layout::SolidState {
+                tau_a: [t[0], t[1], t[2], t[3]],
+                tau_b: [t[4], t[5], 0.0],
+                body: solids.body[i],
+                ..Default::default()
+            }
+        })
+        .collect())
 }
 
 /// Kind word of an excluded particle, for callers filtering outputs.

@@ -1,6 +1,7 @@
 //! What a run needs to continue exactly where it was: the particle arrays of the current parity
 //! in their GPU (cell) order, the last rates (the predictor uses them), the time-step state, the
-//! host clock, the density filter's last step and the bodies' host state. Restoring these into
+//! host clock, the density filter's last step, the elastic solids' stress and the bodies' host
+//! state. Restoring these into
 //! a solver built from the same case continues bit-identically on the same adapter: every other
 //! GPU buffer (keys, cell starts, sorted rates, ghost values, body partials) is rebuilt by the
 //! step before it is read.
@@ -12,7 +13,7 @@ use anyhow::{bail, Context, Result};
 
 use super::Solver;
 use crate::gpu::buffers::read;
-use crate::layout::{Pos, SimState};
+use crate::layout::{Pos, SimState, SolidState};
 
 /// The state of a [`Solver`] between two steps.
 #[derive(Clone, Debug, PartialEq)]
@@ -37,6 +38,8 @@ pub struct SolverState {
     pub rate: Vec<[f32; 4]>,
     /// (e, de/dt), with the energy equation on.
     pub energy: Option<Vec<[f32; 2]>>,
+    /// τ, body and last dτ/dt of every particle, with elastic solids.
+    pub solid: Option<Vec<SolidState>>,
     /// [`crate::body::BodySet::save`], empty without bodies.
     pub bodies: Vec<f64>,
 }
@@ -72,6 +75,10 @@ impl Solver {
             code,
             rate: self.read_rates().context("reading rates")?,
             energy,
+            solid: match &self.elastic {
+                Some(_) => Some(self.read_solid()?),
+                None => None,
+            },
             bodies: self.bodies().map(|b| b.save()).unwrap_or_default(),
         })
     }
@@ -108,6 +115,18 @@ impl Solver {
                 bail!("the saved state has {} energies for {n} particles", e.len());
             }
             q.write_buffer(&self.buffers.energy[p], 0, bytemuck::cast_slice(e));
+        }
+        if s.solid.is_some() != self.elastic.is_some() {
+            bail!("the saved state and this case disagree on elastic solids");
+        }
+        if let Some(solid) = &s.solid {
+            if solid.len() != n {
+                bail!(
+                    "the saved state has {} solid states for {n} particles",
+                    solid.len()
+                );
+            }
+            q.write_buffer(&self.buffers.solid[p], 0, bytemuck::cast_slice(solid));
         }
         q.write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&s.sim));
         if let Some(f) = &self.density_filter {

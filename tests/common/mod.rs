@@ -90,6 +90,7 @@ pub fn scenario(
         walls: WallParams::defaults(physics_dx, 0.5, 9.81),
         periodic: [false; 3],
         bodies: Vec::new(),
+        solids: None,
         domain,
         particles,
         probes,

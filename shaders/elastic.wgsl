@@ -1,0 +1,183 @@
+// Hypoelastic solid particles (Gray, Monaghan & Swift 2001, CMAME 190:6641; "GMS" below), one
+// invocation per particle, after the fluid interaction pass (which leaves solid particles'
+// rates at zero). Solid particles interact only with solid particles of their own elastic body;
+// there is no solid–fluid coupling yet (the case builder refuses cases with both).
+//
+// Equation numbers are not quoted (no copy of the paper at hand): "GMS §2" is its continuum
+// model (continuity, momentum with σ = −p I + τ, Jaumann stress rate, linear EOS), "GMS §4" its
+// SPH equations and the artificial stress.
+// With σ = −p I + τ, p = c_s² (ρ − ρs) (linear EOS, GMS §2, c_s² = K/ρs):
+//   continuity (GMS §4):   dρ_i/dt = Σ_j m_j v_ij·∇_i W_ij
+//   momentum (GMS §4): dv_i/dt = Σ_j m_j (σ_i/ρ_i² + σ_j/ρ_j² − Π_ij I
+//                                         + (R_i + R_j) f_ij^n)·∇_i W_ij + g
+//     Π_ij = −α c_s μ_ij/ρ̄_ij, μ_ij = h v_ij·x_ij/(r² + η²) for v_ij·x_ij < 0, else 0 (Monaghan
+//     1992; written with −Π so that Π ≥ 0 repels, as in interaction.wgsl);
+//     artificial stress (Monaghan 2000, JCP 159:290; GMS §4): f_ij = W_ij/W(Δp),
+//     n = 4, R_i from the principal stresses σ'_aa: R'_aa = −ε σ'_aa/ρ_i² where σ'_aa > 0,
+//     else 0, rotated back; in 2D the closed form of GMS §4 (rotation angle θ with
+//     tan 2θ = 2σ_xy/(σ_xx − σ_yy)). In 3D the artificial stress is not implemented (R = 0).
+//   velocity gradient (GMS §4): (∇v)^ab_i = ∂v^a/∂x^b = Σ_j (m_j/ρ_j)(v_j − v_i)^a ∂_b W_ij,
+//     ∂_b W_ij the b component of ∇_i W_ij = x_ij F(r_ij); the sum runs over solid particles of
+//     i's body (clamped ones included);
+//   strain rate ε̇ = ½(∇v + ∇vᵀ), rotation rate Ω = ½(∇v − ∇vᵀ), i.e. Ω^ab = ½(∂v^a/∂x^b −
+//     ∂v^b/∂x^a);
+//   Jaumann rate (GMS §2): dτ/dt = 2μ (ε̇ − ⅓ tr(ε̇) I) + τ Ωᵀ + Ω τ, i.e.
+//     dτ^ab/dt = 2μ(ε̇^ab − ⅓δ^ab ε̇^cc) + τ^ac Ω^bc + Ω^ac τ^cb.
+//   In 2D this is plane strain: ε̇_zz = 0 but ⅓ tr(ε̇) still enters τ_zz, which is stored (the
+//   deviator stays trace-free) and does not act on the in-plane momentum.
+// Clamped particles get all three rates; integrate.wgsl keeps their position and velocity fixed
+// and integrates their density and stress (stress_predict / stress_correct below).
+
+@group(0) @binding(1) var<storage, read> pos: array<Pos>;
+@group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> code: array<u32>;
+@group(0) @binding(4) var<storage, read> cell_start: array<u32>;
+@group(0) @binding(5) var<storage, read_write> rate: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read_write> solid: array<SolidState>;
+@group(0) @binding(7) var<storage, read_write> stress_rate: array<SymRate>;
+@group(0) @binding(8) var<storage, read_write> state: SimState;
+
+fn tau_of(s: SolidState) -> mat3x3<f32> {
+    // Columns of the symmetric τ.
+    return mat3x3<f32>(
+        vec3<f32>(s.tau_a.x, s.tau_a.w, s.tau_b.x),
+        vec3<f32>(s.tau_a.w, s.tau_a.y, s.tau_b.y),
+        vec3<f32>(s.tau_b.x, s.tau_b.y, s.tau_a.z),
+    );
+}
+
+// p = c_s² (ρ − ρs).
+fn solid_pressure(rho: f32) -> f32 {
+    return params.solid_c2 * (rho - params.solid_rho0);
+}
+
+// Artificial stress R_i of a particle with total stress σ and density ρ (GMS §4, 2D closed
+// form; zero in 3D, see the header).
+fn artificial_stress(sigma: mat3x3<f32>, rho: f32) -> mat3x3<f32> {
+    if (DIM != 2u || params.solid_eps == 0.0) {
+        return mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    }
+    let sxx = sigma[0].x;
+    let syy = sigma[1].y;
+    let sxy = sigma[1].x;
+    var theta = 0.0;
+    if (sxy != 0.0 || sxx != syy) {
+        theta = 0.5 * atan2(2.0 * sxy, sxx - syy);
+    }
+    let c = cos(theta);
+    let s = sin(theta);
+    let pxx = c * c * sxx + 2.0 * c * s * sxy + s * s * syy;
+    let pyy = s * s * sxx - 2.0 * c * s * sxy + c * c * syy;
+    let k = -params.solid_eps / (rho * rho);
+    let rxx = select(0.0, k * pxx, pxx > 0.0);
+    let ryy = select(0.0, k * pyy, pyy > 0.0);
+    let xx = c * c * rxx + s * s * ryy;
+    let yy = s * s * rxx + c * c * ryy;
+    let xy = c * s * (rxx - ryy);
+    return mat3x3<f32>(vec3<f32>(xx, xy, 0.0), vec3<f32>(xy, yy, 0.0), vec3<f32>(0.0));
+}
+
+// What a solid particle contributes to a pair: σ/ρ², R, ρ, v.
+struct SolidParticle {
+    a: mat3x3<f32>,     // σ/ρ²
+    r: mat3x3<f32>,     // artificial stress R
+    v: vec3<f32>,
+    rho: f32,
+}
+
+fn solid_particle(k: u32) -> SolidParticle {
+    let rho = velrho[k].w;
+    let p = solid_pressure(rho);
+    let sigma = tau_of(solid[k]) - mat3x3<f32>(vec3<f32>(p, 0.0, 0.0), vec3<f32>(0.0, p, 0.0), vec3<f32>(0.0, 0.0, p));
+    return SolidParticle(sigma * (1.0 / (rho * rho)), artificial_stress(sigma, rho), velrho[k].xyz, rho);
+}
+
+@compute @workgroup_size(WG)
+fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles || !is_solid(code_kind(code[i]))) {
+        return;
+    }
+    let body_i = solid[i].body;
+    let pi = solid_particle(i);
+    let p_i = pos[i];
+    let support2 = 4.0 * params.h * params.h;
+    let m = params.solid_mass;
+    let c_s = sqrt(params.solid_c2);
+
+    var acc = vec3<f32>(0.0);
+    var drho = 0.0;
+    var grad_v = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    var slots: array<u32, 27>;
+    let n_slots = neighbour_slots(cell_of(p_i), &slots);
+    for (var s = 0u; s < n_slots; s++) {
+        for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
+            if (j == i || !is_solid(code_kind(code[j])) || solid[j].body != body_i) {
+                continue;
+            }
+            let x_ij = rel_pos(p_i, pos[j]);
+            let r2 = dot(x_ij, x_ij);
+            if (r2 >= support2) {
+                continue;
+            }
+            let q = sqrt(r2) / params.h;
+            let dw_ij = x_ij * kernel_f(q);
+            let pj = solid_particle(j);
+            let v_ij = pi.v - pj.v;
+            drho += m * dot(v_ij, dw_ij);
+            var pi_ij = 0.0;
+            let vx = dot(v_ij, x_ij);
+            if (vx < 0.0) {
+                let mu = params.h * vx / (r2 + params.eta2);
+                pi_ij = -params.solid_alpha * c_s * mu / (0.5 * (pi.rho + pj.rho));
+            }
+            let fw = kernel_w(q) * params.solid_inv_w_dx;
+            let fn4 = fw * fw * fw * fw;
+            // σ is symmetric, so T·∇W = T ∇W in either index order.
+            let t = pi.a + pj.a + (pi.r + pj.r) * fn4;
+            acc += m * (t * dw_ij - pi_ij * dw_ij);
+            // ∇v: column b gets (m_j/ρ_j)(v_j − v_i) ∂_b W_ij.
+            let u = (m / pj.rho) * (pj.v - pi.v);
+            grad_v += mat3x3<f32>(u * dw_ij.x, u * dw_ij.y, u * dw_ij.z);
+        }
+    }
+    rate[i] = vec4<f32>(acc + params.gravity, drho);
+
+    let eps = 0.5 * (grad_v + transpose(grad_v));
+    let omega = 0.5 * (grad_v - transpose(grad_v));
+    let tau = tau_of(solid[i]);
+    let tr3 = (eps[0].x + eps[1].y + eps[2].z) / 3.0;
+    let iso = mat3x3<f32>(vec3<f32>(tr3, 0.0, 0.0), vec3<f32>(0.0, tr3, 0.0), vec3<f32>(0.0, 0.0, tr3));
+    let d = 2.0 * params.solid_mu * (eps - iso) + tau * transpose(omega) + omega * tau;
+    stress_rate[i] = SymRate(vec4<f32>(d[0].x, d[1].y, d[2].z, 0.5 * (d[1].x + d[0].y)),
+                             vec4<f32>(0.5 * (d[2].x + d[0].z), 0.5 * (d[2].y + d[1].z), 0.0, 0.0));
+}
+
+// Predictor for τ (see integrate.wgsl): τ* = τ_n + dt (dτ/dt)_n, on the arrays before the sort.
+@compute @workgroup_size(WG)
+fn stress_predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles || !is_solid(code_kind(code[i]))) {
+        return;
+    }
+    let dt = state.dt;
+    let s = solid[i];
+    solid[i].tau_a = s.tau_a + dt * s.rate_a;
+    solid[i].tau_b = s.tau_b + dt * s.rate_b.xyz;
+}
+
+// Corrector for τ: τ_{n+1} = τ* + ½dt ((dτ/dt)_{n+1} − (dτ/dt)_n); keeps the new rate.
+@compute @workgroup_size(WG)
+fn stress_correct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles || !is_solid(code_kind(code[i]))) {
+        return;
+    }
+    let half_dt = 0.5 * state.dt;
+    let s = solid[i];
+    let r = stress_rate[i];
+    solid[i].tau_a = s.tau_a + half_dt * (r.a - s.rate_a);
+    solid[i].tau_b = s.tau_b + half_dt * (r.b.xyz - s.rate_b.xyz);
+    solid[i].rate_a = r.a;
+    solid[i].rate_b = r.b;
+}

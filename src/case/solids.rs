@@ -1,0 +1,448 @@
+//! `[[solid]]`: elastic bodies of hypoelastic solid particles (Gray, Monaghan & Swift 2001), and
+//! the build of a solid-only case (there is no fluid–solid coupling yet, so a case has either
+//! fluid or solids).
+
+use crate::scenario::{
+    Domain, ElasticMaterial, Kind, Particle, Physics, Scenario, Solids, WallParams,
+};
+
+use super::error::CaseError;
+use super::lattice::Lattice;
+use super::locate::Ctx;
+use super::schema::{RawSolid, SolidVelocityName};
+use super::validate::{aabb, number, vector, Aabb, Bound, Case};
+
+/// Initial velocity of a cantilever in its first bending mode (Gray, Monaghan & Swift 2001,
+/// section 6): v(x) = V f(s)/f(L) along `direction`, s = (x − root)·axis, zero for s < 0.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct CantileverMode {
+    pub root: [f64; 3],
+    pub axis: [f64; 3],
+    pub direction: [f64; 3],
+    pub length: f64,
+    pub tip_velocity: f64,
+}
+
+/// kL of the first cantilever mode.
+pub const KL_FIRST: f64 = 1.875;
+
+impl CantileverMode {
+    /// f(s) = (sin kL + sinh kL)(cos ks − cosh ks) − (cos kL + cosh kL)(sin ks − sinh ks).
+    fn shape(&self, s: f64) -> f64 {
+        let kl = KL_FIRST;
+        let k = kl / self.length;
+        (kl.sin() + kl.sinh()) * ((k * s).cos() - (k * s).cosh())
+            - (kl.cos() + kl.cosh()) * ((k * s).sin() - (k * s).sinh())
+    }
+
+    pub(super) fn velocity(&self, x: [f64; 3]) -> [f64; 3] {
+        let s: f64 = (0..3).map(|a| (x[a] - self.root[a]) * self.axis[a]).sum();
+        if s <= 0.0 {
+            return [0.0; 3];
+        }
+        let v = self.tip_velocity * self.shape(s) / self.shape(self.length);
+        self.direction.map(|d| v * d)
+    }
+}
+
+#[derive(Debug, Clone)]
+pub(super) struct SolidSpec {
+    pub name: String,
+    pub bx: Aabb,
+    pub material: ElasticMaterial,
+    pub clamped: Option<Aabb>,
+    pub velocity: Option<CantileverMode>,
+}
+
+fn unit(
+    ctx: &Ctx<'_>,
+    path: &str,
+    v: &[f64],
+    dim: usize,
+    what: &str,
+) -> Result<[f64; 3], CaseError> {
+    let u = vector(ctx, path, v, dim, what)?;
+    let n = u.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if n == 0.0 {
+        return Err(ctx.err(
+            path,
+            Some(format!("{v:?}")),
+            format!("is the zero vector ({what})"),
+            "give a non-zero direction",
+        ));
+    }
+    Ok(u.map(|c| c / n))
+}
+
+pub(super) fn validate_solid(
+    ctx: &Ctx<'_>,
+    i: usize,
+    s: &RawSolid,
+    dim: usize,
+) -> Result<SolidSpec, CaseError> {
+    let path = format!("solid[{i}]");
+    if s.name.is_empty()
+        || !s
+            .name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+    {
+        return Err(ctx.err(
+            &format!("{path}.name"),
+            Some(format!("{:?}", s.name)),
+            "must be a non-empty name of letters, digits, _ and -",
+            "e.g. name = \"plate\"",
+        ));
+    }
+    let bx = aabb(ctx, &path, &s.min_m, &s.max_m, dim, "the solid")?;
+    let density = number(
+        ctx,
+        &format!("{path}.density_kg_m3"),
+        s.density_kg_m3,
+        Bound::Positive,
+        "the solid's density in kg/m³",
+        "e.g. density_kg_m3 = 1000.0",
+    )?;
+    let youngs_modulus = number(
+        ctx,
+        &format!("{path}.youngs_modulus_pa"),
+        s.youngs_modulus_pa,
+        Bound::Positive,
+        "Young's modulus in Pa",
+        "e.g. youngs_modulus_pa = 2.0e6",
+    )?;
+    let poisson_ratio = number(
+        ctx,
+        &format!("{path}.poisson_ratio"),
+        s.poisson_ratio,
+        Bound::Closed(0.0, 0.49),
+        "the Poisson ratio; 0.5 (incompressible) has no finite sound speed",
+        "use a value between 0 and 0.49, e.g. 0.3975",
+    )?;
+    let alpha = number(
+        ctx,
+        &format!("{path}.alpha"),
+        s.alpha.unwrap_or(0.1),
+        Bound::Closed(0.0, 2.0),
+        "the Monaghan artificial viscosity between solid particles",
+        "use 0.1 (the default) or up to 1",
+    )?;
+    let artificial_stress = number(
+        ctx,
+        &format!("{path}.artificial_stress"),
+        s.artificial_stress.unwrap_or(0.3),
+        Bound::Closed(0.0, 1.0),
+        "the artificial stress coefficient ε (Monaghan 2000); 0 disables it",
+        "use 0.3 (Gray, Monaghan & Swift 2001), or 0",
+    )?;
+    let clamped = match (&s.clamped_min_m, &s.clamped_max_m) {
+        (None, None) => None,
+        (Some(lo), Some(hi)) => {
+            let min = vector(
+                ctx,
+                &format!("{path}.clamped_min_m"),
+                lo,
+                dim,
+                "the lower corner of the clamped region",
+            )?;
+            let max = vector(
+                ctx,
+                &format!("{path}.clamped_max_m"),
+                hi,
+                dim,
+                "the upper corner of the clamped region",
+            )?;
+            if let Some(a) = (0..dim).find(|&a| max[a] <= min[a]) {
+                return Err(ctx.err(
+                    &format!("{path}.clamped_max_m"),
+                    Some(format!("{hi:?}")),
+                    format!(
+                        "clamped_max_m[{a}] = {} is not above clamped_min_m[{a}] = {} (the clamped region would be empty)",
+                        max[a], min[a]
+                    ),
+                    "make every component of clamped_max_m larger than that of clamped_min_m",
+                ));
+            }
+            Some(Aabb { min, max })
+        }
+        (Some(_), None) | (None, Some(_)) => {
+            let missing = if s.clamped_min_m.is_none() {
+                "clamped_min_m"
+            } else {
+                "clamped_max_m"
+            };
+            return Err(ctx.err(
+                &format!("{path}.{missing}"),
+                None,
+                "the clamped region needs both clamped_min_m and clamped_max_m",
+                format!("add {missing}, or remove the other"),
+            ));
+        }
+    };
+    let velocity = match &s.initial_velocity {
+        None => None,
+        Some(v) => {
+            let vp = format!("{path}.initial_velocity");
+            match v.kind {
+                SolidVelocityName::CantileverMode => {}
+            }
+            let need = |f: &Option<Vec<f64>>, name: &str| -> Result<Vec<f64>, CaseError> {
+                f.clone().ok_or_else(|| {
+                    ctx.err(
+                        &format!("{vp}.{name}"),
+                        None,
+                        "is required with kind = \"cantilever_mode\"",
+                        format!("add {name}"),
+                    )
+                })
+            };
+            let root = vector(
+                ctx,
+                &format!("{vp}.root_m"),
+                &need(&v.root_m, "root_m")?,
+                dim,
+                "the clamped end of the cantilever",
+            )?;
+            let axis = unit(
+                ctx,
+                &format!("{vp}.axis"),
+                &need(&v.axis, "axis")?,
+                dim,
+                "the cantilever's axis, root to tip",
+            )?;
+            let direction = unit(
+                ctx,
+                &format!("{vp}.direction"),
+                &need(&v.direction, "direction")?,
+                dim,
+                "the direction of the initial velocity",
+            )?;
+            let Some(length) = v.length_m else {
+                return Err(ctx.err(
+                    &format!("{vp}.length_m"),
+                    None,
+                    "is required with kind = \"cantilever_mode\"",
+                    "add length_m, the free length of the cantilever",
+                ));
+            };
+            let length = number(
+                ctx,
+                &format!("{vp}.length_m"),
+                length,
+                Bound::Positive,
+                "the free length of the cantilever in metres",
+                "e.g. length_m = 0.2",
+            )?;
+            let Some(tip) = v.tip_velocity_m_s else {
+                return Err(ctx.err(
+                    &format!("{vp}.tip_velocity_m_s"),
+                    None,
+                    "is required with kind = \"cantilever_mode\"",
+                    "add tip_velocity_m_s",
+                ));
+            };
+            if !tip.is_finite() {
+                return Err(ctx.err(
+                    &format!("{vp}.tip_velocity_m_s"),
+                    Some(format!("{tip}")),
+                    "must be a finite number (the tip velocity in m/s)",
+                    "e.g. tip_velocity_m_s = 0.57",
+                ));
+            }
+            Some(CantileverMode {
+                root,
+                axis,
+                direction,
+                length,
+                tip_velocity: tip,
+            })
+        }
+    };
+    Ok(SolidSpec {
+        name: s.name.clone(),
+        bx,
+        material: ElasticMaterial {
+            density,
+            youngs_modulus,
+            poisson_ratio,
+            alpha,
+            artificial_stress,
+        },
+        clamped,
+        velocity,
+    })
+}
+
+fn point_in(p: [f64; 3], b: &Aabb, dim: usize) -> bool {
+    (0..dim).all(|a| p[a] >= b.min[a] && p[a] <= b.max[a])
+}
+
+/// The scenario of a case whose only particles are solids.
+pub(super) fn build_solid_case(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
+    let first = &case.solids[0];
+    let material = first.material;
+    for (i, s) in case.solids.iter().enumerate().skip(1) {
+        if let Some(j) = case.solids[..i].iter().position(|o| o.name == s.name) {
+            return Err(ctx.err(
+                &format!("solid[{i}].name"),
+                Some(format!("{:?}", s.name)),
+                format!("is also the name of solid[{j}]"),
+                "give every solid its own name",
+            ));
+        }
+        let fields = [
+            ("density_kg_m3", s.material.density, material.density),
+            (
+                "youngs_modulus_pa",
+                s.material.youngs_modulus,
+                material.youngs_modulus,
+            ),
+            (
+                "poisson_ratio",
+                s.material.poisson_ratio,
+                material.poisson_ratio,
+            ),
+            ("alpha", s.material.alpha, material.alpha),
+            (
+                "artificial_stress",
+                s.material.artificial_stress,
+                material.artificial_stress,
+            ),
+        ];
+        for (f, v, v0) in fields {
+            if v != v0 {
+                return Err(ctx.err(
+                    &format!("solid[{i}].{f}"),
+                    Some(format!("{v}")),
+                    format!("differs from solid[0].{f} = {v0}: all solids of a case share one material for now"),
+                    format!("use {f} = {v0}"),
+                ));
+            }
+        }
+    }
+    let lat = Lattice {
+        origin: first.bx.min,
+        dx,
+        dim,
+    };
+    let mut particles = Vec::new();
+    let mut body = Vec::new();
+    for (i, s) in case.solids.iter().enumerate() {
+        let Some((lo, hi)) = lat.range_in(&s.bx) else {
+            return Err(ctx.err(
+                &format!("solid[{i}].max_m"),
+                None,
+                format!("the solid is too thin to hold one particle at dx = {dx} m"),
+                "make it at least dx thick along every axis, or decrease particles.dx_m",
+            ));
+        };
+        let count: f64 = (0..dim).map(|a| hi[a] - lo[a] + 1.0).product();
+        if count > super::MAX_PARTICLES {
+            return Err(ctx.err(
+                "particles.dx_m",
+                Some(format!("{dx}")),
+                format!("solid[{i}] would have {count:.3e} particles, more than the limit of 200 million"),
+                "increase particles.dx_m",
+            ));
+        }
+        let n = [0, 1, 2].map(|a| {
+            if a < dim {
+                (hi[a] - lo[a]) as i64 + 1
+            } else {
+                1
+            }
+        });
+        for k in 0..n[2] {
+            for j in 0..n[1] {
+                for l in 0..n[0] {
+                    let idx = [lo[0] as i64 + l, lo[1] as i64 + j, lo[2] as i64 + k];
+                    let pos = lat.pos(idx);
+                    let clamped = s.clamped.as_ref().is_some_and(|c| point_in(pos, c, dim));
+                    let vel = match (&s.velocity, clamped) {
+                        (Some(m), false) => m.velocity(pos),
+                        _ => [0.0; 3],
+                    };
+                    particles.push(Particle {
+                        pos,
+                        vel,
+                        rho: s.material.density,
+                        kind: if clamped {
+                            Kind::SolidClamped
+                        } else {
+                            Kind::Solid
+                        },
+                    });
+                    body.push(i as u32);
+                }
+            }
+        }
+    }
+    // Default domain: the solids' box, with half its largest extent of room on every side.
+    let mut bb = first.bx;
+    for s in &case.solids {
+        for a in 0..dim {
+            bb.min[a] = bb.min[a].min(s.bx.min[a]);
+            bb.max[a] = bb.max[a].max(s.bx.max[a]);
+        }
+    }
+    let d = match case.domain {
+        Some(d) => d,
+        None => {
+            let room = (0..dim).map(|a| bb.max[a] - bb.min[a]).fold(0.0, f64::max) * 0.5;
+            let mut d = bb;
+            for a in 0..dim {
+                d.min[a] -= room + 2.0 * dx;
+                d.max[a] += room + 2.0 * dx;
+            }
+            d
+        }
+    };
+    for (i, s) in case.solids.iter().enumerate() {
+        if !(point_in(s.bx.min, &d, dim) && point_in(s.bx.max, &d, dim)) {
+            return Err(ctx.err(
+                &format!("solid[{i}]"),
+                None,
+                "leaves the domain; its particles would be dropped",
+                "enlarge [domain] (or remove it to get the default)",
+            ));
+        }
+    }
+    let n = particles.len();
+    let physics = Physics {
+        dim: dim as u32,
+        dx,
+        h: case.h_over_dx * dx,
+        kernel: case.kernel,
+        rho0: case.rho0,
+        // Unused without fluid; the solid's sound speed enters through the material.
+        c0: material.sound_speed(),
+        gamma: case.gamma,
+        gravity: case.gravity,
+        viscosity: case.viscosity,
+        delta_sph: case.delta_sph,
+        particle_mass: case.rho0 * dx.powi(dim as i32),
+        density_filter: case.density_filter,
+        energy: false,
+    };
+    let g = case.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
+    Ok(Scenario {
+        name: case.name,
+        physics,
+        time: case.time,
+        domain: Domain {
+            min: d.min,
+            max: d.max,
+        },
+        particles,
+        probes: case.probes,
+        walls: WallParams::defaults(dx, dx, g),
+        periodic: [false; 3],
+        bodies: Vec::new(),
+        solids: Some(Solids {
+            material,
+            body,
+            tau0: vec![[0.0; 6]; n],
+        }),
+    })
+}

@@ -1,0 +1,116 @@
+//! `[[solid]]`: the oscillating plate case and the loader's errors.
+
+use super::*;
+
+const PLATE: &str = include_str!("../../../cases/oscillating_plate_2d.toml");
+
+#[test]
+fn oscillating_plate_builds_a_clamped_plate_in_its_first_mode() {
+    let s = load_str(PLATE, "cases/oscillating_plate_2d.toml", &[]).unwrap();
+    let solids = s.solids.as_ref().expect("solids");
+    // 0.26 m × 0.02 m at dx = 0.004: 65 × 5 particles, the first 15 columns clamped.
+    assert_eq!(s.particles.len(), 65 * 5);
+    assert_eq!(s.count(Kind::SolidClamped), 15 * 5);
+    assert_eq!(s.count(Kind::Solid), 50 * 5);
+    assert!(solids.body.iter().all(|&b| b == 0));
+    let m = &solids.material;
+    assert!(
+        (m.sound_speed() - 57.0266).abs() < 1e-3,
+        "{}",
+        m.sound_speed()
+    );
+    // Velocity: zero on the clamp, V f(s)/f(L) along y, the tip particle (s = L − dx/2) close
+    // to V = 0.5703 m/s.
+    for p in &s.particles {
+        assert_eq!(p.vel[0], 0.0);
+        if p.kind == Kind::SolidClamped {
+            assert_eq!(p.vel[1], 0.0);
+        }
+    }
+    let tip = s.particles.iter().map(|p| p.vel[1]).fold(0.0, f64::max);
+    assert!(tip > 0.55 && tip < 0.5703, "tip velocity {tip}");
+    // The whole plate and its swing fit the default domain.
+    assert!(s.domain.min[1] < -0.1 && s.domain.max[1] > 0.12);
+}
+
+const SOLID: &str = r#"dimension = 2
+
+[particles]
+dx_m = 0.01
+
+[physics]
+gravity_m_s2 = [0.0, 0.0]
+
+[time]
+end_s = 1.0
+output_every_s = 0.1
+
+[[solid]]
+name = "plate"
+min_m = [0.0, 0.0]
+max_m = [0.2, 0.04]
+density_kg_m3 = 1000.0
+youngs_modulus_pa = 2.0e6
+poisson_ratio = 0.3975
+clamped_min_m = [0.0, 0.0]
+clamped_max_m = [0.05, 0.04]
+"#;
+
+fn solid_with(from: &str, to: &str) -> String {
+    assert!(SOLID.contains(from), "{from}");
+    SOLID.replacen(from, to, 1)
+}
+
+#[test]
+fn solid_errors_name_the_field() {
+    load_str(SOLID, "cases/t.toml", &[]).unwrap();
+    assert_err(
+        &solid_with("poisson_ratio = 0.3975", "poisson_ratio = 0.5"),
+        &[],
+        Some(19),
+        &["solid[0].poisson_ratio", "0.49"],
+    );
+    assert_err(
+        &solid_with("clamped_max_m = [0.05, 0.04]\n", ""),
+        &[],
+        None,
+        &["solid[0].clamped_max_m", "both"],
+    );
+    assert_err(
+        &solid_with(
+            "clamped_max_m = [0.05, 0.04]",
+            "clamped_max_m = [0.0, 0.04]",
+        ),
+        &[],
+        Some(21),
+        &["solid[0].clamped_max_m", "empty"],
+    );
+    assert_err(
+        &format!(
+            "{}\n[[fluid_block]]\nmin_m = [0.5, 0.0]\nmax_m = [0.6, 0.1]\n",
+            SOLID.replace("[physics]\n", "[physics]\nsound_speed_coef = 10.0\n")
+        ),
+        &[],
+        None,
+        &["fluid_block", "not coupled"],
+    );
+    assert_err(
+        &format!("{SOLID}\n[[solid]]\nname = \"b\"\nmin_m = [0.3, 0.0]\nmax_m = [0.4, 0.04]\ndensity_kg_m3 = 1000.0\nyoungs_modulus_pa = 3.0e6\npoisson_ratio = 0.3975\n"),
+        &[],
+        None,
+        &["solid[1].youngs_modulus_pa", "one material"],
+    );
+    assert_err(
+        &format!("{SOLID}\n[solid.initial_velocity]\nkind = \"cantilever_mode\"\nroot_m = [0.05, 0.02]\naxis = [1.0, 0.0]\ndirection = [0.0, 1.0]\ntip_velocity_m_s = 0.5\n"),
+        &[],
+        None,
+        &["solid[0].initial_velocity.length_m", "required"],
+    );
+    // No fluid and no solid.
+    let no_fluid = SOLID
+        .split("[[solid]]")
+        .next()
+        .unwrap()
+        .replace("[physics]\n", "[physics]\nsound_speed_coef = 10.0\n");
+    assert_err(&no_fluid, &[], None, &["fluid_block", "[[solid]]"]);
+}

@@ -1,0 +1,192 @@
+//! Twin of shaders/elastic.wgsl (hypoelastic solid particles, Gray, Monaghan & Swift 2001),
+//! brute force over all pairs, f64. See the shader's header for the equations.
+
+use super::{dot, kernel, RefParticle, Space};
+use crate::scenario::{ElasticMaterial, Physics};
+
+pub const SOLID: u32 = crate::scenario::Kind::Solid as u32;
+pub const SOLID_CLAMPED: u32 = crate::scenario::Kind::SolidClamped as u32;
+
+type M3 = [[f64; 3]; 3];
+
+/// The state of a solid particle beside its `RefParticle`: deviatoric stress τ
+/// (xx, yy, zz, xy, xz, yz) [Pa] and its elastic body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolidRef {
+    pub tau: [f64; 6],
+    pub body: u32,
+}
+
+/// Rates of a solid particle: (dv/dt, dρ/dt) and dτ/dt (xx, yy, zz, xy, xz, yz).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ElasticRates {
+    pub rate: [f64; 4],
+    pub dtau: [f64; 6],
+}
+
+pub fn is_solid(kind: u32) -> bool {
+    kind == SOLID || kind == SOLID_CLAMPED
+}
+
+/// τ as a symmetric 3×3 matrix.
+pub fn tensor(t: &[f64; 6]) -> M3 {
+    [[t[0], t[3], t[4]], [t[3], t[1], t[5]], [t[4], t[5], t[2]]]
+}
+
+/// The 6 independent components (xx, yy, zz, xy, xz, yz) of a symmetric matrix.
+pub fn components(m: &M3) -> [f64; 6] {
+    [m[0][0], m[1][1], m[2][2], m[0][1], m[0][2], m[1][2]]
+}
+
+fn mul(a: &M3, b: &M3) -> M3 {
+    let mut c = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            for k in 0..3 {
+                c[i][j] += a[i][k] * b[k][j];
+            }
+        }
+    }
+    c
+}
+
+fn transpose(a: &M3) -> M3 {
+    let mut t = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            t[i][j] = a[j][i];
+        }
+    }
+    t
+}
+
+/// Artificial stress R of a particle of total stress σ and density ρ (Monaghan 2000; GMS §4,
+/// 2D closed form with tan 2θ = 2σ_xy/(σ_xx − σ_yy)); zero in 3D and for ε = 0.
+pub fn artificial_stress(dim: u32, eps: f64, sigma: &M3, rho: f64) -> M3 {
+    let mut r = [[0.0; 3]; 3];
+    if dim != 2 || eps == 0.0 {
+        return r;
+    }
+    let (sxx, syy, sxy) = (sigma[0][0], sigma[1][1], sigma[0][1]);
+    let theta = if sxy != 0.0 || sxx != syy {
+        0.5 * (2.0 * sxy).atan2(sxx - syy)
+    } else {
+        0.0
+    };
+    let (s, c) = theta.sin_cos();
+    let pxx = c * c * sxx + 2.0 * c * s * sxy + s * s * syy;
+    let pyy = s * s * sxx - 2.0 * c * s * sxy + c * c * syy;
+    let k = -eps / (rho * rho);
+    let rxx = if pxx > 0.0 { k * pxx } else { 0.0 };
+    let ryy = if pyy > 0.0 { k * pyy } else { 0.0 };
+    r[0][0] = c * c * rxx + s * s * ryy;
+    r[1][1] = s * s * rxx + c * c * ryy;
+    r[0][1] = c * s * (rxx - ryy);
+    r[1][0] = r[0][1];
+    r
+}
+
+/// σ/ρ² and R of a solid particle.
+fn stress_terms(ph: &Physics, mat: &ElasticMaterial, p: &RefParticle, s: &SolidRef) -> (M3, M3) {
+    let c2 = mat.sound_speed().powi(2);
+    let pressure = c2 * (p.rho - mat.density);
+    let mut sigma = tensor(&s.tau);
+    for a in 0..3 {
+        sigma[a][a] -= pressure;
+    }
+    let r = artificial_stress(ph.dim, mat.artificial_stress, &sigma, p.rho);
+    (sigma.map(|row| row.map(|x| x / (p.rho * p.rho))), r)
+}
+
+/// Rates of every solid particle (None for the others): continuity, momentum with σ = −pI + τ,
+/// artificial viscosity and artificial stress, and the Jaumann rate of τ, over the solid
+/// particles of the same body.
+pub fn rates(
+    ph: &Physics,
+    mat: &ElasticMaterial,
+    space: &Space,
+    parts: &[RefParticle],
+    solid: &[SolidRef],
+) -> Vec<Option<ElasticRates>> {
+    let h = ph.h;
+    let m = mat.density * ph.dx.powi(ph.dim as i32);
+    let c_s = mat.sound_speed();
+    let mu_shear = mat.shear_modulus();
+    let eta2 = 0.01 * h * h;
+    let w_dx = kernel::w(ph.kernel, ph.dim, h, ph.dx);
+    let terms: Vec<Option<(M3, M3)>> = parts
+        .iter()
+        .zip(solid)
+        .map(|(p, s)| is_solid(p.kind).then(|| stress_terms(ph, mat, p, s)))
+        .collect();
+    (0..parts.len())
+        .map(|i| {
+            let pi = &parts[i];
+            let (a_i, r_i) = terms[i]?;
+            let mut acc = [0.0; 3];
+            let mut drho = 0.0;
+            let mut grad_v = [[0.0; 3]; 3];
+            for (j, pj) in parts.iter().enumerate() {
+                if j == i || !is_solid(pj.kind) || solid[j].body != solid[i].body {
+                    continue;
+                }
+                let x_ij = space.sub(pi.pos, pj.pos);
+                let r2 = dot(x_ij, x_ij);
+                let r = r2.sqrt();
+                if r >= 2.0 * h {
+                    continue;
+                }
+                let (a_j, r_j) = terms[j].expect("solid");
+                let f = kernel::f(ph.kernel, ph.dim, h, r);
+                let dw = x_ij.map(|x| x * f);
+                let v_ij = [0, 1, 2].map(|a| pi.vel[a] - pj.vel[a]);
+                drho += m * dot(v_ij, dw);
+                let vx = dot(v_ij, x_ij);
+                let pi_ij = if vx < 0.0 {
+                    -mat.alpha * c_s * (h * vx / (r2 + eta2)) / (0.5 * (pi.rho + pj.rho))
+                } else {
+                    0.0
+                };
+                let fn4 = (kernel::w(ph.kernel, ph.dim, h, r) / w_dx).powi(4);
+                for a in 0..3 {
+                    for b in 0..3 {
+                        let t = a_i[a][b] + a_j[a][b] + (r_i[a][b] + r_j[a][b]) * fn4
+                            - if a == b { pi_ij } else { 0.0 };
+                        acc[a] += m * t * dw[b];
+                        // (∇v)^ab = Σ_j (m_j/ρ_j)(v_j − v_i)^a ∂_b W_ij
+                        grad_v[a][b] += m / pj.rho * (pj.vel[a] - pi.vel[a]) * dw[b];
+                    }
+                }
+            }
+            let g = transpose(&grad_v);
+            let mut eps = [[0.0; 3]; 3];
+            let mut omega = [[0.0; 3]; 3];
+            for a in 0..3 {
+                for b in 0..3 {
+                    eps[a][b] = 0.5 * (grad_v[a][b] + g[a][b]);
+                    omega[a][b] = 0.5 * (grad_v[a][b] - g[a][b]);
+                }
+            }
+            let tr3 = (eps[0][0] + eps[1][1] + eps[2][2]) / 3.0;
+            let tau = tensor(&solid[i].tau);
+            let t1 = mul(&tau, &transpose(&omega));
+            let t2 = mul(&omega, &tau);
+            let mut d = [[0.0; 3]; 3];
+            for a in 0..3 {
+                for b in 0..3 {
+                    let iso = if a == b { tr3 } else { 0.0 };
+                    d[a][b] = 2.0 * mu_shear * (eps[a][b] - iso) + t1[a][b] + t2[a][b];
+                }
+            }
+            Some(ElasticRates {
+                rate: [
+                    acc[0] + ph.gravity[0],
+                    acc[1] + ph.gravity[1],
+                    acc[2] + ph.gravity[2],
+                    drho,
+                ],
+                dtau: components(&d),
+            })
+        })
+        .collect()
+}

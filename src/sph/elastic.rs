@@ -1,0 +1,76 @@
+//! Hypoelastic solid particles (shaders/elastic.wgsl): continuity, momentum with the total
+//! stress and the artificial stress, and the Jaumann stress rate, plus the predictor and
+//! corrector of the stress. Only built when the case has solid particles.
+
+use anyhow::Result;
+
+use super::buffers::ParticleBuffers;
+use crate::gpu::kernel::ShaderModule;
+use crate::gpu::Kernel;
+
+/// A kernel and its bind groups for both parities.
+struct Bound {
+    kernel: Kernel,
+    bind: [wgpu::BindGroup; 2],
+}
+
+pub struct Elastic {
+    rates: Bound,
+    predict: Bound,
+    correct: Bound,
+    n: u32,
+}
+
+impl Elastic {
+    pub fn new(device: &wgpu::Device, module: &ShaderModule, b: &ParticleBuffers) -> Result<Self> {
+        let bufs = |p: usize| {
+            [
+                (0, &b.params),
+                (1, &b.pos[p]),
+                (2, &b.velrho[p]),
+                (3, &b.code[p]),
+                (4, &b.cell_start),
+                (5, &b.rate),
+                (6, &b.solid[p]),
+                (7, &b.stress_rate),
+                (8, &b.state),
+            ]
+        };
+        let bound = |entry: &str| -> Result<Bound> {
+            let kernel = module.kernel(device, entry)?;
+            let bind = [
+                kernel.bind(device, &bufs(0))?,
+                kernel.bind(device, &bufs(1))?,
+            ];
+            Ok(Bound { kernel, bind })
+        };
+        Ok(Self {
+            rates: bound("elastic_rates")?,
+            predict: bound("stress_predict")?,
+            correct: bound("stress_correct")?,
+            n: b.n,
+        })
+    }
+
+    /// τ* = τ_n + dt (dτ/dt)_n on the arrays of parity `p` (before the sort).
+    pub fn encode_predict(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.predict
+            .kernel
+            .dispatch(pass, &self.predict.bind[p], self.n);
+    }
+
+    /// dρ/dt, dv/dt (into `rate`) and dτ/dt (into `stress_rate`) of the solid particles of the
+    /// sorted arrays of parity `p`; after the interaction pass.
+    pub fn encode_rates(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.rates
+            .kernel
+            .dispatch(pass, &self.rates.bind[p], self.n);
+    }
+
+    /// The corrector of τ on parity `p`.
+    pub fn encode_correct(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.correct
+            .kernel
+            .dispatch(pass, &self.correct.bind[p], self.n);
+    }
+}

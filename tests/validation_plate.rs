@@ -1,0 +1,182 @@
+//! Oscillating cantilever plate (Gray, Monaghan & Swift 2001, section 6; the SPHinXsys
+//! oscillating_beam test): a 2D plate L = 0.2 m long, H = 0.02 m thick, clamped over 0.06 m at
+//! its root, E = 2 MPa, ν = 0.3975, ρ = 1000 kg/m³, set moving in its first bending mode
+//! v_y(x) = V f(x)/f(L). Its period is compared with Euler–Bernoulli plate theory,
+//! ω² = E H² k⁴ / (12 ρ (1 − ν²)), kL = 1.875 (shared/validation/
+//! analytic_oscillating_plate_frequency.csv: T = 0.25406 s).
+
+mod common;
+use common::*;
+use wgsph::scenario::*;
+use wgsph::sph::Solver;
+
+use std::path::Path;
+
+const L: f64 = 0.2;
+const H: f64 = 0.02;
+const KL: f64 = 1.875;
+
+/// Euler–Bernoulli period of the first mode [s].
+fn theory_period(m: &ElasticMaterial) -> f64 {
+    let k = KL / L;
+    let omega2 = m.youngs_modulus * H * H * k.powi(4)
+        / (12.0 * m.density * (1.0 - m.poisson_ratio * m.poisson_ratio));
+    2.0 * std::f64::consts::PI / omega2.sqrt()
+}
+
+/// cases/oscillating_plate_2d.toml with `--set` overrides.
+fn plate(set: &[&str]) -> Scenario {
+    let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+    wgsph::case::load(Path::new("cases/oscillating_plate_2d.toml"), &set).unwrap()
+}
+
+/// Runs the plate to `end` and returns the tip's (t, y-displacement) every `every` seconds;
+/// the tip is the free-end particle nearest the mid-plane.
+fn tip_history(sc: &Scenario, end: f64, every: f64) -> Vec<(f64, f64)> {
+    let tip = sc
+        .particles
+        .iter()
+        .enumerate()
+        .max_by(|(_, a), (_, b)| {
+            let key = |p: &Particle| p.pos[0] - 1e-3 * (p.pos[1] - 0.5 * H).abs();
+            key(a).partial_cmp(&key(b)).unwrap()
+        })
+        .unwrap()
+        .0;
+    let y0 = sc.particles[tip].pos[1];
+    let mut solver = Solver::new(gpu(), sc).unwrap();
+    let mut out = vec![(0.0, 0.0)];
+    let steps = (end / every).round() as usize;
+    for k in 1..=steps {
+        let t = k as f64 * every;
+        solver.advance_to(t).unwrap();
+        let p = solver.read_particles().unwrap();
+        out.push((t, p.pos[tip][1] - y0));
+    }
+    println!("{} steps, last dt {:.3e} s", solver.steps(), solver.dt());
+    out
+}
+
+/// Times at which the displacement changes sign (linear interpolation), after t = 0.
+fn zero_crossings(h: &[(f64, f64)]) -> Vec<f64> {
+    h.windows(2)
+        .skip(1)
+        .filter(|w| (w[0].1 > 0.0) != (w[1].1 > 0.0))
+        .map(|w| w[0].0 + (w[1].0 - w[0].0) * w[0].1 / (w[0].1 - w[1].1))
+        .collect()
+}
+
+/// A plate run: the theory period, the tip's zero crossings (after t = 0) and its history.
+struct PlateRun {
+    t_theory: f64,
+    crossings: Vec<f64>,
+    history: Vec<(f64, f64)>,
+}
+
+impl PlateRun {
+    fn new(set: &[&str]) -> Self {
+        let sc = plate(set);
+        let t_theory = theory_period(&sc.solids.as_ref().unwrap().material);
+        let history = tip_history(&sc, 1.65 * t_theory, t_theory / 200.0);
+        let crossings = zero_crossings(&history);
+        assert!(
+            crossings.len() >= 3,
+            "too few zero crossings: {crossings:?}"
+        );
+        Self {
+            t_theory,
+            crossings,
+            history,
+        }
+    }
+
+    /// The plate starts at zero displacement moving up, so the crossings come at T/2, T, 3T/2:
+    /// the period from the first and third (a full cycle, independent of the start-up).
+    fn period(&self) -> f64 {
+        self.crossings[2] - self.crossings[0]
+    }
+
+    fn error(&self) -> f64 {
+        (self.period() - self.t_theory) / self.t_theory
+    }
+
+    /// Largest |displacement| over [t0, t1].
+    fn peak(&self, t0: f64, t1: f64) -> f64 {
+        self.history
+            .iter()
+            .filter(|(t, _)| *t >= t0 && *t <= t1)
+            .map(|(_, y)| y.abs())
+            .fold(0.0, f64::max)
+    }
+
+    fn report(&self, label: &str) {
+        let c = &self.crossings;
+        println!(
+            "{label}: period {:.4} s, theory {:.4} s, error {:+.1} %; half periods {:.4} / {:.4} s; \
+             peaks {:.4} / {:.4} / {:.4} m",
+            self.period(),
+            self.t_theory,
+            100.0 * self.error(),
+            c[1] - c[0],
+            c[2] - c[1],
+            self.peak(0.0, c[0]),
+            self.peak(c[0], c[1]),
+            self.peak(c[1], c[2]),
+        );
+    }
+}
+
+/// The shipped case (H/dx = 5, tip velocity 0.01 c_s) runs through a full cycle and a half:
+/// the tip crosses its rest position at least three times within 1.65 theory periods.
+#[test]
+fn plate_oscillates() {
+    let run = PlateRun::new(&[]);
+    run.report("H/dx = 5");
+}
+
+/// A steady free oscillation: the two half periods of the first full cycle agree to 3 %, and
+/// the amplitude neither decays nor grows by more than 20 % over a cycle.
+#[test]
+#[ignore = "not met at H/dx = 5: half periods 0.1402 / 0.1449 s (3.4 %), tip peaks 0.0211 / 0.0268 / 0.0292 m (growing); not understood yet (docs/validation.md)"]
+fn plate_oscillates_steadily_h_over_dx_5() {
+    let run = PlateRun::new(&[]);
+    run.report("H/dx = 5");
+    let c = &run.crossings;
+    let (h1, h2) = (c[1] - c[0], c[2] - c[1]);
+    assert!(
+        ((h2 - h1) / h1).abs() < 0.03,
+        "half periods {h1:.4} and {h2:.4} s"
+    );
+    let (first, third) = (run.peak(0.0, c[0]), run.peak(c[1], c[2]));
+    assert!(
+        (third / first - 1.0).abs() < 0.2,
+        "amplitude went from {first:.4} to {third:.4} m in one period"
+    );
+}
+
+/// Gray, Monaghan & Swift's test at the shipped resolution: the first-mode period within 5 %
+/// of Euler–Bernoulli theory.
+#[test]
+#[ignore = "not met at H/dx = 5: the period is 12.2 % longer than theory (docs/validation.md)"]
+fn plate_period_within_5_percent_h_over_dx_5() {
+    let run = PlateRun::new(&[]);
+    run.report("H/dx = 5");
+    assert!(
+        run.error().abs() < 0.05,
+        "period error {:.1} %",
+        100.0 * run.error()
+    );
+}
+
+/// The same at H/dx = 10 (dx = 2 mm): about 8 times the work of the shipped case.
+#[test]
+#[ignore = "not measured yet: slow on lavapipe (tens of CPU minutes); run by hand"]
+fn plate_period_within_5_percent_h_over_dx_10() {
+    let run = PlateRun::new(&["particles.dx_m=0.002"]);
+    run.report("H/dx = 10");
+    assert!(
+        run.error().abs() < 0.05,
+        "period error {:.1} %",
+        100.0 * run.error()
+    );
+}
