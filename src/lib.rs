@@ -12,3 +12,4 @@ pub mod reference;
 pub mod run;
 pub mod scenario;
 pub mod sph;
+pub mod validation;
