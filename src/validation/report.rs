@@ -167,7 +167,11 @@ impl Report {
                     format!(", `{}`", set.trim_start())
                 }
             );
-            let _ = writeln!(s, "- reference: {} ({})", c.reference, c.citation);
+            if c.citation.is_empty() {
+                let _ = writeln!(s, "- reference: {}", c.reference);
+            } else {
+                let _ = writeln!(s, "- reference: `{}`: {}", c.reference, c.citation);
+            }
             let _ = writeln!(s, "- outputs: `{}`", relative(&c.dir, out).display());
             if let Some(r) = &c.summary {
                 let _ = writeln!(
