@@ -108,10 +108,7 @@ impl Report {
             env!("CARGO_PKG_VERSION"),
             self.mode.name()
         );
-        let _ = writeln!(
-            s,
-            "- command: `wgsph validate {flag} --out DIR{case_args}` (from the repository root)"
-        );
+        let _ = writeln!(s, "- command: `wgsph validate {flag} --out DIR{case_args}`");
         let _ = writeln!(s, "- adapter: {}", self.adapter);
         let (fails, judged) = self.cases.iter().fold((0, 0), |(f, j), c| {
             let rows = c
