@@ -13,3 +13,4 @@ pub mod reference;
 pub mod run;
 pub mod scenario;
 pub mod sph;
+pub mod validation;

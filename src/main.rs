@@ -104,6 +104,30 @@ enum Command {
         #[arg(long, value_name = "SECONDS")]
         smooth: Option<f64>,
     },
+    /// Run the shipped validation cases, compare each with its reference data and write
+    /// DIR/report.md: a table (case, metric, error, bound, PASS/FAIL), wall times and PNG plots
+    /// of simulation against reference (DIR/<case>/plots/).
+    ///
+    /// Exit status: 0 when every judged row passes; 1 when a metric is over its bound or a case
+    /// goes unstable or cannot run (the report is written either way), or on an error.
+    Validate {
+        /// The resolutions and bounds of the CI tests (the default): about 8 minutes on a
+        /// software adapter with 2 cores.
+        #[arg(long, conflicts_with = "full")]
+        quick: bool,
+        /// Publication-grade resolutions and the tighter bounds of the fine-resolution tests:
+        /// a GPU's work (hours on a software adapter).
+        #[arg(long)]
+        full: bool,
+        /// Output directory: DIR/report.md, one run folder per case.
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Run only this case (repeatable; default: every case of the mode).
+        #[arg(long = "case", value_name = "NAME", value_parser = clap::builder::PossibleValuesParser::new(
+            wgsph::validation::CASES.iter().map(|c| c.name)
+        ))]
+        cases: Vec<String>,
+    },
     /// List the adapters wgpu sees and their limits.
     Info,
     /// Time N steps of a case (after a warm-up) and report particle-steps per second.
@@ -296,6 +320,26 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                 println!("wrote {}", p.display());
             }
             Ok(ExitCode::SUCCESS)
+        }
+        Command::Validate {
+            quick: _,
+            full,
+            out,
+            cases,
+        } => {
+            use wgsph::validation::{self, Mode};
+            let mode = if full { Mode::Full } else { Mode::Quick };
+            let selected = validation::select(mode, &cases)?;
+            let ctx = context(cli.adapter)?;
+            let report =
+                validation::validate(&ctx, mode, &selected, &out, &mut || progress(false, bars))?;
+            print!("{}", report.table());
+            println!(
+                "{}: wrote {}",
+                if report.passed() { "PASS" } else { "FAIL" },
+                out.join(validation::REPORT_FILE).display()
+            );
+            Ok(ExitCode::from(report.exit_status()))
         }
         Command::Info => {
             let adapters = list_adapters();

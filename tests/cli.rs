@@ -260,3 +260,84 @@ fn a_solid_case_runs_and_writes_the_stress() {
         assert!(head.contains(&format!("Name=\"{name}\"")), "{name} missing");
     }
 }
+
+/// `wgsph validate` on its cheapest case: the report has the case's rows with numeric errors and
+/// PASS, links the plot, the PNG exists, and the exit status is 0.
+#[test]
+fn validate_quick_writes_the_report_and_plots() {
+    let out = temp_dir("validate");
+    let o = wgsph()
+        .args(["validate", "--quick", "--case", "hydrostatic_2d", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("quick mode"), "{report}");
+    assert!(report.contains("--case hydrostatic_2d"), "{report}");
+    let row = report
+        .lines()
+        .find(|l| l.starts_with("| hydrostatic_2d | bottom pressure"))
+        .unwrap_or_else(|| panic!("no pressure row in\n{report}"));
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    // ["", case, metric, error, bound, result, ""]
+    let error: f64 = cells[3].trim_end_matches('%').trim().parse().unwrap();
+    assert!(error.is_finite() && error.abs() < 2.0, "{row}");
+    assert_eq!(cells[4], "±2 %", "{row}");
+    assert_eq!(cells[5], "PASS", "{row}");
+    assert!(report.contains("| hydrostatic_2d | fluid particles lost | 0 | ≤ 0 | PASS |"));
+    assert!(
+        report.contains("](hydrostatic_2d/plots/p_bottom.png)"),
+        "{report}"
+    );
+    let png = std::fs::read(out.join("hydrostatic_2d/plots/p_bottom.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    assert!(out.join("hydrostatic_2d/probes/p_bottom.csv").is_file());
+    // The table is also printed.
+    assert!(stdout.contains(row), "{stdout}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// An unknown case, or one its mode does not run, is refused before anything runs, naming the
+/// cases; --quick and --full exclude each other.
+#[test]
+fn validate_refuses_unknown_cases_and_both_modes() {
+    let out = temp_dir("validate-bad");
+    let o = wgsph()
+        .args(["validate", "--case", "nope", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        stderr.contains("'nope'") && stderr.contains("floating_box_2d"),
+        "{stderr}"
+    );
+    let o = wgsph()
+        .args([
+            "validate",
+            "--case",
+            "water_entry_cylinder_2d_rho1000",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("not run in quick mode"), "{stderr}");
+    assert!(!out.join("report.md").exists());
+    let o = wgsph()
+        .args(["validate", "--quick", "--full", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot be used with"));
+}

@@ -5,64 +5,53 @@
 mod common;
 use common::gpu;
 use std::path::Path;
-use wgsph::scenario::{Kind, ProbeKind};
+use wgsph::scenario::Kind;
 use wgsph::sph::Solver;
+use wgsph::validation::{hydrostatic, Mode};
 
 fn load(case: &str, set: &[&str]) -> wgsph::scenario::Scenario {
     let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
     wgsph::case::load(Path::new(case), &set).unwrap()
 }
 
-/// (x, y) columns of a CSV with '#' comment lines and one header line.
-fn read_csv(path: &str) -> Vec<(f64, f64)> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .filter(|l| !l.starts_with('#'))
-        .skip(1)
-        .map(|l| {
-            let mut it = l.split(',').map(|v| v.trim().parse::<f64>().unwrap());
-            (it.next().unwrap(), it.next().unwrap())
-        })
-        .collect()
-}
-
+/// The pressure metric is `wgsph validate`'s (`validation::hydrostatic`); this test drives the
+/// solver itself to also check every particle at the end. Samples at the case's probe interval
+/// (0.01 s), as `validate` does: the tank's pressure oscillates with a period near 0.1 s, which
+/// a 0.05 s sampling would alias.
 #[test]
 fn hydrostatic_tank_settles_to_rho_g_h() {
-    let sc = load("cases/hydrostatic_2d.toml", &["time.end_s=2.0"]);
+    let case = wgsph::validation::find("hydrostatic_2d").unwrap();
+    let sc = case
+        .scenario(&case.overrides(Mode::Quick).unwrap())
+        .unwrap();
     let ph = sc.physics.clone();
     let probe = sc
         .probes
         .iter()
-        .position(|p| matches!(p.kind, ProbeKind::Pressure { .. }))
+        .position(|p| p.name == hydrostatic::PROBE)
         .unwrap();
-    let ProbeKind::Pressure { point } = sc.probes[probe].kind else {
-        unreachable!()
-    };
-    let depth = 0.5 - point[1];
-    let exact = ph.rho0 * 9.81 * depth;
     let n_fluid = sc.count(Kind::Fluid);
     let mut solver = Solver::new(gpu(), &sc).unwrap();
-    // Average over the last second (after the start-up acoustic waves have decayed).
-    let (mut sum, mut count) = (0.0, 0);
-    for k in 1..=40 {
-        let t = 0.05 * k as f64;
+    let every = sc.time.probe_every_s;
+    let n = (sc.time.end_s / every).round() as usize;
+    let mut series = Vec::with_capacity(n);
+    for k in 1..=n {
+        let t = every * k as f64;
         solver.advance_to(t).unwrap();
-        if t > 1.0 + 1e-9 {
-            sum += solver.sample_probes().unwrap()[probe];
-            count += 1;
-        }
+        series.push((t, solver.sample_probes().unwrap()[probe]));
     }
-    let mean = sum / count as f64;
-    let err = (mean - exact) / exact;
+    let b = hydrostatic::bottom_pressure(&sc, &series).unwrap();
     println!(
-        "hydrostatic: p = {mean:.1} Pa at depth {depth} m, exact {exact:.1} Pa, error {:.2} %",
-        100.0 * err
+        "hydrostatic: p = {:.1} Pa at depth {} m, exact {:.1} Pa, error {:.2} %",
+        b.mean_pa,
+        b.depth_m,
+        b.exact_pa,
+        100.0 * b.error()
     );
     assert!(
-        err.abs() < 0.02,
+        b.error().abs() < hydrostatic::BOUND,
         "bottom pressure error {:.2} %",
-        100.0 * err
+        100.0 * b.error()
     );
     // No exclusions (mass conserved exactly: every particle carries the same mass) and no
     // fluid particle beyond the first layer of wall particles.
@@ -85,92 +74,27 @@ fn hydrostatic_tank_settles_to_rho_g_h() {
     }
 }
 
-/// Linear interpolation of a monotone-in-t series.
-fn interp(series: &[(f64, f64)], t: f64) -> f64 {
-    let k = series
-        .partition_point(|(ti, _)| *ti < t)
-        .clamp(1, series.len() - 1);
-    let (t0, y0) = series[k - 1];
-    let (t1, y1) = series[k];
-    y0 + (y1 - y0) * (t - t0) / (t1 - t0)
-}
-
-/// Surge front Z = z/a against T = t·sqrt(2g/a) of the shipped 2D dam break, T ∈ [0, 3].
-fn dam_break_front() -> Vec<(f64, f64)> {
-    let sc = load("cases/dam_break_2d.toml", &[]);
-    let a: f64 = 0.146;
-    let scale = (2.0 * 9.81 / a).sqrt();
-    let t_end = 3.0 / scale;
-    let front = sc
-        .probes
-        .iter()
-        .position(|p| matches!(p.kind, ProbeKind::Front { .. }))
-        .unwrap();
-    let mut solver = Solver::new(gpu(), &sc).unwrap();
-    let mut sim = vec![(0.0, solver.sample_probes().unwrap()[front] / a)];
-    let n = 60;
-    for k in 1..=n {
-        let t = t_end * k as f64 / n as f64;
-        solver.advance_to(t).unwrap();
-        sim.push((t * scale, solver.sample_probes().unwrap()[front] / a));
-    }
-    sim
-}
-
-fn martin_moyce() -> Vec<(f64, f64)> {
-    read_csv("tests/data/db2d_martin_moyce_1952_front_n2sq2_a2.25in.csv")
-}
-
-/// Least-squares slope of y(x).
-fn slope(points: &[(f64, f64)]) -> f64 {
-    let n = points.len() as f64;
-    let (mx, my) = points
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
-    let sxy: f64 = points.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
-    let sxx: f64 = points.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
-    sxy / sxx
+/// The shipped 2D dam break to T = 3, judged with the bounds of `bounds`
+/// (`validation::dam_break`, the same code as `wgsph validate`).
+fn dam_break_front(tag: &str, bounds: Mode) -> wgsph::validation::CaseOutcome {
+    common::validate_case("dam_break_2d", Mode::Quick, bounds, tag)
 }
 
 /// The front's speed once the column has collapsed (T ∈ [1, 3], before it reaches the far
 /// wall at Z = 4) against Martin & Moyce: this is independent of the experiment's time origin.
 #[test]
 fn dam_break_2d_front_speed_matches_martin_moyce() {
-    let sim = dam_break_front();
-    let exp: Vec<(f64, f64)> = martin_moyce()
-        .into_iter()
-        .filter(|(t, _)| (1.0..=3.0).contains(t))
-        .collect();
-    let at_exp: Vec<(f64, f64)> = exp.iter().map(|&(t, _)| (t, interp(&sim, t))).collect();
-    let (s_exp, s_sim) = (slope(&exp), slope(&at_exp));
-    let e = (s_sim - s_exp) / s_exp;
-    println!(
-        "dam break 2D: front speed dZ/dT = {s_sim:.3} (Martin & Moyce {s_exp:.3}), error {:+.1} %",
-        100.0 * e
-    );
-    assert!(e.abs() < 0.10, "front speed error {:.1} %", 100.0 * e);
+    let o = dam_break_front("speed", Mode::Quick);
+    assert!(o.passed(), "{}", common::rows(&o));
 }
 
-/// Front position against Martin & Moyce at every measured T ≤ 3, within 15 %.
+/// Front position against Martin & Moyce at every measured T ≤ 3, within 15 % (the full mode's
+/// bound, at the shipped resolution).
 #[test]
 #[ignore = "fails: the SPH front leads Martin & Moyce by 12-18 % for T < 3 (docs/validation.md); kept visible, not loosened"]
 fn dam_break_2d_front_position_within_15_percent_of_martin_moyce() {
-    let sim = dam_break_front();
-    let mut worst: f64 = 0.0;
-    for (t, z) in martin_moyce().into_iter().filter(|(t, _)| *t <= 3.0) {
-        let e = (interp(&sim, t) - z) / z;
-        println!(
-            "T = {t:.3}: Z sim {:.3}, Martin & Moyce {z:.3}, error {:+.1} %",
-            interp(&sim, t),
-            100.0 * e
-        );
-        worst = worst.max(e.abs());
-    }
-    assert!(
-        worst < 0.15,
-        "surge front deviates {:.1} % from Martin & Moyce",
-        100.0 * worst
-    );
+    let o = dam_break_front("position", Mode::Full);
+    assert!(o.passed(), "{}", common::rows(&o));
 }
 
 #[test]

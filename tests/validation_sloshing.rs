@@ -10,32 +10,11 @@
 
 use std::path::Path;
 
+use wgsph::plot::{interpolate, read_csv};
 use wgsph::progress::LogLines;
 use wgsph::run::RunOptions;
 
 mod common;
-
-/// (t, value) rows of a CSV with `#` comments and one header line.
-fn read_csv(path: &Path) -> Vec<(f64, f64)> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .filter(|l| !l.starts_with('#'))
-        .skip(1)
-        .map(|l| {
-            let mut it = l.split(',').map(|x| x.trim().parse::<f64>().unwrap());
-            (it.next().unwrap(), it.next().unwrap())
-        })
-        .collect()
-}
-
-fn interp(series: &[(f64, f64)], t: f64) -> f64 {
-    let k = series
-        .partition_point(|&(ts, _)| ts < t)
-        .clamp(1, series.len() - 1);
-    let ((t0, v0), (t1, v1)) = (series[k - 1], series[k]);
-    v0 + (v1 - v0) * (t - t0) / (t1 - t0)
-}
 
 /// Comparison of one transducer over the experiment's samples in [from, to].
 struct Comparison {
@@ -51,12 +30,16 @@ struct Comparison {
 fn compare(dir: &Path, probe: &str, transducer: u32, from: f64, to: f64) -> Comparison {
     let exp = read_csv(&Path::new("tests/data").join(format!(
         "sloshing_akyildiz_unal_2006_pitch_probe{transducer}.csv"
-    )));
-    let sim = read_csv(&dir.join("probes").join(format!("{probe}.csv")));
+    )))
+    .unwrap()
+    .points;
+    let sim = read_csv(&dir.join("probes").join(format!("{probe}.csv")))
+        .unwrap()
+        .points;
     let pairs: Vec<(f64, f64)> = exp
         .iter()
         .filter(|(t, _)| (from..=to).contains(t))
-        .map(|&(t, p)| (interp(&sim, t) / 1000.0, p))
+        .map(|&(t, p)| (interpolate(&sim, t).expect("simulated sample") / 1000.0, p))
         .collect();
     let n = pairs.len() as f64;
     let mean_sim = pairs.iter().map(|p| p.0).sum::<f64>() / n;

@@ -289,11 +289,12 @@ pub struct PlotReport {
     pub errors_csv: Option<PathBuf>,
 }
 
-/// One curve on a plot.
-struct Curve {
-    label: String,
-    points: Vec<(f64, f64)>,
-    reference: bool,
+/// One curve on a plot: a coloured line, or (`reference`) a thin black line with dots.
+#[derive(Clone, Debug)]
+pub struct Curve {
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
+    pub reference: bool,
 }
 
 fn case_name(dir: &Path) -> String {
@@ -558,8 +559,9 @@ fn segments(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
     out
 }
 
-/// Renders the curves into an RGB buffer and writes it to `path` as PNG, atomically.
-fn render_png(
+/// Renders the curves into an RGB buffer and writes it to `path` as PNG, atomically. NaN
+/// points split a line; the axes span the finite points of every curve.
+pub fn render_png(
     path: &Path,
     title: &str,
     xlabel: &str,

@@ -135,3 +135,44 @@ pub fn gpu_particles_and_codes(s: &Solver) -> (Vec<RefParticle>, Vec<u32>) {
 pub fn gpu_particles(s: &Solver) -> Vec<RefParticle> {
     gpu_particles_and_codes(s).0
 }
+
+/// Runs the validation case `name` (`wgsph validate`'s table) at the resolution of `resolution`
+/// into a temporary folder and judges it with the bounds of `bounds`; prints its rows.
+pub fn validate_case(
+    name: &str,
+    resolution: wgsph::validation::Mode,
+    bounds: wgsph::validation::Mode,
+    tag: &str,
+) -> wgsph::validation::CaseOutcome {
+    let case = wgsph::validation::find(name).expect("a validation case");
+    let dir = std::env::temp_dir().join(format!(
+        "wgsph-validate-{name}-{tag}-{}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    let overrides = case.overrides(resolution).expect("run in this mode");
+    let o = wgsph::validation::run_case(
+        gpu(),
+        case,
+        &overrides,
+        bounds,
+        &dir,
+        &mut wgsph::progress::LogLines::default(),
+    );
+    println!("{}", rows(&o));
+    o
+}
+
+/// The outcome's table rows and each metric's detail, for messages.
+pub fn rows(o: &wgsph::validation::CaseOutcome) -> String {
+    let report = wgsph::validation::Report {
+        mode: wgsph::validation::Mode::Quick,
+        adapter: gpu().describe(),
+        cases: vec![o.clone()],
+    };
+    let mut s = report.table();
+    for m in &o.metrics {
+        s.push_str(&format!("{}: {}\n", m.name, m.detail));
+    }
+    s
+}

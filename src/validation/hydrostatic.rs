@@ -1,0 +1,110 @@
+//! Hydrostatic tank (`cases/hydrostatic_2d.toml`): the bottom pressure probe against the
+//! analytic ρ0 g (H − z), averaged once the start-up acoustic waves have decayed.
+
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Result};
+
+use super::{
+    gravity, lost_particles, probe_series, reference_curve, sim_curve, Bound, Evaluation, Figure,
+    Metric, Mode, Unit,
+};
+use crate::scenario::{ProbeKind, Scenario};
+
+/// Water depth H of the case file (its fluid block's top), m.
+pub const DEPTH_M: f64 = 0.5;
+/// The pressure probe compared.
+pub const PROBE: &str = "p_bottom";
+/// Samples after this time are averaged (the acoustic waves of the start have decayed), s.
+pub const SETTLED_AFTER_S: f64 = 1.0;
+/// Bound of the relative error of the mean pressure, both modes.
+pub const BOUND: f64 = 0.02;
+
+/// Quick: the shipped dx = 0.02 m (H/dx = 25); full: dx = 0.01 m (H/dx = 50). Both 2 s.
+pub fn overrides(mode: Mode) -> Option<Vec<String>> {
+    let mut set = vec!["time.end_s=2".to_string()];
+    if mode == Mode::Full {
+        set.push("particles.dx_m=0.01".into());
+    }
+    Some(set)
+}
+
+/// The mean bottom pressure against the analytic one.
+#[derive(Clone, Debug)]
+pub struct BottomPressure {
+    pub mean_pa: f64,
+    pub exact_pa: f64,
+    /// Depth of the probe below the still surface, m.
+    pub depth_m: f64,
+    pub samples: usize,
+}
+
+impl BottomPressure {
+    /// Relative error of the mean.
+    pub fn error(&self) -> f64 {
+        (self.mean_pa - self.exact_pa) / self.exact_pa
+    }
+}
+
+/// The mean of the samples of [`PROBE`] with t > [`SETTLED_AFTER_S`] (`series`: (t, p)) against
+/// ρ0 |g| (H − z) at the probe's point.
+pub fn bottom_pressure(sc: &Scenario, series: &[(f64, f64)]) -> Result<BottomPressure> {
+    let probe = sc
+        .probes
+        .iter()
+        .find(|p| p.name == PROBE)
+        .ok_or_else(|| anyhow!("the case has no probe {PROBE:?}"))?;
+    let ProbeKind::Pressure { point } = probe.kind else {
+        bail!("probe {PROBE:?} is not a pressure probe");
+    };
+    let vertical = sc.physics.dim as usize - 1;
+    let depth_m = DEPTH_M - point[vertical];
+    let exact_pa = sc.physics.rho0 * gravity(sc) * depth_m;
+    let late: Vec<f64> = series
+        .iter()
+        .filter(|(t, _)| *t > SETTLED_AFTER_S + 1e-9)
+        .map(|p| p.1)
+        .collect();
+    if late.is_empty() {
+        bail!("no {PROBE} sample after t = {SETTLED_AFTER_S} s");
+    }
+    Ok(BottomPressure {
+        mean_pa: late.iter().sum::<f64>() / late.len() as f64,
+        exact_pa,
+        depth_m,
+        samples: late.len(),
+    })
+}
+
+pub fn evaluate(sc: &Scenario, dir: &Path, _bounds: Mode) -> Result<Evaluation> {
+    let series = probe_series(dir, PROBE)?;
+    let b = bottom_pressure(sc, &series)?;
+    let end = series.last().map_or(sc.time.end_s, |p| p.0);
+    Ok(Evaluation {
+        metrics: vec![
+            Metric {
+                name: format!(
+                    "bottom pressure, mean over t > {SETTLED_AFTER_S} s, vs ρ0 g (H − z)"
+                ),
+                value: b.error(),
+                unit: Unit::Percent,
+                bound: Some(Bound::Within(BOUND)),
+                detail: format!(
+                    "{:.1} Pa ({} samples) at depth {} m, analytic {:.1} Pa",
+                    b.mean_pa, b.samples, b.depth_m, b.exact_pa
+                ),
+            },
+            lost_particles(dir, true)?,
+        ],
+        figures: vec![Figure {
+            name: PROBE.into(),
+            title: format!("{}: {PROBE}", sc.name),
+            x_label: "t [s]".into(),
+            y_label: "pressure [Pa]".into(),
+            curves: vec![
+                sim_curve("wgsph", series),
+                reference_curve("ρ0 g (H − z)", vec![(0.0, b.exact_pa), (end, b.exact_pa)]),
+            ],
+        }],
+    })
+}

@@ -1,0 +1,330 @@
+//! The validation pipeline on synthetic run folders (no GPU): metrics from made-up outputs whose
+//! exact answer is known, the verdicts, the report's rows and the exit status.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::*;
+use crate::output::RunSummary;
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("wgsph-validation-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(d.join(PROBES_DIR)).unwrap();
+    d
+}
+
+fn summary(case: &str, excluded: u64) -> RunSummary {
+    RunSummary {
+        case: case.into(),
+        adapter: "synthetic".into(),
+        backend: "none".into(),
+        dimension: 2,
+        particles_fluid: 1250,
+        particles_wall: 348,
+        particles_excluded: excluded,
+        steps: 100,
+        simulated_time_s: 2.0,
+        wall_time_s: 1.0,
+        particle_steps_per_s: 1.0,
+        gpu_bytes_per_particle: 1.0,
+        outputs: 1,
+        status: "completed".into(),
+    }
+}
+
+fn write_run_json(dir: &Path, s: &RunSummary) {
+    std::fs::write(
+        dir.join(RUN_SUMMARY_FILE),
+        serde_json::to_string(s).unwrap(),
+    )
+    .unwrap();
+}
+
+/// A probe CSV `t_s,<column>` of `f(t)` at t = 0, dt, ..., end.
+fn write_probe(dir: &Path, name: &str, column: &str, dt: f64, end: f64, f: impl Fn(f64) -> f64) {
+    let mut s = format!("t_s,{column}\n");
+    let n = (end / dt).round() as usize;
+    for k in 0..=n {
+        let t = k as f64 * dt;
+        let _ = writeln!(s, "{t},{}", f(t));
+    }
+    std::fs::write(dir.join(PROBES_DIR).join(format!("{name}.csv")), s).unwrap();
+}
+
+/// A synthetic hydrostatic run whose bottom probe reads `factor` times the analytic pressure;
+/// evaluated with the quick bounds into an outcome.
+fn hydrostatic_outcome(tag: &str, factor: f64) -> CaseOutcome {
+    let case = find("hydrostatic_2d").unwrap();
+    let overrides = case.overrides(Mode::Quick).unwrap();
+    let sc = case.scenario(&overrides).unwrap();
+    let dir = temp_dir(tag);
+    let exact = 1000.0 * 9.81 * 0.45;
+    write_probe(&dir, "p_bottom", "pressure_pa", 0.01, 2.0, |_| {
+        factor * exact
+    });
+    write_run_json(&dir, &summary(case.name, 0));
+    let eval = case.evaluate(&sc, &dir, Mode::Quick).unwrap();
+    let plots = draw(&dir, &eval.figures).unwrap();
+    CaseOutcome {
+        name: case.name.into(),
+        file: case.file.into(),
+        reference: case.reference.into(),
+        citation: case.citation.into(),
+        overrides,
+        dir,
+        summary: Some(summary(case.name, 0)),
+        metrics: eval.metrics,
+        failure: None,
+        plots,
+        wall_s: 1.5,
+    }
+}
+
+fn report(cases: Vec<CaseOutcome>) -> Report {
+    Report {
+        mode: Mode::Quick,
+        adapter: "synthetic adapter".into(),
+        cases,
+    }
+}
+
+#[test]
+fn a_metric_over_its_bound_is_a_fail_row_and_a_nonzero_exit_status() {
+    // 10 % above ρ0 g (H − z): over the 2 % bound.
+    let bad = hydrostatic_outcome("bad", 1.10);
+    assert!(
+        (bad.metrics[0].value - 0.10).abs() < 1e-9,
+        "{:?}",
+        bad.metrics
+    );
+    assert_eq!(bad.metrics[0].verdict(), Verdict::Fail);
+    assert!(!bad.passed());
+    let r = report(vec![bad]);
+    assert!(!r.passed());
+    assert_ne!(r.exit_status(), 0);
+    let rows = r.rows();
+    let row = rows
+        .iter()
+        .find(|row| row[1].starts_with("bottom pressure"))
+        .unwrap();
+    assert_eq!(row[0], "hydrostatic_2d");
+    assert_eq!(row[2], "+10.00 %");
+    assert_eq!(row[3], "±2 %");
+    assert_eq!(row[4], "FAIL");
+    let out = r.cases[0].dir.parent().unwrap().to_path_buf();
+    let md = r.markdown(&out);
+    assert!(md.contains("| hydrostatic_2d | bottom pressure"), "{md}");
+    assert!(md.contains("| +10.00 % | ±2 % | FAIL |"), "{md}");
+    assert!(
+        md.contains("result: **FAIL** (1 of 2 judged rows pass"),
+        "{md}"
+    );
+    std::fs::remove_dir_all(&r.cases[0].dir).unwrap();
+
+    // 0.5 % above: inside the bound, and the report passes.
+    let good = hydrostatic_outcome("good", 1.005);
+    assert_eq!(good.metrics[0].verdict(), Verdict::Pass);
+    assert_eq!(good.metrics[1].verdict(), Verdict::Pass, "no particle lost");
+    let r = report(vec![good]);
+    assert!(r.passed());
+    assert_eq!(r.exit_status(), 0);
+    assert!(r.rows().iter().all(|row| row[4] == "PASS"));
+    // The figure was drawn and is linked relative to the report's folder.
+    let png = &r.cases[0].plots[0];
+    assert_eq!(&std::fs::read(png).unwrap()[..4], b"\x89PNG");
+    let out = r.cases[0].dir.parent().unwrap().to_path_buf();
+    let md = r.markdown(&out);
+    let link = format!(
+        "]({}/plots/p_bottom.png)",
+        r.cases[0].dir.file_name().unwrap().to_string_lossy()
+    );
+    assert!(md.contains(&link), "{md}");
+    std::fs::remove_dir_all(&r.cases[0].dir).unwrap();
+}
+
+#[test]
+fn a_case_that_stops_is_a_fail_row_with_its_reason() {
+    let stopped = CaseOutcome {
+        name: "dam_break_2d".into(),
+        file: "cases/dam_break_2d.toml".into(),
+        reference: dam_break::REFERENCE.into(),
+        citation: dam_break::CITATION.into(),
+        overrides: vec![],
+        dir: PathBuf::from("out/dam_break_2d"),
+        summary: None,
+        metrics: vec![],
+        failure: Some("run stopped: non-finite fluid at step 12 (t = 0.01 s)".into()),
+        plots: vec![],
+        wall_s: 0.1,
+    };
+    let r = report(vec![stopped]);
+    assert_eq!(r.exit_status(), 1);
+    let rows = r.rows();
+    assert_eq!(rows.len(), 1);
+    assert_eq!(rows[0][0], "dam_break_2d");
+    assert!(rows[0][2].contains("non-finite fluid at step 12"));
+    assert_eq!(rows[0][4], "FAIL");
+}
+
+#[test]
+fn a_lost_particle_fails_where_it_is_judged() {
+    let dir = temp_dir("lost");
+    write_run_json(&dir, &summary("x", 3));
+    let m = lost_particles(&dir, true).unwrap();
+    assert_eq!((m.value, m.verdict()), (3.0, Verdict::Fail));
+    assert_eq!(
+        lost_particles(&dir, false).unwrap().verdict(),
+        Verdict::Info
+    );
+    write_run_json(&dir, &summary("x", 0));
+    assert_eq!(lost_particles(&dir, true).unwrap().verdict(), Verdict::Pass);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bounds_are_strict_and_nan_fails() {
+    assert!(Bound::Within(0.1).holds(-0.099) && !Bound::Within(0.1).holds(0.1));
+    assert!(!Bound::Within(0.1).holds(f64::NAN));
+    assert!(Bound::Between(-0.5, 1.0).holds(0.3) && !Bound::Between(-0.5, 1.0).holds(1.0));
+    assert!(!Bound::Between(1.0, 40.0).holds(f64::NAN));
+    assert!(Bound::AtMost(0.0).holds(0.0) && !Bound::AtMost(0.0).holds(1.0));
+    let info = Metric {
+        name: "x".into(),
+        value: 1e9,
+        unit: Unit::Number,
+        bound: None,
+        detail: String::new(),
+    };
+    assert_eq!(info.verdict(), Verdict::Info);
+}
+
+#[test]
+fn cases_are_selected_by_mode_and_name() {
+    let quick: Vec<&str> = select(Mode::Quick, &[])
+        .unwrap()
+        .iter()
+        .map(|c| c.name)
+        .collect();
+    assert_eq!(
+        quick,
+        [
+            "hydrostatic_2d",
+            "dam_break_2d",
+            "dam_break_lobovsky_2d",
+            "floating_box_2d",
+            "water_entry_cylinder_2d"
+        ]
+    );
+    assert_eq!(select(Mode::Full, &[]).unwrap().len(), CASES.len());
+    let one = select(
+        Mode::Quick,
+        &["floating_box_2d".into(), "floating_box_2d".into()],
+    )
+    .unwrap();
+    assert_eq!(one.len(), 1);
+    let e = select(Mode::Quick, &["nope".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("\"nope\"") && e.contains("hydrostatic_2d"),
+        "{e}"
+    );
+    let e = select(Mode::Quick, &["water_entry_cylinder_2d_rho1000".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("not run in quick mode"), "{e}");
+}
+
+/// Every case loads with the overrides of each of its modes (a typo in an override is caught
+/// here, not after a GPU run), and its reference data parses.
+#[test]
+fn every_case_loads_in_each_of_its_modes() {
+    for case in CASES {
+        for mode in [Mode::Quick, Mode::Full] {
+            if let Some(set) = case.overrides(mode) {
+                let sc = case
+                    .scenario(&set)
+                    .unwrap_or_else(|e| panic!("{} {mode:?}: {e:#}", case.name));
+                assert!(sc.time.end_s > 0.0);
+            }
+        }
+    }
+    for r in [&bodies::ENTRY_500, &bodies::ENTRY_1000] {
+        assert!(r.points().unwrap().len() >= 5, "{}", r.file);
+    }
+}
+
+/// A run whose front follows the experiment exactly (in SI units) has zero speed and position
+/// errors: the scalings T = t sqrt(2g/a), Z = z/a are consistent.
+#[test]
+fn dam_break_front_equal_to_the_experiment_has_no_error() {
+    let case = find("dam_break_2d").unwrap();
+    let sc = case
+        .scenario(&case.overrides(Mode::Quick).unwrap())
+        .unwrap();
+    let a = dam_break::COLUMN_WIDTH_M;
+    let scale = (2.0 * 9.81 / a).sqrt();
+    // The experiment's points, extended linearly to T = 0 and T = 3.2, in seconds and metres.
+    let mut pts: Vec<(f64, f64)> = vec![(0.0, 1.0)];
+    pts.extend(
+        dam_break::DATA
+            .points()
+            .unwrap()
+            .into_iter()
+            .take_while(|p| p.0 < 3.2),
+    );
+    let si: Vec<(f64, f64)> = pts.iter().map(|&(t, z)| (t / scale, z * a)).collect();
+    let f = dam_break::front(&sc, &si).unwrap();
+    assert!(f.speed_error().abs() < 1e-9, "{}", f.speed_error());
+    assert!(f.worst_position_error().abs() < 1e-9);
+    assert_eq!(f.positions.len(), 4);
+    // 10 % ahead everywhere: +10 % position error, and the speed too (Z scaled by 1.1).
+    let ahead: Vec<(f64, f64)> = si.iter().map(|&(t, x)| (t, 1.1 * x)).collect();
+    let f = dam_break::front(&sc, &ahead).unwrap();
+    assert!((f.worst_position_error() - 0.1).abs() < 1e-9);
+    assert!((f.speed_error() - 0.1).abs() < 1e-9);
+}
+
+/// The floating box and the water entry from synthetic body tables.
+#[test]
+fn body_metrics_from_synthetic_tables() {
+    let case = find("floating_box_2d").unwrap();
+    let sc = case
+        .scenario(&case.overrides(Mode::Quick).unwrap())
+        .unwrap();
+    let dir = temp_dir("box");
+    // Still water at 0.3 m; the box centre at 0.27 m: draft 0.3 − (0.27 − 0.05) = 0.08 m.
+    for g in ["gauge_left", "gauge_right"] {
+        write_probe(&dir, g, "height_m", 0.01, 2.0, |_| 0.3);
+    }
+    let mut body = format!("t_s,{}\n", crate::body::csv_columns(2).join(","));
+    for k in 0..=200 {
+        let _ = writeln!(body, "{},0.5,0.27,0,0,0,0,0,0,0", k as f64 * 0.01);
+    }
+    std::fs::write(dir.join(PROBES_DIR).join("body_box.csv"), body).unwrap();
+    let d = bodies::draft(&sc, &dir).unwrap();
+    assert!((d.mean_m - 0.08).abs() < 1e-12 && d.from_s == 1.0);
+    assert!((d.error() - 0.6).abs() < 1e-9);
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    // The cylinder following Greenhow & Lin exactly.
+    let case = find("water_entry_cylinder_2d").unwrap();
+    let sc = case
+        .scenario(&case.overrides(Mode::Quick).unwrap())
+        .unwrap();
+    let dir = temp_dir("entry");
+    let (d, y0) = (bodies::DIAMETER_M, 0.355);
+    let ts = (9.81 / d).sqrt();
+    let mut body = format!("t_s,{}\n", crate::body::csv_columns(2).join(","));
+    for (t, p) in bodies::ENTRY_500.points().unwrap() {
+        let _ = writeln!(body, "{},0.5,{},0,0,0,0,0,0,0", t / ts, y0 - p * d);
+    }
+    // One row beyond the last reference time, which rounding could otherwise leave outside.
+    let _ = writeln!(body, "{},0.5,0,0,0,0,0,0,0,0", 2.0 / ts);
+    std::fs::write(dir.join(PROBES_DIR).join("body_cylinder.csv"), body).unwrap();
+    let p = bodies::penetration(&sc, &dir, &bodies::ENTRY_500).unwrap();
+    assert_eq!(p.points.len(), 5, "the first contact point is skipped");
+    assert!(p.worst_error().abs() < 1e-9, "{}", p.worst_error());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
