@@ -323,12 +323,31 @@ fn probe_names(dir: &Path) -> Result<Vec<String>> {
         let p = e?.path();
         if p.extension().is_some_and(|x| x == "csv") && p.is_file() {
             if let Some(s) = p.file_stem().and_then(|s| s.to_str()) {
+                // Tables of several columns (a body's motion and loads) are not time series
+                // of one probe.
+                if is_table(&p) {
+                    log::info!("{}: a table of several columns, not plotted", p.display());
+                    continue;
+                }
                 names.push(s.to_string());
             }
         }
     }
     names.sort();
     Ok(names)
+}
+
+/// True when the CSV's header names more than one value column (e.g. `probes/body_<name>.csv`).
+fn is_table(path: &Path) -> bool {
+    use std::io::BufRead;
+    let Ok(file) = std::fs::File::open(path) else {
+        return false;
+    };
+    std::io::BufReader::new(file)
+        .lines()
+        .map_while(Result::ok)
+        .find(|l| !l.trim().is_empty() && !l.starts_with('#'))
+        .is_some_and(|header| header.split(',').count() > 2)
 }
 
 /// Centred moving average over a window of `width` (same units as t): each sample becomes the
@@ -763,6 +782,12 @@ mod tests {
         }
         std::fs::write(dir.join("probes/p1.csv"), p).unwrap();
         std::fs::write(dir.join("probes/gauge.csv"), h).unwrap();
+        // A body's table (several columns) is left out, not an error.
+        std::fs::write(
+            dir.join("probes/body_box.csv"),
+            "t_s,x_m,y_m,angle_deg\n0,0.5,0.3,0\n0.1,0.5,0.29,1\n",
+        )
+        .unwrap();
         // Dimensionless reference: y = 2 t* with t* = t / 0.5, scaled back: x·0.5, y·250.
         let refp = dir.join("ref.csv");
         std::fs::write(
