@@ -239,6 +239,7 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                 }),
                 interrupt: Some(interrupt_flag()?),
                 halt_at_s: None,
+                lose_device_after_s: None,
             };
             let report = wgsph::run::run(&ctx, &sc, &dir, &options, &mut *progress(quiet, bars))?;
             Ok(finish(&report, &dir, quiet))
@@ -273,6 +274,7 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                 }),
                 interrupt: Some(interrupt_flag()?),
                 halt_at_s: None,
+                lose_device_after_s: None,
             };
             let report =
                 wgsph::run::resume(&ctx, &sc, &dir, &options, &mut *progress(quiet, bars))?;

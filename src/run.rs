@@ -93,6 +93,10 @@ pub struct RunOptions {
     /// Stop with a checkpoint at the first probe time at or after this simulated time, as if
     /// interrupted (batch jobs with a time limit split a run this way; so do the tests).
     pub halt_at_s: Option<f64>,
+    /// Test hook: destroys the GPU device at the first probe interval after this simulated
+    /// time, as a driver reset would.
+    #[doc(hidden)]
+    pub lose_device_after_s: Option<f64>,
 }
 
 /// What a finished (or stopped) run reports.
@@ -429,6 +433,13 @@ impl<'a> Runner<'a> {
     fn probe_interval(&mut self, t: f64) -> Result<bool> {
         let sc = self.sc;
         let every_out = sc.time.output_every_s;
+        if self
+            .options
+            .lose_device_after_s
+            .is_some_and(|lose| self.solver.time() >= lose)
+        {
+            self.solver.lose_device();
+        }
         self.solver.advance_to(t)?;
         if !sc.probes.is_empty() {
             self.probes

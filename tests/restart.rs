@@ -367,6 +367,67 @@ fn a_lost_device_stops_the_solver_with_a_message() {
     assert!(msg.contains("device was lost"), "{msg}");
 }
 
+/// A device lost in the middle of a run (driver reset): the run stops with the reason, writes
+/// run.json saying how to resume, keeps its last checkpoint, and resuming on a working device
+/// gives the uninterrupted run's result.
+#[test]
+fn a_device_lost_mid_run_keeps_the_last_checkpoint_and_resumes() {
+    let sc = load(
+        "cases/dam_break_2d.toml",
+        &[
+            "particles.dx_m=0.0146",
+            "time.end_s=0.16",
+            "time.output_every_s=0.04",
+            "time.probe_every_s=0.01",
+        ],
+    );
+    let straight = temp_dir("lost-straight");
+    wgsph::run::run(
+        gpu(),
+        &sc,
+        &straight,
+        &RunOptions::default(),
+        &mut LogLines::default(),
+    )
+    .unwrap();
+    // Its own device: this one gets destroyed.
+    let ctx =
+        wgsph::gpu::GpuContext::new(wgsph::gpu::AdapterChoice::resolve(None).unwrap()).unwrap();
+    let dir = temp_dir("lost");
+    let opts = RunOptions {
+        checkpoint: wgsph::run::CheckpointPolicy {
+            every_sim_s: Some(0.04),
+            every_wall_s: None,
+        },
+        lose_device_after_s: Some(0.1),
+        ..RunOptions::default()
+    };
+    let r = wgsph::run::run(&ctx, &sc, &dir, &opts, &mut LogLines::default()).unwrap();
+    let msg = format!("{:#}", r.stopped.expect("the run must stop"));
+    assert!(msg.contains("device was lost"), "{msg}");
+    let summary = std::fs::read_to_string(dir.join("run.json")).unwrap();
+    assert!(
+        summary.contains("stopped") && summary.contains("wgsph resume"),
+        "{summary}"
+    );
+    let ck = wgsph::checkpoint::Checkpoint::read(&dir.join("checkpoint.bin")).unwrap();
+    assert!(
+        (ck.time_s - 0.08).abs() < 1e-9,
+        "last checkpoint at {}",
+        ck.time_s
+    );
+    let c = wgsph::run::resume(
+        gpu(),
+        &sc,
+        &dir,
+        &RunOptions::default(),
+        &mut LogLines::default(),
+    )
+    .unwrap();
+    assert!(c.stopped.is_none());
+    assert_same_results(&straight, &dir);
+}
+
 #[test]
 fn a_case_too_large_for_the_adapter_fails_before_the_run_starts() {
     let ctx = wgsph::gpu::GpuContext::with_limits(
