@@ -33,7 +33,7 @@ fn fmt_box(b: &Aabb, dim: usize) -> String {
 
 pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Scenario, CaseError> {
     if !case.solids.is_empty() {
-        return super::solids::build_solid_case(ctx, case);
+        return super::solids::build_solid_case(ctx, case, max_particles);
     }
     let (dim, dx) = (case.dim, case.dx);
     let v = dim - 1;

@@ -278,7 +278,16 @@ fn point_in(p: [f64; 3], b: &Aabb, dim: usize) -> bool {
 }
 
 /// The scenario of a case whose only particles are solids.
-pub(super) fn build_solid_case(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, CaseError> {
+/// How many particles at the end of `body` belong to solid `i` (they are built solid by solid).
+fn body_len(body: &[u32], i: usize) -> usize {
+    body.iter().rev().take_while(|&&b| b == i as u32).count()
+}
+
+pub(super) fn build_solid_case(
+    ctx: &Ctx<'_>,
+    case: Case,
+    max_particles: f64,
+) -> Result<Scenario, CaseError> {
     let (dim, dx) = (case.dim, case.dx);
     let first = &case.solids[0];
     let material = first.material;
@@ -328,6 +337,8 @@ pub(super) fn build_solid_case(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, Ca
     };
     let mut particles = Vec::new();
     let mut body = Vec::new();
+    // Counted over all solids, before any is built (the budget of the other cases).
+    let mut total = 0.0;
     for (i, s) in case.solids.iter().enumerate() {
         let Some((lo, hi)) = lat.range_in(&s.bx) else {
             return Err(ctx.err(
@@ -338,11 +349,15 @@ pub(super) fn build_solid_case(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, Ca
             ));
         };
         let count: f64 = (0..dim).map(|a| hi[a] - lo[a] + 1.0).product();
-        if count > super::MAX_PARTICLES {
+        total += count;
+        if total > max_particles {
             return Err(ctx.err(
                 "particles.dx_m",
                 Some(format!("{dx}")),
-                format!("solid[{i}] would have {count:.3e} particles, more than the limit of 200 million"),
+                format!(
+                    "the solids up to solid[{i}] would have {total:.3e} particles, more than the \
+                     limit of {max_particles:.3e}"
+                ),
                 "increase particles.dx_m",
             ));
         }
@@ -363,6 +378,14 @@ pub(super) fn build_solid_case(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, Ca
                         (Some(m), false) => m.velocity(pos),
                         _ => [0.0; 3],
                     };
+                    if !vel.iter().all(|v| v.is_finite()) {
+                        return Err(ctx.err(
+                            &format!("solid[{i}].initial_velocity"),
+                            None,
+                            format!("gives a non-finite velocity at {pos:?}"),
+                            "give a length_m of the order of the solid's length and a finite tip_velocity_m_s",
+                        ));
+                    }
                     particles.push(Particle {
                         pos,
                         vel,
@@ -376,6 +399,18 @@ pub(super) fn build_solid_case(ctx: &Ctx<'_>, case: Case) -> Result<Scenario, Ca
                     body.push(i as u32);
                 }
             }
+        }
+        // A solid clamped everywhere has nothing to simulate.
+        if !particles[particles.len() - body_len(&body, i)..]
+            .iter()
+            .any(|p| p.kind == Kind::Solid)
+        {
+            return Err(ctx.err(
+                &format!("solid[{i}].clamped_max_m"),
+                None,
+                "the clamped box holds every particle of the solid: nothing is left to move",
+                "clamp only a part of the solid (its root), or remove clamped_min_m/clamped_max_m",
+            ));
         }
     }
     // Default domain: the solids' box, with half its largest extent of room on every side.

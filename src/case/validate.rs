@@ -241,6 +241,15 @@ pub(super) fn validate(
             ))
         }
     };
+    // Before the physics: without fluid or solids nothing else of the case matters.
+    if raw.fluid_block.is_empty() && raw.solid.is_empty() {
+        return Err(ctx.err(
+            "fluid_block",
+            None,
+            "no fluid: at least one [[fluid_block]] (or [[solid]]) is required",
+            "add a [[fluid_block]] table with min_m and max_m",
+        ));
+    }
     let name = match &raw.name {
         Some(n)
             if n.trim().is_empty()
@@ -497,13 +506,6 @@ pub(super) fn validate(
                 format!("remove {what}, or the [[solid]] tables"),
             ));
         }
-    } else if raw.fluid_block.is_empty() {
-        return Err(ctx.err(
-            "fluid_block",
-            None,
-            "no fluid: at least one [[fluid_block]] (or [[solid]]) is required",
-            "add a [[fluid_block]] table with min_m and max_m",
-        ));
     }
     let mut blocks = Vec::with_capacity(raw.fluid_block.len());
     for (i, b) in raw.fluid_block.iter().enumerate() {

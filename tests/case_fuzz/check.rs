@@ -144,8 +144,9 @@ pub(crate) fn check_sane(sc: &Scenario) -> Result<(), String> {
     if n == 0 || n as f64 > MAX_PARTICLES {
         return Err(format!("{n} particles"));
     }
-    if sc.count(Kind::Fluid) == 0 {
-        return Err("no fluid particle".into());
+    // A case moves fluid or elastic solids (the oscillating plate has no fluid).
+    if sc.count(Kind::Fluid) + sc.count(Kind::Solid) == 0 {
+        return Err("no fluid or free solid particle".into());
     }
     let positive = |name: &str, v: f64| {
         if v.is_finite() && v > 0.0 {
