@@ -145,3 +145,32 @@ fn probe_front(
         workgroupBarrier();
     }
 }
+
+// Tracked points (`kind = "point"` probes): the position of each followed particle. `tracked`
+// holds their ids in ascending order; the one invocation whose particle carries such an id
+// (the arrays are re-sorted every step, the ids are stable) copies its position. A binary
+// search keeps the cost O(log P) per particle for P tracked points.
+@group(0) @binding(7) var<storage, read> tracked: array<u32>;
+@group(0) @binding(8) var<storage, read_write> tracked_pos: array<Pos>;
+
+@compute @workgroup_size(WG)
+fn track_points(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let k = linear_index(gid, nwg);
+    if (k >= params.n_particles) {
+        return;
+    }
+    let id = code[k] & ID_MASK;
+    var lo = 0u;
+    var hi = arrayLength(&tracked);
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        if (tracked[mid] < id) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    if (lo < arrayLength(&tracked) && tracked[lo] == id) {
+        tracked_pos[lo] = pos[k];
+    }
+}

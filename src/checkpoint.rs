@@ -121,6 +121,10 @@ pub fn fingerprint(sc: &Scenario) -> u64 {
         sc.name, sc.physics, sc.domain, sc.walls, sc.periodic, sc.probes, sc.bodies
     );
     h.update(settings.as_bytes());
+    // Only when there are any, so checkpoints written before points existed still match.
+    if !sc.points.is_empty() {
+        h.update(format!("|{:?}", sc.points).as_bytes());
+    }
     for p in &sc.particles {
         for x in p.pos.iter().chain(&p.vel).chain([&p.rho]) {
             h.update(&x.to_bits().to_le_bytes());

@@ -157,35 +157,62 @@ impl ParticleOutputs {
     }
 }
 
-/// The bodies' CSVs (`probes/body_<name>.csv`), one row per probe time.
+/// The bodies' CSVs (`probes/body_<name>.csv`) and the tracked points'
+/// (`probes/point_<name>.csv`: position and displacement from t = 0), one row per probe time.
 struct BodyOutputs {
     csv: ProbeWriter,
     dim: u32,
+    /// Initial position of every tracked point.
+    point_starts: Vec<[f64; 3]>,
+}
+
+/// Columns of a tracked point's CSV (after `t_s`).
+fn point_columns(dim: u32) -> Vec<String> {
+    let axes = &["x", "y", "z"][..dim as usize];
+    let at = axes.iter().map(|a| format!("{a}_m"));
+    let moved = axes.iter().map(|a| format!("u{a}_m"));
+    at.chain(moved).collect()
 }
 
 impl BodyOutputs {
     fn new(out: &OutputDir, sc: &Scenario) -> Result<Self> {
-        let tables: Vec<(String, Vec<String>)> = sc
+        let dim = sc.physics.dim;
+        let bodies = sc
             .bodies
             .iter()
-            .map(|b| {
-                (
-                    format!("body_{}", b.name),
-                    body::csv_columns(sc.physics.dim),
-                )
-            })
-            .collect();
+            .map(|b| (format!("body_{}", b.name), body::csv_columns(dim)));
+        let points = sc
+            .points
+            .iter()
+            .map(|p| (format!("point_{}", p.name), point_columns(dim)));
+        let tables: Vec<(String, Vec<String>)> = bodies.chain(points).collect();
         Ok(Self {
             csv: out.table_writer(&tables)?,
-            dim: sc.physics.dim,
+            dim,
+            // The case's positions: the GPU holds them to f32 offsets in their blocks (and
+            // places body particles from the body's pose), so a point at rest reports a
+            // displacement of a few nanometres.
+            point_starts: sc
+                .points
+                .iter()
+                .map(|p| sc.particles[p.particle as usize].pos)
+                .collect(),
         })
     }
 
     fn record(&mut self, solver: &Solver) -> Result<()> {
+        let mut rows: Vec<Vec<f64>> = Vec::new();
         if let Some(set) = solver.bodies() {
-            let rows: Vec<Vec<f64>> = (0..set.len())
-                .map(|k| body::csv_row(&set.pose(k), &set.load(k), self.dim))
-                .collect();
+            rows.extend(
+                (0..set.len()).map(|k| body::csv_row(&set.pose(k), &set.load(k), self.dim)),
+            );
+        }
+        let d = self.dim as usize;
+        for (x, x0) in solver.sample_points()?.iter().zip(&self.point_starts) {
+            let moved = (0..d).map(|a| x[a] - x0[a]);
+            rows.push(x[..d].iter().copied().chain(moved).collect());
+        }
+        if !rows.is_empty() {
             self.csv.record_rows(solver.time(), &rows)?;
         }
         Ok(())
@@ -314,8 +341,8 @@ impl<'a> Runner<'a> {
             .map(|p| (p.name.clone(), probe_column(&p.kind).to_string()))
             .collect();
         let probes = out.probe_writer(&names)?;
-        let bodies = BodyOutputs::new(&out, sc)?;
         let solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
+        let bodies = BodyOutputs::new(&out, sc)?;
         log::info!(
             "{}: {} particles ({} fluid, {} wall) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
             sc.name,

@@ -135,6 +135,16 @@ pub enum ProbeKind {
     Front { origin: [f64; 3], axis: [f64; 3] },
 }
 
+/// A tracked material point (`[[probe]] kind = "point"`): the particle of an elastic solid or
+/// a rigid body nearest to the given point at t = 0. Its position and displacement are written
+/// to `probes/point_<name>.csv`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrackedPoint {
+    pub name: String,
+    /// The particle followed: an index into `Scenario::particles` (its stable id).
+    pub particle: u32,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Probe {
     pub name: String,
@@ -214,6 +224,8 @@ pub struct Scenario {
     pub domain: Domain,
     pub particles: Vec<Particle>,
     pub probes: Vec<Probe>,
+    /// Tracked points of bodies and solids (`[[probe]] kind = "point"`).
+    pub points: Vec<TrackedPoint>,
     pub walls: WallParams,
     /// Periodic axes: a particle leaving the domain through one face re-enters through the
     /// opposite one, and neighbours are found across it (minimum image).

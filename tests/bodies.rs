@@ -455,3 +455,59 @@ fn a_probe_on_an_unknown_body_is_refused() {
         "{e}"
     );
 }
+
+/// Tracked points (`kind = "point"` probes) report exactly the position of the particle they
+/// follow, on a rigid body (the floating box's corner) and on an elastic solid (the plate's
+/// tip), after it has moved; and `wgsph run` writes `probes/point_<name>.csv` with the
+/// position and displacement at every probe time.
+#[test]
+fn tracked_points_follow_their_particles() {
+    for (case, point, end) in [
+        ("cases/floating_box_2d.toml", "corner", 0.1),
+        ("cases/oscillating_plate_2d.toml", "tip", 0.02),
+    ] {
+        let set = vec![
+            format!("time.end_s={end}"),
+            format!("time.output_every_s={end}"),
+            format!("time.probe_every_s={end}"),
+        ];
+        let sc = wgsph::case::load(std::path::Path::new(case), &set).unwrap();
+        let tracked = sc.points.iter().find(|p| p.name == point).unwrap();
+        let id = tracked.particle as usize;
+        let x0 = sc.particles[id].pos;
+        let mut solver = Solver::new(gpu(), &sc).unwrap();
+        let start = solver.sample_points().unwrap();
+        assert!(
+            (0..3).all(|a| (start[0][a] - x0[a]).abs() < 1e-6),
+            "{case}: the point starts at {:?}, its particle at {x0:?}",
+            start[0]
+        );
+        solver.advance_to(end).unwrap();
+        let p = solver.read_particles().unwrap();
+        let k = p.id.iter().position(|&i| i as usize == id).unwrap();
+        let got = solver.sample_points().unwrap();
+        println!("{case}: {point} from {x0:?} to {:?}", got[0]);
+        assert_eq!(got, vec![p.pos[k]], "{case}");
+        let moved = (0..2)
+            .map(|a| (got[0][a] - x0[a]).abs())
+            .fold(0.0, f64::max);
+        assert!(moved > 1e-4, "{case}: the point moved only {moved} m");
+
+        let dir = std::env::temp_dir().join(format!("wgsph-points-{}-{point}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let opts = wgsph::run::RunOptions::default();
+        let mut quiet = wgsph::progress::LogLines::default();
+        wgsph::run::run(gpu(), &sc, &dir, &opts, &mut quiet).unwrap();
+        let csv = std::fs::read_to_string(dir.join(format!("probes/point_{point}.csv"))).unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines[0], "t_s,x_m,y_m,ux_m,uy_m", "{csv}");
+        assert_eq!(lines.len(), 3, "{csv}");
+        let last: Vec<f64> = lines[2].split(',').map(|v| v.parse().unwrap()).collect();
+        assert_eq!(last[0], end);
+        for a in 0..2 {
+            assert!((last[1 + a] - got[0][a]).abs() < 1e-12, "{csv}");
+            assert!((last[3 + a] - (got[0][a] - x0[a])).abs() < 1e-12, "{csv}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -459,6 +459,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         ));
     }
 
+    let points = super::probes::resolve_points(ctx, &case.points, &particles, &bodies, dim, dx)?;
     let physics = Physics {
         dim: dim as u32,
         dx,
@@ -496,6 +497,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         domain,
         particles,
         probes: case.probes,
+        points,
         walls,
         periodic: [false; 3],
         bodies,

@@ -1,14 +1,36 @@
 //! Checks of one `[[probe]]`: a file-safe name, exactly the fields of its kind, vectors of the
-//! case's dimension (padded to 3 components), a non-zero front axis (normalised).
+//! case's dimension (padded to 3 components), a non-zero front axis (normalised); and the
+//! choice of the particle a `"point"` probe follows.
 
-use crate::scenario::{Probe, ProbeKind};
+use crate::scenario::{Body, Particle, Probe, ProbeKind, TrackedPoint};
 
 use super::error::CaseError;
 use super::locate::Ctx;
 use super::schema::{ProbeName, RawProbe};
 use super::validate::vector;
 
-pub(super) fn probe(ctx: &Ctx<'_>, i: usize, p: &RawProbe, dim: usize) -> Result<Probe, CaseError> {
+/// A checked `[[probe]]`: a sampled quantity, or a point of a body to follow.
+pub(super) enum Checked {
+    Sampled(Probe),
+    Point(PointSpec),
+}
+
+/// A `kind = "point"` probe before its particle is chosen (`resolve_points`, once the
+/// particles are built).
+#[derive(Clone, Debug)]
+pub(super) struct PointSpec {
+    /// Its index among the file's `[[probe]]` tables.
+    pub index: usize,
+    pub name: String,
+    pub point: [f64; 3],
+}
+
+pub(super) fn probe(
+    ctx: &Ctx<'_>,
+    i: usize,
+    p: &RawProbe,
+    dim: usize,
+) -> Result<Checked, CaseError> {
     let path = format!("probe[{i}]");
     if p.name.is_empty()
         || !p
@@ -27,7 +49,17 @@ pub(super) fn probe(ctx: &Ctx<'_>, i: usize, p: &RawProbe, dim: usize) -> Result
         ProbeName::Pressure => ("pressure", &["point_m"]),
         ProbeName::Height => ("height", &["base_m"]),
         ProbeName::Front => ("front", &["origin_m", "axis"]),
+        ProbeName::Point => ("point", &["point_m"]),
     };
+    if p.kind == ProbeName::Point && p.body.is_some() {
+        return Err(ctx.err(
+            &format!("{path}.body"),
+            None,
+            "is not used by a \"point\" probe: it follows the particle nearest to point_m, \
+             whatever body that particle belongs to",
+            "remove body",
+        ));
+    }
     let fields = [
         ("point_m", &p.point_m),
         ("base_m", &p.base_m),
@@ -69,6 +101,13 @@ pub(super) fn probe(ctx: &Ctx<'_>, i: usize, p: &RawProbe, dim: usize) -> Result
         )
     };
     let kind = match p.kind {
+        ProbeName::Point => {
+            return Ok(Checked::Point(PointSpec {
+                index: i,
+                name: p.name.clone(),
+                point: get("point_m", &p.point_m, "the point to follow in metres")?,
+            }))
+        }
         ProbeName::Pressure => ProbeKind::Pressure {
             point: get("point_m", &p.point_m, "the sampling point in metres")?,
         },
@@ -104,10 +143,69 @@ pub(super) fn probe(ctx: &Ctx<'_>, i: usize, p: &RawProbe, dim: usize) -> Result
             }
         }
     };
-    Ok(Probe {
+    Ok(Checked::Sampled(Probe {
         name: p.name.clone(),
         kind,
         // Resolved against the bodies once they are known (validate.rs).
         body: None,
-    })
+    }))
+}
+
+/// The particle each point probe follows: the nearest particle of an elastic solid or a rigid
+/// body (moving tank included) at t = 0, which must lie within 2 dx of `point_m`.
+pub(super) fn resolve_points(
+    ctx: &Ctx<'_>,
+    specs: &[PointSpec],
+    particles: &[Particle],
+    bodies: &[Body],
+    dim: usize,
+    dx: f64,
+) -> Result<Vec<TrackedPoint>, CaseError> {
+    let show = |x: &[f64; 3]| {
+        let parts: Vec<String> = x[..dim].iter().map(|v| format!("{v:.4}")).collect();
+        format!("[{}]", parts.join(", "))
+    };
+    let followable =
+        |k: usize| particles[k].kind.is_solid() || bodies.iter().any(|b| b.particles.contains(&k));
+    specs
+        .iter()
+        .map(|s| {
+            let path = format!("probe[{}].point_m", s.index);
+            let d2 = |k: usize| {
+                (0..3)
+                    .map(|a| (particles[k].pos[a] - s.point[a]).powi(2))
+                    .sum::<f64>()
+            };
+            let nearest = (0..particles.len())
+                .filter(|&k| followable(k))
+                .min_by(|&a, &b| d2(a).total_cmp(&d2(b)));
+            let Some(k) = nearest else {
+                return Err(ctx.err(
+                    &format!("probe[{}].kind", s.index),
+                    Some("\"point\"".into()),
+                    "follows a particle of an elastic solid or a rigid body, and the case has \
+                     neither",
+                    "add a [[solid]] or [[body]], or use a pressure or height probe",
+                ));
+            };
+            let d = d2(k).sqrt();
+            if d > 2.0 * dx {
+                return Err(ctx.err(
+                    &path,
+                    Some(show(&s.point)),
+                    format!(
+                        "is {d:.4} m from the nearest particle of a solid or body (at {}), more \
+                         than 2 dx = {:.4} m",
+                        show(&particles[k].pos),
+                        2.0 * dx
+                    ),
+                    "put point_m on (or inside) the body whose point you want to follow",
+                ));
+            }
+            Ok(TrackedPoint {
+                name: s.name.clone(),
+                particle: k as u32,
+            })
+        })
+        .collect()
 }

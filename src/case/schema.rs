@@ -280,6 +280,7 @@ pub(super) enum ProbeName {
     Pressure,
     Height,
     Front,
+    Point,
 }
 
 /// Help for one field: what it is and an example of a valid line.

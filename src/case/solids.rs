@@ -444,6 +444,7 @@ pub(super) fn build_solid_case(
         }
     }
     let n = particles.len();
+    let points = super::probes::resolve_points(ctx, &case.points, &particles, &[], dim, dx)?;
     let physics = Physics {
         dim: dim as u32,
         dx,
@@ -471,6 +472,7 @@ pub(super) fn build_solid_case(
         },
         particles,
         probes: case.probes,
+        points,
         walls: WallParams::defaults(dx, dx, g),
         periodic: [false; 3],
         bodies: Vec::new(),

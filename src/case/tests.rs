@@ -1064,3 +1064,44 @@ fn bad_bodies_and_motions_are_refused() {
 // ---------------------------------------------------------------- found by tests/case_fuzz/
 
 mod fuzz_found;
+
+/// A `kind = "point"` probe follows the nearest particle of a rigid body or elastic solid;
+/// without one nearby, or with `body`, it is refused with the field named.
+#[test]
+fn point_probes_choose_the_nearest_body_particle() {
+    let body =
+        "\n[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.6, 0.6]\nmax_m = [0.8, 0.8]\n\
+                density_kg_m3 = 500.0\n";
+    let point = "\n[[probe]]\nname = \"c\"\nkind = \"point\"\npoint_m = [0.81, 0.79]\n";
+    let sc = load_str(&format!("{BASE}{body}{point}"), "t.toml", &[]).unwrap();
+    assert_eq!(sc.probes.len(), 1, "the point is not a sampled probe");
+    assert_eq!(sc.points.len(), 1);
+    let k = sc.points[0].particle as usize;
+    assert!(sc.bodies[0].particles.contains(&k));
+    // The nearest of the body's particles (dx = 0.1: centres at 0.65 and 0.75).
+    assert_eq!(sc.particles[k].pos, [0.75, 0.75, 0.0]);
+
+    let no_body = format!("{BASE}{point}");
+    assert_err(
+        &no_body,
+        &[],
+        None,
+        &["probe[1].kind", "[[solid]] or [[body]]"],
+    );
+    let far = format!(
+        "{BASE}{body}{}",
+        point.replace("[0.81, 0.79]", "[0.2, 0.2]")
+    );
+    assert_err(
+        &far,
+        &[],
+        None,
+        &[
+            "probe[1].point_m = [0.2000, 0.2000]",
+            "2 dx",
+            "[0.6500, 0.6500]",
+        ],
+    );
+    let attached = format!("{BASE}{body}{point}body = \"b\"\n");
+    assert_err(&attached, &[], None, &["probe[1].body", "remove body"]);
+}

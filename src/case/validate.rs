@@ -8,6 +8,7 @@ use crate::scenario::{
 
 use super::error::{num, CaseError};
 use super::locate::Ctx;
+use super::probes::Checked;
 use super::schema::{
     DensityFilterName, GhostCorrectionName, KernelName, RawCase, RawPhysics, RepulsiveFormName,
     SlipName, ViscosityName, WallName,
@@ -94,6 +95,8 @@ pub(super) struct Case {
     pub domain: Option<Aabb>,
     pub walls: WallSettings,
     pub probes: Vec<Probe>,
+    /// `kind = "point"` probes; their particles are chosen once the particles are built.
+    pub points: Vec<super::probes::PointSpec>,
     pub bodies: Vec<super::bodies::BodySpec>,
     /// Elastic solids; a case has either fluid or solids (no coupling yet).
     pub solids: Vec<super::solids::SolidSpec>,
@@ -609,27 +612,32 @@ pub(super) fn validate(
         Some(d) => Some(aabb(ctx, "domain", &d.min_m, &d.max_m, dim, "the domain")?),
         None => None,
     };
-    let mut probes: Vec<Probe> = Vec::with_capacity(raw.probe.len());
-    for (i, p) in raw.probe.iter().enumerate() {
-        let probe = super::probes::probe(ctx, i, p, dim)?;
-        if let Some(j) = probes.iter().position(|q| q.name == probe.name) {
-            return Err(ctx.err(
-                &format!("probe[{i}].name"),
-                Some(format!("{:?}", p.name)),
-                format!("probe[{j}] already has this name (names become file names)"),
-                "give every probe a different name",
-            ));
-        }
-        probes.push(probe);
+    if let Some((i, j)) = (0..raw.probe.len())
+        .flat_map(|i| (0..i).map(move |j| (i, j)))
+        .find(|&(i, j)| raw.probe[i].name == raw.probe[j].name)
+    {
+        return Err(ctx.err(
+            &format!("probe[{i}].name"),
+            Some(format!("{:?}", raw.probe[i].name)),
+            format!("probe[{j}] already has this name (names become file names)"),
+            "give every probe a different name",
+        ));
     }
-
     let bodies = super::bodies::validate(ctx, &raw.body, dim, case_dir)?;
     let tank_moves = tank.as_ref().is_some_and(|t| t.motion.is_some());
-    for (i, (probe, p)) in probes.iter_mut().zip(&raw.probe).enumerate() {
-        probe.body = match &p.body {
-            None => None,
-            Some(name) => Some(attached_body(ctx, i, name, tank_moves, &bodies)?),
-        };
+    let mut probes: Vec<Probe> = Vec::with_capacity(raw.probe.len());
+    let mut points = Vec::new();
+    for (i, p) in raw.probe.iter().enumerate() {
+        match super::probes::probe(ctx, i, p, dim)? {
+            Checked::Sampled(mut probe) => {
+                probe.body = match &p.body {
+                    None => None,
+                    Some(name) => Some(attached_body(ctx, i, name, tank_moves, &bodies)?),
+                };
+                probes.push(probe);
+            }
+            Checked::Point(spec) => points.push(spec),
+        }
     }
 
     Ok(Case {
@@ -654,6 +662,7 @@ pub(super) fn validate(
         domain,
         walls,
         probes,
+        points,
         bodies,
         solids,
     })

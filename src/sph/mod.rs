@@ -35,7 +35,7 @@ use ghost::Ghost;
 use grid::Grid;
 use integrate::Integrate;
 use interaction::Interaction;
-use probes::Probes;
+use probes::{PointTracker, Probes};
 
 /// Most steps recorded into one submission before the host looks at the state again.
 const MAX_BATCH: u32 = 64;
@@ -185,6 +185,8 @@ pub struct Solver {
     /// Elastic solid particles, if the case has any.
     elastic: Option<Elastic>,
     probes: Probes,
+    /// Tracked points of bodies, if the case has any.
+    points: Option<PointTracker>,
     /// The case's probes and the bodies' centres at t = 0, when a probe moves with a body.
     attached_probes: Option<(Vec<crate::scenario::Probe>, Vec<[f64; 3]>)>,
     /// Moving bodies: the GPU part, the host dynamics, and the buffer the state and the
@@ -330,7 +332,9 @@ impl Solver {
             Some(_) => Some(Elastic::new(&device, &module(Pass::Elastic)?, &buffers)?),
             None => None,
         };
-        let probes = Probes::new(&device, &module(Pass::Probes)?, &buffers, &defs)?;
+        let probe_module = module(Pass::Probes)?;
+        let probes = Probes::new(&device, &probe_module, &buffers, &defs)?;
+        let points = PointTracker::new(&device, &probe_module, &buffers, &sc.points)?;
         let bodies = if sc.bodies.is_empty() {
             None
         } else {
@@ -371,6 +375,7 @@ impl Solver {
             integrate,
             elastic,
             probes,
+            points,
             attached_probes: sc.probes.iter().any(|p| p.body.is_some()).then(|| {
                 (
                     sc.probes.clone(),
@@ -687,6 +692,27 @@ impl Solver {
             self.params.n_probes as usize,
         )?;
         Ok(self.probes.decode(&raw))
+    }
+
+    /// World positions of the tracked points (`Scenario::points`, in order) at the current
+    /// time; empty without points.
+    pub fn sample_points(&self) -> Result<Vec<[f64; 3]>> {
+        let Some(tracker) = &self.points else {
+            return Ok(Vec::new());
+        };
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("track points"),
+            });
+        tracker.encode(&mut encoder, self.parity);
+        self.queue.submit([encoder.finish()]);
+        let pos = tracker.read(&self.device, &self.queue)?;
+        self.faults.check()?;
+        Ok(pos
+            .iter()
+            .map(|p| self.grid.to_world(p.off, unpack_block(p.block)))
+            .collect())
     }
 
     /// Test hook: re-runs only the interaction pass (and the elastic rates, with solids) on the

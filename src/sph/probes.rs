@@ -1,13 +1,15 @@
-//! Probes sampled on the GPU (shaders/probes.wgsl); only one f32 per probe is read back.
+//! Probes sampled on the GPU (shaders/probes.wgsl); only one f32 per probe, and one position
+//! per tracked point, is read back.
 
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
 use crate::body::Pose;
+use crate::gpu::buffers::{read, storage, storage_init};
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::Kernel;
-use crate::layout::ProbeDef;
-use crate::scenario::{Probe, ProbeKind};
+use crate::layout::{Pos, ProbeDef};
+use crate::scenario::{Probe, ProbeKind, TrackedPoint};
 use glam::DVec3;
 
 pub const PROBE_PRESSURE: u32 = 0;
@@ -150,5 +152,83 @@ impl Probes {
                 }
             })
             .collect()
+    }
+}
+
+/// Tracked points on the GPU (`track_points` in probes.wgsl): the followed ids in ascending
+/// order (each once) and, for every point of the scenario, its slot in that list.
+pub struct PointTracker {
+    kernel: Kernel,
+    bind: [wgpu::BindGroup; 2],
+    out: wgpu::Buffer,
+    slot_of_point: Vec<usize>,
+    slots: usize,
+    n: u32,
+}
+
+impl PointTracker {
+    /// `None` when the case tracks no point.
+    pub fn new(
+        device: &wgpu::Device,
+        module: &ShaderModule,
+        b: &ParticleBuffers,
+        points: &[TrackedPoint],
+    ) -> Result<Option<Self>> {
+        if points.is_empty() {
+            return Ok(None);
+        }
+        let mut ids: Vec<u32> = points.iter().map(|p| p.particle).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        let slot_of_point = points
+            .iter()
+            .map(|p| {
+                ids.binary_search(&p.particle)
+                    .expect("every id is in the list")
+            })
+            .collect();
+        let tracked = storage_init(device, "tracked ids", &ids);
+        let out = storage(
+            device,
+            "tracked positions",
+            (ids.len() * std::mem::size_of::<Pos>()) as u64,
+        );
+        let kernel = module.kernel(device, "track_points")?;
+        let bufs = |p: usize| {
+            [
+                (0, &b.params),
+                (1, &b.pos[p]),
+                (3, &b.code[p]),
+                (7, &tracked),
+                (8, &out),
+            ]
+        };
+        Ok(Some(Self {
+            bind: [
+                kernel.bind(device, &bufs(0))?,
+                kernel.bind(device, &bufs(1))?,
+            ],
+            kernel,
+            out,
+            slot_of_point,
+            slots: ids.len(),
+            n: b.n,
+        }))
+    }
+
+    /// Copies the followed particles' positions (arrays of parity `p`) into the output buffer.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, p: usize) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("track points"),
+            timestamp_writes: None,
+        });
+        self.kernel.dispatch(&mut pass, &self.bind[p], self.n);
+    }
+
+    /// The positions, in the scenario's point order (after [`encode`](Self::encode) was
+    /// submitted).
+    pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<Pos>> {
+        let raw: Vec<Pos> = read(device, queue, &self.out, self.slots)?;
+        Ok(self.slot_of_point.iter().map(|&s| raw[s]).collect())
     }
 }

@@ -94,6 +94,7 @@ pub fn scenario(
         domain,
         particles,
         probes,
+        points: Vec::new(),
     }
 }
 
