@@ -1,7 +1,7 @@
 // Hypoelastic solid particles (Gray, Monaghan & Swift 2001, CMAME 190:6641; "GMS" below), one
-// invocation per particle, after the fluid interaction pass (which leaves solid particles'
-// rates at zero). Solid particles interact only with solid particles of their own elastic body;
-// there is no solid–fluid coupling yet (the case builder refuses cases with both).
+// invocation per particle, after the fluid interaction pass, whose rates of solid particles
+// (the fluid's force on them, interaction.wgsl) this pass adds to. Here solid particles
+// interact with solid particles of their own elastic body.
 //
 // Equation numbers are not quoted (no copy of the paper at hand): "GMS §2" is its continuum
 // model (continuity, momentum with σ = −p I + τ, Jaumann stress rate, linear EOS), "GMS §4" its
@@ -36,20 +36,6 @@
 @group(0) @binding(6) var<storage, read_write> solid: array<SolidState>;
 @group(0) @binding(7) var<storage, read_write> stress_rate: array<SymRate>;
 @group(0) @binding(8) var<storage, read_write> state: SimState;
-
-fn tau_of(s: SolidState) -> mat3x3<f32> {
-    // Columns of the symmetric τ.
-    return mat3x3<f32>(
-        vec3<f32>(s.tau_a.x, s.tau_a.w, s.tau_b.x),
-        vec3<f32>(s.tau_a.w, s.tau_a.y, s.tau_b.y),
-        vec3<f32>(s.tau_b.x, s.tau_b.y, s.tau_a.z),
-    );
-}
-
-// p = c_s² (ρ − ρs).
-fn solid_pressure(rho: f32) -> f32 {
-    return params.solid_c2 * (rho - params.solid_rho0);
-}
 
 // Artificial stress R_i of a particle with total stress σ and density ρ (GMS §4, 2D closed
 // form; zero in 3D, see the header).
@@ -141,7 +127,7 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
             grad_v += mat3x3<f32>(u * dw_ij.x, u * dw_ij.y, u * dw_ij.z);
         }
     }
-    rate[i] = vec4<f32>(acc + params.gravity, drho);
+    rate[i] += vec4<f32>(acc + params.gravity, drho);
 
     let eps = 0.5 * (grad_v + transpose(grad_v));
     let omega = 0.5 * (grad_v - transpose(grad_v));

@@ -19,8 +19,18 @@
 //   each fluid j near the image of i, the ghost x_g = 2x_w − x_j with p_g = p_j, ρ_g = ρ_j and
 //   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip), the latter in
 //   the viscous terms only; near a corner also the double image across both planes.
-// Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts, repulsive and solid
-// particles get nothing here (solid particles get theirs from elastic.wgsl, which runs next).
+// Fluid–solid pairs (elastic solids, Kind::Solid/SolidClamped), from either side, with the
+//   full stress tensors of the seed's eq. 2 (σ = −P I for the fluid, σ = −p I + τ for the
+//   solid, p = c_s² (ρ − ρs)), each particle with its own mass, and the seed's density-rate
+//   correction between materials of different density:
+//     dρ_i/dt += m_j v_ij·∇_i W_ij (ρ_i/ρ_j)
+//     dv_i/dt += m_j (σ_i/ρ_i² + σ_j/ρ_j² − Π_ij I)·∇_i W_ij
+//   with the fluid's viscosity (Π_ij with the fluid's α and c0, or the laminar term). The pair
+//   terms are equal and opposite (m_i dv_i = −m_j dv_j): momentum is conserved across the
+//   interface. Solid particles get only these fluid terms here; elastic.wgsl adds the
+//   solid–solid ones and gravity.
+// Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
+// get nothing here.
 // Particles of moving bodies (dynamic boundary particles too) also get the force per unit mass
 // of their fluid neighbours, −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (the opposite
 // of what the fluid receives from them), and a contact force from boundary particles of other
@@ -38,6 +48,7 @@
 @group(0) @binding(6) var<storage, read> mirror_planes: array<MirrorPlane>;
 @group(0) @binding(7) var<storage, read_write> energy_rate: array<f32>;
 @group(0) @binding(8) var<storage, read> body_particles: array<BodyParticle>;
+@group(0) @binding(9) var<storage, read> solid: array<SolidState>;
 
 // The state of particle i that every pair term needs.
 struct Particle {
@@ -85,6 +96,59 @@ fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_cont: vec3<f32>, v_visc:
         de = 0.5 * params.mass * (pressure_term * dot(v_ij, dw_ij) + pi_ij * dot(w_ij, dw_ij));
     }
     return PairRates(vec4<f32>(acc, drho), de);
+}
+
+// (dv/dt, dρ/dt) on i from a neighbour j of the other material (fluid–solid), see the header:
+// a_i, a_j are σ/ρ² of each, m_j the neighbour's mass.
+fn interface_rates(a_i: mat3x3<f32>, v_i: vec3<f32>, rho_i: f32, a_j: mat3x3<f32>, v_j: vec3<f32>, rho_j: f32, m_j: f32, x_ij: vec3<f32>, r2: f32) -> vec4<f32> {
+    let f_ij = kernel_f(sqrt(r2) / params.h);
+    let dw_ij = x_ij * f_ij;
+    let v_ij = v_i - v_j;
+    let drho = m_j * dot(v_ij, dw_ij) * rho_i / rho_j;
+    // σ/ρ² is symmetric, so T·∇W = T ∇W in either index order.
+    var acc = m_j * ((a_i + a_j) * dw_ij);
+    if (VISCOSITY == 0u) {
+        let vx = dot(v_ij, x_ij);
+        if (vx < 0.0) {
+            let mu = params.h * vx / (r2 + params.eta2);
+            acc += m_j * params.alpha * params.c0 * mu / (0.5 * (rho_i + rho_j)) * dw_ij;
+        }
+    } else {
+        acc += m_j * 4.0 * params.nu * r2 * f_ij / ((rho_i + rho_j) * (r2 + params.eta2)) * v_ij;
+    }
+    return vec4<f32>(acc, drho);
+}
+
+// −P/ρ² I of a fluid particle of density ρ, as a stress over density squared.
+fn fluid_stress_over_rho2(rho: f32) -> mat3x3<f32> {
+    let s = -pressure_of(rho) / (rho * rho);
+    return mat3x3<f32>(vec3<f32>(s, 0.0, 0.0), vec3<f32>(0.0, s, 0.0), vec3<f32>(0.0, 0.0, s));
+}
+
+// Rates of solid particle i from its fluid neighbours (the fluid's load on the solid).
+fn solid_from_fluid(i: u32) -> vec4<f32> {
+    let p_i = pos[i];
+    let vr_i = velrho[i];
+    let a_i = solid_stress_over_rho2(solid[i], vr_i.w);
+    let support2 = 4.0 * params.h * params.h;
+    var r = vec4<f32>(0.0);
+    var slots: array<u32, 27>;
+    let n_slots = neighbour_slots(cell_of(p_i), &slots);
+    for (var s = 0u; s < n_slots; s++) {
+        for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
+            if (code_kind(code[j]) != KIND_FLUID) {
+                continue;
+            }
+            let x_ij = rel_pos(p_i, pos[j]);
+            let r2 = dot(x_ij, x_ij);
+            if (r2 >= support2) {
+                continue;
+            }
+            let vr_j = velrho[j];
+            r += interface_rates(a_i, vr_i.xyz, vr_i.w, fluid_stress_over_rho2(vr_j.w), vr_j.xyz, vr_j.w, params.mass, x_ij, r2);
+        }
+    }
+    return r;
 }
 
 // Force (per unit mass) of a repulsive boundary particle at x_ij: Lennard-Jones (Monaghan 1994)
@@ -201,6 +265,10 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     if (ENERGY) {
         energy_rate[i] = 0.0;
     }
+    if (is_solid(kind_i)) {
+        rate[i] = solid_from_fluid(i);
+        return;
+    }
     if (kind_i != KIND_FLUID && kind_i != KIND_WALL) {
         rate[i] = vec4<f32>(0.0);
         return;
@@ -248,8 +316,9 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                 continue;
             }
             if (is_solid(kind_j)) {
-                // No fluid–solid coupling yet (elastic.wgsl); the case builder refuses cases
-                // with both.
+                let vr_j = velrho[j];
+                let a_j = solid_stress_over_rho2(solid[j], vr_j.w);
+                r += interface_rates(fluid_stress_over_rho2(pi.rho), pi.v, pi.rho, a_j, vr_j.xyz, vr_j.w, params.solid_mass, x_ij, r2);
                 continue;
             }
             let vr_j = velrho[j];

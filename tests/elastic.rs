@@ -172,3 +172,167 @@ fn artificial_stress_is_exercised() {
         [[0.0; 3]; 3]
     );
 }
+
+/// A solid block under a fluid block, jittered, with random velocities, densities (fluid
+/// ρ0 = 1000, solid ρs = 1200: the density-rate correction ρ_i/ρ_j matters) and stresses.
+fn fluid_on_solid(dim: u32, kernel: KernelKind, viscosity: Viscosity, seed: u64) -> Scenario {
+    let dx = 0.01;
+    let mut ph = physics(dim, dx, 20.0);
+    ph.kernel = kernel;
+    ph.viscosity = viscosity;
+    let mat = ElasticMaterial {
+        density: 1200.0,
+        ..material()
+    };
+    let mut rng = Rng(seed);
+    let up = dim as usize - 1;
+    let (lo, hi) = if dim == 2 {
+        ([0.1, 0.1, 0.0], [0.26, 0.26, 0.0])
+    } else {
+        ([0.1; 3], [0.18; 3])
+    };
+    let split = 0.5 * (lo[up] + hi[up]);
+    let mut parts = Vec::new();
+    let mut tau0 = Vec::new();
+    for p in lattice(dim, dx, lo, hi) {
+        let solid = p[up] < split;
+        let mut pos = p;
+        let mut vel = [0.0; 3];
+        for a in 0..dim as usize {
+            pos[a] += rng.range(-0.2, 0.2) * dx;
+            vel[a] = rng.range(-0.5, 0.5);
+        }
+        let mut t = [0.0; 6];
+        if solid {
+            for (c, tc) in t.iter_mut().enumerate() {
+                if dim == 3 || c < 4 {
+                    *tc = rng.range(-2.0e4, 2.0e4);
+                }
+            }
+        }
+        let clamped = solid && p[0] < lo[0] + 2.0 * dx;
+        let (rho0, kind) = match (solid, clamped) {
+            (false, _) => (1000.0, Kind::Fluid),
+            (true, false) => (mat.density, Kind::Solid),
+            (true, true) => (mat.density, Kind::SolidClamped),
+        };
+        parts.push(Particle {
+            pos,
+            vel: if clamped { [0.0; 3] } else { vel },
+            rho: rho0 * (1.0 + rng.range(-0.01, 0.01)),
+            kind,
+        });
+        tau0.push(t);
+    }
+    let n = parts.len();
+    let dmax = if dim == 2 { [0.4, 0.4, 0.0] } else { [0.3; 3] };
+    let mut sc = scenario(
+        ph,
+        parts,
+        Domain {
+            min: [0.0; 3],
+            max: dmax,
+        },
+        vec![],
+    );
+    sc.solids = Some(Solids {
+        material: mat,
+        body: vec![0; n],
+        tau0,
+    });
+    sc
+}
+
+/// Layer 1 for the fluid–solid coupling: every particle's (dv/dt, dρ/dt) on the GPU (the
+/// interaction pass with its fluid–solid pairs, then the elastic pass) against the f64
+/// reference's sum of the fluid terms, the interface terms and the solid terms; outputs
+/// poisoned first. And the interface conserves momentum: Σ m_i (dv_i/dt − g) over all
+/// particles vanishes to f32 rounding (every pair term is equal and opposite).
+#[test]
+fn fluid_solid_interface_matches_reference() {
+    for (dim, kernel, viscosity) in [
+        (
+            2,
+            KernelKind::WendlandC2,
+            Viscosity::Artificial { alpha: 0.1 },
+        ),
+        (2, KernelKind::CubicSpline, Viscosity::Laminar { nu: 1e-3 }),
+        (
+            3,
+            KernelKind::WendlandC2,
+            Viscosity::Artificial { alpha: 0.1 },
+        ),
+    ] {
+        let sc = fluid_on_solid(dim, kernel, viscosity, 5 + dim as u64);
+        let ph = &sc.physics;
+        let mat = sc.solids.as_ref().unwrap().material;
+        let solver = Solver::new(gpu(), &sc).unwrap();
+        let parts = gpu_particles(&solver);
+        let solid: Vec<SolidRef> = solver
+            .read_solid()
+            .unwrap()
+            .iter()
+            .map(|s| SolidRef {
+                tau: [
+                    s.tau_a[0], s.tau_a[1], s.tau_a[2], s.tau_a[3], s.tau_b[0], s.tau_b[1],
+                ]
+                .map(|x| x as f64),
+                body: s.body,
+            })
+            .collect();
+        let gpu_rate = solver.rerun_interaction(true).unwrap();
+        let space = Space::of(&sc);
+        let fluid = wgsph::reference::interaction::rates(ph, &sc.walls, &space, &parts);
+        let interface = elastic::interface_rates(ph, &mat, &space, &parts, &solid);
+        let solids = elastic::rates(ph, &mat, &space, &parts, &solid);
+        let cpu: Vec<[f64; 4]> = (0..parts.len())
+            .map(|i| {
+                let s = solids[i].map_or([0.0; 4], |s| s.rate);
+                [0, 1, 2, 3].map(|k| fluid[i][k] + interface[i][k] + s[k])
+            })
+            .collect();
+        let across = interface
+            .iter()
+            .filter(|r| r.iter().any(|x| *x != 0.0))
+            .count();
+        assert!(across > 20, "only {across} particles see the interface");
+        let acc_rms = rms(cpu.iter().flat_map(|c| c[..3].to_vec()));
+        let rho_rms = rms(cpu.iter().map(|c| c[3]));
+        let (mut e_acc, mut e_rho) = (0.0f64, 0.0f64);
+        for (i, (g, c)) in gpu_rate.iter().zip(&cpu).enumerate() {
+            assert!(
+                g.iter().all(|x| x.is_finite()),
+                "particle {i}: non-finite GPU rate {g:?}"
+            );
+            for a in 0..3 {
+                e_acc = e_acc.max((g[a] as f64 - c[a]).abs() / acc_rms);
+            }
+            e_rho = e_rho.max((g[3] as f64 - c[3]).abs() / rho_rms);
+        }
+        // Momentum: Σ m (a − g) against Σ m |a − g|.
+        let solid_mass = mat.density * ph.dx.powi(dim as i32);
+        let (mut total, mut scale) = ([0.0f64; 3], 0.0f64);
+        for (p, g) in parts.iter().zip(&gpu_rate) {
+            let m = if p.kind == 0 {
+                ph.particle_mass
+            } else {
+                solid_mass
+            };
+            for a in 0..3 {
+                let f = m * (g[a] as f64 - ph.gravity[a]);
+                total[a] += f;
+                scale += f.abs();
+            }
+        }
+        let imbalance = total.iter().map(|t| t.abs()).fold(0.0, f64::max) / scale;
+        println!(
+            "{dim}D {kernel:?} {viscosity:?}, {} particles ({across} at the interface): dv/dt \
+             error {e_acc:.1e} of RMS {acc_rms:.3e}, dρ/dt {e_rho:.1e} of {rho_rms:.3e}; \
+             momentum imbalance {imbalance:.1e} of Σ m|a − g|",
+            parts.len()
+        );
+        assert!(e_acc < 2e-4, "acceleration error {e_acc}");
+        assert!(e_rho < 2e-4, "density-rate error {e_rho}");
+        assert!(imbalance < 1e-5, "momentum imbalance {imbalance}");
+    }
+}

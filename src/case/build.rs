@@ -5,7 +5,8 @@
 use std::collections::HashSet;
 
 use crate::scenario::{
-    Body, Domain, Kind, MirrorPlane, Motion, Particle, Physics, ProbeKind, Scenario, WallParams,
+    Body, Domain, Kind, MirrorPlane, Motion, Particle, Physics, ProbeKind, Scenario, Solids,
+    WallParams,
 };
 
 use super::bodies::Shape;
@@ -32,7 +33,7 @@ fn fmt_box(b: &Aabb, dim: usize) -> String {
 }
 
 pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Scenario, CaseError> {
-    if !case.solids.is_empty() {
+    if !case.solids.is_empty() && case.blocks.is_empty() {
         return super::solids::build_solid_case(ctx, case, max_particles);
     }
     let (dim, dx) = (case.dim, case.dx);
@@ -167,6 +168,29 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         max_particles,
     )?;
     let wall = tank.map(|(_, n)| wall_of(n));
+    // Elastic solids in the fluid: their particles, bodies and material, within what is left
+    // of the budget; and the box of each solid's particles.
+    let elastic = if case.solids.is_empty() {
+        None
+    } else {
+        let (material, parts, body) =
+            super::solids::solid_particles(ctx, &case.solids, dim, dx, max_particles - total)?;
+        let mut extents = vec![
+            Aabb {
+                min: [f64::MAX; 3],
+                max: [f64::MIN; 3],
+            };
+            case.solids.len()
+        ];
+        for (p, &b) in parts.iter().zip(&body) {
+            let e = &mut extents[b as usize];
+            for a in 0..3 {
+                e.min[a] = e.min[a].min(p.pos[a]);
+                e.max[a] = e.max[a].max(p.pos[a]);
+            }
+        }
+        Some((material, parts, body, extents))
+    };
 
     let domain = domain(ctx, &case, &lat, wall.as_ref())?;
 
@@ -233,27 +257,39 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             )
         })
         .collect();
-    // The obstacle or body that takes the place of a fluid particle at `p`, if any.
+    // Whether `p` lies in the user's box or within a spacing of the particles' box.
+    let covered = |p: [f64; 3], user: &Aabb, parts: &Aabb| {
+        let d2: f64 = (0..dim)
+            .map(|a| {
+                (parts.min[a] - p[a])
+                    .max(p[a] - parts.max[a])
+                    .max(0.0)
+                    .powi(2)
+            })
+            .sum();
+        point_inside(p, user, dim) || d2 < (dx * (1.0 - 1e-6)).powi(2)
+    };
+    // The obstacle, elastic solid or body that takes the place of a fluid particle at `p`.
     let blocker = |p: [f64; 3]| {
-        let obstacle = solids.iter().position(|(user, parts)| {
-            let d2: f64 = (0..dim)
-                .map(|a| {
-                    (parts.min[a] - p[a])
-                        .max(p[a] - parts.max[a])
-                        .max(0.0)
-                        .powi(2)
-                })
-                .sum();
-            point_inside(p, user, dim) || d2 < (dx * (1.0 - 1e-6)).powi(2)
-        });
+        let obstacle = solids
+            .iter()
+            .position(|(user, parts)| covered(p, user, parts));
+        let elastic_solid = || {
+            let (_, _, _, extents) = elastic.as_ref()?;
+            case.solids
+                .iter()
+                .zip(extents)
+                .position(|(s, parts)| covered(p, &s.bx, parts))
+        };
         let body = || {
             case.bodies
                 .iter()
                 .position(|b| b.shape.signed_distance(p, dim) < 0.5 * dx * (1.0 - 1e-6))
         };
-        match obstacle {
-            Some(i) => Some(("obstacle", i)),
-            None => body().map(|i| ("body", i)),
+        match (obstacle, elastic_solid()) {
+            (Some(i), _) => Some(("obstacle", i)),
+            (None, Some(i)) => Some(("solid", i)),
+            (None, None) => body().map(|i| ("body", i)),
         }
     };
     let mut particles = Vec::with_capacity(total as usize);
@@ -381,6 +417,31 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         }
     }
 
+    // Elastic solids after the fixed walls (bodies come last), each particle inside the domain.
+    let mut solids_of_particles = None;
+    if let Some((material, mut parts, body, _)) = elastic {
+        if let Some((p, &b)) = parts.iter().zip(&body).find(|(p, _)| {
+            !(0..dim).all(|a| domain.min[a] <= p.pos[a] && p.pos[a] <= domain.max[a])
+        }) {
+            return Err(ctx.err(
+                &format!("solid[{b}]"),
+                None,
+                format!(
+                    "has a particle at {:?}, outside the domain ({:?} to {:?})",
+                    &p.pos[..dim],
+                    &domain.min[..dim],
+                    &domain.max[..dim]
+                ),
+                "keep the solid inside the tank, or enlarge [domain]",
+            ));
+        }
+        let start = particles.len();
+        let mut of_particle = vec![0; start];
+        of_particle.extend(body);
+        particles.append(&mut parts);
+        solids_of_particles = Some((material, of_particle));
+    }
+
     let mut bodies = Vec::with_capacity(case.bodies.len() + 1);
     if let (Some(t), Some(motion)) = (
         &case.tank,
@@ -490,6 +551,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     }
     walls.repulsive_beta = case.walls.repulsive_beta;
     walls.mirror_planes = mirror_planes;
+    let n_particles = particles.len();
     Ok(Scenario {
         name: case.name,
         physics,
@@ -501,7 +563,14 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         walls,
         periodic: [false; 3],
         bodies,
-        solids: None,
+        solids: solids_of_particles.map(|(material, mut body)| {
+            body.resize(n_particles, 0);
+            Solids {
+                material,
+                tau0: vec![[0.0; 6]; n_particles],
+                body,
+            }
+        }),
     })
 }
 

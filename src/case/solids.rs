@@ -1,6 +1,5 @@
-//! `[[solid]]`: elastic bodies of hypoelastic solid particles (Gray, Monaghan & Swift 2001), and
-//! the build of a solid-only case (there is no fluid–solid coupling yet, so a case has either
-//! fluid or solids).
+//! `[[solid]]`: elastic bodies of hypoelastic solid particles (Gray, Monaghan & Swift 2001):
+//! their particles, and the build of a solid-only case (with fluid, `build.rs` adds them).
 
 use crate::scenario::{
     Domain, ElasticMaterial, Kind, Particle, Physics, Scenario, Solids, WallParams,
@@ -283,16 +282,19 @@ fn body_len(body: &[u32], i: usize) -> usize {
     body.iter().rev().take_while(|&&b| b == i as u32).count()
 }
 
-pub(super) fn build_solid_case(
+/// The particles of the solids (on one lattice from the first solid's corner), their bodies
+/// (the solid's index) and the shared material; at most `max_particles` of them.
+pub(super) fn solid_particles(
     ctx: &Ctx<'_>,
-    case: Case,
+    solids: &[SolidSpec],
+    dim: usize,
+    dx: f64,
     max_particles: f64,
-) -> Result<Scenario, CaseError> {
-    let (dim, dx) = (case.dim, case.dx);
-    let first = &case.solids[0];
+) -> Result<(ElasticMaterial, Vec<Particle>, Vec<u32>), CaseError> {
+    let first = &solids[0];
     let material = first.material;
-    for (i, s) in case.solids.iter().enumerate().skip(1) {
-        if let Some(j) = case.solids[..i].iter().position(|o| o.name == s.name) {
+    for (i, s) in solids.iter().enumerate().skip(1) {
+        if let Some(j) = solids[..i].iter().position(|o| o.name == s.name) {
             return Err(ctx.err(
                 &format!("solid[{i}].name"),
                 Some(format!("{:?}", s.name)),
@@ -339,7 +341,7 @@ pub(super) fn build_solid_case(
     let mut body = Vec::new();
     // Counted over all solids, before any is built (the budget of the other cases).
     let mut total = 0.0;
-    for (i, s) in case.solids.iter().enumerate() {
+    for (i, s) in solids.iter().enumerate() {
         let Some((lo, hi)) = lat.range_in(&s.bx) else {
             return Err(ctx.err(
                 &format!("solid[{i}].max_m"),
@@ -413,6 +415,17 @@ pub(super) fn build_solid_case(
             ));
         }
     }
+    Ok((material, particles, body))
+}
+
+pub(super) fn build_solid_case(
+    ctx: &Ctx<'_>,
+    case: Case,
+    max_particles: f64,
+) -> Result<Scenario, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
+    let first = &case.solids[0];
+    let (material, particles, body) = solid_particles(ctx, &case.solids, dim, dx, max_particles)?;
     // Default domain: the solids' box, with half its largest extent of room on every side.
     let mut bb = first.bx;
     for s in &case.solids {

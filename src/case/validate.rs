@@ -98,7 +98,7 @@ pub(super) struct Case {
     /// `kind = "point"` probes; their particles are chosen once the particles are built.
     pub points: Vec<super::probes::PointSpec>,
     pub bodies: Vec<super::bodies::BodySpec>,
-    /// Elastic solids; a case has either fluid or solids (no coupling yet).
+    /// Elastic solids, alone or in fluid (held by a fixed tank and obstacles).
     pub solids: Vec<super::solids::SolidSpec>,
 }
 
@@ -494,18 +494,33 @@ pub(super) fn validate(
         .map(|(i, s)| super::solids::validate_solid(ctx, i, s, dim))
         .collect::<Result<Vec<_>, _>>()?;
     if !solids.is_empty() {
-        // No fluid–solid (or wall–solid) coupling yet: solids come alone.
+        // Solids are coupled to fluid (interaction.wgsl), not to walls or rigid bodies: a tank
+        // and obstacles only hold the fluid. Without fluid, solids come alone.
+        let alone = raw.fluid_block.is_empty();
         let other = [
-            ("fluid_block", !raw.fluid_block.is_empty()),
-            ("tank", raw.tank.is_some()),
-            ("obstacle", !raw.obstacle.is_empty()),
-            ("body", !raw.body.is_empty()),
+            ("tank", alone && raw.tank.is_some(), "without fluid"),
+            (
+                "obstacle",
+                alone && !raw.obstacle.is_empty(),
+                "without fluid",
+            ),
+            ("body", !raw.body.is_empty(), "yet (no solid–body contact)"),
+            (
+                "tank.motion",
+                raw.tank.as_ref().is_some_and(|t| t.motion.is_some()),
+                "yet (clamped solid particles stay where they are)",
+            ),
+            (
+                "physics.energy",
+                raw.physics.energy == Some(true),
+                "yet (the energy equation has no solid terms)",
+            ),
         ];
-        if let Some((what, _)) = other.iter().find(|(_, present)| *present) {
+        if let Some((what, _, why)) = other.iter().find(|(_, present, _)| *present) {
             return Err(ctx.err(
                 what,
                 None,
-                format!("a case with [[solid]] cannot have {what} yet: elastic solids are not coupled to fluid, walls or rigid bodies"),
+                format!("a case with [[solid]] cannot have {what} {why}"),
                 format!("remove {what}, or the [[solid]] tables"),
             ));
         }

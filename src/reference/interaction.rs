@@ -101,8 +101,9 @@ fn add(a: &mut [f64; 4], b: [f64; 4]) {
     }
 }
 
-/// (dv/dt, dρ/dt) of every particle: fluid gets everything, dynamic walls only dρ/dt from
-/// fluid neighbours, ghosts and repulsive particles nothing. Body particles (dynamic walls of a
+/// (dv/dt, dρ/dt) of every particle: fluid gets everything but its elastic-solid neighbours'
+/// terms (`elastic::interface_rates`), dynamic walls only dρ/dt from fluid neighbours, ghosts,
+/// repulsive and solid particles nothing. Body particles (dynamic walls of a
 /// body) also get the fluid's force and the contact force of other solids' particles.
 pub fn rates(
     ph: &Physics,
@@ -158,7 +159,11 @@ pub fn rates_and_energy(
                             r[3] +=
                                 ph.particle_mass * dot(sub(pi.vel, pj.vel), x_ij.map(|x| x * f_ij));
                         }
-                    } else if pi.body.is_some() && pj.kind != EXCLUDED && pj.body != pi.body {
+                    } else if pi.body.is_some()
+                        && pj.kind != EXCLUDED
+                        && !super::elastic::is_solid(pj.kind)
+                        && pj.body != pi.body
+                    {
                         // Contact with a fixed wall or another body.
                         let f = repulsion(ph, walls, x_ij);
                         add(&mut r, [f[0], f[1], f[2], 0.0]);
@@ -179,6 +184,10 @@ pub fn rates_and_energy(
                 if pj.kind == REPULSIVE {
                     let f = repulsion(ph, walls, x_ij);
                     add(&mut r, [f[0], f[1], f[2], 0.0]);
+                    continue;
+                }
+                if super::elastic::is_solid(pj.kind) {
+                    // Fluid–solid pairs: super::elastic::interface_rates.
                     continue;
                 }
                 let ghost = pj.kind == GHOST_NO_SLIP || pj.kind == GHOST_FREE_SLIP;

@@ -988,9 +988,6 @@ fn solid_states(sc: &Scenario) -> Result<Vec<crate::layout::SolidState>> {
             solids.tau0.len()
         );
     }
-    if sc.particles.iter().any(|p| p.kind.is_fluid()) {
-        bail!("cases with both fluid and elastic solids are not supported yet (no fluid–solid coupling)");
-    }
     Ok((0..n)
         .map(|i| {
             let t = solids.tau0[i].map(|x| x as f32);

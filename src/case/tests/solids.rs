@@ -86,13 +86,10 @@ fn solid_errors_name_the_field() {
         &["solid[0].clamped_max_m", "empty"],
     );
     assert_err(
-        &format!(
-            "{}\n[[fluid_block]]\nmin_m = [0.5, 0.0]\nmax_m = [0.6, 0.1]\n",
-            SOLID.replace("[physics]\n", "[physics]\nsound_speed_coef = 10.0\n")
-        ),
+        &format!("{SOLID}\n[tank]\nmin_m = [0.0, 0.0]\nmax_m = [0.5, 0.5]\n"),
         &[],
         None,
-        &["fluid_block", "not coupled"],
+        &["tank", "without fluid"],
     );
     assert_err(
         &format!("{SOLID}\n[[solid]]\nname = \"b\"\nmin_m = [0.3, 0.0]\nmax_m = [0.4, 0.04]\ndensity_kg_m3 = 1000.0\nyoungs_modulus_pa = 3.0e6\npoisson_ratio = 0.3975\n"),
@@ -113,4 +110,80 @@ fn solid_errors_name_the_field() {
         .unwrap()
         .replace("[physics]\n", "[physics]\nsound_speed_coef = 10.0\n");
     assert_err(&no_fluid, &[], None, &["fluid_block", "[[solid]]"]);
+}
+
+/// A gate of solid particles in a tank of water (the elastic gate's layout): fluid where the
+/// solid is not (at least a spacing from its particles), solid particles before the walls'
+/// end, a solid state for every particle; bodies, a moving tank and the energy equation are
+/// refused beside solids.
+#[test]
+fn fluid_and_solids_build_together() {
+    let case = r#"dimension = 2
+[particles]
+dx_m = 0.01
+[physics]
+sound_speed_coef = 20.0
+[time]
+end_s = 0.1
+output_every_s = 0.01
+[tank]
+min_m = [0.0, 0.0]
+max_m = [0.6, 0.4]
+[[fluid_block]]
+min_m = [0.0, 0.0]
+max_m = [0.4, 0.2]
+[[solid]]
+name = "gate"
+min_m = [0.2, 0.02]
+max_m = [0.22, 0.3]
+density_kg_m3 = 1100.0
+youngs_modulus_pa = 1.2e7
+poisson_ratio = 0.4
+clamped_min_m = [0.2, 0.25]
+clamped_max_m = [0.22, 0.3]
+"#;
+    let s = load_str(case, "cases/t.toml", &[]).unwrap();
+    let solids = s.solids.as_ref().expect("solids");
+    assert_eq!(solids.body.len(), s.particles.len());
+    assert_eq!(solids.tau0.len(), s.particles.len());
+    let gate: Vec<&Particle> = s.particles.iter().filter(|p| p.kind.is_solid()).collect();
+    assert_eq!(gate.len(), 2 * 28);
+    assert_eq!(s.count(Kind::SolidClamped), 2 * 5);
+    assert!(gate.iter().all(|p| p.rho == 1100.0));
+    for f in s.particles.iter().filter(|p| p.kind == Kind::Fluid) {
+        for g in &gate {
+            let d = ((f.pos[0] - g.pos[0]).powi(2) + (f.pos[1] - g.pos[1]).powi(2)).sqrt();
+            assert!(
+                d > 0.01 - 1e-9,
+                "fluid at {:?} within {d} of the gate",
+                f.pos
+            );
+        }
+    }
+    // 40 × 20 fluid lattice points minus the gate's 2 columns (x = 0.205, 0.215) over the
+    // 18 rows from y = 0.025 (the gap under the gate stays fluid, a spacing from it).
+    assert_eq!(s.count(Kind::Fluid), 40 * 20 - 2 * 18);
+    assert!(
+        (s.physics.particle_mass - 0.1).abs() < 1e-12,
+        "the fluid's mass"
+    );
+
+    for (extra, words) in [
+        (
+            "[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.5, 0.25]\nmax_m = [0.55, 0.3]\ndensity_kg_m3 = 500.0\n",
+            &["body", "solid–body contact"][..],
+        ),
+        (
+            "[tank.motion]\nkind = \"sine\"\nperiod_s = 1.0\ntranslation_m = [0.01, 0.0]\n",
+            &["tank.motion", "clamped"][..],
+        ),
+    ] {
+        assert_err(&format!("{case}{extra}"), &[], None, words);
+    }
+    assert_err(
+        &case.replace("[physics]\n", "[physics]\nenergy = true\n"),
+        &[],
+        None,
+        &["physics.energy", "no solid terms"],
+    );
 }
