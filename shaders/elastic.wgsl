@@ -37,6 +37,20 @@
 @group(0) @binding(7) var<storage, read_write> stress_rate: array<SymRate>;
 @group(0) @binding(8) var<storage, read_write> state: SimState;
 
+fn tau_of(s: SolidState) -> mat3x3<f32> {
+    // Columns of the symmetric τ.
+    return mat3x3<f32>(
+        vec3<f32>(s.tau_a.x, s.tau_a.w, s.tau_b.x),
+        vec3<f32>(s.tau_a.w, s.tau_a.y, s.tau_b.y),
+        vec3<f32>(s.tau_b.x, s.tau_b.y, s.tau_a.z),
+    );
+}
+
+// p = c_s² (ρ − ρs).
+fn solid_pressure(rho: f32) -> f32 {
+    return params.solid_c2 * (rho - params.solid_rho0);
+}
+
 // Artificial stress R_i of a particle with total stress σ and density ρ (GMS §4, 2D closed
 // form; zero in 3D, see the header).
 fn artificial_stress(sigma: mat3x3<f32>, rho: f32) -> mat3x3<f32> {
@@ -149,7 +163,7 @@ fn stress_predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     let dt = state.dt;
     let s = solid[i];
     solid[i].tau_a = s.tau_a + dt * s.rate_a;
-    solid[i].tau_b = s.tau_b + dt * s.rate_b.xyz;
+    solid[i].tau_b = s.tau_b + dt * vec3<f32>(s.rate_b, 0.0);
 }
 
 // Corrector for τ: τ_{n+1} = τ* + ½dt ((dτ/dt)_{n+1} − (dτ/dt)_n); keeps the new rate.
@@ -163,7 +177,7 @@ fn stress_correct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     let s = solid[i];
     let r = stress_rate[i];
     solid[i].tau_a = s.tau_a + half_dt * (r.a - s.rate_a);
-    solid[i].tau_b = s.tau_b + half_dt * (r.b.xyz - s.rate_b.xyz);
+    solid[i].tau_b = s.tau_b + half_dt * vec3<f32>(r.b.xy - s.rate_b, 0.0);
     solid[i].rate_a = r.a;
-    solid[i].rate_b = r.b;
+    solid[i].rate_b = r.b.xy;
 }

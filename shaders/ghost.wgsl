@@ -9,8 +9,9 @@
 // the fluid sees the hydrostatic increase (g points down) and a hydrostatic field is exact.
 // Free-slip ghosts use the interpolated velocity itself in the viscous terms (no tangential
 // shear from the wall).
-// Only fluid particles count (the interpolation domain of fixed-wall ghosts). Fallbacks: MLS →
-// Shepard where the moment matrix is ill-conditioned; no fluid in reach → P_g = 0, v_g = v_wall.
+// Only fluid particles count (the interpolation domain of fixed-wall and elastic-body ghosts).
+// Fallbacks: MLS → Shepard where the moment matrix is ill-conditioned; no fluid in reach →
+// P_g = 0, v_g = v_wall.
 // ρ_g follows from P_g by the inverse Tait equation, so the interaction pass sees P_g.
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
@@ -23,17 +24,8 @@ fn density_of(p: f32) -> f32 {
     return params.rho0 * pow(max(1.0 + p / params.tait_b, 0.5), 1.0 / params.gamma);
 }
 
-@compute @workgroup_size(WG)
-fn ghost_interpolate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let g = linear_index(gid, nwg);
-    if (g >= params.n_particles) {
-        return;
-    }
-    let kind = code_kind(code[g]);
-    if (!is_ghost(kind)) {
-        return;
-    }
-    let pg = pos[g];
+// The fluid's velocity and pressure interpolated at `pg` with W^I (see the header): (v, P).
+fn fluid_at(pg: Pos) -> vec4<f32> {
     let support2 = 4.0 * params.h * params.h;
     // Moments Σ f_j W V [1, x_gj] of f = 1 (the MLS matrix), P and v.
     var a = mls_zero();
@@ -64,22 +56,45 @@ fn ghost_interpolate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
         }
     }
     let volume = a[0][0];
-    var p = 0.0;
-    var v = vec3<f32>(0.0);
-    if (volume > 1e-6) {
-        // Shepard: the zeroth moments over Σ W V.
-        var beta = vec4<f32>(1.0 / volume, 0.0, 0.0, 0.0);
-        if (params.ghost_mls != 0u) {
-            let sol = mls_solve(a);
-            if (sol.ok) {
-                beta = sol.beta;
-            }
-        }
-        p = dot(beta, m_p);
-        v = vec3<f32>(dot(beta, m_vx), dot(beta, m_vy), dot(beta, m_vz));
+    if (volume <= 1e-6) {
+        return vec4<f32>(0.0);
     }
+    // Shepard: the zeroth moments over Σ W V.
+    var beta = vec4<f32>(1.0 / volume, 0.0, 0.0, 0.0);
+    if (params.ghost_mls != 0u) {
+        let sol = mls_solve(a);
+        if (sol.ok) {
+            beta = sol.beta;
+        }
+    }
+    return vec4<f32>(dot(beta, m_vx), dot(beta, m_vy), dot(beta, m_vz), dot(beta, m_p));
+}
+
+@compute @workgroup_size(WG)
+fn ghost_interpolate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let g = linear_index(gid, nwg);
+    if (g >= params.n_particles || !is_ghost(code_kind(code[g]))) {
+        return;
+    }
+    let f = fluid_at(pos[g]);
     // The interpolated fluid velocity is stored; the interaction makes the no-slip ghost
     // velocity 2 v_wall − v (v_wall = 0) from it for the viscous terms, and uses the wall's own
     // velocity in continuity.
-    velrho[g] = vec4<f32>(v, density_of(p));
+    velrho[g] = vec4<f32>(f.xyz, density_of(f.w));
+}
+
+// Elastic solid particles are the ghosts of their body for the fluid (the seed's third kind,
+// elastic-body ghosts, which move with their solid): each gets the fluid pressure interpolated
+// at its position, P_g = Σ_j P_j W^I_gj V_j (with the same hydrostatic correction), stored in
+// its `interface_p`. interaction.wgsl uses P_g, not the solid's own stress, in the fluid–solid
+// pair terms, so the solid's deviatoric stress never acts on the fluid directly.
+@group(0) @binding(5) var<storage, read_write> solid: array<SolidState>;
+
+@compute @workgroup_size(WG)
+fn solid_interface_pressure(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let g = linear_index(gid, nwg);
+    if (g >= params.n_particles || !is_solid(code_kind(code[g]))) {
+        return;
+    }
+    solid[g].interface_p = fluid_at(pos[g]).w;
 }

@@ -19,16 +19,20 @@
 //   each fluid j near the image of i, the ghost x_g = 2x_w − x_j with p_g = p_j, ρ_g = ρ_j and
 //   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip), the latter in
 //   the viscous terms only; near a corner also the double image across both planes.
-// Fluid–solid pairs (elastic solids, Kind::Solid/SolidClamped), from either side, with the
-//   full stress tensors of the seed's eq. 2 (σ = −P I for the fluid, σ = −p I + τ for the
-//   solid, p = c_s² (ρ − ρs)), each particle with its own mass, and the seed's density-rate
+// Fluid–solid pairs (elastic solids, Kind::Solid/SolidClamped), from either side: the solid
+//   particle acts as a ghost of its body (the seed's improved interface, third ghost kind) with
+//   the fluid pressure interpolated at it, P_g (ghost.wgsl, `interface_p`), its own velocity,
+//   mass m_s and density; each particle with its own mass, and the seed's density-rate
 //   correction between materials of different density:
 //     dρ_i/dt += m_j v_ij·∇_i W_ij (ρ_i/ρ_j)
-//     dv_i/dt += m_j (σ_i/ρ_i² + σ_j/ρ_j² − Π_ij I)·∇_i W_ij
-//   with the fluid's viscosity (Π_ij with the fluid's α and c0, or the laminar term). The pair
-//   terms are equal and opposite (m_i dv_i = −m_j dv_j): momentum is conserved across the
-//   interface. Solid particles get only these fluid terms here; elastic.wgsl adds the
-//   solid–solid ones and gravity.
+//     dv_i/dt += −m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij
+//   with P = P_g on the solid side, and the fluid's viscosity (Π_ij with the fluid's α and c0,
+//   or the laminar term). The solid's own stress (its pressure and τ) stays inside the solid:
+//   with it in these terms, the solid's large deviatoric stresses push the fluid along the
+//   interface and the run blows up within milliseconds (the elastic gate). The pair terms are
+//   equal and opposite (m_i dv_i = −m_j dv_j): momentum is conserved across the interface.
+//   Solid particles get only these fluid terms here; elastic.wgsl adds the solid–solid ones
+//   and gravity.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
 // get nothing here.
 // Particles of moving bodies (dynamic boundary particles too) also get the force per unit mass
@@ -99,14 +103,13 @@ fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_cont: vec3<f32>, v_visc:
 }
 
 // (dv/dt, dρ/dt) on i from a neighbour j of the other material (fluid–solid), see the header:
-// a_i, a_j are σ/ρ² of each, m_j the neighbour's mass.
-fn interface_rates(a_i: mat3x3<f32>, v_i: vec3<f32>, rho_i: f32, a_j: mat3x3<f32>, v_j: vec3<f32>, rho_j: f32, m_j: f32, x_ij: vec3<f32>, r2: f32) -> vec4<f32> {
+// b_i, b_j are P/ρ² of each (P_g for the solid), m_j the neighbour's mass.
+fn interface_rates(b_i: f32, v_i: vec3<f32>, rho_i: f32, b_j: f32, v_j: vec3<f32>, rho_j: f32, m_j: f32, x_ij: vec3<f32>, r2: f32) -> vec4<f32> {
     let f_ij = kernel_f(sqrt(r2) / params.h);
     let dw_ij = x_ij * f_ij;
     let v_ij = v_i - v_j;
     let drho = m_j * dot(v_ij, dw_ij) * rho_i / rho_j;
-    // σ/ρ² is symmetric, so T·∇W = T ∇W in either index order.
-    var acc = m_j * ((a_i + a_j) * dw_ij);
+    var acc = -m_j * (b_i + b_j) * dw_ij;
     if (VISCOSITY == 0u) {
         let vx = dot(v_ij, x_ij);
         if (vx < 0.0) {
@@ -119,17 +122,11 @@ fn interface_rates(a_i: mat3x3<f32>, v_i: vec3<f32>, rho_i: f32, a_j: mat3x3<f32
     return vec4<f32>(acc, drho);
 }
 
-// −P/ρ² I of a fluid particle of density ρ, as a stress over density squared.
-fn fluid_stress_over_rho2(rho: f32) -> mat3x3<f32> {
-    let s = -pressure_of(rho) / (rho * rho);
-    return mat3x3<f32>(vec3<f32>(s, 0.0, 0.0), vec3<f32>(0.0, s, 0.0), vec3<f32>(0.0, 0.0, s));
-}
-
 // Rates of solid particle i from its fluid neighbours (the fluid's load on the solid).
 fn solid_from_fluid(i: u32) -> vec4<f32> {
     let p_i = pos[i];
     let vr_i = velrho[i];
-    let a_i = solid_stress_over_rho2(solid[i], vr_i.w);
+    let b_i = solid[i].interface_p / (vr_i.w * vr_i.w);
     let support2 = 4.0 * params.h * params.h;
     var r = vec4<f32>(0.0);
     var slots: array<u32, 27>;
@@ -145,7 +142,7 @@ fn solid_from_fluid(i: u32) -> vec4<f32> {
                 continue;
             }
             let vr_j = velrho[j];
-            r += interface_rates(a_i, vr_i.xyz, vr_i.w, fluid_stress_over_rho2(vr_j.w), vr_j.xyz, vr_j.w, params.mass, x_ij, r2);
+            r += interface_rates(b_i, vr_i.xyz, vr_i.w, pressure_of(vr_j.w) / (vr_j.w * vr_j.w), vr_j.xyz, vr_j.w, params.mass, x_ij, r2);
         }
     }
     return r;
@@ -317,8 +314,8 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             }
             if (is_solid(kind_j)) {
                 let vr_j = velrho[j];
-                let a_j = solid_stress_over_rho2(solid[j], vr_j.w);
-                r += interface_rates(fluid_stress_over_rho2(pi.rho), pi.v, pi.rho, a_j, vr_j.xyz, vr_j.w, params.solid_mass, x_ij, r2);
+                let b_j = solid[j].interface_p / (vr_j.w * vr_j.w);
+                r += interface_rates(pi.p_over_rho2, pi.v, pi.rho, b_j, vr_j.xyz, vr_j.w, params.solid_mass, x_ij, r2);
                 continue;
             }
             let vr_j = velrho[j];

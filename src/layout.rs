@@ -52,7 +52,8 @@ pub struct Params {
 }
 
 /// Mirrors `SolidState` in shaders/lib/common.wgsl: the deviatoric stress τ of a solid particle
-/// (xx, yy, zz, xy | xz, yz) [Pa], its elastic body, and dτ/dt of the last evaluation.
+/// (xx, yy, zz, xy | xz, yz) [Pa], its elastic body, dτ/dt of the last evaluation, and the
+/// fluid pressure interpolated at it (what the fluid sees of the solid) [Pa].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct SolidState {
@@ -60,7 +61,9 @@ pub struct SolidState {
     pub tau_b: [f32; 3],
     pub body: u32,
     pub rate_a: [f32; 4],
-    pub rate_b: [f32; 4],
+    pub rate_b: [f32; 2],
+    pub interface_p: f32,
+    pub pad: f32,
 }
 
 /// Mirrors `SymRate`: dτ/dt (xx, yy, zz, xy | xz, yz, 0, 0) [Pa/s].
@@ -258,7 +261,7 @@ mod tests {
             Pass::Elastic,
             "SolidState",
             SolidState,
-            [tau_a, tau_b, body, rate_a, rate_b]
+            [tau_a, tau_b, body, rate_a, rate_b, interface_p, pad]
         );
         check_layout!(Pass::Elastic, "SymRate", SymRate, [a, b]);
     }

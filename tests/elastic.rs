@@ -243,27 +243,36 @@ fn fluid_on_solid(dim: u32, kernel: KernelKind, viscosity: Viscosity, seed: u64)
     sc
 }
 
-/// Layer 1 for the fluid–solid coupling: every particle's (dv/dt, dρ/dt) on the GPU (the
-/// interaction pass with its fluid–solid pairs, then the elastic pass) against the f64
-/// reference's sum of the fluid terms, the interface terms and the solid terms; outputs
-/// poisoned first. And the interface conserves momentum: Σ m_i (dv_i/dt − g) over all
-/// particles vanishes to f32 rounding (every pair term is equal and opposite).
+/// Layer 1 for the fluid–solid coupling: every particle's (dv/dt, dρ/dt) on the GPU (the solids'
+/// interface pressure P_g interpolated from the fluid, Shepard or MLS; the interaction pass
+/// with its fluid–solid pairs; the elastic pass) against the f64 reference's sum of the fluid
+/// terms, the interface terms and the solid terms; outputs poisoned first. And the interface
+/// conserves momentum: Σ m_i (dv_i/dt − g) over all particles vanishes to f32 rounding (every
+/// pair term is equal and opposite).
 #[test]
 fn fluid_solid_interface_matches_reference() {
-    for (dim, kernel, viscosity) in [
+    for (dim, kernel, viscosity, correction) in [
         (
             2,
             KernelKind::WendlandC2,
             Viscosity::Artificial { alpha: 0.1 },
+            GhostCorrection::Shepard,
         ),
-        (2, KernelKind::CubicSpline, Viscosity::Laminar { nu: 1e-3 }),
+        (
+            2,
+            KernelKind::CubicSpline,
+            Viscosity::Laminar { nu: 1e-3 },
+            GhostCorrection::Mls,
+        ),
         (
             3,
             KernelKind::WendlandC2,
             Viscosity::Artificial { alpha: 0.1 },
+            GhostCorrection::Mls,
         ),
     ] {
-        let sc = fluid_on_solid(dim, kernel, viscosity, 5 + dim as u64);
+        let mut sc = fluid_on_solid(dim, kernel, viscosity, 5 + dim as u64);
+        sc.walls.ghost_correction = correction;
         let ph = &sc.physics;
         let mat = sc.solids.as_ref().unwrap().material;
         let solver = Solver::new(gpu(), &sc).unwrap();
@@ -283,7 +292,16 @@ fn fluid_solid_interface_matches_reference() {
         let gpu_rate = solver.rerun_interaction(true).unwrap();
         let space = Space::of(&sc);
         let fluid = wgsph::reference::interaction::rates(ph, &sc.walls, &space, &parts);
-        let interface = elastic::interface_rates(ph, &mat, &space, &parts, &solid);
+        let p_g = wgsph::reference::ghost::interface_pressure(ph, &sc.walls, &space, &parts);
+        let on_solid: Vec<f64> = (0..parts.len())
+            .filter(|&i| elastic::is_solid(parts[i].kind))
+            .map(|i| p_g[i])
+            .collect();
+        assert!(
+            on_solid.iter().any(|p| p.abs() > 100.0),
+            "the interface pressures are all small: {on_solid:?}"
+        );
+        let interface = elastic::interface_rates(ph, &mat, &space, &parts, &p_g);
         let solids = elastic::rates(ph, &mat, &space, &parts, &solid);
         let cpu: Vec<[f64; 4]> = (0..parts.len())
             .map(|i| {
@@ -326,7 +344,7 @@ fn fluid_solid_interface_matches_reference() {
         }
         let imbalance = total.iter().map(|t| t.abs()).fold(0.0, f64::max) / scale;
         println!(
-            "{dim}D {kernel:?} {viscosity:?}, {} particles ({across} at the interface): dv/dt \
+            "{dim}D {kernel:?} {viscosity:?} {correction:?}, {} particles ({across} at the interface): dv/dt \
              error {e_acc:.1e} of RMS {acc_rms:.3e}, dρ/dt {e_rho:.1e} of {rho_rms:.3e}; \
              momentum imbalance {imbalance:.1e} of Σ m|a − g|",
             parts.len()

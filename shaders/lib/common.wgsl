@@ -103,35 +103,17 @@ fn is_solid(kind: u32) -> bool {
 }
 
 // Per solid particle, sorted with it: deviatoric stress τ = (xx, yy, zz, xy | xz, yz) [Pa],
-// its elastic body, and dτ/dt of the last evaluation (for the corrector). Mirrored by
-// `layout::SolidState`.
+// its elastic body, dτ/dt of the last evaluation (for the corrector: xx, yy, zz, xy | xz, yz),
+// and the fluid pressure interpolated at it this step (ghost.wgsl), which is what the fluid
+// sees of the solid. Mirrored by `layout::SolidState`.
 struct SolidState {
     tau_a: vec4<f32>,
     tau_b: vec3<f32>,
     body: u32,
     rate_a: vec4<f32>,
-    rate_b: vec4<f32>,
-}
-
-// τ of a solid particle as a symmetric matrix (columns).
-fn tau_of(s: SolidState) -> mat3x3<f32> {
-    return mat3x3<f32>(
-        vec3<f32>(s.tau_a.x, s.tau_a.w, s.tau_b.x),
-        vec3<f32>(s.tau_a.w, s.tau_a.y, s.tau_b.y),
-        vec3<f32>(s.tau_b.x, s.tau_b.y, s.tau_a.z),
-    );
-}
-
-// Solid pressure, linear EOS (Gray, Monaghan & Swift 2001): p = c_s² (ρ − ρs).
-fn solid_pressure(rho: f32) -> f32 {
-    return params.solid_c2 * (rho - params.solid_rho0);
-}
-
-// Total stress over density squared, σ/ρ² with σ = −p I + τ, of a solid particle.
-fn solid_stress_over_rho2(s: SolidState, rho: f32) -> mat3x3<f32> {
-    let p = solid_pressure(rho);
-    let sigma = tau_of(s) - mat3x3<f32>(vec3<f32>(p, 0.0, 0.0), vec3<f32>(0.0, p, 0.0), vec3<f32>(0.0, 0.0, p));
-    return sigma * (1.0 / (rho * rho));
+    rate_b: vec2<f32>,
+    interface_p: f32,
+    pad: f32,
 }
 
 // dτ/dt as written by the elastic pass: (xx, yy, zz, xy | xz, yz, 0, 0). Mirrored by

@@ -193,37 +193,41 @@ pub fn rates(
 
 /// The fluid–solid pair terms of interaction.wgsl (see its header): for every particle, the
 /// (dv/dt, dρ/dt) it gets from neighbours of the other material (fluid from solid particles,
-/// solid from fluid ones), with the full stress tensors, each neighbour's own mass, the
-/// fluid's viscosity and the seed's density-rate correction ρ_i/ρ_j; zero for the others.
+/// solid from fluid ones). A solid particle enters with its interface pressure `p_g`
+/// (`ghost::interface_pressure`), its own mass, density and velocity; with the fluid's
+/// viscosity and the seed's density-rate correction ρ_i/ρ_j; zero for the others.
 pub fn interface_rates(
     ph: &Physics,
     mat: &ElasticMaterial,
     space: &Space,
     parts: &[RefParticle],
-    solid: &[SolidRef],
+    p_g: &[f64],
 ) -> Vec<[f64; 4]> {
     let h = ph.h;
     let eta2 = 0.01 * h * h;
     let solid_mass = mat.density * ph.dx.powi(ph.dim as i32);
-    // σ/ρ² and mass of each particle that takes part (fluid or solid).
-    let side = |k: usize| -> Option<(M3, f64)> {
+    // P/ρ² and mass of each particle that takes part (fluid or solid).
+    let side = |k: usize| -> Option<(f64, f64)> {
         let p = &parts[k];
         if p.kind == super::FLUID {
-            let s = -super::pressure(ph, p.rho) / (p.rho * p.rho);
             Some((
-                [[s, 0.0, 0.0], [0.0, s, 0.0], [0.0, 0.0, s]],
+                super::pressure(ph, p.rho) / (p.rho * p.rho),
                 ph.particle_mass,
             ))
         } else if is_solid(p.kind) {
-            Some((stress_terms(ph, mat, p, &solid[k]).0, solid_mass))
+            Some((p_g[k] / (p.rho * p.rho), solid_mass))
         } else {
             None
         }
     };
+    let alpha = match ph.viscosity {
+        crate::scenario::Viscosity::Artificial { alpha } => alpha,
+        crate::scenario::Viscosity::Laminar { .. } => 0.0,
+    };
     (0..parts.len())
         .map(|i| {
             let mut r = [0.0; 4];
-            let Some((a_i, _)) = side(i) else {
+            let Some((b_i, _)) = side(i) else {
                 return r;
             };
             let pi = &parts[i];
@@ -231,7 +235,7 @@ pub fn interface_rates(
                 if (pi.kind == super::FLUID) == (pj.kind == super::FLUID) {
                     continue;
                 }
-                let Some((a_j, m_j)) = side(j) else {
+                let Some((b_j, m_j)) = side(j) else {
                     continue;
                 };
                 let x_ij = space.sub(pi.pos, pj.pos);
@@ -243,15 +247,12 @@ pub fn interface_rates(
                 let dw = x_ij.map(|x| x * f);
                 let v_ij = [0, 1, 2].map(|a| pi.vel[a] - pj.vel[a]);
                 r[3] += m_j * dot(v_ij, dw) * pi.rho / pj.rho;
-                let rho_bar = 0.5 * (pi.rho + pj.rho);
+                // Π_ij (as −Π in the sum) or the laminar term.
                 let (visc, laminar) = match super::laminar_nu(ph) {
                     None => {
                         let vx = dot(v_ij, x_ij);
-                        let alpha = match ph.viscosity {
-                            crate::scenario::Viscosity::Artificial { alpha } => alpha,
-                            crate::scenario::Viscosity::Laminar { .. } => 0.0,
-                        };
                         let mu = h * vx / (r2 + eta2);
+                        let rho_bar = 0.5 * (pi.rho + pj.rho);
                         (
                             if vx < 0.0 {
                                 alpha * ph.c0 * mu / rho_bar
@@ -264,10 +265,7 @@ pub fn interface_rates(
                     Some(nu) => (0.0, 4.0 * nu * r2 * f / ((pi.rho + pj.rho) * (r2 + eta2))),
                 };
                 for a in 0..3 {
-                    for b in 0..3 {
-                        r[a] += m_j * (a_i[a][b] + a_j[a][b]) * dw[b];
-                    }
-                    r[a] += m_j * (visc * dw[a] + laminar * v_ij[a]);
+                    r[a] += m_j * ((visc - b_i - b_j) * dw[a] + laminar * v_ij[a]);
                 }
             }
             r

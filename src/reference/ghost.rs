@@ -100,6 +100,52 @@ pub fn basis(dim: usize, h: f64, x: [f64; 3]) -> [f64; 4] {
     ]
 }
 
+/// The fluid's pressure (with the hydrostatic correction) and velocity interpolated at `x`
+/// with W^I (Shepard, or MLS where asked and well conditioned); zeros with no fluid in reach.
+pub fn fluid_at(
+    ph: &Physics,
+    walls: &WallParams,
+    space: &Space,
+    parts: &[RefParticle],
+    x: [f64; 3],
+) -> (f64, [f64; 3]) {
+    let dim = ph.dim as usize;
+    let h = ph.h;
+    let mut a = [[0.0; 4]; 4];
+    let mut m_p = [0.0; 4];
+    let mut m_v = [[0.0; 4]; 3];
+    for j in parts.iter().filter(|p| p.kind == FLUID) {
+        let d = space.sub(x, j.pos);
+        let r2 = dot(d, d);
+        if r2 >= 4.0 * h * h {
+            continue;
+        }
+        let wv = kernel::w(ph.kernel, ph.dim, h, r2.sqrt()) * ph.particle_mass / j.rho;
+        let b = basis(dim, h, d);
+        let p = pressure(ph, j.rho) + j.rho * dot(ph.gravity, d);
+        for r in 0..4 {
+            for c in 0..4 {
+                a[r][c] += wv * b[r] * b[c];
+            }
+            m_p[r] += p * wv * b[r];
+            for k in 0..3 {
+                m_v[k][r] += j.vel[k] * wv * b[r];
+            }
+        }
+    }
+    if a[0][0] <= 1e-6 {
+        return (0.0, [0.0; 3]);
+    }
+    let mut beta = [1.0 / a[0][0], 0.0, 0.0, 0.0];
+    if walls.ghost_correction == GhostCorrection::Mls {
+        if let Some(b) = mls_beta(dim, a) {
+            beta = b;
+        }
+    }
+    let d4 = |m: [f64; 4]| (0..4).map(|k| beta[k] * m[k]).sum::<f64>();
+    (d4(m_p), [d4(m_v[0]), d4(m_v[1]), d4(m_v[2])])
+}
+
 /// Sets (v, ρ) of every ghost from the fluid; other particles are returned unchanged.
 pub fn interpolate(
     ph: &Physics,
@@ -107,53 +153,38 @@ pub fn interpolate(
     space: &Space,
     parts: &[RefParticle],
 ) -> Vec<RefParticle> {
-    let dim = ph.dim as usize;
-    let h = ph.h;
     parts
         .iter()
         .map(|g| {
             if g.kind != GHOST_NO_SLIP && g.kind != GHOST_FREE_SLIP {
                 return *g;
             }
-            let mut a = [[0.0; 4]; 4];
-            let mut m_p = [0.0; 4];
-            let mut m_v = [[0.0; 4]; 3];
-            for j in parts.iter().filter(|p| p.kind == FLUID) {
-                let x = space.sub(g.pos, j.pos);
-                let r2 = dot(x, x);
-                if r2 >= 4.0 * h * h {
-                    continue;
-                }
-                let wv = kernel::w(ph.kernel, ph.dim, h, r2.sqrt()) * ph.particle_mass / j.rho;
-                let b = basis(dim, h, x);
-                let p = pressure(ph, j.rho) + j.rho * dot(ph.gravity, x);
-                for r in 0..4 {
-                    for c in 0..4 {
-                        a[r][c] += wv * b[r] * b[c];
-                    }
-                    m_p[r] += p * wv * b[r];
-                    for k in 0..3 {
-                        m_v[k][r] += j.vel[k] * wv * b[r];
-                    }
-                }
-            }
-            let (mut p, mut v) = (0.0, [0.0; 3]);
-            if a[0][0] > 1e-6 {
-                let mut beta = [1.0 / a[0][0], 0.0, 0.0, 0.0];
-                if walls.ghost_correction == GhostCorrection::Mls {
-                    if let Some(b) = mls_beta(dim, a) {
-                        beta = b;
-                    }
-                }
-                let d4 = |m: [f64; 4]| (0..4).map(|k| beta[k] * m[k]).sum::<f64>();
-                p = d4(m_p);
-                v = [d4(m_v[0]), d4(m_v[1]), d4(m_v[2])];
-            }
+            let (p, v) = fluid_at(ph, walls, space, parts, g.pos);
             // The interpolated fluid velocity; interaction.rs makes the ghost velocities.
             let mut out = *g;
             out.vel = v;
             out.rho = ph.rho0 * (1.0 + p / ph.tait_b()).max(0.5).powf(1.0 / ph.gamma);
             out
+        })
+        .collect()
+}
+
+/// The interface pressure P_g of every elastic solid particle (the fluid pressure
+/// interpolated at it, as for a ghost), 0 for the others.
+pub fn interface_pressure(
+    ph: &Physics,
+    walls: &WallParams,
+    space: &Space,
+    parts: &[RefParticle],
+) -> Vec<f64> {
+    parts
+        .iter()
+        .map(|s| {
+            if super::elastic::is_solid(s.kind) {
+                fluid_at(ph, walls, space, parts, s.pos).0
+            } else {
+                0.0
+            }
         })
         .collect()
 }

@@ -1,5 +1,6 @@
-//! Fixed-ghost interpolation (shaders/ghost.wgsl): sets the pressure (through ρ) and velocity
-//! of every ghost particle from the fluid, after the sort and before the interaction.
+//! Ghost interpolation (shaders/ghost.wgsl), after the sort and before the interaction: the
+//! pressure (through ρ) and velocity of every fixed ghost particle, and the interface pressure
+//! of every elastic solid particle, interpolated from the fluid.
 
 use anyhow::Result;
 
@@ -7,36 +8,72 @@ use super::buffers::ParticleBuffers;
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::Kernel;
 
-pub struct Ghost {
+/// A kernel with its bind groups of both parities.
+struct Bound {
     kernel: Kernel,
     bind: [wgpu::BindGroup; 2],
+}
+
+pub struct Ghost {
+    /// Fixed ghosts, when the case has any.
+    walls: Option<Bound>,
+    /// Elastic solid particles in fluid, when the case has both.
+    solids: Option<Bound>,
     n: u32,
 }
 
 impl Ghost {
-    pub fn new(device: &wgpu::Device, module: &ShaderModule, b: &ParticleBuffers) -> Result<Self> {
-        let kernel = module.kernel(device, "ghost_interpolate")?;
-        let bufs = |p: usize| {
-            [
-                (0, &b.params),
-                (1, &b.pos[p]),
-                (2, &b.velrho[p]),
-                (3, &b.code[p]),
-                (4, &b.cell_start),
-            ]
+    pub fn new(
+        device: &wgpu::Device,
+        module: &ShaderModule,
+        b: &ParticleBuffers,
+        fixed_ghosts: bool,
+        solids_in_fluid: bool,
+    ) -> Result<Self> {
+        let bound = |entry: &str, with_solid: bool| -> Result<Bound> {
+            let kernel = module.kernel(device, entry)?;
+            let bind = [0, 1].map(|p| {
+                let mut bufs = vec![
+                    (0, &b.params),
+                    (1, &b.pos[p]),
+                    (2, &b.velrho[p]),
+                    (3, &b.code[p]),
+                    (4, &b.cell_start),
+                ];
+                if with_solid {
+                    bufs.push((5, &b.solid[p]));
+                }
+                kernel.bind(device, &bufs)
+            });
+            let [b0, b1] = bind;
+            Ok(Bound {
+                bind: [b0?, b1?],
+                kernel,
+            })
         };
-        let bind = [
-            kernel.bind(device, &bufs(0))?,
-            kernel.bind(device, &bufs(1))?,
-        ];
         Ok(Self {
-            kernel,
-            bind,
+            walls: fixed_ghosts
+                .then(|| bound("ghost_interpolate", false))
+                .transpose()?,
+            solids: solids_in_fluid
+                .then(|| bound("solid_interface_pressure", true))
+                .transpose()?,
             n: b.n,
         })
     }
 
+    /// Both interpolations, on the arrays of parity `p`.
     pub fn encode(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.kernel.dispatch(pass, &self.bind[p], self.n);
+        for k in [&self.walls, &self.solids].into_iter().flatten() {
+            k.kernel.dispatch(pass, &k.bind[p], self.n);
+        }
+    }
+
+    /// Only the solids' interface pressure, on the current arrays: the interaction test hook
+    /// recomputes it, while fixed ghosts keep the values their step gave them.
+    pub fn encode_solids(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        if let Some(k) = &self.solids {
+            k.kernel.dispatch(pass, &k.bind[p], self.n);
+        }
     }
 }

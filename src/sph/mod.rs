@@ -179,7 +179,6 @@ pub struct Solver {
     /// Shepard/MLS density re-initialisation, if the case asks for one.
     density_filter: Option<DensityFilter>,
     ghost: Ghost,
-    has_ghosts: bool,
     energy: bool,
     integrate: Integrate,
     /// Elastic solid particles, if the case has any.
@@ -322,7 +321,14 @@ impl Solver {
             sc.solids.is_some(),
         )?;
         let interaction = Interaction::new(&device, &module(Pass::Interaction)?, &buffers)?;
-        let ghost = Ghost::new(&device, &module(Pass::Ghost)?, &buffers)?;
+        let has_kind = |k: &[Kind]| sc.particles.iter().any(|p| k.contains(&p.kind));
+        let ghost = Ghost::new(
+            &device,
+            &module(Pass::Ghost)?,
+            &buffers,
+            has_kind(&[Kind::GhostNoSlip, Kind::GhostFreeSlip]),
+            has_kind(&[Kind::Fluid]) && has_kind(&[Kind::Solid, Kind::SolidClamped]),
+        )?;
         let density_filter = match ph.density_filter {
             crate::scenario::DensityFilter::None => None,
             mode => DensityFilter::new(&device, &module(Pass::DensityFilter)?, &buffers, mode)?,
@@ -368,10 +374,6 @@ impl Solver {
             density_filter,
             ghost,
             energy: ph.energy,
-            has_ghosts: sc
-                .particles
-                .iter()
-                .any(|p| matches!(p.kind, Kind::GhostNoSlip | Kind::GhostFreeSlip)),
             integrate,
             elastic,
             probes,
@@ -509,9 +511,7 @@ impl Solver {
             if let Some(b) = bodies {
                 b.encode_index(&mut pass, q);
             }
-            if self.has_ghosts {
-                self.ghost.encode(&mut pass, q);
-            }
+            self.ghost.encode(&mut pass, q);
             self.interaction.encode(&mut pass, q);
             if let Some(e) = &self.elastic {
                 e.encode_rates(&mut pass, q);
@@ -715,8 +715,8 @@ impl Solver {
             .collect())
     }
 
-    /// Test hook: re-runs only the interaction pass (and the elastic rates, with solids) on the
-    /// current arrays and returns the rates. With `poison`, `rate` (and the stress rates) are
+    /// Test hook: re-runs only the interaction pass (and, with solids, their interface pressure
+    /// before it and the elastic rates after it) on the current arrays and returns the rates. With `poison`, `rate` (and the stress rates) are
     /// first filled with NaN so an entry the kernel skips cannot pass.
     #[doc(hidden)]
     pub fn rerun_interaction(&self, poison: bool) -> Result<Vec<[f32; 4]>> {
@@ -739,6 +739,7 @@ impl Solver {
             label: Some("interaction"),
             timestamp_writes: None,
         });
+        self.ghost.encode_solids(&mut pass, self.parity);
         self.interaction.encode(&mut pass, self.parity);
         if let Some(e) = &self.elastic {
             e.encode_rates(&mut pass, self.parity);
