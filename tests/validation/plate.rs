@@ -5,8 +5,7 @@
 //! ω² = E H² k⁴ / (12 ρ (1 − ν²)), kL = 1.875 (shared/validation/
 //! analytic_oscillating_plate_frequency.csv: T = 0.25406 s).
 
-mod common;
-use common::*;
+use crate::common::*;
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
 

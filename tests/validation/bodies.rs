@@ -5,8 +5,7 @@
 //! the water entry are `wgsph validate`'s cases (`validation::bodies`). Numbers are printed and
 //! recorded in docs/validation.md.
 
-mod common;
-use common::{gpu, validate_case};
+use crate::common::{gpu, validate_case};
 
 use wgsph::scenario::Scenario;
 use wgsph::sph::Solver;
@@ -34,7 +33,7 @@ fn floating_box_settles_near_the_archimedes_draft_coarse() {
     // the fine test). Mean draft over 1-2 s within 25 % of Archimedes'.
     let o = validate_case("floating_box_2d", Mode::Quick, Mode::Quick, "coarse");
     let _ = std::fs::remove_dir_all(&o.dir);
-    assert!(o.passed(), "{}", common::rows(&o));
+    assert!(o.passed(), "{}", crate::common::rows(&o));
 }
 
 #[test]
@@ -43,7 +42,7 @@ fn floating_box_draft_within_2_percent_fine() {
     // dx = 0.01 m, mean draft over 1.5-3 s within 2 %.
     let o = validate_case("floating_box_2d", Mode::Full, Mode::Full, "fine");
     let _ = std::fs::remove_dir_all(&o.dir);
-    assert!(o.passed(), "{}", common::rows(&o));
+    assert!(o.passed(), "{}", crate::common::rows(&o));
 }
 
 #[test]
@@ -93,7 +92,7 @@ fn water_entry_penetration_within_30_percent_coarse() {
         "coarse",
     );
     let _ = std::fs::remove_dir_all(&o.dir);
-    assert!(o.passed(), "{}", common::rows(&o));
+    assert!(o.passed(), "{}", crate::common::rows(&o));
 }
 
 #[test]
@@ -103,6 +102,6 @@ fn water_entry_penetration_within_10_percent_fine() {
     for case in ["water_entry_cylinder_2d", "water_entry_cylinder_2d_rho1000"] {
         let o = validate_case(case, Mode::Full, Mode::Full, "fine");
         let _ = std::fs::remove_dir_all(&o.dir);
-        assert!(o.passed(), "{}", common::rows(&o));
+        assert!(o.passed(), "{}", crate::common::rows(&o));
     }
 }

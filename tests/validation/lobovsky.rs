@@ -5,14 +5,13 @@
 //! `wgsph plot` draws it over the experiment. The comparison is `wgsph validate`'s
 //! (`validation::lobovsky`); numbers are printed and recorded in docs/validation.md.
 
-mod common;
 use std::process::Command;
 
 use wgsph::validation::{lobovsky, probe_series, CaseOutcome, Mode};
 
 /// The case at its shipped resolution to t* = 3, judged with the bounds of `bounds`.
 fn run(tag: &str, bounds: Mode) -> CaseOutcome {
-    common::validate_case("dam_break_lobovsky_2d", Mode::Quick, bounds, tag)
+    crate::common::validate_case("dam_break_lobovsky_2d", Mode::Quick, bounds, tag)
 }
 
 /// Impact time within 10 %, the raw peak between the front's stagnation pressure and the
@@ -21,7 +20,7 @@ fn run(tag: &str, bounds: Mode) -> CaseOutcome {
 #[test]
 fn lobovsky_sensor1_first_impact_matches_experiment() {
     let o = run("impact", Mode::Quick);
-    assert!(o.passed(), "{}", common::rows(&o));
+    assert!(o.passed(), "{}", crate::common::rows(&o));
 
     // `wgsph plot` with the experiment overlaid in SI units.
     let case = wgsph::validation::find("dam_break_lobovsky_2d").unwrap();
@@ -79,11 +78,11 @@ fn lobovsky_sensor1_first_impact_matches_experiment() {
 /// time within 3 % and the averaged peak within 30 % of the experiment (the full mode's bounds).
 /// Measured: see docs/validation.md (impact +5.0 %, averaged peak +29.8 %, just inside). Kept
 /// visible rather than loosened; run with
-/// `cargo test --release --test validation_lobovsky -- --ignored --nocapture`.
+/// `cargo test --release --test validation lobovsky -- --ignored --nocapture`.
 #[test]
 #[ignore = "not met at dx = 0.01 m: impact +5.0 % (docs/validation.md)"]
 fn lobovsky_sensor1_impact_within_3_percent_and_peak_within_30_percent() {
     let o = run("strict", Mode::Full);
     let _ = std::fs::remove_dir_all(&o.dir);
-    assert!(o.passed(), "{}", common::rows(&o));
+    assert!(o.passed(), "{}", crate::common::rows(&o));
 }

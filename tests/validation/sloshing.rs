@@ -14,8 +14,6 @@ use wgsph::plot::{interpolate, read_csv};
 use wgsph::progress::LogLines;
 use wgsph::run::RunOptions;
 
-mod common;
-
 /// Comparison of one transducer over the experiment's samples in [from, to].
 struct Comparison {
     samples: usize,
@@ -67,7 +65,7 @@ fn run(dx: &str, end: f64, tag: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("wgsph-sloshing-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let report = wgsph::run::run(
-        common::gpu(),
+        crate::common::gpu(),
         &sc,
         &dir,
         &RunOptions::default(),

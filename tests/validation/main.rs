@@ -1,0 +1,12 @@
+//! Layers 2 and 3 on the shipped cases, in one test binary so that the harness runs the long
+//! validation runs side by side (on a software adapter each is mostly one core's work).
+//! The modules name their experiments; docs/validation.md records the numbers they print.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod bodies;
+mod cases;
+mod lobovsky;
+mod plate;
+mod sloshing;
