@@ -497,13 +497,10 @@ pub(super) fn validate(
         // Solids are coupled to fluid (interaction.wgsl), not to walls or rigid bodies: a tank
         // and obstacles only hold the fluid. Without fluid, solids come alone.
         let alone = raw.fluid_block.is_empty();
+        let lonely = "without a [[fluid_block]] (walls hold fluid; solids alone take none)";
         let other = [
-            ("tank", alone && raw.tank.is_some(), "without fluid"),
-            (
-                "obstacle",
-                alone && !raw.obstacle.is_empty(),
-                "without fluid",
-            ),
+            ("tank", alone && raw.tank.is_some(), lonely),
+            ("obstacle", alone && !raw.obstacle.is_empty(), lonely),
             ("body", !raw.body.is_empty(), "yet (no solid–body contact)"),
             (
                 "tank.motion",
@@ -517,11 +514,16 @@ pub(super) fn validate(
             ),
         ];
         if let Some((what, _, why)) = other.iter().find(|(_, present, _)| *present) {
+            let fix = if alone && (*what == "tank" || *what == "obstacle") {
+                format!("add the fluid, or remove {what}")
+            } else {
+                format!("remove {what}, or the [[solid]] tables")
+            };
             return Err(ctx.err(
                 what,
                 None,
                 format!("a case with [[solid]] cannot have {what} {why}"),
-                format!("remove {what}, or the [[solid]] tables"),
+                fix,
             ));
         }
     }

@@ -89,7 +89,7 @@ fn solid_errors_name_the_field() {
         &format!("{SOLID}\n[tank]\nmin_m = [0.0, 0.0]\nmax_m = [0.5, 0.5]\n"),
         &[],
         None,
-        &["tank", "without fluid"],
+        &["tank", "without a [[fluid_block]]"],
     );
     assert_err(
         &format!("{SOLID}\n[[solid]]\nname = \"b\"\nmin_m = [0.3, 0.0]\nmax_m = [0.4, 0.04]\ndensity_kg_m3 = 1000.0\nyoungs_modulus_pa = 3.0e6\npoisson_ratio = 0.3975\n"),
