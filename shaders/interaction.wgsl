@@ -22,12 +22,14 @@
 // Fluid–solid pairs (elastic solids, Kind::Solid/SolidClamped), from either side: the solid
 //   particle acts as a ghost of its body (the seed's improved interface, third ghost kind) with
 //   the fluid pressure interpolated at it, P_g (ghost.wgsl, `interface_p`), its own velocity,
-//   mass m_s and density; each particle with its own mass, and the seed's density-rate
-//   correction between materials of different density:
-//     dρ_i/dt += m_j v_ij·∇_i W_ij (ρ_i/ρ_j)
-//     dv_i/dt += −m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij
-//   with P = P_g on the solid side, and the fluid's viscosity (Π_ij with the fluid's α and c0,
-//   or the laminar term). The solid's own stress (its pressure and τ) stays inside the solid:
+//   mass m_s and density:
+//     dv_i/dt += −m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij   (fluid and solid i)
+//     dρ_i/dt += m_j v_ij·∇_i W_ij (ρ_i/ρ_j)                   (fluid i only)
+//   with P = P_g on the solid side, the fluid's viscosity (Π_ij with the fluid's α and c0, or
+//   the laminar term), and the seed's density-rate correction ρ_i/ρ_j between materials of
+//   different density. A solid particle's density (its volumetric strain) follows its own
+//   body's motion only (elastic.wgsl): with the fluid's relative velocity in it, a column
+//   clamped in still water pumped energy in and blew up within 0.1 s. The solid's own stress (its pressure and τ) stays inside the solid:
 //   with it in these terms, the solid's large deviatoric stresses push the fluid along the
 //   interface and the run blows up within milliseconds (the elastic gate). The pair terms are
 //   equal and opposite (m_i dv_i = −m_j dv_j): momentum is conserved across the interface.
@@ -122,13 +124,13 @@ fn interface_rates(b_i: f32, v_i: vec3<f32>, rho_i: f32, b_j: f32, v_j: vec3<f32
     return vec4<f32>(acc, drho);
 }
 
-// Rates of solid particle i from its fluid neighbours (the fluid's load on the solid).
-fn solid_from_fluid(i: u32) -> vec4<f32> {
+// Acceleration of solid particle i by its fluid neighbours (the fluid's load on the solid).
+fn solid_from_fluid(i: u32) -> vec3<f32> {
     let p_i = pos[i];
     let vr_i = velrho[i];
     let b_i = solid[i].interface_p / (vr_i.w * vr_i.w);
     let support2 = 4.0 * params.h * params.h;
-    var r = vec4<f32>(0.0);
+    var r = vec3<f32>(0.0);
     var slots: array<u32, 27>;
     let n_slots = neighbour_slots(cell_of(p_i), &slots);
     for (var s = 0u; s < n_slots; s++) {
@@ -142,7 +144,7 @@ fn solid_from_fluid(i: u32) -> vec4<f32> {
                 continue;
             }
             let vr_j = velrho[j];
-            r += interface_rates(b_i, vr_i.xyz, vr_i.w, pressure_of(vr_j.w) / (vr_j.w * vr_j.w), vr_j.xyz, vr_j.w, params.mass, x_ij, r2);
+            r += interface_rates(b_i, vr_i.xyz, vr_i.w, pressure_of(vr_j.w) / (vr_j.w * vr_j.w), vr_j.xyz, vr_j.w, params.mass, x_ij, r2).xyz;
         }
     }
     return r;
@@ -263,7 +265,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         energy_rate[i] = 0.0;
     }
     if (is_solid(kind_i)) {
-        rate[i] = solid_from_fluid(i);
+        rate[i] = vec4<f32>(solid_from_fluid(i), 0.0);
         return;
     }
     if (kind_i != KIND_FLUID && kind_i != KIND_WALL) {

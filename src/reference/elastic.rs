@@ -195,7 +195,8 @@ pub fn rates(
 /// (dv/dt, dρ/dt) it gets from neighbours of the other material (fluid from solid particles,
 /// solid from fluid ones). A solid particle enters with its interface pressure `p_g`
 /// (`ghost::interface_pressure`), its own mass, density and velocity; with the fluid's
-/// viscosity and the seed's density-rate correction ρ_i/ρ_j; zero for the others.
+/// viscosity, and on the fluid side the seed's density-rate correction ρ_i/ρ_j (a solid's
+/// density follows its own body only); zero for the others.
 pub fn interface_rates(
     ph: &Physics,
     mat: &ElasticMaterial,
@@ -246,7 +247,10 @@ pub fn interface_rates(
                 let f = kernel::f(ph.kernel, ph.dim, h, r2.sqrt());
                 let dw = x_ij.map(|x| x * f);
                 let v_ij = [0, 1, 2].map(|a| pi.vel[a] - pj.vel[a]);
-                r[3] += m_j * dot(v_ij, dw) * pi.rho / pj.rho;
+                if pi.kind == super::FLUID {
+                    // A solid's density follows its own body only.
+                    r[3] += m_j * dot(v_ij, dw) * pi.rho / pj.rho;
+                }
                 // Π_ij (as −Π in the sum) or the laminar term.
                 let (visc, laminar) = match super::laminar_nu(ph) {
                     None => {

@@ -10,3 +10,4 @@ mod cases;
 mod lobovsky;
 mod plate;
 mod sloshing;
+mod submerged;
