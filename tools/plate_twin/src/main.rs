@@ -9,11 +9,16 @@
 //! stress and by the artificial viscosity, so the energy budget can be closed.
 //!
 //!   cargo run --release -- [res=H/dx] [hdx=1.3] [kern=wendland|cubic] [eps=0.3] [alpha=0.1]
-//!                          [n=4] [cfl=0.2] [corr=0..4] [periods=1.65] [tipv=0.01] [v=1]
+//!                          [n=4] [cfl=0.2] [corr=0..4] [hg=0] [periods=1.65] [tipv=0.01] [v=1]
 //!
 //! corr (experiments, not in wgsph): 1 corrected ∇v for τ (B_i = (Σ V_j x_ji ⊗ ∇W_ij)⁻¹),
 //! 2 and the momentum with B_i∇W, B_j∇W, 3 corrected ∇v for τ and ρ, 4 all three.
+//! hg (experiment, not in wgsph): a viscosity on the part of v_ij that the (corrected when
+//! corr ≥ 1) velocity gradients do not explain, e_ij = v_ij − ½(∇v_i + ∇v_j) x_ij, in Monaghan's
+//! form with coefficient hg, both signs; meant with alpha=0.
 //! SHAPE=1 prints the mid-thickness deflection against the mode shape at t = T/4.
+#![allow(clippy::needless_range_loop)]
+
 use std::f64::consts::PI;
 
 #[derive(Clone, Copy, PartialEq)]
@@ -32,6 +37,7 @@ struct Cfg {
     cfl: f64,
     n_exp: i32,
     corr: u32, // see the header
+    hg: f64,
     periods: f64,
     tipv: f64,
     verbose: bool,
@@ -282,6 +288,39 @@ impl Sim {
                 ]
             })
             .collect();
+        // Velocity gradients (corrected with B when corr ≥ 1) for the non-affine viscosity.
+        let grads: Vec<[[f64; 2]; 2]> = (0..n)
+            .map(|i| {
+                let mut g = [[0.0; 2]; 2];
+                if self.c.hg == 0.0 {
+                    return g;
+                }
+                for &j in &nb[i] {
+                    let x_ij = [
+                        self.p[i].x[0] - self.p[j].x[0],
+                        self.p[i].x[1] - self.p[j].x[1],
+                    ];
+                    let r = (x_ij[0] * x_ij[0] + x_ij[1] * x_ij[1]).sqrt();
+                    let f = fk(self.c.kern, h, r);
+                    for aa in 0..2 {
+                        for bb in 0..2 {
+                            g[aa][bb] += m / self.p[j].rho
+                                * (self.p[j].v[aa] - self.p[i].v[aa])
+                                * x_ij[bb]
+                                * f;
+                        }
+                    }
+                }
+                let b = &bmat[i];
+                let g0 = g;
+                for aa in 0..2 {
+                    for bb in 0..2 {
+                        g[aa][bb] = g0[aa][0] * b[0][bb] + g0[aa][1] * b[1][bb];
+                    }
+                }
+                g
+            })
+            .collect();
         (0..n)
             .map(|i| {
                 let pi = &self.p[i];
@@ -300,11 +339,32 @@ impl Sim {
                     let v_ij = [pi.v[0] - pj.v[0], pi.v[1] - pj.v[1]];
                     drho += m * (v_ij[0] * dw[0] + v_ij[1] * dw[1]);
                     let vx = v_ij[0] * x_ij[0] + v_ij[1] * x_ij[1];
-                    let piij = if vx < 0.0 {
-                        -self.c.alpha * cs * (h * vx / (r2 + eta2)) / (0.5 * (pi.rho + pj.rho))
+                    let hgp = if self.c.hg > 0.0 {
+                        let gm = [
+                            [
+                                0.5 * (grads[i][0][0] + grads[j][0][0]),
+                                0.5 * (grads[i][0][1] + grads[j][0][1]),
+                            ],
+                            [
+                                0.5 * (grads[i][1][0] + grads[j][1][0]),
+                                0.5 * (grads[i][1][1] + grads[j][1][1]),
+                            ],
+                        ];
+                        let e = [
+                            v_ij[0] - gm[0][0] * x_ij[0] - gm[0][1] * x_ij[1],
+                            v_ij[1] - gm[1][0] * x_ij[0] - gm[1][1] * x_ij[1],
+                        ];
+                        let ex = e[0] * x_ij[0] + e[1] * x_ij[1];
+                        -self.c.hg * cs * (h * ex / (r2 + eta2)) / (0.5 * (pi.rho + pj.rho))
                     } else {
                         0.0
                     };
+                    let piij = hgp
+                        + if vx < 0.0 {
+                            -self.c.alpha * cs * (h * vx / (r2 + eta2)) / (0.5 * (pi.rho + pj.rho))
+                        } else {
+                            0.0
+                        };
                     let fn_ = (w(self.c.kern, h, r) / self.w_dx).powi(self.c.n_exp);
                     // momentum: with corr==2 use corrected gradients B_i ∇W for σ_i and B_j ∇W for σ_j
                     let (dwi, dwj) = if self.c.corr == 2 || self.c.corr == 4 {
@@ -471,6 +531,7 @@ fn main() {
         cfl: 0.2,
         n_exp: 4,
         corr: 0,
+        hg: 0.0,
         periods: 1.65,
         tipv: 0.01,
         verbose: false,
@@ -492,6 +553,7 @@ fn main() {
             "cfl" => c.cfl = v.parse().unwrap(),
             "n" => c.n_exp = v.parse().unwrap(),
             "corr" => c.corr = v.parse().unwrap(),
+            "hg" => c.hg = v.parse().unwrap(),
             "periods" => c.periods = v.parse().unwrap(),
             "tipv" => c.tipv = v.parse().unwrap(),
             "v" => c.verbose = v == "1",
