@@ -16,6 +16,8 @@
 //! hg (experiment, not in wgsph): a viscosity on the part of v_ij that the (corrected when
 //! corr ≥ 1) velocity gradients do not explain, e_ij = v_ij − ½(∇v_i + ∇v_j) x_ij, in Monaghan's
 //! form with coefficient hg, both signs; meant with alpha=0.
+//! AXIAL=1 starts the first axial mode instead, v_x = V sin(πs/2L), and measures the tip's
+//! x-displacement against T = 4L/sqrt(E/((1 − ν²)ρ)) (plane strain, σ_yy = 0).
 //! SHAPE=1 prints the mid-thickness deflection against the mode shape at t = T/4.
 #![allow(clippy::needless_range_loop)]
 
@@ -140,9 +142,15 @@ impl Sim {
                 } else {
                     vtip * shape(s) / shape(L)
                 };
+                let axial = std::env::var("AXIAL").is_ok();
+                let vx = if axial && !clamped && s > 0.0 {
+                    vtip * (0.5 * PI * s / L).sin()
+                } else {
+                    0.0
+                };
                 p.push(P {
                     x,
-                    v: [0.0, v],
+                    v: if axial { [vx, 0.0] } else { [0.0, v] },
                     rho: RHO0,
                     tau: [0.0; 4],
                     clamped,
@@ -564,7 +572,11 @@ fn main() {
     let mut s = Sim::new(c.clone());
     let k = KL / L;
     let omega2 = E * H * H * k.powi(4) / (12.0 * RHO0 * (1.0 - NU * NU));
-    let tth = 2.0 * PI / omega2.sqrt();
+    let mut tth = 2.0 * PI / omega2.sqrt();
+    let axial = std::env::var("AXIAL").is_ok();
+    if axial {
+        tth = 4.0 * L / (E / (1.0 - NU * NU) / RHO0).sqrt();
+    }
     s.r = s.rates();
     let e0 = s.energy();
     let every = tth / 200.0;
@@ -595,7 +607,11 @@ fn main() {
             steps += 1;
         }
         t = target;
-        let y = s.p[s.tip].x[1] - s.y0;
+        let y = if axial {
+            s.p[s.tip].x[0] - (0.26 - 0.5 * s.c.dx)
+        } else {
+            s.p[s.tip].x[1] - s.y0
+        };
         hist.push((t, y));
         let e = s.energy();
         en.push((t, e.0 + e.1));
