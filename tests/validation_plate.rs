@@ -157,7 +157,7 @@ fn plate_oscillates_steadily_h_over_dx_5() {
 /// Gray, Monaghan & Swift's test at the shipped resolution: the first-mode period within 5 %
 /// of Euler–Bernoulli theory.
 #[test]
-#[ignore = "not met at H/dx = 5: period +12.2 %; the bare scheme is soft (zero-energy modes: +21 to +25 % at even H/dx) and ε, α move the period by ±20 % (docs/validation.md)"]
+#[ignore = "not met at H/dx = 5: period +12.2 %; without α and ε the plate is −6.5 % at H/dx = 5 but +21 to +25 % at even H/dx, not understood; ε, α move the period by ±20 % (docs/validation.md)"]
 fn plate_period_within_5_percent_h_over_dx_5() {
     let run = PlateRun::new(&[]);
     run.report("H/dx = 5");
