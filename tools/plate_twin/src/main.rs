@@ -18,6 +18,8 @@
 //! form with coefficient hg, both signs; meant with alpha=0.
 //! AXIAL=1 starts the first axial mode instead, v_x = V sin(πs/2L), and measures the tip's
 //! x-displacement against T = 4L/sqrt(E/((1 − ν²)ρ)) (plane strain, σ_yy = 0).
+//! HOLDER=1 clamps like SPHinXsys instead: the insert (x ≤ 0.06 m) is free, held by fixed
+//! particles 3 dx thick above, below and behind it.
 //! SHAPE=1 prints the mid-thickness deflection against the mode shape at t = T/4.
 #![allow(clippy::needless_range_loop)]
 
@@ -135,7 +137,7 @@ impl Sim {
         for j in 0..ny {
             for i in 0..nx {
                 let x = [(i as f64 + 0.5) * dx, (j as f64 + 0.5) * dx];
-                let clamped = x[0] <= 0.06;
+                let clamped = x[0] <= 0.06 && std::env::var("HOLDER").is_err();
                 let s = x[0] - 0.06;
                 let v = if clamped || s <= 0.0 {
                     0.0
@@ -155,6 +157,25 @@ impl Sim {
                     tau: [0.0; 4],
                     clamped,
                 });
+            }
+        }
+        if std::env::var("HOLDER").is_ok() {
+            // SPHinXsys-like: a fixed holder 3 dx thick above, below and behind the free insert.
+            let ni = (0.06 / dx).round() as i64;
+            for j in -3..(ny as i64 + 3) {
+                for i in -3..ni {
+                    if i >= 0 && j >= 0 && j < ny as i64 {
+                        continue;
+                    }
+                    let x = [(i as f64 + 0.5) * dx, (j as f64 + 0.5) * dx];
+                    p.push(P {
+                        x,
+                        v: [0.0; 2],
+                        rho: RHO0,
+                        tau: [0.0; 4],
+                        clamped: true,
+                    });
+                }
             }
         }
         let tip = (0..p.len())
