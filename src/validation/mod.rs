@@ -13,6 +13,7 @@
 
 pub mod bodies;
 pub mod dam_break;
+pub mod gate;
 pub mod hydrostatic;
 pub mod lobovsky;
 mod report;
@@ -229,6 +230,15 @@ pub static CASES: &[Case] = &[
         overrides: bodies::water_entry_1000_overrides,
         evaluate: bodies::evaluate_water_entry_1000,
     },
+    Case {
+        name: "elastic_gate_2d",
+        file: "cases/elastic_gate_2d.toml",
+        text: include_str!("../../cases/elastic_gate_2d.toml"),
+        reference: gate::X_DISPLACEMENT.file,
+        citation: gate::CITATION,
+        overrides: gate::overrides,
+        evaluate: gate::evaluate,
+    },
 ];
 
 /// The case called `name`.
@@ -421,7 +431,13 @@ pub fn probe_series(dir: &Path, probe: &str) -> Result<Vec<(f64, f64)>> {
 /// `(t, column)` of a body's table, `DIR/probes/body_<body>.csv` (`t_s` first, then the
 /// columns of [`crate::body::csv_columns`]).
 pub fn body_series(dir: &Path, body: &str, column: &str) -> Result<Vec<(f64, f64)>> {
-    let path = dir.join(PROBES_DIR).join(format!("body_{body}.csv"));
+    table_series(dir, &format!("body_{body}"), column)
+}
+
+/// `(t, column)` of a table with several columns, `DIR/probes/<table>.csv` (`t_s` first): a
+/// body's or a tracked point's.
+pub fn table_series(dir: &Path, table: &str, column: &str) -> Result<Vec<(f64, f64)>> {
+    let path = dir.join(PROBES_DIR).join(format!("{table}.csv"));
     let text = std::fs::read_to_string(&path)
         .with_context(|| format!("cannot read {}", path.display()))?;
     let mut lines = text.lines().enumerate();

@@ -328,3 +328,45 @@ fn body_metrics_from_synthetic_tables() {
     assert!(p.worst_error().abs() < 1e-9, "{}", p.worst_error());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The elastic gate's free end following the experiment (x) and 4 mm above it (y): no error,
+/// then 4 mm over the peak measured y displacement, judged against the full bound.
+#[test]
+fn gate_metrics_from_a_synthetic_point_table() {
+    let case = find("elastic_gate_2d").unwrap();
+    assert!(case.overrides(Mode::Quick).is_none(), "hours on lavapipe");
+    let sc = case.scenario(&case.overrides(Mode::Full).unwrap()).unwrap();
+    let dir = temp_dir("gate");
+    let x = gate::X_DISPLACEMENT.points().unwrap();
+    let y = gate::Y_DISPLACEMENT.points().unwrap();
+    // Rows at every time of both series (and the ends), each column interpolated linearly.
+    let mut times: Vec<f64> = x.iter().chain(&y).map(|p| p.0).collect();
+    times.extend([0.0, 0.4]);
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    let at = |s: &[(f64, f64)], t: f64| {
+        crate::plot::interpolate(s, t.clamp(s[0].0, s[s.len() - 1].0)).unwrap()
+    };
+    let mut table = String::from("t_s,x_m,y_m,ux_m,uy_m\n");
+    for t in times {
+        let _ = writeln!(table, "{t},0,0,{},{}", at(&x, t), at(&y, t) + 0.004);
+    }
+    std::fs::write(dir.join(PROBES_DIR).join("point_free_end.csv"), table).unwrap();
+    write_run_json(&dir, &summary(case.name, 0));
+    let eval = case.evaluate(&sc, &dir, Mode::Full).unwrap();
+    let (mx, my) = (&eval.metrics[0], &eval.metrics[1]);
+    let peak_y = y.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
+    assert!(
+        mx.value.abs() < 1e-12 && mx.verdict() == Verdict::Pass,
+        "{mx:?}"
+    );
+    assert!((my.value - 0.004 / peak_y).abs() < 1e-9, "{my:?}");
+    assert_eq!(
+        my.verdict(),
+        Verdict::Fail,
+        "{:.3} of the peak is over the bound",
+        my.value
+    );
+    assert_eq!(eval.figures.len(), 2);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
