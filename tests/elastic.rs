@@ -87,6 +87,22 @@ fn random_solid(dim: u32, kernel: KernelKind, seed: u64) -> Scenario {
     sc
 }
 
+/// The solid state of the GPU arrays (GPU order) as reference input.
+fn solid_refs(solver: &Solver) -> Vec<SolidRef> {
+    solver
+        .read_solid()
+        .unwrap()
+        .iter()
+        .map(|s| SolidRef {
+            tau: [
+                s.tau_a[0], s.tau_a[1], s.tau_a[2], s.tau_a[3], s.tau_b[0], s.tau_b[1],
+            ]
+            .map(|x| x as f64),
+            body: s.body,
+        })
+        .collect()
+}
+
 fn rms(v: impl Iterator<Item = f64>) -> f64 {
     let (s, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x * x, n + 1));
     (s / n as f64).sqrt()
@@ -102,18 +118,7 @@ fn elastic_rates_match_reference() {
         let sc = random_solid(dim, kernel, 11 + dim as u64);
         let solver = Solver::new(gpu(), &sc).unwrap();
         let parts = gpu_particles(&solver);
-        let solid: Vec<SolidRef> = solver
-            .read_solid()
-            .unwrap()
-            .iter()
-            .map(|s| SolidRef {
-                tau: [
-                    s.tau_a[0], s.tau_a[1], s.tau_a[2], s.tau_a[3], s.tau_b[0], s.tau_b[1],
-                ]
-                .map(|x| x as f64),
-                body: s.body,
-            })
-            .collect();
+        let solid = solid_refs(&solver);
         let gpu_rate = solver.rerun_interaction(true).unwrap();
         let gpu_dtau = solver.read_stress_rates().unwrap();
         let cpu = elastic::rates(
@@ -277,18 +282,7 @@ fn fluid_solid_interface_matches_reference() {
         let mat = sc.solids.as_ref().unwrap().material;
         let solver = Solver::new(gpu(), &sc).unwrap();
         let parts = gpu_particles(&solver);
-        let solid: Vec<SolidRef> = solver
-            .read_solid()
-            .unwrap()
-            .iter()
-            .map(|s| SolidRef {
-                tau: [
-                    s.tau_a[0], s.tau_a[1], s.tau_a[2], s.tau_a[3], s.tau_b[0], s.tau_b[1],
-                ]
-                .map(|x| x as f64),
-                body: s.body,
-            })
-            .collect();
+        let solid = solid_refs(&solver);
         let gpu_rate = solver.rerun_interaction(true).unwrap();
         let space = Space::of(&sc);
         let fluid = wgsph::reference::interaction::rates(ph, &sc.walls, &space, &parts);
