@@ -1,0 +1,13 @@
+//! Layer 3 for elastic solids in water: the dam break through a rubber gate (Antoci, Gallati &
+//! Sibilla 2007), `cases/elastic_gate_2d.toml` at its shipped resolution, the free end's
+//! displacement against the experiment (`wgsph validate --full --case elastic_gate_2d`).
+
+use crate::common::validate_case;
+use wgsph::validation::Mode;
+
+#[test]
+#[ignore = "not run to its end yet: 0.4 s is about 250 000 steps of 17 000 particles, ~4 h on lavapipe (a GPU job); the first 45 ms ran stably on lavapipe and meet the first measured point (x +3 %, y −5 %, docs/validation.md)"]
+fn elastic_gate_free_end_follows_antoci_2007() {
+    let o = validate_case("elastic_gate_2d", Mode::Full, Mode::Full, "full");
+    assert!(o.passed(), "{}", crate::common::rows(&o));
+}
