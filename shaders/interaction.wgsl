@@ -29,12 +29,12 @@
 //   the laminar term), and the seed's density-rate correction ρ_i/ρ_j between materials of
 //   different density. A solid particle's density (its volumetric strain) follows its own
 //   body's motion only (elastic.wgsl): with the fluid's relative velocity in it, a column
-//   clamped in still water pumped energy in and blew up within 0.1 s. The solid's own stress (its pressure and τ) stays inside the solid:
-//   with it in these terms, the solid's large deviatoric stresses push the fluid along the
-//   interface and the run blows up within milliseconds (the elastic gate). The pair terms are
-//   equal and opposite (m_i dv_i = −m_j dv_j): momentum is conserved across the interface.
-//   Solid particles get only these fluid terms here; elastic.wgsl adds the solid–solid ones
-//   and gravity.
+//   clamped in still water pumped energy in and blew up within 0.1 s. The solid's own stress
+//   (its pressure and τ) stays inside the solid: with it in these terms, the solid's large
+//   deviatoric stresses push the fluid along the interface and the run blows up within
+//   milliseconds (the elastic gate). The pair terms are equal and opposite
+//   (m_i dv_i = −m_j dv_j): momentum is conserved across the interface. Solid particles get
+//   only these fluid terms here; elastic.wgsl adds the solid–solid ones and gravity.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
 // get nothing here.
 // Particles of moving bodies (dynamic boundary particles too) also get the force per unit mass
