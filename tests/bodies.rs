@@ -386,49 +386,62 @@ fn a_body_in_free_flight_follows_the_exact_trajectory() {
     }
 }
 
-/// A probe attached to a moving tank samples where the tank has taken it: at t = T/4 of the
-/// sloshing case's pitch (θ = −4°), an attached pressure probe and a fixed probe placed by hand
-/// at the rotated point read the same pressure; and the attached probe is not where it started.
+/// A probe attached to a moving tank samples where the tank has taken it: at t1 into the
+/// sloshing cases' pitch, an attached pressure probe and a fixed probe placed by hand at the
+/// rotated point read the same pressure; and the attached probe is not where it started. In 2D
+/// at t1 = T/4 (θ = −4°); in 3D (rotation about −y, the same sense) at t1 = 0.25 s (θ = −1.9°),
+/// coarse.
 #[test]
 fn a_probe_attached_to_the_tank_moves_with_it() {
-    let set: Vec<String> = ["particles.dx_m=0.04", "time.end_s=1"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    let mut sc = wgsph::case::load(std::path::Path::new("cases/sloshing_2d.toml"), &set).unwrap();
-    let p2 = sc.probes.iter().find(|p| p.name == "p2").unwrap().clone();
-    assert_eq!(p2.body, Some(0), "p2 is attached to the tank");
-    let ProbeKind::Pressure { point: x0 } = p2.kind else {
-        panic!("p2 is a pressure probe")
-    };
-    // The case's law: θ(t) = 4° sin(2t + π) about the pivot (0.46, 0), no translation.
-    let t1 = std::f64::consts::FRAC_PI_4;
-    let theta = 4f64.to_radians() * (2.0 * t1 + std::f64::consts::PI).sin();
-    let (s, c) = theta.sin_cos();
-    let r = [x0[0] - 0.46, x0[1]];
-    let x1 = [0.46 + c * r[0] - s * r[1], s * r[0] + c * r[1], 0.0];
-    assert!(
-        (x1[1] - x0[1]).abs() > 0.02,
-        "the probe must have moved noticeably"
-    );
-    for (name, point) in [("fixed_at_x1", x1), ("fixed_at_x0", x0)] {
-        sc.probes.push(Probe {
-            name: name.into(),
-            kind: ProbeKind::Pressure { point },
-            body: None,
-        });
+    for (case, dx, t1, up) in [
+        (
+            "cases/sloshing_2d.toml",
+            "0.04",
+            std::f64::consts::FRAC_PI_4,
+            1,
+        ),
+        ("cases/sloshing_3d.toml", "0.04", 0.25, 2),
+    ] {
+        let set: Vec<String> = [format!("particles.dx_m={dx}"), "time.end_s=1".into()].into();
+        let mut sc = wgsph::case::load(std::path::Path::new(case), &set).unwrap();
+        let p2 = sc.probes.iter().find(|p| p.name == "p2").unwrap().clone();
+        assert_eq!(p2.body, Some(0), "p2 is attached to the tank");
+        let ProbeKind::Pressure { point: x0 } = p2.kind else {
+            panic!("p2 is a pressure probe")
+        };
+        // The cases' law: θ(t) = 4° sin(2t + π) about the pivot (0.46, ·, 0), no translation;
+        // positive θ lifts the right-hand end (+x) in the x–up plane.
+        let theta = 4f64.to_radians() * (2.0 * t1 + std::f64::consts::PI).sin();
+        let (s, c) = theta.sin_cos();
+        let r = [x0[0] - 0.46, x0[up]];
+        let mut x1 = x0;
+        x1[0] = 0.46 + c * r[0] - s * r[1];
+        x1[up] = s * r[0] + c * r[1];
+        assert!(
+            (x1[up] - x0[up]).abs() > 0.01,
+            "{case}: the probe must have moved noticeably"
+        );
+        for (name, point) in [("fixed_at_x1", x1), ("fixed_at_x0", x0)] {
+            sc.probes.push(Probe {
+                name: name.into(),
+                kind: ProbeKind::Pressure { point },
+                body: None,
+            });
+        }
+        let mut solver = Solver::new(gpu(), &sc).unwrap();
+        solver.advance_to(t1).unwrap();
+        let v = solver.sample_probes().unwrap();
+        let value = |name: &str| v[sc.probes.iter().position(|p| p.name == name).unwrap()];
+        let (attached, at_x1, at_x0) = (value("p2"), value("fixed_at_x1"), value("fixed_at_x0"));
+        println!(
+            "{case}: attached {attached:.3} Pa, fixed at x1 {at_x1:.3} Pa, fixed at x0 {at_x0:.3} Pa"
+        );
+        assert!(
+            (attached - at_x1).abs() <= 1e-4 * at_x1.abs(),
+            "{case}: attached {attached} vs fixed at the moved point {at_x1}"
+        );
+        assert!((attached - at_x0).abs() > 0.03 * at_x0.abs(), "{case}");
     }
-    let mut solver = Solver::new(gpu(), &sc).unwrap();
-    solver.advance_to(t1).unwrap();
-    let v = solver.sample_probes().unwrap();
-    let value = |name: &str| v[sc.probes.iter().position(|p| p.name == name).unwrap()];
-    let (attached, at_x1, at_x0) = (value("p2"), value("fixed_at_x1"), value("fixed_at_x0"));
-    println!("attached {attached:.3} Pa, fixed at x1 {at_x1:.3} Pa, fixed at x0 {at_x0:.3} Pa");
-    assert!(
-        (attached - at_x1).abs() <= 1e-4 * at_x1.abs(),
-        "attached {attached} vs fixed at the moved point {at_x1}"
-    );
-    assert!((attached - at_x0).abs() > 0.05 * at_x0.abs());
 }
 
 /// `probe[].body` must name a moving body; the error names the field and the choices.

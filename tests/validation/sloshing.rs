@@ -55,13 +55,13 @@ fn compare(dir: &Path, probe: &str, transducer: u32, from: f64, to: f64) -> Comp
     }
 }
 
-fn run(dx: &str, end: f64, tag: &str) -> std::path::PathBuf {
+fn run(case: &str, dx: &str, end: f64, tag: &str) -> std::path::PathBuf {
     let set = vec![
         format!("particles.dx_m={dx}"),
         format!("time.end_s={end}"),
         "time.output_every_s=1".to_string(),
     ];
-    let sc = wgsph::case::load(Path::new("cases/sloshing_2d.toml"), &set).unwrap();
+    let sc = wgsph::case::load(Path::new(case), &set).unwrap();
     let dir = std::env::temp_dir().join(format!("wgsph-sloshing-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let report = wgsph::run::run(
@@ -101,7 +101,7 @@ const P2_HYDROSTATIC_KPA: f64 = 9.81 * (0.465 - 0.17);
 
 #[test]
 fn sloshing_transducer_2_follows_the_experiment_coarse() {
-    let dir = run("0.02", 3.2, "coarse");
+    let dir = run("cases/sloshing_2d.toml", "0.02", 3.2, "coarse");
     // The first pitch period (t < π s) without the first half second of start-up.
     let (p2, _) = report(&dir, 0.5, 3.2);
     assert!(p2.samples >= 7);
@@ -120,8 +120,19 @@ fn sloshing_transducer_2_follows_the_experiment_coarse() {
 #[test]
 #[ignore = "10 s of sloshing at dx = 0.01 takes about an hour on lavapipe; run with --ignored"]
 fn sloshing_transducers_follow_the_experiment_fine() {
-    let dir = run("0.01", 10.0, "fine");
+    let dir = run("cases/sloshing_2d.toml", "0.01", 10.0, "fine");
     // As in the PySPH comparison of this case: after the start-up, t in [3, 10] s.
+    let (p2, p8) = report(&dir, 3.0, 10.0);
+    assert!(p2.fluctuation_error < 0.3, "transducer 2");
+    assert!(p8.fluctuation_error < 0.5, "transducer 8");
+}
+
+/// The experiment's own geometry, 3D (`cases/sloshing_3d.toml`), at its shipped dx = 0.02 m,
+/// judged as the fine 2D run.
+#[test]
+#[ignore = "not run yet: 10 s of the 3D tank at dx = 0.02 m (43 000 particles, one readback per step for the moving tank) is hours on lavapipe; a GPU job"]
+fn sloshing_3d_transducers_follow_the_experiment() {
+    let dir = run("cases/sloshing_3d.toml", "0.02", 10.0, "3d");
     let (p2, p8) = report(&dir, 3.0, 10.0);
     assert!(p2.fluctuation_error < 0.3, "transducer 2");
     assert!(p8.fluctuation_error < 0.5, "transducer 8");
