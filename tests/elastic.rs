@@ -69,18 +69,26 @@ fn random_solid(dim: u32, kernel: KernelKind, seed: u64) -> Scenario {
         body.push((p[1] > min[1] + 0.5 * side) as u32);
         tau0.push(t);
     }
-    let dmax = if dim == 2 { [0.4, 0.4, 0.0] } else { [0.3; 3] };
-    let mut sc = scenario(
-        ph,
-        parts,
-        Domain {
-            min: [0.0; 3],
-            max: dmax,
-        },
-        vec![],
-    );
+    with_solids(ph, parts, mat, body, tau0)
+}
+
+/// The test scenario of `parts` in the domain these tests use (0.4 m square in 2D, 0.3 m cube
+/// in 3D), with the solid state of every particle.
+fn with_solids(
+    ph: Physics,
+    parts: Vec<Particle>,
+    material: ElasticMaterial,
+    body: Vec<u32>,
+    tau0: Vec<[f64; 6]>,
+) -> Scenario {
+    let max = if ph.dim == 2 {
+        [0.4, 0.4, 0.0]
+    } else {
+        [0.3; 3]
+    };
+    let mut sc = scenario(ph, parts, Domain { min: [0.0; 3], max }, vec![]);
     sc.solids = Some(Solids {
-        material: mat,
+        material,
         body,
         tau0,
     });
@@ -229,23 +237,8 @@ fn fluid_on_solid(dim: u32, kernel: KernelKind, viscosity: Viscosity, seed: u64)
         });
         tau0.push(t);
     }
-    let n = parts.len();
-    let dmax = if dim == 2 { [0.4, 0.4, 0.0] } else { [0.3; 3] };
-    let mut sc = scenario(
-        ph,
-        parts,
-        Domain {
-            min: [0.0; 3],
-            max: dmax,
-        },
-        vec![],
-    );
-    sc.solids = Some(Solids {
-        material: mat,
-        body: vec![0; n],
-        tau0,
-    });
-    sc
+    let body = vec![0; parts.len()];
+    with_solids(ph, parts, mat, body, tau0)
 }
 
 /// Layer 1 for the fluid–solid coupling: every particle's (dv/dt, dρ/dt) on the GPU (the solids'
