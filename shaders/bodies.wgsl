@@ -11,21 +11,6 @@
 // viscous force of their fluid neighbours (interaction.wgsl), the opposite of what the fluid
 // receives from them, so momentum is exchanged pairwise.
 
-// A body's rigid motion for the step being taken. Mirrored by `layout::BodyMotion`.
-struct BodyMotion {
-    center_off: vec3<f32>,      // centre of mass, as a Pos: offset in its block
-    center_block: u32,
-    rotation: mat3x3<f32>,      // from the body's orientation at t = 0
-    velocity: vec3<f32>,        // of the centre of mass
-    first: u32,                 // its first body-particle index (id − body_id_base)
-    omega: vec3<f32>,
-    count: u32,                 // its number of particles
-    first_group: u32,           // its first workgroup in body_force
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
-}
-
 @group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> code: array<u32>;

@@ -1,17 +1,20 @@
 // Fixed ghost particles, the seed's improved fluid–solid interface: ghosts are generated once
-// inside walls and never move relative to their solid; each step their pressure and velocity
-// are interpolated from the fluid with a corrected kernel W^I (Shepard here; MLS where the case
-// asks for it and the moment matrix is well conditioned):
-//   P_g = Σ_j P_j W^I_gj V_j,   no-slip v_g = 2 v_wall − Σ_j v_j W^I_gj V_j (walls at rest: v_wall = 0),
-// the latter applied in the viscous terms (interaction.wgsl); continuity sees v_wall.
+// inside walls and bodies and never move relative to their solid (a body's ghosts move with it,
+// bodies.wgsl); each step their pressure and velocity are interpolated from the fluid with a
+// corrected kernel W^I (Shepard here; MLS where the case asks for it and the moment matrix is
+// well conditioned):
+//   P_g = Σ_j P_j W^I_gj V_j,   no-slip v_g = 2 v_wall − Σ_j v_j W^I_gj V_j,
+// the latter applied in the viscous terms (interaction.wgsl, which knows v_wall: zero for fixed
+// walls, the body's rigid velocity at the ghost for a body); continuity sees v_wall.
 // Hydrostatic correction (as in Adami, Hu & Adams 2012, eq. 27): each fluid pressure is carried
 // to the ghost along gravity before it is interpolated, P_j + ρ_j g·(x_g − x_j), so a ghost below
 // the fluid sees the hydrostatic increase (g points down) and a hydrostatic field is exact.
 // Free-slip ghosts use the interpolated velocity itself in the viscous terms (no tangential
 // shear from the wall).
-// Only fluid particles count (the interpolation domain of fixed-wall and elastic-body ghosts).
+// Only fluid particles count (the interpolation domain of the fixed-wall, rigid-body and
+// elastic-body ghosts alike).
 // Fallbacks: MLS → Shepard where the moment matrix is ill-conditioned; no fluid in reach →
-// P_g = 0, v_g = v_wall.
+// P_g = 0 and an interpolated velocity of 0.
 // ρ_g follows from P_g by the inverse Tait equation, so the interaction pass sees P_g.
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;

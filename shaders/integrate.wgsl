@@ -131,6 +131,10 @@ fn correct(
             velrho[i].w = rho;
             // Moving walls (bodies) count with their speed.
             speed = sound_speed_of(rho) + length(vr.xyz);
+        } else if (kind != KIND_EXCLUDED && is_body_particle(code[i] & ID_MASK)) {
+            // A body's ghost or repulsive particle: with its velocity (a ghost's is the fluid's
+            // interpolated at it, which follows the body it touches).
+            speed = sound_speed_of(vr.w) + length(vr.xyz);
         }
     }
     // Workgroup max, then one atomic per workgroup (max is order-independent: deterministic).

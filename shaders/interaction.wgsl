@@ -37,11 +37,14 @@
 //   only these fluid terms here; elastic.wgsl adds the solid–solid ones and gravity.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
 // get nothing here.
-// Particles of moving bodies (dynamic boundary particles too) also get the force per unit mass
-// of their fluid neighbours, −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (the opposite
-// of what the fluid receives from them), and a contact force from boundary particles of other
-// bodies and of the fixed walls (the repulsive law above, Monaghan 1994): bodies.wgsl sums both
-// into the body's force and torque.
+// Particles of moving bodies get the force per unit mass of their fluid neighbours, the opposite
+// of what the fluid receives from them: for dynamic and fixed-ghost body particles
+// −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (a ghost with its interpolated P_g and its
+// viscous velocity), for repulsive ones Σ_j F(x_ij); and a contact force from boundary
+// particles of other bodies and of the fixed walls (the repulsive law above, Monaghan 1994):
+// bodies.wgsl sums both into the body's force and torque. A body's fixed ghosts move with it:
+// continuity sees the body's rigid velocity at the ghost, v_wall = u_c + ω × (R r), and the
+// no-slip viscous velocity is 2 v_wall − v_f.
 // Energy (the seed's eq. 3 with σ = −P I, when ENERGY): de_i/dt = ½ Σ_j m_j (P_i/ρ_i² + P_j/ρ_j²
 //   + Π_ij) v_ij·∇_i W_ij (Monaghan 1992, eq. 2.19 with the artificial-viscosity heating);
 //   laminar viscous heating is not included.
@@ -55,6 +58,7 @@
 @group(0) @binding(7) var<storage, read_write> energy_rate: array<f32>;
 @group(0) @binding(8) var<storage, read> body_particles: array<BodyParticle>;
 @group(0) @binding(9) var<storage, read> solid: array<SolidState>;
+@group(0) @binding(10) var<storage, read> bodies: array<BodyMotion>;
 
 // The state of particle i that every pair term needs.
 struct Particle {
@@ -173,6 +177,26 @@ fn repulsion(x_ij: vec3<f32>, r2: f32) -> vec3<f32> {
     return params.repulsive_d * (q12 - q4) / r2 * x_ij;
 }
 
+// The two velocities of a fixed ghost (see pair_rates): `cont`, the wall's own, for continuity;
+// `visc`, the no-slip 2 v_wall − v_f or free-slip v_f, for viscosity; v_f is the fluid velocity
+// interpolated at the ghost (stored in its velrho by ghost.wgsl). v_wall is zero for the ghosts
+// of fixed walls and the rigid velocity u_c + ω × (R r) of the body for a body's ghosts (the
+// seed's second ghost kind; bodies.wgsl's placement, from the pose of this step).
+struct GhostVelocity {
+    cont: vec3<f32>,
+    visc: vec3<f32>,
+}
+
+fn fixed_ghost_velocity(kind: u32, id: u32, v_f: vec3<f32>) -> GhostVelocity {
+    var v_wall = vec3<f32>(0.0);
+    if (is_body_particle(id)) {
+        let bp = body_particles[id - params.body_id_base];
+        let m = bodies[bp.body];
+        v_wall = m.velocity + cross(m.omega, m.rotation * bp.r);
+    }
+    return GhostVelocity(v_wall, select(v_f, 2.0 * v_wall - v_f, kind == KIND_GHOST_NO_SLIP));
+}
+
 const NO_PLANE: u32 = 0xFFFFFFFFu;
 const NO_BODY: u32 = 0xFFFFFFFFu;
 
@@ -268,18 +292,25 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         rate[i] = vec4<f32>(solid_from_fluid(i), 0.0);
         return;
     }
-    if (kind_i != KIND_FLUID && kind_i != KIND_WALL) {
+    let fluid_i = kind_i == KIND_FLUID;
+    let id_i = code[i] & ID_MASK;
+    let on_body = !fluid_i && kind_i != KIND_EXCLUDED && is_body_particle(id_i);
+    if (!fluid_i && kind_i != KIND_WALL && !on_body) {
         rate[i] = vec4<f32>(0.0);
         return;
     }
-    let fluid_i = kind_i == KIND_FLUID;
-    let id_i = code[i] & ID_MASK;
     var body_i = NO_BODY;
-    if (!fluid_i && is_body_particle(id_i)) {
+    if (on_body) {
         body_i = body_particles[id_i - params.body_id_base].body;
     }
     let p_i = pos[i];
-    let pi = Particle(velrho[i].xyz, velrho[i].w, pressure_of(velrho[i].w) / (velrho[i].w * velrho[i].w));
+    let vr_i = velrho[i];
+    var v_i = vr_i.xyz;
+    if (is_ghost(kind_i)) {
+        // A body's ghost takes its reaction with the velocity the fluid sees in viscosity.
+        v_i = fixed_ghost_velocity(kind_i, id_i, v_i).visc;
+    }
+    let pi = Particle(v_i, vr_i.w, pressure_of(vr_i.w) / (vr_i.w * vr_i.w));
     let support2 = 4.0 * params.h * params.h;
 
     var r = vec4<f32>(0.0);
@@ -302,8 +333,14 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                     if (body_i == NO_BODY) {
                         // Fixed dynamic wall particle: continuity only.
                         r.w += params.mass * dot(pi.v - vr_j.xyz, x_ij * kernel_f(sqrt(r2) / params.h));
+                    } else if (kind_i == KIND_REPULSIVE) {
+                        // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
+                        r += vec4<f32>(repulsion(x_ij, r2), 0.0);
                     } else {
-                        r += pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, false, 1.0).rate;
+                        // The reaction to the fluid's pressure and viscous force; a dynamic
+                        // body particle also its dρ/dt (ghosts have none).
+                        let pr = pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, false, 1.0).rate;
+                        r += select(vec4<f32>(pr.xyz, 0.0), pr, kind_i == KIND_WALL);
                     }
                 } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && !is_solid(kind_j) && other_solid(body_i, code[j] & ID_MASK)) {
                     r += vec4<f32>(repulsion(x_ij, r2), 0.0);
@@ -323,12 +360,13 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             let vr_j = velrho[j];
             let ghost = is_ghost(kind_j);
             // A ghost stores the fluid velocity interpolated at its position (ghost.wgsl):
-            // continuity sees the wall at rest, viscosity the no-slip or free-slip ghost.
+            // continuity sees the wall's velocity, viscosity the no-slip or free-slip ghost.
             var v_cont = vr_j.xyz;
             var v_visc = vr_j.xyz;
             if (ghost) {
-                v_cont = vec3<f32>(0.0);
-                v_visc = select(vr_j.xyz, -vr_j.xyz, kind_j == KIND_GHOST_NO_SLIP);
+                let gv = fixed_ghost_velocity(kind_j, code[j] & ID_MASK, vr_j.xyz);
+                v_cont = gv.cont;
+                v_visc = gv.visc;
             }
             let pr = pair_rates(pi, x_ij, r2, v_cont, v_visc, vr_j.w, kind_j == KIND_FLUID, select(1.0, pi.rho / vr_j.w, ghost));
             r += pr.rate;

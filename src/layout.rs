@@ -129,7 +129,7 @@ pub struct BodyParticle {
     pub body: u32,
 }
 
-/// Mirrors `BodyMotion` in shaders/bodies.wgsl: a body's rigid motion for one step.
+/// Mirrors `BodyMotion` in shaders/lib/common.wgsl: a body's rigid motion for one step.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct BodyMotion {

@@ -11,7 +11,9 @@ use wgsph::reference::{self, RefParticle};
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
 
-/// Particles of a box body from `min` to `max`, appended to `parts`; returns the body.
+/// Particles of a box body from `min` to `max`, of `kind`, appended to `parts`; returns the
+/// body.
+#[allow(clippy::too_many_arguments)]
 fn box_body(
     name: &str,
     dim: u32,
@@ -19,6 +21,7 @@ fn box_body(
     (min, max): ([f64; 3], [f64; 3]),
     density: f64,
     motion: Motion,
+    kind: Kind,
     parts: &mut Vec<Particle>,
 ) -> Body {
     let start = parts.len();
@@ -47,7 +50,7 @@ fn box_body(
             pos: p,
             vel: [0.0; 3],
             rho: 1000.0,
-            kind: Kind::Wall,
+            kind,
         });
     }
     Body {
@@ -76,8 +79,9 @@ fn rocking() -> Motion {
 }
 
 /// Jittered fluid with random velocities over a fixed floor, a free box half in the fluid
-/// (moving and spinning) and a prescribed box pressed against the floor (contact).
-fn scene(dim: u32, seed: u64) -> Scenario {
+/// (moving and spinning) and a prescribed box pressed against the floor (contact); both boxes
+/// made of particles of `kind`.
+fn scene(dim: u32, seed: u64, kind: Kind) -> Scenario {
     let dx = 0.02;
     let ph = physics(dim, dx, 15.0);
     let up = dim as usize - 1;
@@ -112,8 +116,15 @@ fn scene(dim: u32, seed: u64) -> Scenario {
         }
         m
     };
+    // Fluid up to a spacing from the boxes; repulsive particles only act within r0 = dx, so
+    // nearer for them.
+    let gap = if kind == Kind::Repulsive {
+        0.4 * dx
+    } else {
+        dx
+    };
     let inside = |p: [f64; 3], lo: [f64; 3], hi: [f64; 3]| {
-        (0..dim as usize).all(|a| p[a] > lo[a] - dx && p[a] < hi[a] + dx)
+        (0..dim as usize).all(|a| p[a] > lo[a] - gap && p[a] < hi[a] + gap)
     };
     let press_min = {
         let mut m = [0.3; 3];
@@ -156,6 +167,7 @@ fn scene(dim: u32, seed: u64) -> Scenario {
             velocity: [0.3, -0.2, 0.0],
             omega,
         },
+        kind,
         &mut parts,
     );
     let pressed = box_body(
@@ -165,6 +177,7 @@ fn scene(dim: u32, seed: u64) -> Scenario {
         (press_min, press_max),
         1000.0,
         rocking(),
+        kind,
         &mut parts,
     );
     let mut dmax = [0.6; 3];
@@ -194,10 +207,37 @@ fn by_id(solver: &Solver) -> Vec<RefParticle> {
     out
 }
 
+/// The largest error over `rows` of the GPU's acceleration and dρ/dt, each relative to the
+/// RMS of the reference's over those rows; a non-finite GPU rate fails.
+fn rate_errors(rows: &[usize], cpu: &[[f64; 4]], gpu: &[[f32; 4]]) -> (f64, f64) {
+    let rms = |f: &dyn Fn(&[f64; 4]) -> f64| {
+        (rows.iter().map(|&i| f(&cpu[i])).sum::<f64>() / rows.len() as f64).sqrt()
+    };
+    let rms_a = rms(&|r| r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    let rms_d = rms(&|r| r[3] * r[3]);
+    let (mut ea, mut ed) = (0.0f64, 0.0f64);
+    for &i in rows {
+        let g = gpu[i];
+        assert!(
+            g.iter().all(|x| x.is_finite()),
+            "non-finite rate {g:?} in row {i}"
+        );
+        let da = (0..3)
+            .map(|a| (g[a] as f64 - cpu[i][a]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        ea = ea.max(da / rms_a);
+        if rms_d > 0.0 {
+            ed = ed.max((g[3] as f64 - cpu[i][3]).abs() / rms_d);
+        }
+    }
+    (ea, ed)
+}
+
 #[test]
 fn body_particles_follow_their_pose() {
     for dim in [2, 3] {
-        let sc = scene(dim, 3);
+        let sc = scene(dim, 3, Kind::Wall);
         let mut solver = Solver::new(gpu(), &sc).unwrap();
         for _ in 0..3 {
             solver.single_step(2e-3).unwrap();
@@ -229,81 +269,107 @@ fn body_particles_follow_their_pose() {
     }
 }
 
+/// Every wall treatment a body can have: dynamic particles, fixed ghosts (no-slip and
+/// free-slip, interpolated from the fluid and moving with the body) and repulsive particles.
+const BODY_KINDS: [Kind; 4] = [
+    Kind::Wall,
+    Kind::GhostNoSlip,
+    Kind::GhostFreeSlip,
+    Kind::Repulsive,
+];
+
 #[test]
 fn body_rates_and_loads_match_reference() {
     for (dim, seed) in [(2, 11), (3, 12)] {
-        let sc = scene(dim, seed);
-        let mut solver = Solver::new(gpu(), &sc).unwrap();
-        solver.single_step(1e-3).unwrap();
-        let parts = gpu_particles(&solver);
-        let gpu_rates = solver.rerun_interaction(true).unwrap();
-        let cpu = reference::interaction::rates(
-            &sc.physics,
-            &sc.walls,
-            &reference::Space::of(&sc),
-            &parts,
-        );
-        // Rows of body particles, in two groups of very different size: those in contact with
-        // the floor (within the cut-off r0 = dx of its top layer, at 0.03) and the others (the
-        // fluid's force only). Each group's error is relative to its own RMS.
-        let floor_contact =
-            |p: &RefParticle| p.body == Some(1) && p.pos[dim as usize - 1] < 0.03 + sc.physics.dx;
-        for contact in [false, true] {
-            let rows: Vec<usize> = (0..parts.len())
-                .filter(|&i| parts[i].body.is_some() && floor_contact(&parts[i]) == contact)
-                .collect();
-            assert!(
-                !rows.is_empty(),
-                "the scene must have rows with contact = {contact}"
-            );
-            let rms = (rows
-                .iter()
-                .map(|&i| (0..3).map(|a| cpu[i][a].powi(2)).sum::<f64>())
-                .sum::<f64>()
-                / rows.len() as f64)
-                .sqrt();
-            let mut worst = 0.0f64;
-            for &i in &rows {
-                let e = (0..3)
-                    .map(|a| (gpu_rates[i][a] as f64 - cpu[i][a]).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
-                assert!(e.is_finite(), "non-finite body rate {:?}", gpu_rates[i]);
-                worst = worst.max(e / rms);
-            }
-            println!(
-                "dim {dim}, contact {contact}: {} rows, RMS {rms:.3e} m/s², error {worst:.2e} of RMS",
-                rows.len()
-            );
-            assert!(worst < 2e-4, "body-particle acceleration error {worst}");
+        for kind in BODY_KINDS {
+            body_rates_and_loads(dim, seed, kind);
         }
+    }
+}
 
-        let centers: Vec<DVec3> = (0..2)
-            .map(|k| solver.bodies().unwrap().pose(k).center)
-            .collect();
-        let cpu_rates: Vec<[f64; 4]> = gpu_rates.iter().map(|g| g.map(|x| x as f64)).collect();
-        let want = reference::bodies::loads(&sc.physics, &parts, &cpu_rates, &centers);
-        let got = solver.rerun_body_loads().unwrap();
-        for (k, (w, g)) in want.iter().zip(&got).enumerate() {
-            // Scale: the sum of the magnitudes (the force is a sum with cancellation).
-            let (mut fs, mut ts) = (0.0, 0.0);
-            for (p, r) in parts.iter().zip(&cpu_rates) {
-                if p.body == Some(k as u32) {
-                    let f = sc.physics.particle_mass * DVec3::new(r[0], r[1], r[2]);
-                    fs += f.length();
-                    ts += (DVec3::from_array(p.pos) - centers[k]).cross(f).length();
-                }
+fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind) {
+    let sc = scene(dim, seed, kind);
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    solver.single_step(1e-3).unwrap();
+    let gpu_rates = solver.rerun_interaction(true).unwrap();
+    // Read after the rerun: a body's ghosts hold the values interpolated for it.
+    let parts = gpu_particles(&solver);
+    let space = reference::Space::of(&sc);
+    if matches!(kind, Kind::GhostNoSlip | Kind::GhostFreeSlip) {
+        // The ghosts of moving bodies interpolate the fluid like those of fixed walls.
+        let cpu_parts = reference::ghost::interpolate(&sc.physics, &sc.walls, &space, &parts);
+        let (mut ev, mut er, mut ghosts) = (0.0f64, 0.0f64, 0);
+        for (g, c) in parts.iter().zip(&cpu_parts) {
+            if g.body.is_none()
+                || g.kind == reference::EXCLUDED
+                || mls_borderline(&sc, &parts, g.pos)
+            {
+                continue;
             }
-            let ef = (g.force - w.force).length() / fs;
-            let et = (g.torque - w.torque).length() / ts;
-            println!(
-                "dim {dim} body {k}: F {:?} (error {ef:.1e}), T {:?} (error {et:.1e})",
-                g.force, g.torque
-            );
-            assert!(ef.is_finite() && ef < 1e-5, "force error {ef}");
-            assert!(et.is_finite() && et < 1e-5, "torque error {et}");
-            assert!(w.force.length() > 1e-3 * fs, "the force must not vanish");
+            ghosts += 1;
+            assert!(g.rho.is_finite() && g.vel.iter().all(|v| v.is_finite()));
+            let dv = reference::sub(g.vel, c.vel);
+            ev = ev.max(reference::dot(dv, dv).sqrt() / 0.5);
+            er = er.max((g.rho - c.rho).abs() / (c.rho - 1000.0).abs().max(1.0));
         }
+        println!("dim {dim} {kind:?}: {ghosts} body ghosts, v error {ev:.1e}, ρ error {er:.1e}");
+        assert!(ghosts > 0);
+        assert!(ev < 1e-4 && er < 1e-3, "body ghost interpolation");
+    }
+    let cpu = reference::interaction::rates(&sc.physics, &sc.walls, &space, &parts);
+    // The fluid's rows see the bodies' particles (their rigid velocity for ghosts).
+    let fluid: Vec<usize> = (0..parts.len())
+        .filter(|&i| parts[i].kind == reference::FLUID)
+        .collect();
+    let (ea, ed) = rate_errors(&fluid, &cpu, &gpu_rates);
+    println!("dim {dim} {kind:?}: fluid rows accel error {ea:.1e}, dρ/dt error {ed:.1e} of RMS");
+    assert!(ea < 2e-4 && ed < 2e-4, "fluid rates beside {kind:?} bodies");
+    // Rows of body particles, in two groups of very different size: those in contact with
+    // the floor (within the cut-off r0 = dx of its top layer, at 0.03) and the others (the
+    // fluid's force only). Each group's error is relative to its own RMS.
+    let floor_contact =
+        |p: &RefParticle| p.body == Some(1) && p.pos[dim as usize - 1] < 0.03 + sc.physics.dx;
+    for contact in [false, true] {
+        let rows: Vec<usize> = (0..parts.len())
+            .filter(|&i| parts[i].body.is_some() && floor_contact(&parts[i]) == contact)
+            .collect();
+        assert!(
+            !rows.is_empty(),
+            "the scene must have rows with contact = {contact}"
+        );
+        let (worst, _) = rate_errors(&rows, &cpu, &gpu_rates);
+        println!(
+            "dim {dim} {kind:?}, contact {contact}: {} rows, error {worst:.2e} of RMS",
+            rows.len()
+        );
+        assert!(worst < 2e-4, "body-particle acceleration error {worst}");
+    }
+
+    let centers: Vec<DVec3> = (0..2)
+        .map(|k| solver.bodies().unwrap().pose(k).center)
+        .collect();
+    let cpu_rates: Vec<[f64; 4]> = gpu_rates.iter().map(|g| g.map(|x| x as f64)).collect();
+    let want = reference::bodies::loads(&sc.physics, &parts, &cpu_rates, &centers);
+    let got = solver.rerun_body_loads().unwrap();
+    for (k, (w, g)) in want.iter().zip(&got).enumerate() {
+        // Scale: the sum of the magnitudes (the force is a sum with cancellation).
+        let (mut fs, mut ts) = (0.0, 0.0);
+        for (p, r) in parts.iter().zip(&cpu_rates) {
+            if p.body == Some(k as u32) {
+                let f = sc.physics.particle_mass * DVec3::new(r[0], r[1], r[2]);
+                fs += f.length();
+                ts += (DVec3::from_array(p.pos) - centers[k]).cross(f).length();
+            }
+        }
+        let ef = (g.force - w.force).length() / fs;
+        let et = (g.torque - w.torque).length() / ts;
+        println!(
+            "dim {dim} {kind:?} body {k}: F {:?} (error {ef:.1e}), T {:?} (error {et:.1e})",
+            g.force, g.torque
+        );
+        assert!(ef.is_finite() && ef < 1e-5, "force error {ef}");
+        assert!(et.is_finite() && et < 1e-5, "torque error {et}");
+        assert!(w.force.length() > 1e-3 * fs, "the force must not vanish");
     }
 }
 
@@ -338,6 +404,7 @@ fn a_body_in_free_flight_follows_the_exact_trajectory() {
             velocity: v0,
             omega: [0.0, 0.0, w0],
         },
+        Kind::Wall,
         &mut parts,
     );
     let mut sc = scenario(

@@ -94,6 +94,21 @@ struct BodyParticle {
     body: u32,
 }
 
+// A body's rigid motion for the step being taken. Mirrored by `layout::BodyMotion`.
+struct BodyMotion {
+    center_off: vec3<f32>,      // centre of mass, as a Pos: offset in its block
+    center_block: u32,
+    rotation: mat3x3<f32>,      // from the body's orientation at t = 0
+    velocity: vec3<f32>,        // of the centre of mass
+    first: u32,                 // its first body-particle index (id − body_id_base)
+    omega: vec3<f32>,
+    count: u32,                 // its number of particles
+    first_group: u32,           // its first workgroup in body_force
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
 fn is_body_particle(id: u32) -> bool {
     return id >= params.body_id_base;
 }

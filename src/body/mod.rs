@@ -12,7 +12,7 @@ use crate::scenario::{Body, Motion, Prescribed};
 use dynamics::RigidBody;
 
 /// Where a body is and how it moves at one instant.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Pose {
     /// Centre of mass [m].
     pub center: DVec3,

@@ -10,7 +10,8 @@ use crate::scenario::{Motion, MotionLaw, Prescribed};
 
 use super::error::{num, CaseError};
 use super::locate::Ctx;
-use super::schema::{MotionName, RawBody, RawMotion, ShapeName, WallName};
+use super::schema::{MotionName, RawBody, RawMotion, ShapeName};
+use super::validate::Treatment;
 use super::validate::{aabb, number, vector, Aabb, Bound};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,6 +32,8 @@ pub(super) struct BodySpec {
     pub mass: Option<f64>,
     /// Particle layers under the surface; `None`: the whole body.
     pub layers: Option<u32>,
+    /// The kind of its particles (never `Mirror`).
+    pub wall: Treatment,
     pub motion: Motion,
 }
 
@@ -67,13 +70,13 @@ pub(super) fn validate(
                 "give every body a different name",
             ));
         }
-        if let Some(w) = b.wall.filter(|w| *w != WallName::Dynamic) {
+        let wall = super::validate::treatment(ctx, &path, b.wall, b.slip)?;
+        if let Treatment::Mirror { .. } = wall {
             return Err(ctx.err(
                 &format!("{path}.wall"),
-                Some(format!("\"{}\"", w.as_str())),
-                "bodies are made of dynamic boundary particles; fixed-ghost, repulsive and \
-                 mirror bodies are not implemented yet",
-                "use wall = \"dynamic\" (or remove the field)",
+                Some("\"mirror\"".into()),
+                "mirror ghosts are for the tank's straight faces",
+                "use wall = \"fixed_ghost\" (or \"dynamic\", \"repulsive\")",
             ));
         }
         let shape = shape(ctx, &path, b, dim)?;
@@ -164,6 +167,7 @@ pub(super) fn validate(
             shape,
             mass,
             layers,
+            wall,
             motion,
         });
     }

@@ -342,26 +342,21 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             None => case.rho0,
         }
     };
+    // Repulsive particles carry no pressure: ρ0.
+    let boundary_rho = |t: Treatment, pos: [f64; 3]| match t {
+        Treatment::Repulsive => case.rho0,
+        _ => wall_rho(pos),
+    };
     // Mirror walls have no particles (their TankWall has no layers). A moving tank's walls and
     // obstacles become the body "tank", after every fixed particle.
     let tank_moves = case.tank.as_ref().is_some_and(|t| t.motion.is_some());
     let mut tank_particles = Vec::new();
     let mut push_wall = |pos: [f64; 3], t: Treatment| {
-        let (kind, rho) = match t {
-            Treatment::Dynamic => (Kind::Wall, wall_rho(pos)),
-            Treatment::Repulsive => (Kind::Repulsive, case.rho0),
-            Treatment::FixedGhost { no_slip: true } | Treatment::Mirror { no_slip: true } => {
-                (Kind::GhostNoSlip, wall_rho(pos))
-            }
-            Treatment::FixedGhost { no_slip: false } | Treatment::Mirror { no_slip: false } => {
-                (Kind::GhostFreeSlip, wall_rho(pos))
-            }
-        };
         let p = Particle {
             pos,
             vel: [0.0; 3],
-            rho,
-            kind,
+            rho: boundary_rho(t, pos),
+            kind: kind_of(t),
         };
         if tank_moves {
             tank_particles.push(p);
@@ -461,7 +456,12 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     for (i, spec) in case.bodies.iter().enumerate() {
         let start = particles.len();
         let center = spec.shape.center();
-        let points = spec.shape.points(dx, dim, spec.layers);
+        // A repulsive body is its surface layer (as a repulsive wall).
+        let layers = match spec.wall {
+            Treatment::Repulsive => Some(1),
+            _ => spec.layers,
+        };
+        let points = spec.shape.points(dx, dim, layers);
         if let (true, Shape::Ball { radius, .. }) = (points.is_empty(), spec.shape) {
             // Particles sit half a spacing inside the surface: a smaller ball has none, and
             // a body without particles would feel no fluid.
@@ -492,8 +492,8 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             particles.push(Particle {
                 pos,
                 vel,
-                rho: wall_rho(pos),
-                kind: Kind::Wall,
+                rho: boundary_rho(spec.wall, pos),
+                kind: kind_of(spec.wall),
             });
         }
         let mass = spec.mass.unwrap_or(0.0);
@@ -787,5 +787,20 @@ fn highest_column(particles: &[Particle], dim: usize, dx: f64) -> f64 {
         dx
     } else {
         hi - lo + dx
+    }
+}
+
+/// The particle kind of a wall treatment (mirror walls have no particles of their own; their
+/// kind is never used).
+fn kind_of(t: Treatment) -> Kind {
+    match t {
+        Treatment::Dynamic => Kind::Wall,
+        Treatment::Repulsive => Kind::Repulsive,
+        Treatment::FixedGhost { no_slip: true } | Treatment::Mirror { no_slip: true } => {
+            Kind::GhostNoSlip
+        }
+        Treatment::FixedGhost { no_slip: false } | Treatment::Mirror { no_slip: false } => {
+            Kind::GhostFreeSlip
+        }
     }
 }

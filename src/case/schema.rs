@@ -145,6 +145,7 @@ pub(super) struct RawBody {
     pub mass_kg: Option<f64>,
     pub layers: Option<i64>,
     pub wall: Option<WallName>,
+    pub slip: Option<SlipName>,
     pub motion: Option<RawMotion>,
 }
 
@@ -619,8 +620,13 @@ pub(super) const FIELDS: &[FieldHelp] = &[
     ),
     f(
         "body[].wall",
-        "the body's wall treatment (dynamic)",
+        "the body's wall treatment: dynamic, repulsive or fixed_ghost",
         "wall = \"dynamic\"",
+    ),
+    f(
+        "body[].slip",
+        "the velocity condition of a fixed_ghost body",
+        "slip = \"no_slip\"",
     ),
     f(
         "body[].motion",

@@ -1024,6 +1024,66 @@ fn a_moving_tank_becomes_the_last_body_and_widens_the_domain() {
     assert!(matches!(tank.motion, Motion::Prescribed(_)));
 }
 
+/// A body's `wall` makes its particles dynamic, fixed ghosts (with `slip`) or repulsive (the
+/// surface layer only); a moving tank may have fixed-ghost or repulsive walls, not mirrors.
+#[test]
+fn bodies_and_moving_tanks_take_the_particle_wall_treatments() {
+    let body = |extra: &str| {
+        format!(
+            "{BASE}\n[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.2, 0.6]\n\
+             max_m = [0.8, 0.9]\ndensity_kg_m3 = 500.0\n{extra}\n"
+        )
+    };
+    let kinds = |text: &str| -> Vec<Kind> {
+        let sc = load_str(text, "c.toml", &[]).unwrap();
+        sc.particles[sc.bodies[0].particles.clone()]
+            .iter()
+            .map(|p| p.kind)
+            .collect()
+    };
+    let dynamic = kinds(&body(""));
+    assert!(dynamic.iter().all(|k| *k == Kind::Wall));
+    let ghosts = kinds(&body("wall = \"fixed_ghost\"\nslip = \"free_slip\""));
+    assert_eq!(ghosts.len(), dynamic.len());
+    assert!(ghosts.iter().all(|k| *k == Kind::GhostFreeSlip));
+    assert!(kinds(&body("wall = \"fixed_ghost\""))
+        .iter()
+        .all(|k| *k == Kind::GhostNoSlip));
+    let repulsive = kinds(&body("wall = \"repulsive\""));
+    let shell = kinds(&body("layers = 1"));
+    assert!(repulsive.iter().all(|k| *k == Kind::Repulsive));
+    assert_eq!(repulsive.len(), shell.len(), "the surface layer only");
+    assert!(repulsive.len() < dynamic.len());
+    assert_err(
+        &body("slip = \"free_slip\""),
+        &[],
+        None,
+        &["body[0].slip", "fixed_ghost"],
+    );
+
+    let motion = "[tank.motion]\nkind = \"sine\"\npivot_m = [0.5, 0.0]\nrotation_deg = 4.0\n\
+                  period_s = 3.14159\n";
+    let tank = |wall: &str| {
+        format!(
+            "{}\n{motion}",
+            BASE.replace("[tank]", &format!("[tank]\nwall = \"{wall}\""))
+        )
+    };
+    let sc = load_str(&tank("fixed_ghost"), "c.toml", &[]).unwrap();
+    let fixed = load_str(BASE, "c.toml", &[]).unwrap();
+    assert_eq!(sc.bodies[0].name, "tank");
+    assert_eq!(sc.bodies[0].particles.len(), fixed.count(Kind::Wall));
+    assert!(sc.particles[sc.bodies[0].particles.clone()]
+        .iter()
+        .all(|p| p.kind == Kind::GhostNoSlip));
+    assert_err(
+        &tank("mirror"),
+        &[],
+        None,
+        &["tank.motion", "mirror", "fixed_ghost"],
+    );
+}
+
 #[test]
 fn bad_bodies_and_motions_are_refused() {
     let with_body = |body: &str| format!("{BASE}\n[[body]]\nname = \"b\"\n{body}\n");

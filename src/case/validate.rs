@@ -459,13 +459,14 @@ pub(super) fn validate(
             let motion = match &tk.motion {
                 None => None,
                 Some(m) => {
-                    if wall != Treatment::Dynamic {
+                    if let Treatment::Mirror { .. } = wall {
                         return Err(ctx.err(
                             "tank.motion",
                             None,
-                            "a moving tank needs dynamic boundary particles; moving mirror, \
-                             fixed-ghost and repulsive walls are not implemented yet",
-                            "set tank.wall = \"dynamic\", or remove [tank.motion]",
+                            "a moving tank needs wall particles that move with it; mirror \
+                             walls are fixed planes",
+                            "set tank.wall = \"fixed_ghost\" (or \"dynamic\", \"repulsive\"), \
+                             or remove [tank.motion]",
                         ));
                     }
                     Some(super::bodies::motion(
@@ -751,7 +752,7 @@ fn density_filter(ctx: &Ctx<'_>, ph: &RawPhysics) -> Result<DensityFilter, CaseE
 }
 
 /// The treatment of `{path}.wall` with `{path}.slip` (only for mirror and fixed_ghost walls).
-fn treatment(
+pub(super) fn treatment(
     ctx: &Ctx<'_>,
     path: &str,
     wall: Option<WallName>,

@@ -190,6 +190,7 @@ mod tests {
                         rho: 1000.0 * (1.0 + rng.range(-0.02, 0.02)),
                         kind: FLUID,
                         body: None,
+                        wall_vel: [0.0; 3],
                     });
                 }
             }
@@ -298,6 +299,7 @@ mod tests {
                 rho: 1010.0,
                 kind: FLUID,
                 body: None,
+                wall_vel: [0.0; 3],
             };
             let mut pair = vec![far, far];
             pair[1].pos[0] += 0.5 * ph.h;

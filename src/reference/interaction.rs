@@ -95,6 +95,18 @@ pub fn repulsion(ph: &Physics, walls: &WallParams, x_ij: [f64; 3]) -> [f64; 3] {
     x_ij.map(|x| f * x)
 }
 
+/// The velocities a fixed ghost presents (as `fixed_ghost_velocity` in interaction.wgsl): its
+/// wall's in continuity, and in viscosity 2 v_wall − v_f (no-slip) or v_f (free-slip), v_f the
+/// fluid velocity interpolated at it (its `vel`).
+fn ghost_velocities(g: &RefParticle) -> ([f64; 3], [f64; 3]) {
+    let visc = if g.kind == GHOST_NO_SLIP {
+        [0, 1, 2].map(|a| 2.0 * g.wall_vel[a] - g.vel[a])
+    } else {
+        g.vel
+    };
+    (g.wall_vel, visc)
+}
+
 fn add(a: &mut [f64; 4], b: [f64; 4]) {
     for k in 0..4 {
         a[k] += b[k];
@@ -102,9 +114,10 @@ fn add(a: &mut [f64; 4], b: [f64; 4]) {
 }
 
 /// (dv/dt, dρ/dt) of every particle: fluid gets everything but its elastic-solid neighbours'
-/// terms (`elastic::interface_rates`), dynamic walls only dρ/dt from fluid neighbours, ghosts,
-/// repulsive and solid particles nothing. Body particles (dynamic walls of a
-/// body) also get the fluid's force and the contact force of other solids' particles.
+/// terms (`elastic::interface_rates`), dynamic walls only dρ/dt from fluid neighbours, fixed
+/// ghosts, repulsive and solid particles nothing. Body particles (of any wall treatment) also
+/// get the fluid's force, the opposite of what they exert on it, and the contact force of
+/// other solids' particles.
 pub fn rates(
     ph: &Physics,
     walls: &WallParams,
@@ -140,7 +153,16 @@ pub fn rates_and_energy(
         .enumerate()
         .map(|(i, pi)| {
             let mut r = [0.0; 4];
-            if pi.kind == WALL {
+            let on_body = pi.body.is_some() && pi.kind != FLUID && pi.kind != EXCLUDED;
+            if pi.kind == WALL || on_body {
+                // A body's ghost reacts with the velocity the fluid sees in viscosity.
+                let pb = match pi.kind {
+                    GHOST_NO_SLIP | GHOST_FREE_SLIP => RefParticle {
+                        vel: ghost_velocities(pi).1,
+                        ..*pi
+                    },
+                    _ => *pi,
+                };
                 for (j, pj) in parts.iter().enumerate() {
                     let x_ij = space.sub(pi.pos, pj.pos);
                     let r2 = dot(x_ij, x_ij);
@@ -148,12 +170,19 @@ pub fn rates_and_energy(
                         continue;
                     }
                     if pj.kind == FLUID {
-                        if pi.body.is_some() {
-                            // A body particle: the fluid's force on it too.
-                            add(
-                                &mut r,
-                                pair.rates(pi, x_ij, pj.vel, pj.vel, pj.rho, false, 1.0).0,
-                            );
+                        if pi.body.is_some() && pi.kind == REPULSIVE {
+                            // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
+                            let f = repulsion(ph, walls, x_ij);
+                            add(&mut r, [f[0], f[1], f[2], 0.0]);
+                        } else if pi.body.is_some() {
+                            // A body particle: the fluid's force on it too (and a dynamic
+                            // one its dρ/dt).
+                            let mut pr =
+                                pair.rates(&pb, x_ij, pj.vel, pj.vel, pj.rho, false, 1.0).0;
+                            if pi.kind != WALL {
+                                pr[3] = 0.0;
+                            }
+                            add(&mut r, pr);
                         } else {
                             let f_ij = kernel::f(ph.kernel, ph.dim, h, r2.sqrt());
                             r[3] +=
@@ -192,12 +221,12 @@ pub fn rates_and_energy(
                 }
                 let ghost = pj.kind == GHOST_NO_SLIP || pj.kind == GHOST_FREE_SLIP;
                 let ratio = if ghost { pi.rho / pj.rho } else { 1.0 };
-                // Ghosts hold the interpolated fluid velocity: the wall (at rest) in continuity,
+                // Ghosts hold the interpolated fluid velocity: the wall's velocity in continuity,
                 // the no-slip or free-slip ghost velocity in viscosity.
-                let (v_cont, v_visc) = match pj.kind {
-                    GHOST_NO_SLIP => ([0.0; 3], pj.vel.map(|v| -v)),
-                    GHOST_FREE_SLIP => ([0.0; 3], pj.vel),
-                    _ => (pj.vel, pj.vel),
+                let (v_cont, v_visc) = if ghost {
+                    ghost_velocities(pj)
+                } else {
+                    (pj.vel, pj.vel)
                 };
                 let (pr, pe) =
                     pair.rates(pi, x_ij, v_cont, v_visc, pj.rho, pj.kind == FLUID, ratio);

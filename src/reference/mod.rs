@@ -26,6 +26,10 @@ pub struct RefParticle {
     pub kind: u32,
     /// The moving body the particle belongs to, if any.
     pub body: Option<u32>,
+    /// The velocity of the solid a boundary particle belongs to, at the particle: a body's
+    /// rigid velocity, zero for fixed walls (and unused for fluid). A fixed ghost's `vel` is
+    /// the fluid velocity interpolated at it; this is the wall it stands for.
+    pub wall_vel: [f64; 3],
 }
 
 pub const FLUID: u32 = 0;

@@ -29,10 +29,33 @@ pub fn body_particles(sc: &Scenario) -> Vec<BodyParticle> {
     out
 }
 
+/// The per-body table of `bodies`, whose particles have ids from `first_id` on: each body's
+/// particle range and first workgroup of `body_force` (the motion comes with each step).
+pub fn initial_motions(sc: &Scenario, first_id: u32) -> Vec<BodyMotion> {
+    let mut groups = 0;
+    sc.bodies
+        .iter()
+        .map(|body| {
+            let count = body.particles.len() as u32;
+            let m = BodyMotion {
+                first: body.particles.start as u32 - first_id,
+                count,
+                first_group: groups,
+                ..Default::default()
+            };
+            groups += count.div_ceil(WORKGROUP_SIZE).max(1);
+            m
+        })
+        .collect()
+}
+
 pub struct Bodies {
-    /// The per-body table; `first`, `count` and `first_group` never change.
+    /// The per-body table (`ParticleBuffers::body_motions`); `first`, `count` and
+    /// `first_group` never change.
     motions: Vec<BodyMotion>,
     motion_buf: wgpu::Buffer,
+    /// The poses of the last upload (what the GPU moves the bodies with).
+    poses: Vec<Pose>,
     pub partials: wgpu::Buffer,
     /// Workgroups of `body_force` (each covers particles of one body).
     groups: u32,
@@ -47,29 +70,20 @@ pub struct Bodies {
 }
 
 impl Bodies {
+    /// `motions` is the table the buffers were made with ([`initial_motions`]).
     pub fn new(
         device: &wgpu::Device,
         module: &ShaderModule,
         b: &ParticleBuffers,
-        sc: &Scenario,
+        motions: Vec<BodyMotion>,
         first_id: u32,
     ) -> Result<Self> {
-        let mut motions = Vec::with_capacity(sc.bodies.len());
-        let mut groups = 0;
-        for body in &sc.bodies {
-            let count = body.particles.len() as u32;
-            motions.push(BodyMotion {
-                first: body.particles.start as u32 - first_id,
-                count,
-                first_group: groups,
-                ..Default::default()
-            });
-            groups += count.div_ceil(WORKGROUP_SIZE).max(1);
-        }
-        let n_body = (sc.particles.len() as u32) - first_id;
+        let groups = motions.last().map_or(0, |m| {
+            m.first_group + m.count.div_ceil(WORKGROUP_SIZE).max(1)
+        });
+        let n_body = b.n - first_id;
         // The particles start in id order.
         let slots: Vec<u32> = (first_id..first_id + n_body).collect();
-        let motion_buf = storage_init(device, "body motions", &motions);
         let body_slot = storage_init(device, "body slots", &slots);
         let partials = storage(device, "body partials", Self::partials_bytes_for(groups));
         let body_move = module.kernel(device, "body_move")?;
@@ -83,7 +97,7 @@ impl Bodies {
                 (3, &b.code[p]),
                 (4, &b.rate),
                 (5, &b.body_particles),
-                (6, &motion_buf),
+                (6, &b.body_motions),
                 (7, &body_slot),
                 (8, &partials),
             ]
@@ -95,8 +109,9 @@ impl Bodies {
             bind_move: bind(&body_move)?,
             bind_index: bind(&body_index)?,
             bind_force: bind(&body_force)?,
+            poses: vec![Pose::default(); motions.len()],
             motions,
-            motion_buf,
+            motion_buf: b.body_motions.clone(),
             partials,
             groups,
             body_move,
@@ -131,6 +146,15 @@ impl Bodies {
             m.omega = pose.omega.as_vec3().to_array();
         }
         queue.write_buffer(&self.motion_buf, 0, bytemuck::cast_slice(&self.motions));
+        self.poses = poses.to_vec();
+    }
+
+    /// The rigid velocity at `x` of body `b` as last uploaded, u_c + ω × (x − x_c): what its
+    /// particles (and the walls its fixed ghosts stand for) move with in the step.
+    pub fn wall_velocity(&self, b: u32, x: [f64; 3]) -> [f64; 3] {
+        self.poses[b as usize]
+            .velocity_at(DVec3::from_array(x))
+            .to_array()
     }
 
     /// Moves the body particles of parity `p` (after the predictor, before the sort).

@@ -3,7 +3,7 @@
 
 use crate::gpu::buffers::{storage, storage_init, uniform_init};
 use crate::layout::{
-    BodyParticle, MirrorPlane, Params, Pos, ProbeDef, SimState, SolidState, SymRate,
+    BodyMotion, BodyParticle, MirrorPlane, Params, Pos, ProbeDef, SimState, SolidState, SymRate,
 };
 
 pub struct ParticleBuffers {
@@ -39,6 +39,9 @@ pub struct ParticleBuffers {
     /// Body-frame offset and body of every body particle (by id − body_id_base); one dummy
     /// element without bodies.
     pub body_particles: wgpu::Buffer,
+    /// Each body's rigid motion for the step (uploaded by the host every step); one dummy
+    /// element without bodies.
+    pub body_motions: wgpu::Buffer,
     /// Deviatoric stress, body and last dτ/dt of solid particles, 2 parities, and the new
     /// dτ/dt: one element each when the case has no solids.
     pub solid: [wgpu::Buffer; 2],
@@ -58,6 +61,8 @@ pub struct InitialParticles<'a> {
     pub velrho: &'a [[f32; 4]],
     pub code: &'a [u32],
     pub body_particles: &'a [BodyParticle],
+    /// One per body (its particle range and workgroups; the motion comes with each step).
+    pub body_motions: &'a [BodyMotion],
     /// One per particle when the case has solids, else empty.
     pub solid: &'a [SolidState],
 }
@@ -158,6 +163,15 @@ impl ParticleBuffers {
             } else {
                 storage_init(device, "body particles", init.body_particles)
             },
+            body_motions: if init.body_motions.is_empty() {
+                storage(
+                    device,
+                    "body motions",
+                    std::mem::size_of::<BodyMotion>() as u64,
+                )
+            } else {
+                storage_init(device, "body motions", init.body_motions)
+            },
             mirror_planes: if planes.is_empty() {
                 storage(
                     device,
@@ -186,6 +200,7 @@ impl ParticleBuffers {
             &self.mirror_planes,
             &self.energy_rate,
             &self.body_particles,
+            &self.body_motions,
             &self.stress_rate,
         ];
         all.extend(self.energy.iter());

@@ -68,12 +68,4 @@ impl Ghost {
             k.kernel.dispatch(pass, &k.bind[p], self.n);
         }
     }
-
-    /// Only the solids' interface pressure, on the current arrays: the interaction test hook
-    /// recomputes it, while fixed ghosts keep the values their step gave them.
-    pub fn encode_solids(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        if let Some(k) = &self.solids {
-            k.kernel.dispatch(pass, &k.bind[p], self.n);
-        }
-    }
 }

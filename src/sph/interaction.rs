@@ -27,6 +27,7 @@ impl Interaction {
                 (7, &b.energy_rate),
                 (8, &b.body_particles),
                 (9, &b.solid[p]),
+                (10, &b.body_motions),
             ]
         };
         let bind = [

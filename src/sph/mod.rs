@@ -295,6 +295,7 @@ impl Solver {
         let defs = probes::probe_defs(&sc.probes, grid.origin);
         let planes = mirror_planes(sc, grid.origin);
         let body_particles = bodies::body_particles(sc);
+        let body_motions = bodies::initial_motions(sc, body_id_base);
         let solid = solid_states(sc)?;
         let buffers = ParticleBuffers::new(
             &device,
@@ -305,6 +306,7 @@ impl Solver {
                 velrho: &velrho,
                 code: &code,
                 body_particles: &body_particles,
+                body_motions: &body_motions,
                 solid: &solid,
             },
             &defs,
@@ -344,7 +346,13 @@ impl Solver {
         let bodies = if sc.bodies.is_empty() {
             None
         } else {
-            let gpu = Bodies::new(&device, &module(Pass::Bodies)?, &buffers, sc, body_id_base)?;
+            let gpu = Bodies::new(
+                &device,
+                &module(Pass::Bodies)?,
+                &buffers,
+                body_motions,
+                body_id_base,
+            )?;
             let staging = readback_buffer(
                 &device,
                 "state and body loads",
@@ -715,9 +723,10 @@ impl Solver {
             .collect())
     }
 
-    /// Test hook: re-runs only the interaction pass (and, with solids, their interface pressure
-    /// before it and the elastic rates after it) on the current arrays and returns the rates. With `poison`, `rate` (and the stress rates) are
-    /// first filled with NaN so an entry the kernel skips cannot pass.
+    /// Test hook: re-runs the ghost interpolation (fixed ghosts and the solids' interface
+    /// pressure), the interaction pass and, with solids, the elastic rates on the current arrays
+    /// and returns the rates. With `poison`, `rate` (and the stress rates) are first filled with
+    /// NaN so an entry the kernel skips cannot pass.
     #[doc(hidden)]
     pub fn rerun_interaction(&self, poison: bool) -> Result<Vec<[f32; 4]>> {
         if poison {
@@ -739,7 +748,7 @@ impl Solver {
             label: Some("interaction"),
             timestamp_writes: None,
         });
-        self.ghost.encode_solids(&mut pass, self.parity);
+        self.ghost.encode(&mut pass, self.parity);
         self.interaction.encode(&mut pass, self.parity);
         if let Some(e) = &self.elastic {
             e.encode_rates(&mut pass, self.parity);
@@ -782,6 +791,15 @@ impl Solver {
         let (gpu, _, _) = self.bodies.as_ref()?;
         id.checked_sub(self.params.body_id_base)
             .and_then(|k| gpu.body_of(k))
+    }
+
+    /// The velocity at `x` of the solid particle `id` belongs to, as the GPU moves it this step:
+    /// a body's rigid velocity (from the pose of the last upload); zero for every other particle.
+    pub fn wall_velocity_of(&self, id: u32, x: [f64; 3]) -> [f64; 3] {
+        match (self.body_of_id(id), &self.bodies) {
+            (Some(b), Some((gpu, _, _))) => gpu.wall_velocity(b, x),
+            _ => [0.0; 3],
+        }
     }
 
     /// Test hook: re-runs the interaction and the body sums on the current arrays and returns
