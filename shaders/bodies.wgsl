@@ -40,7 +40,7 @@ fn body_move(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let arm = m.rotation * bp.r;
     let moved = move_by(Pos(m.center_off, m.center_block), arm);
     pos[i] = moved.pos;
-    velrho[i] = vec4<f32>(m.velocity + cross(m.omega, arm), velrho[i].w);
+    velrho[i] = vec4<f32>(body_wall_motion(m, bp.r).velocity, velrho[i].w);
     if (!moved.inside) {
         code[i] = with_kind(code[i], KIND_EXCLUDED);
     }

@@ -6,9 +6,11 @@
 //   P_g = Σ_j P_j W^I_gj V_j,   no-slip v_g = 2 v_wall − Σ_j v_j W^I_gj V_j,
 // the latter applied in the viscous terms (interaction.wgsl, which knows v_wall: zero for fixed
 // walls, the body's rigid velocity at the ghost for a body); continuity sees v_wall.
-// Hydrostatic correction (as in Adami, Hu & Adams 2012, eq. 27): each fluid pressure is carried
-// to the ghost along gravity before it is interpolated, P_j + ρ_j g·(x_g − x_j), so a ghost below
-// the fluid sees the hydrostatic increase (g points down) and a hydrostatic field is exact.
+// Hydrostatic correction (Adami, Hu & Adams 2012, eq. 27): each fluid pressure is carried to
+// the ghost along gravity before it is interpolated, P_j + ρ_j (g − a_w)·(x_g − x_j), so a ghost
+// below the fluid sees the hydrostatic increase (g points down) and a hydrostatic field is
+// exact; a_w is the acceleration of the wall at the ghost (zero for fixed walls; a body's
+// a_c + α × R r + ω × (ω × R r), so fluid accelerated with the body is carried correctly too).
 // Free-slip ghosts use the interpolated velocity itself in the viscous terms (no tangential
 // shear from the wall).
 // Only fluid particles count (the interpolation domain of the fixed-wall, rigid-body and
@@ -21,14 +23,17 @@
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read> code: array<u32>;
 @group(0) @binding(4) var<storage, read> cell_start: array<u32>;
+@group(0) @binding(6) var<storage, read> body_particles: array<BodyParticle>;
+@group(0) @binding(7) var<storage, read> bodies: array<BodyMotion>;
 
 // ρ from P by the inverse Tait equation; the base is kept positive for any pressure.
 fn density_of(p: f32) -> f32 {
     return params.rho0 * pow(max(1.0 + p / params.tait_b, 0.5), 1.0 / params.gamma);
 }
 
-// The fluid's velocity and pressure interpolated at `pg` with W^I (see the header): (v, P).
-fn fluid_at(pg: Pos) -> vec4<f32> {
+// The fluid's velocity and pressure interpolated at `pg` with W^I (see the header), each fluid
+// pressure carried to `pg` along `g_eff` = g − a_w: (v, P).
+fn fluid_at(pg: Pos, g_eff: vec3<f32>) -> vec4<f32> {
     let support2 = 4.0 * params.h * params.h;
     // Moments Σ f_j W V [1, x_gj] of f = 1 (the MLS matrix), P and v.
     var a = mls_zero();
@@ -52,7 +57,7 @@ fn fluid_at(pg: Pos) -> vec4<f32> {
             let wv = kernel_w(sqrt(r2) / params.h) * params.mass / vr.w;
             let basis = mls_basis(x_gj);
             a = mls_add(a, x_gj, wv);
-            m_p += (pressure_of(vr.w) + vr.w * dot(params.gravity, x_gj)) * wv * basis;
+            m_p += (pressure_of(vr.w) + vr.w * dot(g_eff, x_gj)) * wv * basis;
             m_vx += vr.x * wv * basis;
             m_vy += vr.y * wv * basis;
             m_vz += vr.z * wv * basis;
@@ -79,7 +84,13 @@ fn ghost_interpolate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     if (g >= params.n_particles || !is_ghost(code_kind(code[g]))) {
         return;
     }
-    let f = fluid_at(pos[g]);
+    var g_eff = params.gravity;
+    let id = code[g] & ID_MASK;
+    if (is_body_particle(id)) {
+        let bp = body_particles[id - params.body_id_base];
+        g_eff -= body_wall_motion(bodies[bp.body], bp.r).accel;
+    }
+    let f = fluid_at(pos[g], g_eff);
     // The interpolated fluid velocity is stored; the interaction makes the no-slip ghost
     // velocity 2 v_wall − v (v_wall = 0) from it for the viscous terms, and uses the wall's own
     // velocity in continuity.
@@ -99,5 +110,6 @@ fn solid_interface_pressure(@builtin(global_invocation_id) gid: vec3<u32>, @buil
     if (g >= params.n_particles || !is_solid(code_kind(code[g]))) {
         return;
     }
-    solid[g].interface_p = fluid_at(pos[g]).w;
+    // (Along g only: the solid's own acceleration is left out of the correction.)
+    solid[g].interface_p = fluid_at(pos[g], params.gravity).w;
 }

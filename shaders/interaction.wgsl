@@ -191,8 +191,7 @@ fn fixed_ghost_velocity(kind: u32, id: u32, v_f: vec3<f32>) -> GhostVelocity {
     var v_wall = vec3<f32>(0.0);
     if (is_body_particle(id)) {
         let bp = body_particles[id - params.body_id_base];
-        let m = bodies[bp.body];
-        v_wall = m.velocity + cross(m.omega, m.rotation * bp.r);
+        v_wall = body_wall_motion(bodies[bp.body], bp.r).velocity;
     }
     return GhostVelocity(v_wall, select(v_f, 2.0 * v_wall - v_f, kind == KIND_GHOST_NO_SLIP));
 }

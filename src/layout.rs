@@ -143,9 +143,13 @@ pub struct BodyMotion {
     pub first: u32,
     pub omega: [f32; 3],
     pub count: u32,
+    /// Acceleration of the centre of mass.
+    pub accel: [f32; 3],
     /// First workgroup of the body in `body_force`.
     pub first_group: u32,
-    pub pad: [u32; 3],
+    /// Angular acceleration.
+    pub alpha: [f32; 3],
+    pub pad: u32,
 }
 
 pub const KIND_SHIFT: u32 = 28;
@@ -313,7 +317,9 @@ mod tests {
                 first,
                 omega,
                 count,
-                first_group
+                accel,
+                first_group,
+                alpha
             ]
         );
     }

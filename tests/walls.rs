@@ -289,6 +289,7 @@ fn mirror_planes_cannot_be_crossed() {
         kind: 0,
         body: None,
         wall_vel: [0.0; 3],
+        wall_acc: [0.0; 3],
     };
     let r = reference::integrate::reflect_at_mirrors(&walls, &crossing);
     assert_eq!(r.pos, [0.3, 0.01, 0.0]);

@@ -103,10 +103,23 @@ struct BodyMotion {
     first: u32,                 // its first body-particle index (id − body_id_base)
     omega: vec3<f32>,
     count: u32,                 // its number of particles
+    accel: vec3<f32>,           // of the centre of mass
     first_group: u32,           // its first workgroup in body_force
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
+    alpha: vec3<f32>,           // angular acceleration
+    pad: u32,
+}
+
+// The rigid velocity and acceleration of the body particle `id` (id ≥ body_id_base) at its
+// place x_c + R r this step: u = u_c + ω × R r, a = a_c + α × R r + ω × (ω × R r).
+struct WallMotion {
+    velocity: vec3<f32>,
+    accel: vec3<f32>,
+}
+
+fn body_wall_motion(m: BodyMotion, r: vec3<f32>) -> WallMotion {
+    let arm = m.rotation * r;
+    let w_arm = cross(m.omega, arm);
+    return WallMotion(m.velocity + w_arm, m.accel + cross(m.alpha, arm) + cross(m.omega, w_arm));
 }
 
 fn is_body_particle(id: u32) -> bool {

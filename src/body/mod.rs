@@ -202,6 +202,34 @@ impl BodySet {
             .collect()
     }
 
+    /// Each body's linear and angular acceleration at `t` (the step's predicted time): a free
+    /// body's of the last evaluation (what its predictor moved it with), a prescribed one's by
+    /// central differences of its law's velocities (ε = 1e-5 s). What a body's fixed ghosts
+    /// carry the fluid pressure along (g − a, Adami, Hu & Adams 2012, eq. 27).
+    pub fn accelerations(&self, t: f64) -> Vec<[DVec3; 2]> {
+        const EPS: f64 = 1e-5;
+        self.states
+            .iter()
+            .map(|s| match s {
+                State::Free(b) => [b.accel, b.alpha],
+                State::Prescribed { law, center0, .. } => {
+                    let (a, b) = (law.pose(*center0, t - EPS), law.pose(*center0, t + EPS));
+                    [
+                        (b.velocity - a.velocity) / (2.0 * EPS),
+                        (b.omega - a.omega) / (2.0 * EPS),
+                    ]
+                }
+            })
+            .map(|[a, alpha]| {
+                if self.planar {
+                    [DVec3::new(a.x, a.y, 0.0), DVec3::new(0.0, 0.0, alpha.z)]
+                } else {
+                    [a, alpha]
+                }
+            })
+            .collect()
+    }
+
     /// Corrector with the loads evaluated at the predicted poses.
     pub fn correct(&mut self, dt: f64, loads: &[Load]) {
         for ((s, load), last) in self.states.iter_mut().zip(loads).zip(&mut self.loads) {

@@ -191,6 +191,7 @@ mod tests {
                         kind: FLUID,
                         body: None,
                         wall_vel: [0.0; 3],
+                        wall_acc: [0.0; 3],
                     });
                 }
             }
@@ -300,6 +301,7 @@ mod tests {
                 kind: FLUID,
                 body: None,
                 wall_vel: [0.0; 3],
+                wall_acc: [0.0; 3],
             };
             let mut pair = vec![far, far];
             pair[1].pos[0] += 0.5 * ph.h;

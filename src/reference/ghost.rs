@@ -100,14 +100,16 @@ pub fn basis(dim: usize, h: f64, x: [f64; 3]) -> [f64; 4] {
     ]
 }
 
-/// The fluid's pressure (with the hydrostatic correction) and velocity interpolated at `x`
-/// with W^I (Shepard, or MLS where asked and well conditioned); zeros with no fluid in reach.
+/// The fluid's pressure (with the hydrostatic correction along `g_eff` = g − a_wall) and
+/// velocity interpolated at `x` with W^I (Shepard, or MLS where asked and well conditioned);
+/// zeros with no fluid in reach.
 pub fn fluid_at(
     ph: &Physics,
     walls: &WallParams,
     space: &Space,
     parts: &[RefParticle],
     x: [f64; 3],
+    g_eff: [f64; 3],
 ) -> (f64, [f64; 3]) {
     let dim = ph.dim as usize;
     let h = ph.h;
@@ -122,7 +124,7 @@ pub fn fluid_at(
         }
         let wv = kernel::w(ph.kernel, ph.dim, h, r2.sqrt()) * ph.particle_mass / j.rho;
         let b = basis(dim, h, d);
-        let p = pressure(ph, j.rho) + j.rho * dot(ph.gravity, d);
+        let p = pressure(ph, j.rho) + j.rho * dot(g_eff, d);
         for r in 0..4 {
             for c in 0..4 {
                 a[r][c] += wv * b[r] * b[c];
@@ -159,7 +161,9 @@ pub fn interpolate(
             if g.kind != GHOST_NO_SLIP && g.kind != GHOST_FREE_SLIP {
                 return *g;
             }
-            let (p, v) = fluid_at(ph, walls, space, parts, g.pos);
+            // A body's ghost carries the pressure along g − a_wall.
+            let g_eff = [0, 1, 2].map(|a| ph.gravity[a] - g.wall_acc[a]);
+            let (p, v) = fluid_at(ph, walls, space, parts, g.pos, g_eff);
             // The interpolated fluid velocity; interaction.rs makes the ghost velocities.
             let mut out = *g;
             out.vel = v;
@@ -181,7 +185,7 @@ pub fn interface_pressure(
         .iter()
         .map(|s| {
             if super::elastic::is_solid(s.kind) {
-                fluid_at(ph, walls, space, parts, s.pos).0
+                fluid_at(ph, walls, space, parts, s.pos, ph.gravity).0
             } else {
                 0.0
             }

@@ -30,6 +30,9 @@ pub struct RefParticle {
     /// rigid velocity, zero for fixed walls (and unused for fluid). A fixed ghost's `vel` is
     /// the fluid velocity interpolated at it; this is the wall it stands for.
     pub wall_vel: [f64; 3],
+    /// The acceleration of that solid at the particle (zero for fixed walls): a body's fixed
+    /// ghosts carry the fluid pressure along g − wall_acc.
+    pub wall_acc: [f64; 3],
 }
 
 pub const FLUID: u32 = 0;

@@ -54,8 +54,10 @@ pub struct Bodies {
     /// `first_group` never change.
     motions: Vec<BodyMotion>,
     motion_buf: wgpu::Buffer,
-    /// The poses of the last upload (what the GPU moves the bodies with).
+    /// The poses and accelerations (linear, angular) of the last upload (what the GPU moves
+    /// the bodies with).
     poses: Vec<Pose>,
+    accels: Vec<[DVec3; 2]>,
     pub partials: wgpu::Buffer,
     /// Workgroups of `body_force` (each covers particles of one body).
     groups: u32,
@@ -110,6 +112,7 @@ impl Bodies {
             bind_index: bind(&body_index)?,
             bind_force: bind(&body_force)?,
             poses: vec![Pose::default(); motions.len()],
+            accels: vec![[DVec3::ZERO; 2]; motions.len()],
             motions,
             motion_buf: b.body_motions.clone(),
             partials,
@@ -131,9 +134,16 @@ impl Bodies {
         Self::partials_bytes_for(self.groups)
     }
 
-    /// Uploads the poses of the step about to be taken (one per body, in order).
-    pub fn upload(&mut self, queue: &wgpu::Queue, grid: &Grid, poses: &[Pose]) {
-        for (m, pose) in self.motions.iter_mut().zip(poses) {
+    /// Uploads the poses and accelerations of the step about to be taken (one per body, in
+    /// order).
+    pub fn upload(
+        &mut self,
+        queue: &wgpu::Queue,
+        grid: &Grid,
+        poses: &[Pose],
+        accels: &[[DVec3; 2]],
+    ) {
+        for ((m, pose), [a, alpha]) in self.motions.iter_mut().zip(poses).zip(accels) {
             let (off, block) = grid.to_block(pose.center.to_array());
             let r = DMat3::from_quat(pose.rotation);
             m.center_off = off;
@@ -144,17 +154,25 @@ impl Bodies {
             });
             m.velocity = pose.velocity.as_vec3().to_array();
             m.omega = pose.omega.as_vec3().to_array();
+            m.accel = a.as_vec3().to_array();
+            m.alpha = alpha.as_vec3().to_array();
         }
         queue.write_buffer(&self.motion_buf, 0, bytemuck::cast_slice(&self.motions));
         self.poses = poses.to_vec();
+        self.accels = accels.to_vec();
     }
 
-    /// The rigid velocity at `x` of body `b` as last uploaded, u_c + ω × (x − x_c): what its
-    /// particles (and the walls its fixed ghosts stand for) move with in the step.
-    pub fn wall_velocity(&self, b: u32, x: [f64; 3]) -> [f64; 3] {
-        self.poses[b as usize]
-            .velocity_at(DVec3::from_array(x))
-            .to_array()
+    /// The rigid velocity and acceleration at `x` of body `b` as last uploaded,
+    /// u_c + ω × r and a_c + α × r + ω × (ω × r) with r = x − x_c: how its particles (and the
+    /// walls its fixed ghosts stand for) move in the step.
+    pub fn wall_motion(&self, b: u32, x: [f64; 3]) -> [[f64; 3]; 2] {
+        let (pose, [a, alpha]) = (&self.poses[b as usize], self.accels[b as usize]);
+        let r = DVec3::from_array(x) - pose.center;
+        let w = pose.omega;
+        [
+            pose.velocity_at(DVec3::from_array(x)).to_array(),
+            (a + alpha.cross(r) + w.cross(w.cross(r))).to_array(),
+        ]
     }
 
     /// Moves the body particles of parity `p` (after the predictor, before the sort).

@@ -42,6 +42,9 @@ impl Ghost {
                 ];
                 if with_solid {
                     bufs.push((5, &b.solid[p]));
+                } else {
+                    bufs.push((6, &b.body_particles));
+                    bufs.push((7, &b.body_motions));
                 }
                 kernel.bind(device, &bufs)
             });

@@ -476,7 +476,7 @@ impl Solver {
         let t_next = self.time() + dt;
         let (gpu, host, _) = self.bodies.as_mut().expect("a run with bodies");
         let poses = host.predict(t_next, dt);
-        gpu.upload(&self.queue, &self.grid, &poses);
+        gpu.upload(&self.queue, &self.grid, &poses, &host.accelerations(t_next));
         let mut encoder = self.encode_steps(1);
         let (gpu, _, staging) = self.bodies.as_ref().expect("a run with bodies");
         let state_bytes = std::mem::size_of::<SimState>() as u64;
@@ -793,12 +793,13 @@ impl Solver {
             .and_then(|k| gpu.body_of(k))
     }
 
-    /// The velocity at `x` of the solid particle `id` belongs to, as the GPU moves it this step:
-    /// a body's rigid velocity (from the pose of the last upload); zero for every other particle.
-    pub fn wall_velocity_of(&self, id: u32, x: [f64; 3]) -> [f64; 3] {
+    /// The velocity and acceleration at `x` of the solid particle `id` belongs to, as the GPU
+    /// moves it this step: a body's rigid motion (from the last upload); zero for every other
+    /// particle.
+    pub fn wall_motion_of(&self, id: u32, x: [f64; 3]) -> [[f64; 3]; 2] {
         match (self.body_of_id(id), &self.bodies) {
-            (Some(b), Some((gpu, _, _))) => gpu.wall_velocity(b, x),
-            _ => [0.0; 3],
+            (Some(b), Some((gpu, _, _))) => gpu.wall_motion(b, x),
+            _ => [[0.0; 3]; 2],
         }
     }
 

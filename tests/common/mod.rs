@@ -123,13 +123,15 @@ pub fn gpu_particles_and_codes(s: &Solver) -> (Vec<RefParticle>, Vec<u32>) {
         .zip(&code)
         .map(|((p, v), c)| {
             let pos = s.grid.to_world(p.off, unpack_block(p.block));
+            let [wall_vel, wall_acc] = s.wall_motion_of(c & ID_MASK, pos);
             RefParticle {
                 pos,
                 vel: [v[0] as f64, v[1] as f64, v[2] as f64],
                 rho: v[3] as f64,
                 kind: c >> KIND_SHIFT,
                 body: s.body_of_id(c & ID_MASK),
-                wall_vel: s.wall_velocity_of(c & ID_MASK, pos),
+                wall_vel,
+                wall_acc,
             }
         })
         .collect();
