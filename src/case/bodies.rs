@@ -657,7 +657,9 @@ impl Shape {
                     let n = ((PI / (0.5 * dx / r).asin()).floor() as usize).max(3);
                     let shift = if ring % 2 == 0 { 0.0 } else { 0.5 };
                     for j in 0..n {
-                        let a = 2.0 * PI * (j as f64 + shift) / n as f64;
+                        // From the bottom: every ring is mirror-symmetric about the vertical
+                        // through the centre, as a vertical entry or a floating body is.
+                        let a = -0.5 * PI + 2.0 * PI * (j as f64 + shift) / n as f64;
                         out.push([center[0] + r * a.cos(), center[1] + r * a.sin(), 0.0]);
                     }
                     r -= dx;
@@ -690,6 +692,24 @@ impl Shape {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A circle's rings are mirror images of themselves across the vertical through the
+    /// centre (rings of odd counts started at angle 0 were not, and a vertical entry turned).
+    #[test]
+    fn circles_are_symmetric_about_their_vertical() {
+        let c = [0.45, 0.355, 0.0];
+        for (radius, dx) in [(0.055, 0.01), (0.055, 0.005), (0.1, 0.013)] {
+            let pts = Shape::Ball { center: c, radius }.points(dx, 2, None);
+            for p in &pts {
+                let mirrored = [2.0 * c[0] - p[0], p[1]];
+                assert!(
+                    pts.iter()
+                        .any(|q| (q[0] - mirrored[0]).hypot(q[1] - mirrored[1]) < 1e-12),
+                    "no mirror image of {p:?} (r = {radius}, dx = {dx})"
+                );
+            }
+        }
+    }
 
     #[test]
     fn shell_and_filled_boxes() {

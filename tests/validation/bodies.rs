@@ -7,12 +7,13 @@
 
 use crate::common::{gpu, validate_case};
 
+use wgsph::body::Pose;
 use wgsph::scenario::Scenario;
 use wgsph::sph::Solver;
 use wgsph::validation::Mode;
 
-/// Samples every `every` seconds up to `end`: (t, body 0 centre).
-fn sample(sc: &Scenario, every: f64, end: f64) -> Vec<(f64, [f64; 3])> {
+/// Samples every `every` seconds up to `end`: (t, body 0's pose).
+fn sample(sc: &Scenario, every: f64, end: f64) -> Vec<(f64, Pose)> {
     let mut solver = Solver::new(gpu(), sc).unwrap();
     let mut out = Vec::new();
     let n = (end / every).round() as usize;
@@ -20,8 +21,7 @@ fn sample(sc: &Scenario, every: f64, end: f64) -> Vec<(f64, [f64; 3])> {
         if k > 0 {
             solver.advance_to(k as f64 * every).unwrap();
         }
-        let c = solver.bodies().unwrap().pose(0).center.to_array();
-        out.push((solver.time(), c));
+        out.push((solver.time(), solver.bodies().unwrap().pose(0)));
     }
     out
 }
@@ -75,7 +75,7 @@ fn a_neutrally_buoyant_box_stays_put() {
     let s = sample(&sc, 0.05, 1.0);
     let drift = s
         .iter()
-        .map(|(_, c)| ((c[0] - 0.3).powi(2) + (c[1] - 0.2).powi(2)).sqrt())
+        .map(|(_, p)| ((p.center.x - 0.3).powi(2) + (p.center.y - 0.2).powi(2)).sqrt())
         .fold(0.0, f64::max);
     println!("neutral box: largest drift {drift:.5} m in 1 s (dx = 0.02 m)");
     assert!(drift < 0.25 * 0.02, "drift {drift} m");
@@ -104,4 +104,68 @@ fn water_entry_penetration_within_10_percent_fine() {
         let _ = std::fs::remove_dir_all(&o.dir);
         assert!(o.passed(), "{}", crate::common::rows(&o));
     }
+}
+
+/// The oblique entry (`cases/water_entry_oblique_2d.toml`, 30° from the vertical) and its
+/// mirror image across the tank's middle follow mirrored paths: x − x0 and the rotation change
+/// sign, the depth is the same. The particle set is symmetric, so only the order of the f32
+/// sums differs. And the entry slows the cylinder down sideways as well as downwards.
+#[test]
+fn oblique_entry_paths_mirror_each_other() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/water_entry_oblique_2d.toml");
+    // dx = 0.01 m (D/11), 0.1 s after the first contact (t* = 0.94).
+    let run = |x0: f64, vx: f64| {
+        let sc = wgsph::case::load(
+            &path,
+            &[
+                "particles.dx_m=0.01".into(),
+                "time.end_s=0.1".into(),
+                format!("body[0].center_m=[{x0}, 0.355]"),
+                format!("body[0].motion.velocity_m_s=[{vx}, -2.55911]"),
+            ],
+        )
+        .unwrap();
+        sample(&sc, 0.01, 0.1)
+    };
+    let (right, left) = (run(0.45, 1.4775), run(0.75, -1.4775));
+    let (mut worst_x, mut worst_y, mut worst_angle) = (0.0f64, 0.0f64, 0.0f64);
+    for ((t, a), (_, b)) in right.iter().zip(&left) {
+        let (ax, bx) = (a.center.x - 0.45, b.center.x - 0.75);
+        println!(
+            "t = {t:.3} s: right x − x0 {ax:+.5} y {:.5} angle {:+.3}°; left {bx:+.5} {:.5} {:+.3}°",
+            a.center.y,
+            a.angle_z().to_degrees(),
+            b.center.y,
+            b.angle_z().to_degrees()
+        );
+        worst_x = worst_x.max((ax + bx).abs());
+        worst_y = worst_y.max((a.center.y - b.center.y).abs());
+        worst_angle = worst_angle.max((a.angle_z() + b.angle_z()).abs());
+    }
+    let (_, end) = right.last().unwrap();
+    println!(
+        "mirror differences: x {worst_x:.2e} m, y {worst_y:.2e} m, angle {:.2e}°; end velocity {:?}",
+        worst_angle.to_degrees(),
+        end.velocity
+    );
+    assert!(
+        worst_x < 1e-5 && worst_y < 1e-5,
+        "the paths are not mirror images"
+    );
+    assert!(
+        worst_angle.to_degrees() < 0.01,
+        "the rotations are not mirror images"
+    );
+    // Slowed sideways and downwards, still entering.
+    assert!(
+        end.velocity.x > 0.0 && end.velocity.x < 0.9 * 1.4775,
+        "vx {}",
+        end.velocity.x
+    );
+    assert!(
+        end.velocity.y < 0.0 && end.velocity.y > -0.9 * 2.55911,
+        "vy {}",
+        end.velocity.y
+    );
 }
