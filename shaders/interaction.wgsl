@@ -18,7 +18,8 @@
 //   Monaghan & Kajtar (2009) force; mirror planes add, for
 //   each fluid j near the image of i, the ghost x_g = 2x_w − x_j with p_g = p_j, ρ_g = ρ_j and
 //   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip), the latter in
-//   the viscous terms only; near a corner also the double image across both planes.
+//   the viscous terms only; near an edge also the double image across both planes, near a 3D
+//   vertex the triple image across all three.
 // Fluid–solid pairs (elastic solids, Kind::Solid/SolidClamped), from either side: the solid
 //   particle acts as a ghost of its body (the seed's improved interface, third ghost kind) with
 //   the fluid pressure interpolated at it, P_g (ghost.wgsl, `interface_p`), its own velocity,
@@ -210,15 +211,13 @@ fn ghost_velocity(v: vec3<f32>, plane: MirrorPlane) -> vec3<f32> {
     return select(reflect_vec(v, plane.normal), -v, plane.no_slip != 0u);
 }
 
-// Ghosts seen by i through plane k1, or through k1 and then k2 (the corner image, without
-// which fluid leaks out of corners). `image` is i reflected the opposite way, so that the
-// ghosts of i's neighbourhood are the fluid particles near `image`, transformed back.
-fn image_rates(pi: Particle, image: vec3<f32>, k1: u32, k2: u32) -> PairRates {
+// Ghosts seen by i through the chain of planes chain[0], …, chain[n − 1] (one plane; two at an
+// edge, the corner image without which fluid leaks out of corners; three at a 3D vertex).
+// `image` is i reflected through the chain the opposite way, R_n … R_1 x_i, so that the ghosts
+// of i's neighbourhood, R_1 … R_n x_j, are the fluid particles near `image`, transformed back.
+fn image_rates(pi: Particle, image: vec3<f32>, chain: vec3<u32>, n: u32) -> PairRates {
     var out = PairRates(vec4<f32>(0.0), 0.0);
     let support2 = 4.0 * params.h * params.h;
-    let p1 = mirror_planes[k1];
-    let double = k2 != NO_PLANE;
-    let p2 = mirror_planes[select(k1, k2, double)];
     let at = pos_of_point(image);
     var slots: array<u32, 27>;
     let n_slots = neighbour_slots(cell_of(at), &slots);
@@ -235,14 +234,12 @@ fn image_rates(pi: Particle, image: vec3<f32>, k1: u32, k2: u32) -> PairRates {
             var x_ig = x;
             var v_cont = velrho[j].xyz;
             var v_visc = v_cont;
-            if (double) {
-                x_ig = reflect_vec(x_ig, p2.normal);
-                v_cont = reflect_vec(v_cont, p2.normal);
-                v_visc = ghost_velocity(v_visc, p2);
+            for (var c = n; c > 0u; c--) {
+                let plane = mirror_planes[chain[c - 1u]];
+                x_ig = reflect_vec(x_ig, plane.normal);
+                v_cont = reflect_vec(v_cont, plane.normal);
+                v_visc = ghost_velocity(v_visc, plane);
             }
-            x_ig = reflect_vec(x_ig, p1.normal);
-            v_cont = reflect_vec(v_cont, p1.normal);
-            v_visc = ghost_velocity(v_visc, p1);
             let pr = pair_rates(pi, x_ig, r2, v_cont, v_visc, velrho[j].w, true, 1.0);
             out.rate += pr.rate;
             out.de += pr.de;
@@ -255,7 +252,8 @@ fn add_rates(a: PairRates, b: PairRates) -> PairRates {
     return PairRates(a.rate + b.rate, a.de + b.de);
 }
 
-// Sum over the mirror images across the planes (and pairs of planes) within 2h of i.
+// Sum over the mirror images across the planes within 2h of i, and across every pair and
+// triple of them (edges and 3D vertices).
 fn mirror_rates(i: u32, pi: Particle) -> PairRates {
     var out = PairRates(vec4<f32>(0.0), 0.0);
     let xi = domain_pos(pos[i]);
@@ -266,11 +264,19 @@ fn mirror_rates(i: u32, pi: Particle) -> PairRates {
             continue;
         }
         let once = reflect_point(xi, p1);
-        out = add_rates(out, image_rates(pi, once, k1, NO_PLANE));
+        out = add_rates(out, image_rates(pi, once, vec3<u32>(k1, 0u, 0u), 1u));
         for (var k2 = k1 + 1u; k2 < params.n_mirror_planes; k2++) {
             let p2 = mirror_planes[k2];
-            if (dot(xi - p2.point, p2.normal) < reach) {
-                out = add_rates(out, image_rates(pi, reflect_point(once, p2), k1, k2));
+            if (dot(xi - p2.point, p2.normal) >= reach) {
+                continue;
+            }
+            let twice = reflect_point(once, p2);
+            out = add_rates(out, image_rates(pi, twice, vec3<u32>(k1, k2, 0u), 2u));
+            for (var k3 = k2 + 1u; k3 < params.n_mirror_planes; k3++) {
+                let p3 = mirror_planes[k3];
+                if (dot(xi - p3.point, p3.normal) < reach) {
+                    out = add_rates(out, image_rates(pi, reflect_point(twice, p3), vec3<u32>(k1, k2, k3), 3u));
+                }
             }
         }
     }

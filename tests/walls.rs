@@ -10,7 +10,8 @@ use wgsph::sph::Solver;
 const L: f64 = 0.3;
 
 /// Jittered fluid over a no-slip ghost floor, a repulsive left wall, a free-slip ghost right
-/// wall, a mirror lid just above the fluid and a no-slip mirror plane on the right.
+/// wall, a mirror lid just above the fluid and a no-slip mirror plane on the right (and in 3D a
+/// free-slip mirror plane at the back, so the fluid in the vertex sees triple images).
 fn wall_scenario(dim: u32, correction: GhostCorrection, seed: u64) -> Scenario {
     let dx = 0.02;
     let mut ph = physics(dim, dx, 15.0);
@@ -64,9 +65,10 @@ fn wall_scenario(dim: u32, correction: GhostCorrection, seed: u64) -> Scenario {
     point[up] = o + L + 0.5 * dx;
     let mut normal = [0.0; 3];
     normal[up] = -1.0;
-    // A second plane on the right makes a corner with the lid (double images).
+    // A second plane on the right, between the fluid and the free-slip ghosts, makes an edge
+    // with the lid (double images).
     let mut right = [0.0; 3];
-    right[0] = o + L;
+    right[0] = o + L - 2.0 * dx;
     sc.walls.mirror_planes = vec![
         MirrorPlane {
             point,
@@ -79,6 +81,14 @@ fn wall_scenario(dim: u32, correction: GhostCorrection, seed: u64) -> Scenario {
             no_slip: true,
         },
     ];
+    if dim == 3 {
+        // A back plane: the vertex with the lid and the right plane (triple images).
+        sc.walls.mirror_planes.push(MirrorPlane {
+            point: [0.0, 0.0, o + L],
+            normal: [0.0, 0.0, -1.0],
+            no_slip: false,
+        });
+    }
     sc
 }
 

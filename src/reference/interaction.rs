@@ -233,8 +233,8 @@ pub fn rates_and_energy(
                 add(&mut r, pr);
                 de += pe;
             }
-            // Mirror images of the fluid across each plane near i, and across pairs of planes
-            // (corners).
+            // Mirror images of the fluid across each plane near i, and across pairs (edges)
+            // and triples (3D vertices) of them.
             let near: Vec<&MirrorPlane> = walls
                 .mirror_planes
                 .iter()
@@ -244,6 +244,9 @@ pub fn rates_and_energy(
             for a in 0..near.len() {
                 for b in a + 1..near.len() {
                     chains.push(vec![near[a], near[b]]);
+                    for c in b + 1..near.len() {
+                        chains.push(vec![near[a], near[b], near[c]]);
+                    }
                 }
             }
             for chain in chains {
