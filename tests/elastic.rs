@@ -21,6 +21,7 @@ fn material() -> ElasticMaterial {
         poisson_ratio: 0.3975,
         alpha: 0.5,
         artificial_stress: 0.3,
+        formulation: SolidFormulation::UpdatedLagrangian,
     }
 }
 
