@@ -143,14 +143,6 @@ pub(super) fn validate_solid(
                 ));
             }
         }
-        if dim != 2 {
-            return Err(ctx.err(
-                &format!("{path}.formulation"),
-                Some("\"total_lagrangian\"".into()),
-                "is 2D only for now (3D needs the 9×9 quadratic basis, not implemented)",
-                "use formulation = \"updated_lagrangian\" in 3D",
-            ));
-        }
     }
     let tl = formulation == SolidFormulation::TotalLagrangian;
     let alpha = number(

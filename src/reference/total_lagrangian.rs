@@ -333,6 +333,56 @@ pub fn first_piola(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64
         .collect()
 }
 
+/// The discrete elastic energy at current positions `x` (per metre of depth in 2D):
+/// Σ_i V [ψ(E_i) + dx²/24 Σ_k D_i^k : C : D_i^k], ψ(E) = ½λ (tr E)² + G E:E, V = dx^d; the
+/// accelerations are its negative gradient over the particle masses ρ0 V.
+pub fn energy(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64; 3]]) -> f64 {
+    let n = setup.len();
+    let dim = ph.dim as usize;
+    let (lam, g) = lame(m);
+    let vol = ph.dx.powi(ph.dim as i32);
+    let k2 = ph.dx * ph.dx / 12.0;
+    let dens = |e: &M3| -> f64 {
+        let t = e[0][0] + e[1][1] + e[2][2];
+        let ee: f64 = (0..3)
+            .flat_map(|a| (0..3).map(move |b| (a, b)))
+            .map(|(a, b)| e[a][b] * e[a][b])
+            .sum();
+        0.5 * lam * t * t + g * ee
+    };
+    let e: Vec<M3> = (0..n)
+        .map(|i| {
+            let mut h = zero();
+            for p in setup.pairs_of(i) {
+                for a in 0..3 {
+                    for b in 0..3 {
+                        h[a][b] += ((x[p.j][a] - x[i][a]) - p.d0[a]) * p.w_ij[b];
+                    }
+                }
+            }
+            green(&h)
+        })
+        .collect();
+    (0..n)
+        .map(|i| {
+            let mut u = dens(&e[i]);
+            for k in 0..dim {
+                let mut d = zero();
+                for p in setup.pairs_of(i) {
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            d[a][b] += (e[p.j][a][b] - e[i][a][b]) * p.w_ij[k];
+                        }
+                    }
+                }
+                // ½ k2 D:C:D = k2 ψ(D)
+                u += k2 * dens(&d);
+            }
+            vol * u
+        })
+        .sum()
+}
+
 /// dv/dt of every TL particle at current positions `x` (TL numbering), gravity included
 /// (clamped particles get theirs too; the integrator ignores it).
 pub fn accelerations(
@@ -433,6 +483,67 @@ mod tests {
                 assert!((g[c] - e[c]).abs() < 1e-9, "particle {i}: {g:?} vs {e:?}");
             }
         }
+    }
+
+    /// The same in 3D (the 9-term basis).
+    #[test]
+    fn weights_are_exact_for_quadratics_3d() {
+        let (mut ph, _, _, _) = setup_2d(0.0);
+        ph.dim = 3;
+        let dx = ph.dx;
+        let mut x0 = Vec::new();
+        let mut s = 11u64;
+        for k in 0..5 {
+            for j in 0..6 {
+                for i in 0..7 {
+                    let mut r = || {
+                        s = s
+                            .wrapping_mul(6364136223846793005)
+                            .wrapping_add(1442695040888963407);
+                        ((s >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.3 * dx
+                    };
+                    x0.push([
+                        (i as f64 + 0.5) * dx + r(),
+                        (j as f64 + 0.5) * dx + r(),
+                        (k as f64 + 0.5) * dx + r(),
+                    ]);
+                }
+            }
+        }
+        let st = TlSetup::new(&ph, &x0, &vec![0; x0.len()]).unwrap();
+        let f = |x: &[f64; 3]| {
+            1.0 + x[0] - 2.0 * x[2] + 3.0 * x[0] * x[1] - x[1] * x[2] + 4.0 * x[2] * x[2]
+        };
+        let grad = |x: &[f64; 3]| {
+            [
+                1.0 + 3.0 * x[1],
+                3.0 * x[0] - x[2],
+                -2.0 - x[1] + 8.0 * x[2],
+            ]
+        };
+        for i in 0..st.len() {
+            let mut g = [0.0; 3];
+            for p in st.pairs_of(i) {
+                for c in 0..3 {
+                    g[c] += (f(&x0[p.j]) - f(&x0[i])) * p.w_ij[c];
+                }
+            }
+            let e = grad(&x0[i]);
+            for c in 0..3 {
+                assert!((g[c] - e[c]).abs() < 1e-8, "particle {i}: {g:?} vs {e:?}");
+            }
+        }
+    }
+
+    /// A strip two particles thick has no quadratic fit across it: refused, naming why.
+    #[test]
+    fn thin_solid_is_refused() {
+        let (ph, _, _, _) = setup_2d(0.0);
+        let x0: Vec<[f64; 3]> = (0..20)
+            .map(|k| [(k / 2) as f64 * ph.dx, (k % 2) as f64 * ph.dx, 0.0])
+            .collect();
+        let err = TlSetup::new(&ph, &x0, &[0; 20]).unwrap_err();
+        assert!(err.contains("singular") && err.contains("three"), "{err}");
     }
 
     /// A rigid rotation and translation is stress free; a uniform stretch gives the SVK stress.

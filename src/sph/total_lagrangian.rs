@@ -66,9 +66,6 @@ impl TotalLagrangian {
         b: &ParticleBuffers,
         sc: &Scenario,
     ) -> Result<Self> {
-        if sc.physics.dim != 2 {
-            bail!("the total-Lagrangian solid is 2D only for now");
-        }
         if sc.particles.iter().any(|p| !p.kind.is_solid()) {
             bail!("the total-Lagrangian solid is not coupled to fluid or walls yet");
         }
