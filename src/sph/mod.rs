@@ -454,7 +454,7 @@ impl Solver {
 
     /// GPU memory of the run's buffers, in bytes.
     pub fn gpu_bytes(&self) -> u64 {
-        self.buffers.bytes()
+        self.buffers.bytes() + self.total_lagrangian.as_ref().map_or(0, |t| t.bytes())
     }
 
     fn read_state(&self) -> Result<SimState> {

@@ -32,6 +32,8 @@ pub struct TotalLagrangian {
     /// Particles (all kinds) and TL particles.
     n: u32,
     n_tl: u32,
+    /// GPU memory of the TL buffers.
+    bytes: u64,
 }
 
 /// The solid particles' first id and count; they must have consecutive ids (the case loader
@@ -110,6 +112,12 @@ impl TotalLagrangian {
         let tl_h = storage(device, "tl H", mat * n_tl as u64);
         let tl_t = storage(device, "tl T", 3 * mat * n_tl as u64);
         let tl_p = storage(device, "tl P", mat * n_tl as u64);
+        let bytes = [
+            &tl_params, &tl_start, &tl_pairs, &tl_slot, &tl_h, &tl_t, &tl_p,
+        ]
+        .iter()
+        .map(|b| b.size())
+        .sum();
         let bufs = |p: usize| {
             [
                 (0, &b.params),
@@ -141,7 +149,13 @@ impl TotalLagrangian {
             accel: bound("tl_accel")?,
             n: b.n,
             n_tl,
+            bytes,
         })
+    }
+
+    /// GPU memory of the lists and per-particle matrices, in bytes.
+    pub fn bytes(&self) -> u64 {
+        self.bytes
     }
 
     /// Records where the sort put every TL particle (arrays of parity `p`, after the sort).
