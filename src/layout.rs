@@ -166,6 +166,35 @@ pub fn unpack_block(b: u32) -> [u32; 3] {
     [b & 0x7FF, (b >> 11) & 0x7FF, b >> 22]
 }
 
+/// Mirrors `TlParams` in shaders/total_lagrangian.wgsl: the total-Lagrangian solid's
+/// particle count and first particle id (its particles have consecutive ids), Lamé's λ, the
+/// shear modulus G, the cell quadrature factor dx²/12 and 1/ρ0.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct TlParams {
+    pub n: u32,
+    pub first_id: u32,
+    pub lambda: f32,
+    pub mu: f32,
+    pub k2: f32,
+    pub inv_rho0: f32,
+    pub pad: [u32; 2],
+}
+
+/// Mirrors `TlPair` in shaders/total_lagrangian.wgsl: one entry of particle i's fixed
+/// reference neighbour list: the weights w_ij = V γ_ij and w_ji = V γ_ji, the neighbour's TL
+/// index j and X_j − X_i.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct TlPair {
+    pub w_ij: [f32; 3],
+    pub j: u32,
+    pub w_ji: [f32; 3],
+    pub pad0: u32,
+    pub d0: [f32; 3],
+    pub pad1: u32,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -268,6 +297,22 @@ mod tests {
             [tau_a, tau_b, body, rate_a, rate_b, interface_p, pad]
         );
         check_layout!(Pass::Elastic, "SymRate", SymRate, [a, b]);
+    }
+
+    #[test]
+    fn total_lagrangian_structs_match_wgsl() {
+        check_layout!(
+            Pass::TotalLagrangian,
+            "TlParams",
+            TlParams,
+            [n, first_id, lambda, mu, k2, inv_rho0, pad]
+        );
+        check_layout!(
+            Pass::TotalLagrangian,
+            "TlPair",
+            TlPair,
+            [w_ij, j, w_ji, pad0, d0, pad1]
+        );
     }
 
     #[test]

@@ -250,6 +250,21 @@ pub struct ElasticMaterial {
     pub alpha: f64,
     /// Artificial stress ε (Monaghan 2000; Gray, Monaghan & Swift 2001 use 0.3); 0 disables it.
     pub artificial_stress: f64,
+    /// How the solid is discretised (`formulation` in `[[solid]]`).
+    pub formulation: SolidFormulation,
+}
+
+/// The discretisation of the elastic solids.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SolidFormulation {
+    /// Updated-Lagrangian hypoelastic SPH (Gray, Monaghan & Swift 2001; shaders/elastic.wgsl):
+    /// density and Jaumann stress rates, artificial viscosity and stress.
+    #[default]
+    UpdatedLagrangian,
+    /// Total-Lagrangian St Venant–Kirchhoff SPH on the reference lattice with a fixed
+    /// neighbour list (shaders/total_lagrangian.wgsl): quadratic least-squares gradients and the
+    /// cell quadrature term; no artificial viscosity or stress.
+    TotalLagrangian,
 }
 
 impl ElasticMaterial {

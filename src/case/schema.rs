@@ -40,6 +40,7 @@ pub(super) struct RawSolid {
     pub poisson_ratio: f64,
     pub alpha: Option<f64>,
     pub artificial_stress: Option<f64>,
+    pub formulation: Option<SolidFormulationName>,
     pub clamped_min_m: Option<Vec<f64>>,
     pub clamped_max_m: Option<Vec<f64>>,
     pub initial_velocity: Option<RawSolidVelocity>,
@@ -55,6 +56,13 @@ pub(super) struct RawSolidVelocity {
     pub direction: Option<Vec<f64>>,
     pub length_m: Option<f64>,
     pub tip_velocity_m_s: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum SolidFormulationName {
+    UpdatedLagrangian,
+    TotalLagrangian,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -757,6 +765,11 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "solid[].artificial_stress",
         "the artificial stress coefficient epsilon",
         "artificial_stress = 0.3",
+    ),
+    f(
+        "solid[].formulation",
+        "the solid discretisation: updated_lagrangian or total_lagrangian",
+        "formulation = \"total_lagrangian\"",
     ),
     f(
         "solid[].clamped_min_m",

@@ -2,13 +2,14 @@
 //! their particles, and the build of a solid-only case (with fluid, `build.rs` adds them).
 
 use crate::scenario::{
-    Domain, ElasticMaterial, Kind, Particle, Physics, Scenario, Solids, WallParams,
+    Domain, ElasticMaterial, Kind, Particle, Physics, Scenario, SolidFormulation, Solids,
+    WallParams,
 };
 
 use super::error::CaseError;
 use super::lattice::Lattice;
 use super::locate::Ctx;
-use super::schema::{RawSolid, SolidVelocityName};
+use super::schema::{RawSolid, SolidFormulationName, SolidVelocityName};
 use super::validate::{aabb, number, vector, Aabb, Bound, Case};
 
 /// Initial velocity of a cantilever in its first bending mode (Gray, Monaghan & Swift 2001,
@@ -118,10 +119,36 @@ pub(super) fn validate_solid(
         "the Poisson ratio; 0.5 (incompressible) has no finite sound speed",
         "use a value between 0 and 0.49, e.g. 0.3975",
     )?;
+    let formulation = match s.formulation {
+        None | Some(SolidFormulationName::UpdatedLagrangian) => SolidFormulation::UpdatedLagrangian,
+        Some(SolidFormulationName::TotalLagrangian) => SolidFormulation::TotalLagrangian,
+    };
+    if formulation == SolidFormulation::TotalLagrangian {
+        // The total-Lagrangian solid is stable without either stabiliser: a value given for one
+        // would be silently ignored, so it is refused.
+        for (field, given) in [
+            ("alpha", s.alpha.map(|v| v.to_string())),
+            (
+                "artificial_stress",
+                s.artificial_stress.map(|v| v.to_string()),
+            ),
+        ] {
+            if let Some(v) = given {
+                return Err(ctx.err(
+                    &format!("{path}.{field}"),
+                    Some(v),
+                    "is not used with formulation = \"total_lagrangian\" (no artificial \
+                     viscosity or stress: the formulation is stable without them)",
+                    format!("remove {field}, or use formulation = \"updated_lagrangian\""),
+                ));
+            }
+        }
+    }
+    let tl = formulation == SolidFormulation::TotalLagrangian;
     let alpha = number(
         ctx,
         &format!("{path}.alpha"),
-        s.alpha.unwrap_or(0.1),
+        s.alpha.unwrap_or(if tl { 0.0 } else { 0.1 }),
         Bound::Closed(0.0, 2.0),
         "the Monaghan artificial viscosity between solid particles",
         "use 0.1 (the default) or up to 1",
@@ -129,7 +156,7 @@ pub(super) fn validate_solid(
     let artificial_stress = number(
         ctx,
         &format!("{path}.artificial_stress"),
-        s.artificial_stress.unwrap_or(0.3),
+        s.artificial_stress.unwrap_or(if tl { 0.0 } else { 0.3 }),
         Bound::Closed(0.0, 1.0),
         "the artificial stress coefficient ε (Monaghan 2000); 0 disables it",
         "use 0.3 (Gray, Monaghan & Swift 2001), or 0",
@@ -266,6 +293,7 @@ pub(super) fn validate_solid(
             poisson_ratio,
             alpha,
             artificial_stress,
+            formulation,
         },
         clamped,
         velocity,
@@ -321,6 +349,18 @@ pub(super) fn solid_particles(
                 material.artificial_stress,
             ),
         ];
+        if s.material.formulation != material.formulation {
+            return Err(ctx.err(
+                &format!("solid[{i}].formulation"),
+                None,
+                format!(
+                    "differs from solid[0].formulation ({:?}): all solids of a case share one \
+                     material for now",
+                    material.formulation
+                ),
+                "give every solid the same formulation",
+            ));
+        }
         for (f, v, v0) in fields {
             if v != v0 {
                 return Err(ctx.err(

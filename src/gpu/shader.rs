@@ -23,10 +23,11 @@ pub enum Pass {
     DensityFilter,
     Bodies,
     Elastic,
+    TotalLagrangian,
 }
 
 impl Pass {
-    pub const ALL: [Pass; 9] = [
+    pub const ALL: [Pass; 10] = [
         Pass::CellList,
         Pass::PrefixScan,
         Pass::Interaction,
@@ -36,6 +37,7 @@ impl Pass {
         Pass::DensityFilter,
         Pass::Bodies,
         Pass::Elastic,
+        Pass::TotalLagrangian,
     ];
 
     pub fn name(self) -> &'static str {
@@ -49,6 +51,7 @@ impl Pass {
             Pass::DensityFilter => "density_filter",
             Pass::Bodies => "bodies",
             Pass::Elastic => "elastic",
+            Pass::TotalLagrangian => "total_lagrangian",
         }
     }
 
@@ -63,6 +66,7 @@ impl Pass {
             Pass::DensityFilter => include_str!("../../shaders/density_filter.wgsl"),
             Pass::Bodies => include_str!("../../shaders/bodies.wgsl"),
             Pass::Elastic => include_str!("../../shaders/elastic.wgsl"),
+            Pass::TotalLagrangian => include_str!("../../shaders/total_lagrangian.wgsl"),
         }
     }
 

@@ -13,6 +13,7 @@ pub mod integrate;
 pub mod interaction;
 pub mod kernel;
 pub mod probes;
+pub mod total_lagrangian;
 
 use crate::scenario::{Physics, Viscosity};
 

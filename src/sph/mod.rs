@@ -13,6 +13,7 @@ pub mod integrate;
 pub mod interaction;
 pub mod probes;
 pub mod state;
+pub mod total_lagrangian;
 
 use anyhow::{bail, Context, Result};
 
@@ -36,6 +37,7 @@ use grid::Grid;
 use integrate::Integrate;
 use interaction::Interaction;
 use probes::{PointTracker, Probes};
+use total_lagrangian::TotalLagrangian;
 
 /// Most steps recorded into one submission before the host looks at the state again.
 const MAX_BATCH: u32 = 64;
@@ -181,8 +183,10 @@ pub struct Solver {
     ghost: Ghost,
     energy: bool,
     integrate: Integrate,
-    /// Elastic solid particles, if the case has any.
+    /// Elastic solid particles, if the case has any (updated-Lagrangian formulation).
     elastic: Option<Elastic>,
+    /// Elastic solid particles of the total-Lagrangian formulation.
+    total_lagrangian: Option<TotalLagrangian>,
     probes: Probes,
     /// Tracked points of bodies, if the case has any.
     points: Option<PointTracker>,
@@ -336,9 +340,22 @@ impl Solver {
             mode => DensityFilter::new(&device, &module(Pass::DensityFilter)?, &buffers, mode)?,
         };
         let integrate = Integrate::new(&device, &module(Pass::Integrate)?, &buffers)?;
+        let tl = sc.solids.as_ref().is_some_and(|s| {
+            s.material.formulation == crate::scenario::SolidFormulation::TotalLagrangian
+        });
         let elastic = match sc.solids {
-            Some(_) => Some(Elastic::new(&device, &module(Pass::Elastic)?, &buffers)?),
-            None => None,
+            Some(_) if !tl => Some(Elastic::new(&device, &module(Pass::Elastic)?, &buffers)?),
+            _ => None,
+        };
+        let total_lagrangian = if tl {
+            Some(TotalLagrangian::new(
+                &device,
+                &module(Pass::TotalLagrangian)?,
+                &buffers,
+                sc,
+            )?)
+        } else {
+            None
         };
         let probe_module = module(Pass::Probes)?;
         let probes = Probes::new(&device, &probe_module, &buffers, &defs)?;
@@ -384,6 +401,7 @@ impl Solver {
             energy: ph.energy,
             integrate,
             elastic,
+            total_lagrangian,
             probes,
             points,
             attached_probes: sc.probes.iter().any(|p| p.body.is_some()).then(|| {
@@ -436,7 +454,7 @@ impl Solver {
 
     /// GPU memory of the run's buffers, in bytes.
     pub fn gpu_bytes(&self) -> u64 {
-        self.buffers.bytes()
+        self.buffers.bytes() + self.total_lagrangian.as_ref().map_or(0, |t| t.bytes())
     }
 
     fn read_state(&self) -> Result<SimState> {
@@ -516,6 +534,9 @@ impl Solver {
                 b.encode_move(&mut pass, p);
             }
             self.cell_list.encode(&mut pass, p);
+            if let Some(t) = &self.total_lagrangian {
+                t.encode_index(&mut pass, q);
+            }
             if let Some(b) = bodies {
                 b.encode_index(&mut pass, q);
             }
@@ -524,6 +545,9 @@ impl Solver {
             if let Some(e) = &self.elastic {
                 e.encode_rates(&mut pass, q);
                 e.encode_correct(&mut pass, q);
+            }
+            if let Some(t) = &self.total_lagrangian {
+                t.encode_rates(&mut pass, q);
             }
             if let Some(b) = bodies {
                 b.encode_force(&mut pass, q);
@@ -752,6 +776,9 @@ impl Solver {
         self.interaction.encode(&mut pass, self.parity);
         if let Some(e) = &self.elastic {
             e.encode_rates(&mut pass, self.parity);
+        }
+        if let Some(t) = &self.total_lagrangian {
+            t.encode_rates(&mut pass, self.parity);
         }
         drop(pass);
         self.queue.submit([encoder.finish()]);

@@ -1,8 +1,10 @@
 //! `[[solid]]`: the oscillating plate case and the loader's errors.
 
 use super::*;
+use crate::scenario::SolidFormulation;
 
 const PLATE: &str = include_str!("../../../cases/oscillating_plate_2d.toml");
+const PLATE_TL: &str = include_str!("../../../cases/oscillating_plate_tl_2d.toml");
 
 #[test]
 fn oscillating_plate_builds_a_clamped_plate_in_its_first_mode() {
@@ -110,6 +112,88 @@ fn solid_errors_name_the_field() {
         .unwrap()
         .replace("[physics]\n", "[physics]\nsound_speed_coef = 10.0\n");
     assert_err(&no_fluid, &[], None, &["fluid_block", "[[solid]]"]);
+}
+
+/// `formulation`: the default is the updated-Lagrangian solid; the total-Lagrangian plate reads
+/// without α and ε (also in 3D), and the total-Lagrangian refusals (α or ε given, fluid) name
+/// the field.
+#[test]
+fn total_lagrangian_formulation_and_its_refusals() {
+    let ul = load_str(PLATE, "cases/oscillating_plate_2d.toml", &[]).unwrap();
+    let m = ul.solids.unwrap().material;
+    assert_eq!(m.formulation, SolidFormulation::UpdatedLagrangian);
+    let tl = load_str(PLATE_TL, "cases/oscillating_plate_tl_2d.toml", &[]).unwrap();
+    let mt = tl.solids.unwrap().material;
+    assert_eq!(mt.formulation, SolidFormulation::TotalLagrangian);
+    assert_eq!((mt.alpha, mt.artificial_stress), (0.0, 0.0));
+    assert_eq!(tl.particles.len(), ul.particles.len());
+    let with_tl = |extra: &str| {
+        solid_with(
+            "poisson_ratio = 0.3975\n",
+            &format!("poisson_ratio = 0.3975\nformulation = \"total_lagrangian\"\n{extra}"),
+        )
+    };
+    load_str(&with_tl(""), "cases/t.toml", &[]).unwrap();
+    assert_err(
+        &with_tl("alpha = 0.1\n"),
+        &[],
+        None,
+        &["solid[0].alpha", "total_lagrangian", "remove alpha"],
+    );
+    assert_err(
+        &with_tl("artificial_stress = 0.3\n"),
+        &[],
+        None,
+        &["solid[0].artificial_stress", "remove artificial_stress"],
+    );
+    let three_d = r#"dimension = 3
+[particles]
+dx_m = 0.01
+[physics]
+gravity_m_s2 = [0.0, 0.0, 0.0]
+[time]
+end_s = 1.0
+output_every_s = 0.1
+[[solid]]
+name = "block"
+min_m = [0.0, 0.0, 0.0]
+max_m = [0.05, 0.05, 0.05]
+density_kg_m3 = 1000.0
+youngs_modulus_pa = 2.0e6
+poisson_ratio = 0.3975
+formulation = "total_lagrangian"
+"#;
+    let s3 = load_str(three_d, "cases/t.toml", &[]).unwrap();
+    assert_eq!(
+        s3.solids.unwrap().material.formulation,
+        SolidFormulation::TotalLagrangian
+    );
+    let fluid = r#"dimension = 2
+[particles]
+dx_m = 0.01
+[physics]
+sound_speed_coef = 20.0
+[time]
+end_s = 0.1
+output_every_s = 0.01
+[tank]
+min_m = [0.0, 0.0]
+max_m = [0.6, 0.4]
+[[fluid_block]]
+min_m = [0.0, 0.0]
+max_m = [0.4, 0.2]
+[[solid]]
+name = "gate"
+min_m = [0.2, 0.02]
+max_m = [0.25, 0.3]
+density_kg_m3 = 1100.0
+youngs_modulus_pa = 1.2e7
+poisson_ratio = 0.4
+formulation = "total_lagrangian"
+clamped_min_m = [0.2, 0.25]
+clamped_max_m = [0.25, 0.3]
+"#;
+    assert_err(fluid, &[], None, &["solid[0].formulation", "fluid"]);
 }
 
 /// A gate of solid particles in a tank of water (the elastic gate's layout): fluid where the

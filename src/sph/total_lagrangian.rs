@@ -1,0 +1,175 @@
+//! Total-Lagrangian elastic solid (shaders/total_lagrangian.wgsl): the reference neighbour
+//! lists and gradient weights, computed once in f64 (src/reference/total_lagrangian.rs) and
+//! uploaded; per step the slot of every solid particle after the sort, then F, the strain
+//! gradient's stress T, the first Piola–Kirchhoff stress P and the accelerations. Replaces the
+//! hypoelastic pass (src/sph/elastic.rs) when `formulation = "total_lagrangian"`; there is no
+//! stress or density to integrate, integrate.wgsl moves the particles (velocity Verlet).
+//! GPU memory only for the solid particles: the lists (48 bytes a pair) and 5 matrices a
+//! particle.
+
+use anyhow::{bail, Result};
+
+use super::buffers::ParticleBuffers;
+use crate::gpu::buffers::{storage, storage_init, uniform_init};
+use crate::gpu::kernel::ShaderModule;
+use crate::gpu::Kernel;
+use crate::layout::{TlPair, TlParams};
+use crate::reference::total_lagrangian::{lame, TlSetup};
+use crate::scenario::{Kind, Scenario};
+
+/// A kernel and its bind groups for both parities.
+struct Bound {
+    kernel: Kernel,
+    bind: [wgpu::BindGroup; 2],
+}
+
+pub struct TotalLagrangian {
+    index: Bound,
+    deform: Bound,
+    gradient: Bound,
+    stress: Bound,
+    accel: Bound,
+    /// Particles (all kinds) and TL particles.
+    n: u32,
+    n_tl: u32,
+    /// GPU memory of the TL buffers.
+    bytes: u64,
+}
+
+/// The solid particles' first id and count; they must have consecutive ids (the case loader
+/// builds them so: a solid-only case is nothing else).
+fn solid_range(sc: &Scenario) -> Result<std::ops::Range<usize>> {
+    let ids: Vec<usize> = (0..sc.particles.len())
+        .filter(|&i| matches!(sc.particles[i].kind, Kind::Solid | Kind::SolidClamped))
+        .collect();
+    let (Some(&first), Some(&last)) = (ids.first(), ids.last()) else {
+        bail!("the total-Lagrangian solid has no particles");
+    };
+    if last - first + 1 != ids.len() {
+        bail!("the total-Lagrangian solid's particles must have consecutive ids");
+    }
+    Ok(first..last + 1)
+}
+
+/// The f64 setup of the scenario's solid particles (TL index = id − first solid id).
+pub fn setup(sc: &Scenario) -> Result<(std::ops::Range<usize>, TlSetup)> {
+    let range = solid_range(sc)?;
+    let solids = sc.solids.as_ref().expect("a case with solids");
+    let x0: Vec<[f64; 3]> = sc.particles[range.clone()].iter().map(|p| p.pos).collect();
+    let setup =
+        TlSetup::new(&sc.physics, &x0, &solids.body[range.clone()]).map_err(anyhow::Error::msg)?;
+    Ok((range, setup))
+}
+
+impl TotalLagrangian {
+    pub fn new(
+        device: &wgpu::Device,
+        module: &ShaderModule,
+        b: &ParticleBuffers,
+        sc: &Scenario,
+    ) -> Result<Self> {
+        if sc.particles.iter().any(|p| !p.kind.is_solid()) {
+            bail!("the total-Lagrangian solid is not coupled to fluid or walls yet");
+        }
+        let (range, setup) = setup(sc)?;
+        let m = &sc.solids.as_ref().expect("a case with solids").material;
+        let (lambda, mu) = lame(m);
+        let n_tl = setup.len() as u32;
+        let params = TlParams {
+            n: n_tl,
+            first_id: range.start as u32,
+            lambda: lambda as f32,
+            mu: mu as f32,
+            k2: (sc.physics.dx * sc.physics.dx / 12.0) as f32,
+            inv_rho0: (1.0 / m.density) as f32,
+            pad: [0; 2],
+        };
+        let start: Vec<u32> = setup.start.iter().map(|&s| s as u32).collect();
+        let f3 = |v: [f64; 3]| v.map(|x| x as f32);
+        let mut pairs: Vec<TlPair> = setup
+            .pairs
+            .iter()
+            .map(|p| TlPair {
+                w_ij: f3(p.w_ij),
+                j: p.j as u32,
+                w_ji: f3(p.w_ji),
+                pad0: 0,
+                d0: f3(p.d0),
+                pad1: 0,
+            })
+            .collect();
+        if pairs.is_empty() {
+            // A binding cannot be empty.
+            pairs.push(TlPair::default());
+        }
+        let tl_params = uniform_init(device, "tl params", &params);
+        let tl_start = storage_init(device, "tl start", &start);
+        let tl_pairs = storage_init(device, "tl pairs", &pairs);
+        // The particles start in id order.
+        let slots: Vec<u32> = (range.start as u32..range.end as u32).collect();
+        let tl_slot = storage_init(device, "tl slots", &slots);
+        let mat = 48u64; // mat3x3<f32> in a storage array
+        let tl_h = storage(device, "tl H", mat * n_tl as u64);
+        let tl_t = storage(device, "tl T", 3 * mat * n_tl as u64);
+        let tl_p = storage(device, "tl P", mat * n_tl as u64);
+        let bytes = [
+            &tl_params, &tl_start, &tl_pairs, &tl_slot, &tl_h, &tl_t, &tl_p,
+        ]
+        .iter()
+        .map(|b| b.size())
+        .sum();
+        let bufs = |p: usize| {
+            [
+                (0, &b.params),
+                (1, &b.pos[p]),
+                (2, &b.code[p]),
+                (3, &b.rate),
+                (4, &tl_params),
+                (5, &tl_start),
+                (6, &tl_pairs),
+                (7, &tl_slot),
+                (8, &tl_h),
+                (9, &tl_t),
+                (10, &tl_p),
+            ]
+        };
+        let bound = |entry: &str| -> Result<Bound> {
+            let kernel = module.kernel(device, entry)?;
+            let bind = [
+                kernel.bind(device, &bufs(0))?,
+                kernel.bind(device, &bufs(1))?,
+            ];
+            Ok(Bound { kernel, bind })
+        };
+        Ok(Self {
+            index: bound("tl_index")?,
+            deform: bound("tl_deform")?,
+            gradient: bound("tl_gradient")?,
+            stress: bound("tl_stress")?,
+            accel: bound("tl_accel")?,
+            n: b.n,
+            n_tl,
+            bytes,
+        })
+    }
+
+    /// GPU memory of the lists and per-particle matrices, in bytes.
+    pub fn bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// Records where the sort put every TL particle (arrays of parity `p`, after the sort).
+    pub fn encode_index(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.index
+            .kernel
+            .dispatch(pass, &self.index.bind[p], self.n);
+    }
+
+    /// The four passes: dv/dt of the TL particles added to `rate` (after the interaction
+    /// pass, which initialises it), on the arrays of parity `p`.
+    pub fn encode_rates(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        for b in [&self.deform, &self.gradient, &self.stress, &self.accel] {
+            b.kernel.dispatch(pass, &b.bind[p], self.n_tl);
+        }
+    }
+}
