@@ -6,7 +6,7 @@ use crate::scenario::{
     WallParams,
 };
 
-use super::error::CaseError;
+use super::error::{num, CaseError};
 use super::lattice::Lattice;
 use super::locate::Ctx;
 use super::schema::{RawSolid, SolidFormulationName, SolidVelocityName};
@@ -119,6 +119,25 @@ pub(super) fn validate_solid(
         "the Poisson ratio; 0.5 (incompressible) has no finite sound speed",
         "use a value between 0 and 0.49, e.g. 0.3975",
     )?;
+    // The GPU works with c_s² = K/ρ and μ in f32: a modulus or density at the ends of the f64
+    // range (5e-324 Pa passes "positive") would give a zero or infinite sound speed.
+    let c2 = youngs_modulus / (3.0 * (1.0 - 2.0 * poisson_ratio)) / density;
+    if !(1e-12..=1e20).contains(&c2) {
+        return Err(ctx.err(
+            &format!("{path}.youngs_modulus_pa"),
+            Some(num(youngs_modulus)),
+            format!(
+                "with density_kg_m3 = {} and poisson_ratio = {} gives the solid a sound speed \
+                 c_s = sqrt(K/ρ) of {} m/s, outside what the solver computes with \
+                 (1e-6 to 1e10 m/s)",
+                num(density),
+                num(poisson_ratio),
+                num(c2.sqrt())
+            ),
+            "give a realistic Young's modulus and density, e.g. youngs_modulus_pa = 2.0e6 with \
+             density_kg_m3 = 1000.0",
+        ));
+    }
     let formulation = match s.formulation {
         None | Some(SolidFormulationName::UpdatedLagrangian) => SolidFormulation::UpdatedLagrangian,
         Some(SolidFormulationName::TotalLagrangian) => SolidFormulation::TotalLagrangian,

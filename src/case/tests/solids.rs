@@ -72,6 +72,13 @@ fn solid_errors_name_the_field() {
         Some(19),
         &["solid[0].poisson_ratio", "0.49"],
     );
+    // Found by tests/case_fuzz: a positive but subnormal modulus gave a zero sound speed.
+    assert_err(
+        &solid_with("youngs_modulus_pa = 2.0e6", "youngs_modulus_pa = 5e-324"),
+        &[],
+        None,
+        &["solid[0].youngs_modulus_pa", "sound speed"],
+    );
     assert_err(
         &solid_with("clamped_max_m = [0.05, 0.04]\n", ""),
         &[],
