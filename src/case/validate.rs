@@ -527,20 +527,6 @@ pub(super) fn validate(
                 fix,
             ));
         }
-        if let Some(i) = solids.iter().position(|s| {
-            s.material.formulation == crate::scenario::SolidFormulation::TotalLagrangian
-        }) {
-            if !alone {
-                return Err(ctx.err(
-                    &format!("solid[{i}].formulation"),
-                    Some("\"total_lagrangian\"".into()),
-                    "is not coupled to fluid yet (the fluid–solid interface of interaction.wgsl \
-                     and ghost.wgsl uses the updated-Lagrangian stress)",
-                    "use formulation = \"updated_lagrangian\" with [[fluid_block]], or run the \
-                     solid alone",
-                ));
-            }
-        }
     }
     let mut blocks = Vec::with_capacity(raw.fluid_block.len());
     for (i, b) in raw.fluid_block.iter().enumerate() {

@@ -68,9 +68,6 @@ impl TotalLagrangian {
         b: &ParticleBuffers,
         sc: &Scenario,
     ) -> Result<Self> {
-        if sc.particles.iter().any(|p| !p.kind.is_solid()) {
-            bail!("the total-Lagrangian solid is not coupled to fluid or walls yet");
-        }
         let (range, setup) = setup(sc)?;
         let m = &sc.solids.as_ref().expect("a case with solids").material;
         let (lambda, mu) = lame(m);
