@@ -25,12 +25,17 @@ fn material() -> ElasticMaterial {
     }
 }
 
-fn random_solid(dim: u32, kernel: KernelKind, seed: u64) -> Scenario {
+/// A jittered solid with random velocities (two bodies side by side, a clamped strip) of
+/// `mat`: of the updated-Lagrangian formulation also with random stresses and densities (and g
+/// along −y); of the total-Lagrangian one at rest density and stress free (its state is F).
+fn random_solid(dim: u32, kernel: KernelKind, seed: u64, mat: ElasticMaterial) -> Scenario {
+    let ul = mat.formulation == SolidFormulation::UpdatedLagrangian;
     let dx = 0.01;
     let mut ph = physics(dim, dx, 20.0);
     ph.kernel = kernel;
-    ph.gravity = [0.0, -9.81, 0.0];
-    let mat = material();
+    if ul {
+        ph.gravity = [0.0, -9.81, 0.0];
+    }
     let mut rng = Rng(seed);
     let side = if dim == 2 { 0.16 } else { 0.08 };
     let (min, max) = if dim == 2 {
@@ -49,17 +54,21 @@ fn random_solid(dim: u32, kernel: KernelKind, seed: u64) -> Scenario {
             vel[a] = rng.range(-0.5, 0.5);
         }
         let mut t = [0.0; 6];
-        for c in 0..6 {
-            // 2D: only xx, yy, zz, xy.
-            if dim == 3 || c < 4 {
-                t[c] = rng.range(-2.0e4, 2.0e4);
+        let mut rho = mat.density;
+        if ul {
+            for c in 0..6 {
+                // 2D: only xx, yy, zz, xy.
+                if dim == 3 || c < 4 {
+                    t[c] = rng.range(-2.0e4, 2.0e4);
+                }
             }
+            rho *= 1.0 + rng.range(-0.01, 0.01);
         }
         let clamped = p[0] < min[0] + 2.0 * dx;
         parts.push(Particle {
             pos,
             vel: if clamped { [0.0; 3] } else { vel },
-            rho: mat.density * (1.0 + rng.range(-0.01, 0.01)),
+            rho,
             kind: if clamped {
                 Kind::SolidClamped
             } else {
@@ -124,7 +133,7 @@ fn elastic_rates_match_reference() {
         (2, KernelKind::CubicSpline),
         (3, KernelKind::WendlandC2),
     ] {
-        let sc = random_solid(dim, kernel, 11 + dim as u64);
+        let sc = random_solid(dim, kernel, 11 + dim as u64, material());
         let solver = Solver::new(gpu(), &sc).unwrap();
         let parts = gpu_particles(&solver);
         let solid = solid_refs(&solver);
@@ -345,46 +354,13 @@ fn fluid_solid_interface_matches_reference() {
 
 /// A total-Lagrangian solid on a jittered reference lattice (two bodies, a clamped strip).
 fn random_tl_solid(dim: u32, kernel: KernelKind, seed: u64) -> Scenario {
-    let dx = 0.01;
-    let mut ph = physics(dim, dx, 20.0);
-    ph.kernel = kernel;
     let mat = ElasticMaterial {
         alpha: 0.0,
         artificial_stress: 0.0,
         formulation: SolidFormulation::TotalLagrangian,
         ..material()
     };
-    let mut rng = Rng(seed);
-    let side = if dim == 2 { 0.16 } else { 0.08 };
-    let (min, max) = if dim == 2 {
-        ([0.1, 0.1, 0.0], [0.1 + side, 0.1 + side, 0.0])
-    } else {
-        ([0.1; 3], [0.1 + side; 3])
-    };
-    let mut parts = Vec::new();
-    let mut body = Vec::new();
-    for p in lattice(dim, dx, min, max) {
-        let mut pos = p;
-        let mut vel = [0.0; 3];
-        for a in 0..dim as usize {
-            pos[a] += rng.range(-0.2, 0.2) * dx;
-            vel[a] = rng.range(-0.5, 0.5);
-        }
-        let clamped = p[0] < min[0] + 2.0 * dx;
-        parts.push(Particle {
-            pos,
-            vel: if clamped { [0.0; 3] } else { vel },
-            rho: mat.density,
-            kind: if clamped {
-                Kind::SolidClamped
-            } else {
-                Kind::Solid
-            },
-        });
-        body.push((p[1] > min[1] + 0.5 * side) as u32);
-    }
-    let n = parts.len();
-    with_solids(ph, parts, mat, body, vec![[0.0; 6]; n])
+    random_solid(dim, kernel, seed, mat)
 }
 
 /// Layer 1 for the total-Lagrangian solid: its GPU accelerations against the f64 reference

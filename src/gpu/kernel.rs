@@ -147,3 +147,32 @@ pub fn fold_groups(groups: u32) -> (u32, u32) {
         (MAX, groups.div_ceil(MAX))
     }
 }
+
+/// A kernel with its bind groups over the two parities of the particle arrays (the cell sort
+/// gathers from one into the other every step).
+pub struct ParityKernel {
+    kernel: Kernel,
+    bind: [wgpu::BindGroup; 2],
+}
+
+impl ParityKernel {
+    /// Entry point `entry` of `module`, bound to `buffers(p)` for parity p = 0 and 1.
+    pub fn new<'a>(
+        device: &wgpu::Device,
+        module: &ShaderModule,
+        entry: &str,
+        buffers: impl Fn(usize) -> Vec<(u32, &'a wgpu::Buffer)>,
+    ) -> Result<Self> {
+        let kernel = module.kernel(device, entry)?;
+        let bind = [
+            kernel.bind(device, &buffers(0))?,
+            kernel.bind(device, &buffers(1))?,
+        ];
+        Ok(Self { kernel, bind })
+    }
+
+    /// `invocations` invocations on the arrays of parity `p`.
+    pub fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, p: usize, invocations: u32) {
+        self.kernel.dispatch(pass, &self.bind[p], invocations);
+    }
+}

@@ -5,19 +5,12 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
-use crate::gpu::kernel::ShaderModule;
-use crate::gpu::Kernel;
-
-/// A kernel and its bind groups for both parities.
-struct Bound {
-    kernel: Kernel,
-    bind: [wgpu::BindGroup; 2],
-}
+use crate::gpu::kernel::{ParityKernel, ShaderModule};
 
 pub struct Elastic {
-    rates: Bound,
-    predict: Bound,
-    correct: Bound,
+    rates: ParityKernel,
+    predict: ParityKernel,
+    correct: ParityKernel,
     n: u32,
 }
 
@@ -36,14 +29,7 @@ impl Elastic {
                 (8, &b.state),
             ]
         };
-        let bound = |entry: &str| -> Result<Bound> {
-            let kernel = module.kernel(device, entry)?;
-            let bind = [
-                kernel.bind(device, &bufs(0))?,
-                kernel.bind(device, &bufs(1))?,
-            ];
-            Ok(Bound { kernel, bind })
-        };
+        let bound = |entry: &str| ParityKernel::new(device, module, entry, |p| bufs(p).to_vec());
         Ok(Self {
             rates: bound("elastic_rates")?,
             predict: bound("stress_predict")?,
@@ -54,23 +40,17 @@ impl Elastic {
 
     /// τ* = τ_n + dt (dτ/dt)_n on the arrays of parity `p` (before the sort).
     pub fn encode_predict(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.predict
-            .kernel
-            .dispatch(pass, &self.predict.bind[p], self.n);
+        self.predict.dispatch(pass, p, self.n);
     }
 
     /// dρ/dt, dv/dt (into `rate`) and dτ/dt (into `stress_rate`) of the solid particles of the
     /// sorted arrays of parity `p`; after the interaction pass.
     pub fn encode_rates(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.rates
-            .kernel
-            .dispatch(pass, &self.rates.bind[p], self.n);
+        self.rates.dispatch(pass, p, self.n);
     }
 
     /// The corrector of τ on parity `p`.
     pub fn encode_correct(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.correct
-            .kernel
-            .dispatch(pass, &self.correct.bind[p], self.n);
+        self.correct.dispatch(pass, p, self.n);
     }
 }

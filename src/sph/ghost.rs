@@ -5,20 +5,13 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
-use crate::gpu::kernel::ShaderModule;
-use crate::gpu::Kernel;
-
-/// A kernel with its bind groups of both parities.
-struct Bound {
-    kernel: Kernel,
-    bind: [wgpu::BindGroup; 2],
-}
+use crate::gpu::kernel::{ParityKernel, ShaderModule};
 
 pub struct Ghost {
     /// Fixed ghosts, when the case has any.
-    walls: Option<Bound>,
+    walls: Option<ParityKernel>,
     /// Elastic solid particles in fluid, when the case has both.
-    solids: Option<Bound>,
+    solids: Option<ParityKernel>,
     n: u32,
 }
 
@@ -30,9 +23,8 @@ impl Ghost {
         fixed_ghosts: bool,
         solids_in_fluid: bool,
     ) -> Result<Self> {
-        let bound = |entry: &str, with_solid: bool| -> Result<Bound> {
-            let kernel = module.kernel(device, entry)?;
-            let bind = [0, 1].map(|p| {
+        let bound = |entry: &str, with_solid: bool| {
+            ParityKernel::new(device, module, entry, |p| {
                 let mut bufs = vec![
                     (0, &b.params),
                     (1, &b.pos[p]),
@@ -46,12 +38,7 @@ impl Ghost {
                     bufs.push((6, &b.body_particles));
                     bufs.push((7, &b.body_motions));
                 }
-                kernel.bind(device, &bufs)
-            });
-            let [b0, b1] = bind;
-            Ok(Bound {
-                bind: [b0?, b1?],
-                kernel,
+                bufs
             })
         };
         Ok(Self {
@@ -68,7 +55,7 @@ impl Ghost {
     /// Both interpolations, on the arrays of parity `p`.
     pub fn encode(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         for k in [&self.walls, &self.solids].into_iter().flatten() {
-            k.kernel.dispatch(pass, &k.bind[p], self.n);
+            k.dispatch(pass, p, self.n);
         }
     }
 }

@@ -11,24 +11,17 @@ use anyhow::{bail, Result};
 
 use super::buffers::ParticleBuffers;
 use crate::gpu::buffers::{storage, storage_init, uniform_init};
-use crate::gpu::kernel::ShaderModule;
-use crate::gpu::Kernel;
+use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::layout::{TlPair, TlParams};
 use crate::reference::total_lagrangian::{lame, TlSetup};
 use crate::scenario::{Kind, Scenario};
 
-/// A kernel and its bind groups for both parities.
-struct Bound {
-    kernel: Kernel,
-    bind: [wgpu::BindGroup; 2],
-}
-
 pub struct TotalLagrangian {
-    index: Bound,
-    deform: Bound,
-    gradient: Bound,
-    stress: Bound,
-    accel: Bound,
+    index: ParityKernel,
+    deform: ParityKernel,
+    gradient: ParityKernel,
+    stress: ParityKernel,
+    accel: ParityKernel,
     /// Particles (all kinds) and TL particles.
     n: u32,
     n_tl: u32,
@@ -130,14 +123,7 @@ impl TotalLagrangian {
                 (10, &tl_p),
             ]
         };
-        let bound = |entry: &str| -> Result<Bound> {
-            let kernel = module.kernel(device, entry)?;
-            let bind = [
-                kernel.bind(device, &bufs(0))?,
-                kernel.bind(device, &bufs(1))?,
-            ];
-            Ok(Bound { kernel, bind })
-        };
+        let bound = |entry: &str| ParityKernel::new(device, module, entry, |p| bufs(p).to_vec());
         Ok(Self {
             index: bound("tl_index")?,
             deform: bound("tl_deform")?,
@@ -157,16 +143,14 @@ impl TotalLagrangian {
 
     /// Records where the sort put every TL particle (arrays of parity `p`, after the sort).
     pub fn encode_index(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.index
-            .kernel
-            .dispatch(pass, &self.index.bind[p], self.n);
+        self.index.dispatch(pass, p, self.n);
     }
 
     /// The four passes: dv/dt of the TL particles added to `rate` (after the interaction
     /// pass, which initialises it), on the arrays of parity `p`.
     pub fn encode_rates(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         for b in [&self.deform, &self.gradient, &self.stress, &self.accel] {
-            b.kernel.dispatch(pass, &b.bind[p], self.n_tl);
+            b.dispatch(pass, p, self.n_tl);
         }
     }
 }
