@@ -7,9 +7,10 @@
 //               contact) exerts on each body particle and its moment (R r_a) × m a_a about the
 //               centre of mass. Each workgroup covers particles of one body only; the host
 //               finishes the sums in f64, in workgroup order (deterministic).
-// Body particles are dynamic boundary particles: the interaction gives them the pressure and
-// viscous force of their fluid neighbours (interaction.wgsl), the opposite of what the fluid
-// receives from them, so momentum is exchanged pairwise.
+// Body particles are dynamic, fixed-ghost or repulsive boundary particles: the interaction
+// gives each the force of its fluid neighbours (interaction.wgsl), the opposite of what the
+// fluid receives from it, so momentum is exchanged pairwise. A ghost's stored velocity is the
+// fluid's interpolated at it (ghost.wgsl), replaced here by the rigid one every step.
 
 @group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
