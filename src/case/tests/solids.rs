@@ -121,6 +121,32 @@ fn solid_errors_name_the_field() {
     assert_err(&no_fluid, &[], None, &["fluid_block", "[[solid]]"]);
 }
 
+/// A gate of solid particles (2 particles thick) clamped at its top in a tank of water.
+const GATE_IN_WATER: &str = r#"dimension = 2
+[particles]
+dx_m = 0.01
+[physics]
+sound_speed_coef = 20.0
+[time]
+end_s = 0.1
+output_every_s = 0.01
+[tank]
+min_m = [0.0, 0.0]
+max_m = [0.6, 0.4]
+[[fluid_block]]
+min_m = [0.0, 0.0]
+max_m = [0.4, 0.2]
+[[solid]]
+name = "gate"
+min_m = [0.2, 0.02]
+max_m = [0.22, 0.3]
+density_kg_m3 = 1100.0
+youngs_modulus_pa = 1.2e7
+poisson_ratio = 0.4
+clamped_min_m = [0.2, 0.25]
+clamped_max_m = [0.22, 0.3]
+"#;
+
 /// `formulation`: the default is the updated-Lagrangian solid; the total-Lagrangian plate reads
 /// without α and ε (also in 3D), its refusals (α or ε given) name the field, and it takes
 /// fluid like the updated-Lagrangian solid.
@@ -175,33 +201,16 @@ formulation = "total_lagrangian"
         s3.solids.unwrap().material.formulation,
         SolidFormulation::TotalLagrangian
     );
-    let fluid = r#"dimension = 2
-[particles]
-dx_m = 0.01
-[physics]
-sound_speed_coef = 20.0
-[time]
-end_s = 0.1
-output_every_s = 0.01
-[tank]
-min_m = [0.0, 0.0]
-max_m = [0.6, 0.4]
-[[fluid_block]]
-min_m = [0.0, 0.0]
-max_m = [0.4, 0.2]
-[[solid]]
-name = "gate"
-min_m = [0.2, 0.02]
-max_m = [0.25, 0.3]
-density_kg_m3 = 1100.0
-youngs_modulus_pa = 1.2e7
-poisson_ratio = 0.4
-formulation = "total_lagrangian"
-clamped_min_m = [0.2, 0.25]
-clamped_max_m = [0.25, 0.3]
-"#;
-    let sc = load_str(fluid, "c.toml", &[]).unwrap();
+    let fluid = GATE_IN_WATER.replace(
+        "poisson_ratio = 0.4\n",
+        "poisson_ratio = 0.4\nformulation = \"total_lagrangian\"\n",
+    );
+    let sc = load_str(&fluid, "c.toml", &[]).unwrap();
     assert!(sc.count(Kind::Fluid) > 0 && sc.count(Kind::Solid) > 0);
+    assert_eq!(
+        sc.solids.unwrap().material.formulation,
+        SolidFormulation::TotalLagrangian
+    );
 }
 
 /// A gate of solid particles in a tank of water (the elastic gate's layout): fluid where the
@@ -210,30 +219,7 @@ clamped_max_m = [0.25, 0.3]
 /// refused beside solids.
 #[test]
 fn fluid_and_solids_build_together() {
-    let case = r#"dimension = 2
-[particles]
-dx_m = 0.01
-[physics]
-sound_speed_coef = 20.0
-[time]
-end_s = 0.1
-output_every_s = 0.01
-[tank]
-min_m = [0.0, 0.0]
-max_m = [0.6, 0.4]
-[[fluid_block]]
-min_m = [0.0, 0.0]
-max_m = [0.4, 0.2]
-[[solid]]
-name = "gate"
-min_m = [0.2, 0.02]
-max_m = [0.22, 0.3]
-density_kg_m3 = 1100.0
-youngs_modulus_pa = 1.2e7
-poisson_ratio = 0.4
-clamped_min_m = [0.2, 0.25]
-clamped_max_m = [0.22, 0.3]
-"#;
+    let case = GATE_IN_WATER;
     let s = load_str(case, "cases/t.toml", &[]).unwrap();
     let solids = s.solids.as_ref().expect("solids");
     assert_eq!(solids.body.len(), s.particles.len());
