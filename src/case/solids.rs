@@ -143,22 +143,24 @@ pub(super) fn validate_solid(
         Some(SolidFormulationName::TotalLagrangian) => SolidFormulation::TotalLagrangian,
     };
     if formulation == SolidFormulation::TotalLagrangian {
-        // The total-Lagrangian solid is stable without either stabiliser: a value given for one
-        // would be silently ignored, so it is refused.
+        // The total-Lagrangian solid is stable without either stabiliser: a nonzero value
+        // given for one would be silently ignored, so it is refused (0, which is what the
+        // formulation uses, is accepted, so a case of the other formulation can be switched
+        // with --set).
         for (field, given) in [
-            ("alpha", s.alpha.map(|v| v.to_string())),
-            (
-                "artificial_stress",
-                s.artificial_stress.map(|v| v.to_string()),
-            ),
+            ("alpha", s.alpha),
+            ("artificial_stress", s.artificial_stress),
         ] {
-            if let Some(v) = given {
+            if let Some(v) = given.filter(|&v| v != 0.0) {
                 return Err(ctx.err(
                     &format!("{path}.{field}"),
-                    Some(v),
+                    Some(v.to_string()),
                     "is not used with formulation = \"total_lagrangian\" (no artificial \
                      viscosity or stress: the formulation is stable without them)",
-                    format!("remove {field}, or use formulation = \"updated_lagrangian\""),
+                    format!(
+                        "remove {field} (or set it to 0), or use formulation = \
+                         \"updated_lagrangian\""
+                    ),
                 ));
             }
         }

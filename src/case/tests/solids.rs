@@ -167,6 +167,12 @@ fn total_lagrangian_formulation_and_its_refusals() {
         )
     };
     load_str(&with_tl(""), "cases/t.toml", &[]).unwrap();
+    load_str(
+        &with_tl("alpha = 0.0\nartificial_stress = 0.0\n"),
+        "cases/t.toml",
+        &[],
+    )
+    .unwrap();
     assert_err(
         &with_tl("alpha = 0.1\n"),
         &[],
