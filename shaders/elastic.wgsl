@@ -14,8 +14,7 @@
 //     1992; written with −Π so that Π ≥ 0 repels, as in interaction.wgsl);
 //     artificial stress (Monaghan 2000, JCP 159:290; GMS §4): f_ij = W_ij/W(Δp),
 //     n = 4, R_i from the principal stresses σ'_aa: R'_aa = −ε σ'_aa/ρ_i² where σ'_aa > 0,
-//     else 0, rotated back; in 2D the closed form of GMS §4 (rotation angle θ with
-//     tan 2θ = 2σ_xy/(σ_xx − σ_yy)). In 3D the artificial stress is not implemented (R = 0).
+//     else 0, rotated back (see artificial_stress: 2D and 3D).
 //   velocity gradient (GMS §4): (∇v)^ab_i = ∂v^a/∂x^b = Σ_j (m_j/ρ_j)(v_j − v_i)^a ∂_b W_ij,
 //     ∂_b W_ij the b component of ∇_i W_ij = x_ij F(r_ij); the sum runs over solid particles of
 //     i's body (clamped ones included);
@@ -51,30 +50,69 @@ fn solid_pressure(rho: f32) -> f32 {
     return params.solid_c2 * (rho - params.solid_rho0);
 }
 
-// Artificial stress R_i of a particle with total stress σ and density ρ (GMS §4, 2D closed
-// form; zero in 3D, see the header).
+// One Jacobi rotation of the symmetric `a` in the plane (p, q), zeroing a_pq, with the
+// eigenvector estimates `v` (columns) rotated alongside (Press et al., Numerical Recipes §11.1,
+// eqs. 11.1.8–11.1.18; t = tan φ written without θ = (a_qq − a_pp)/(2 a_pq) so that a tiny a_pq
+// cannot overflow it).
+fn jacobi_rotate(a: ptr<function, mat3x3<f32>>, v: ptr<function, mat3x3<f32>>, p: u32, q: u32) {
+    let apq = (*a)[q][p];
+    if (apq == 0.0) {
+        return;
+    }
+    let d = (*a)[q][q] - (*a)[p][p];
+    let t = select(-1.0, 1.0, d >= 0.0) * 2.0 * apq / (abs(d) + sqrt(d * d + 4.0 * apq * apq));
+    let c = inverseSqrt(t * t + 1.0);
+    let s = t * c;
+    var r = *a;
+    r[p][p] = (*a)[p][p] - t * apq;
+    r[q][q] = (*a)[q][q] + t * apq;
+    r[q][p] = 0.0;
+    r[p][q] = 0.0;
+    let o = 3u - p - q; // the third axis
+    let aop = (*a)[p][o];
+    let aoq = (*a)[q][o];
+    r[p][o] = c * aop - s * aoq;
+    r[o][p] = r[p][o];
+    r[q][o] = s * aop + c * aoq;
+    r[o][q] = r[q][o];
+    *a = r;
+    for (var k = 0u; k < 3u; k++) {
+        let vp = (*v)[p][k];
+        let vq = (*v)[q][k];
+        (*v)[p][k] = c * vp - s * vq;
+        (*v)[q][k] = s * vp + c * vq;
+    }
+}
+
+// Artificial stress R_i of a particle with total stress σ and density ρ (Monaghan 2000; GMS §4):
+// in the principal frame R'_aa = −ε σ'_aa/ρ² where σ'_aa > 0, else 0, rotated back, i.e.
+// R = −(ε/ρ²) σ⁺ with σ⁺ the tensile part of σ. The principal frame comes from cyclic Jacobi
+// sweeps (four, a fixed count so that every invocation does the same work; for 3×3 the
+// off-diagonal is at f32 rounding after three). In 2D σ_xz = σ_yz = 0 and one rotation in
+// the xy-plane is exact: GMS's closed form, tan 2θ = 2σ_xy/(σ_xx − σ_yy); R_zz does not act on
+// the in-plane momentum.
 fn artificial_stress(sigma: mat3x3<f32>, rho: f32) -> mat3x3<f32> {
-    if (DIM != 2u || params.solid_eps == 0.0) {
+    if (params.solid_eps == 0.0) {
         return mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     }
-    let sxx = sigma[0].x;
-    let syy = sigma[1].y;
-    let sxy = sigma[1].x;
-    var theta = 0.0;
-    if (sxy != 0.0 || sxx != syy) {
-        theta = 0.5 * atan2(2.0 * sxy, sxx - syy);
+    var a = sigma;
+    var v = mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+    if (DIM == 2u) {
+        jacobi_rotate(&a, &v, 0u, 1u);
+    } else {
+        for (var sweep = 0u; sweep < 4u; sweep++) {
+            jacobi_rotate(&a, &v, 0u, 1u);
+            jacobi_rotate(&a, &v, 0u, 2u);
+            jacobi_rotate(&a, &v, 1u, 2u);
+        }
     }
-    let c = cos(theta);
-    let s = sin(theta);
-    let pxx = c * c * sxx + 2.0 * c * s * sxy + s * s * syy;
-    let pyy = s * s * sxx - 2.0 * c * s * sxy + c * c * syy;
     let k = -params.solid_eps / (rho * rho);
-    let rxx = select(0.0, k * pxx, pxx > 0.0);
-    let ryy = select(0.0, k * pyy, pyy > 0.0);
-    let xx = c * c * rxx + s * s * ryy;
-    let yy = s * s * rxx + c * c * ryy;
-    let xy = c * s * (rxx - ryy);
-    return mat3x3<f32>(vec3<f32>(xx, xy, 0.0), vec3<f32>(xy, yy, 0.0), vec3<f32>(0.0));
+    var r = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    for (var e = 0u; e < 3u; e++) {
+        let n = v[e];
+        r += mat3x3<f32>(n * n.x, n * n.y, n * n.z) * (k * max(a[e][e], 0.0));
+    }
+    return r;
 }
 
 // What a solid particle contributes to a pair: σ/ρ², R, ρ, v.

@@ -60,41 +60,67 @@ fn transpose(a: &M3) -> M3 {
     t
 }
 
-/// Artificial stress R of a particle of total stress σ and density ρ (Monaghan 2000; GMS §4,
-/// 2D closed form with tan 2θ = 2σ_xy/(σ_xx − σ_yy)); zero in 3D and for ε = 0.
-pub fn artificial_stress(dim: u32, eps: f64, sigma: &M3, rho: f64) -> M3 {
+/// Eigenvalues and eigenvectors (columns of the second matrix) of the symmetric `a`, by cyclic
+/// Jacobi rotations in f64 until the off-diagonal part is below 1e-15 of the norm (Press et
+/// al., Numerical Recipes §11.1).
+pub fn symmetric_eigen(a: &M3) -> ([f64; 3], M3) {
+    let mut a = *a;
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let norm = a.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
+    for _ in 0..50 {
+        let off = 2.0 * (a[0][1].powi(2) + a[0][2].powi(2) + a[1][2].powi(2));
+        if off.sqrt() <= 1e-15 * norm {
+            break;
+        }
+        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
+            if a[p][q] == 0.0 {
+                continue;
+            }
+            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+            let c = 1.0 / (t * t + 1.0).sqrt();
+            let s = t * c;
+            // A ← Jᵀ A J with the plane rotation J (cos, sin at pp, pq; −sin, cos at qp, qq).
+            let mut j = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+            j[p][p] = c;
+            j[q][q] = c;
+            j[p][q] = s;
+            j[q][p] = -s;
+            a = mul(&transpose(&j), &mul(&a, &j));
+            v = mul(&v, &j);
+        }
+    }
+    ([a[0][0], a[1][1], a[2][2]], v)
+}
+
+/// Artificial stress R of a particle of total stress σ and density ρ (Monaghan 2000; GMS §4):
+/// R = −(ε/ρ²) Σ_a max(σ_a, 0) n_a n_aᵀ over the principal stresses σ_a and directions n_a.
+pub fn artificial_stress(eps: f64, sigma: &M3, rho: f64) -> M3 {
     let mut r = [[0.0; 3]; 3];
-    if dim != 2 || eps == 0.0 {
+    if eps == 0.0 {
         return r;
     }
-    let (sxx, syy, sxy) = (sigma[0][0], sigma[1][1], sigma[0][1]);
-    let theta = if sxy != 0.0 || sxx != syy {
-        0.5 * (2.0 * sxy).atan2(sxx - syy)
-    } else {
-        0.0
-    };
-    let (s, c) = theta.sin_cos();
-    let pxx = c * c * sxx + 2.0 * c * s * sxy + s * s * syy;
-    let pyy = s * s * sxx - 2.0 * c * s * sxy + c * c * syy;
+    let (lambda, v) = symmetric_eigen(sigma);
     let k = -eps / (rho * rho);
-    let rxx = if pxx > 0.0 { k * pxx } else { 0.0 };
-    let ryy = if pyy > 0.0 { k * pyy } else { 0.0 };
-    r[0][0] = c * c * rxx + s * s * ryy;
-    r[1][1] = s * s * rxx + c * c * ryy;
-    r[0][1] = c * s * (rxx - ryy);
-    r[1][0] = r[0][1];
+    for (e, l) in lambda.iter().enumerate() {
+        for a in 0..3 {
+            for b in 0..3 {
+                r[a][b] += k * l.max(0.0) * v[a][e] * v[b][e];
+            }
+        }
+    }
     r
 }
 
 /// σ/ρ² and R of a solid particle.
-fn stress_terms(ph: &Physics, mat: &ElasticMaterial, p: &RefParticle, s: &SolidRef) -> (M3, M3) {
+fn stress_terms(mat: &ElasticMaterial, p: &RefParticle, s: &SolidRef) -> (M3, M3) {
     let c2 = mat.sound_speed().powi(2);
     let pressure = c2 * (p.rho - mat.density);
     let mut sigma = tensor(&s.tau);
     for a in 0..3 {
         sigma[a][a] -= pressure;
     }
-    let r = artificial_stress(ph.dim, mat.artificial_stress, &sigma, p.rho);
+    let r = artificial_stress(mat.artificial_stress, &sigma, p.rho);
     (sigma.map(|row| row.map(|x| x / (p.rho * p.rho))), r)
 }
 
@@ -117,7 +143,7 @@ pub fn rates(
     let terms: Vec<Option<(M3, M3)>> = parts
         .iter()
         .zip(solid)
-        .map(|(p, s)| is_solid(p.kind).then(|| stress_terms(ph, mat, p, s)))
+        .map(|(p, s)| is_solid(p.kind).then(|| stress_terms(mat, p, s)))
         .collect();
     (0..parts.len())
         .map(|i| {
@@ -275,4 +301,91 @@ pub fn interface_rates(
             r
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Q diag(λ) Qᵀ for the rotation of the unit quaternion (w, x, y, z).
+    fn rotated(q: [f64; 4], lambda: [f64; 3]) -> (M3, M3) {
+        let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let [w, x, y, z] = q.map(|c| c / n);
+        let r = [
+            [
+                1.0 - 2.0 * (y * y + z * z),
+                2.0 * (x * y - w * z),
+                2.0 * (x * z + w * y),
+            ],
+            [
+                2.0 * (x * y + w * z),
+                1.0 - 2.0 * (x * x + z * z),
+                2.0 * (y * z - w * x),
+            ],
+            [
+                2.0 * (x * z - w * y),
+                2.0 * (y * z + w * x),
+                1.0 - 2.0 * (x * x + y * y),
+            ],
+        ];
+        let d = [
+            [lambda[0], 0.0, 0.0],
+            [0.0, lambda[1], 0.0],
+            [0.0, 0.0, lambda[2]],
+        ];
+        (mul(&r, &mul(&d, &transpose(&r))), r)
+    }
+
+    /// R is −(ε/ρ²) times the tensile part of σ, for stresses built from known principal
+    /// values and directions (3D rotations, a 2D rotation about z, repeated values).
+    #[test]
+    fn artificial_stress_is_the_tensile_part() {
+        let (eps, rho) = (0.3, 1100.0);
+        let k = -eps / (rho * rho);
+        for (q, lambda) in [
+            ([0.9, 0.1, -0.3, 0.2], [3.0e4, -2.0e4, 1.0e4]),
+            ([0.2, 0.7, 0.5, -0.4], [-5.0e3, -1.0e3, 2.0e5]),
+            ([0.5, -0.5, 0.5, 0.5], [1.0e4, 1.0e4, -3.0e4]),
+            ([0.8, 0.0, 0.0, 0.6], [2.0e4, -7.0e4, 0.0]),
+            ([1.0, 0.3, 0.2, 0.1], [-1.0e4, -2.0e4, -3.0e4]),
+        ] {
+            let (sigma, _) = rotated(q, lambda);
+            let (want, _) = rotated(q, lambda.map(|l| k * l.max(0.0)));
+            let got = artificial_stress(eps, &sigma, rho);
+            let scale = lambda.iter().fold(0.0f64, |m, l| m.max(l.abs())) * k.abs();
+            for a in 0..3 {
+                for b in 0..3 {
+                    assert!(
+                        (got[a][b] - want[a][b]).abs() <= 1e-12 * scale,
+                        "λ {lambda:?}: R[{a}][{b}] = {} against {}",
+                        got[a][b],
+                        want[a][b]
+                    );
+                }
+            }
+        }
+        assert_eq!(
+            artificial_stress(0.0, &rotated([0.9, 0.1, -0.3, 0.2], [1e4; 3]).0, rho),
+            [[0.0; 3]; 3]
+        );
+    }
+
+    #[test]
+    fn symmetric_eigen_diagonalises() {
+        let (sigma, _) = rotated([0.3, -0.2, 0.9, 0.1], [7.0, -2.0, 3.5]);
+        let (mut lambda, v) = symmetric_eigen(&sigma);
+        // Vᵀ σ V is diagonal with the eigenvalues.
+        let d = mul(&transpose(&v), &mul(&sigma, &v));
+        for a in 0..3 {
+            for b in 0..3 {
+                let want = if a == b { lambda[a] } else { 0.0 };
+                assert!((d[a][b] - want).abs() < 1e-13, "{d:?}");
+            }
+        }
+        lambda.sort_by(f64::total_cmp);
+        assert!(
+            (lambda[0] + 2.0).abs() < 1e-13 && (lambda[2] - 7.0).abs() < 1e-13,
+            "{lambda:?}"
+        );
+    }
 }
