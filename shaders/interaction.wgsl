@@ -35,14 +35,17 @@
 //   deviatoric stresses push the fluid along the interface and the run blows up within
 //   milliseconds (the elastic gate). The pair terms are equal and opposite
 //   (m_i dv_i = −m_j dv_j): momentum is conserved across the interface. Solid particles get
-//   only these fluid terms here; elastic.wgsl adds the solid–solid ones and gravity.
+//   these fluid terms here and contact (the repulsive law below, per unit mass) from boundary
+//   particles of walls and bodies and from particles of other elastic bodies; elastic.wgsl
+//   (or total_lagrangian.wgsl) adds the forces within the body and gravity.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
 // get nothing here.
 // Particles of moving bodies get the force per unit mass of their fluid neighbours, the opposite
 // of what the fluid receives from them: for dynamic and fixed-ghost body particles
 // −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (a ghost with its interpolated P_g and its
 // viscous velocity), for repulsive ones Σ_j F(x_ij); and a contact force from boundary
-// particles of other bodies and of the fixed walls (the repulsive law above, Monaghan 1994):
+// particles of other bodies and of the fixed walls and from elastic solids' particles (the
+// repulsive law above, Monaghan 1994):
 // bodies.wgsl sums both into the body's force and torque. A body's fixed ghosts move with it:
 // continuity sees the body's rigid velocity at the ghost, v_wall = u_c + ω × (R r), and the
 // no-slip viscous velocity is 2 v_wall − v_f.
@@ -129,18 +132,32 @@ fn interface_rates(b_i: f32, v_i: vec3<f32>, rho_i: f32, b_j: f32, v_j: vec3<f32
     return vec4<f32>(acc, drho);
 }
 
-// Acceleration of solid particle i by its fluid neighbours (the fluid's load on the solid).
-fn solid_from_fluid(i: u32) -> vec3<f32> {
+// Contact between a solid particle (mass m_s) and a moving body's particle, which carries the
+// fluid's mass m_f (bodies.wgsl sums m_f × its rate): the pair force is 2 m_s m_f/(m_s + m_f)
+// times the law per unit mass, equal and opposite; this is the acceleration factor of the side
+// whose partner has mass `m_other` (m_f for the solid particle, m_s for the body's).
+fn solid_body_contact_weight(m_other: f32) -> f32 {
+    return 2.0 * m_other / (params.mass + params.solid_mass);
+}
+
+// Acceleration of solid particle i by everything outside its own elastic body: the fluid's load
+// (interface_rates) and contact (the repulsive law of the walls, `repulsion`) with boundary
+// particles (fixed walls, as for fluid; moving bodies' particles of any wall treatment, with
+// solid_body_contact_weight) and with the particles of other elastic bodies (one material:
+// equal masses).
+fn solid_loads(i: u32) -> vec3<f32> {
     let p_i = pos[i];
     let vr_i = velrho[i];
     let b_i = solid[i].interface_p / (vr_i.w * vr_i.w);
+    let body_i = solid[i].body;
     let support2 = 4.0 * params.h * params.h;
     var r = vec3<f32>(0.0);
     var slots: array<u32, 27>;
     let n_slots = neighbour_slots(cell_of(p_i), &slots);
     for (var s = 0u; s < n_slots; s++) {
         for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
-            if (code_kind(code[j]) != KIND_FLUID) {
+            let kind_j = code_kind(code[j]);
+            if (kind_j == KIND_EXCLUDED || j == i) {
                 continue;
             }
             let x_ij = rel_pos(p_i, pos[j]);
@@ -148,8 +165,18 @@ fn solid_from_fluid(i: u32) -> vec3<f32> {
             if (r2 >= support2) {
                 continue;
             }
-            let vr_j = velrho[j];
-            r += interface_rates(b_i, vr_i.xyz, vr_i.w, pressure_of(vr_j.w) / (vr_j.w * vr_j.w), vr_j.xyz, vr_j.w, params.mass, x_ij, r2).xyz;
+            if (kind_j == KIND_FLUID) {
+                let vr_j = velrho[j];
+                r += interface_rates(b_i, vr_i.xyz, vr_i.w, pressure_of(vr_j.w) / (vr_j.w * vr_j.w), vr_j.xyz, vr_j.w, params.mass, x_ij, r2).xyz;
+            } else if (!is_solid(kind_j)) {
+                var k = 1.0;
+                if (is_body_particle(code[j] & ID_MASK)) {
+                    k = solid_body_contact_weight(params.mass);
+                }
+                r += k * repulsion(x_ij, r2);
+            } else if (solid[j].body != body_i) {
+                r += repulsion(x_ij, r2);
+            }
         }
     }
     return r;
@@ -294,7 +321,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         energy_rate[i] = 0.0;
     }
     if (is_solid(kind_i)) {
-        rate[i] = vec4<f32>(solid_from_fluid(i), 0.0);
+        rate[i] = vec4<f32>(solid_loads(i), 0.0);
         return;
     }
     let fluid_i = kind_i == KIND_FLUID;
@@ -347,7 +374,11 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                         let pr = pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, false, 1.0).rate;
                         r += select(vec4<f32>(pr.xyz, 0.0), pr, kind_i == KIND_WALL);
                     }
-                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && !is_solid(kind_j) && other_solid(body_i, code[j] & ID_MASK)) {
+                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
+                    // Contact with an elastic solid.
+                    r += vec4<f32>(solid_body_contact_weight(params.solid_mass) * repulsion(x_ij, r2), 0.0);
+                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && other_solid(body_i, code[j] & ID_MASK)) {
+                    // Contact with a fixed wall or another body.
                     r += vec4<f32>(repulsion(x_ij, r2), 0.0);
                 }
                 continue;

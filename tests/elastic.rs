@@ -65,6 +65,13 @@ fn random_solid(dim: u32, kernel: KernelKind, seed: u64, mat: ElasticMaterial) -
             rho *= 1.0 + rng.range(-0.01, 0.01);
         }
         let clamped = p[0] < min[0] + 2.0 * dx;
+        // Two bodies side by side: no pair across the line y = centre. The upper one sits
+        // 0.5 dx higher, so that no two particles across are within the contact law's reach
+        // r0 = dx (1.1 dx apart at least) but all are within the kernel's 2h.
+        let upper = p[1] > min[1] + 0.5 * side;
+        if upper {
+            pos[1] += 0.5 * dx;
+        }
         parts.push(Particle {
             pos,
             vel: if clamped { [0.0; 3] } else { vel },
@@ -75,8 +82,7 @@ fn random_solid(dim: u32, kernel: KernelKind, seed: u64, mat: ElasticMaterial) -
                 Kind::Solid
             },
         });
-        // Two bodies side by side: no pair across the line y = centre.
-        body.push((p[1] > min[1] + 0.5 * side) as u32);
+        body.push(upper as u32);
         tau0.push(t);
     }
     with_solids(ph, parts, mat, body, tau0)
@@ -190,6 +196,173 @@ fn elastic_rates_match_reference() {
         assert!(e_acc < 2e-4, "acceleration error {e_acc}");
         assert!(e_rho < 2e-4, "density-rate error {e_rho}");
         assert!(e_tau < 2e-4, "stress-rate error {e_tau}");
+    }
+}
+
+/// Two elastic bodies side by side on a floor of dynamic wall particles, beside a rigid body
+/// (dynamic particles, free), each 0.8 dx (±0.1 dx of jitter) from the next: within the
+/// repulsive law's reach r0 = dx. The solid is denser than the fluid's particle mass that body
+/// particles carry, so the contact weights differ from 1.
+fn solids_in_contact(dim: u32, seed: u64) -> Scenario {
+    let dx = 0.01;
+    let mut ph = physics(dim, dx, 20.0);
+    ph.gravity = [0.0; 3];
+    let up = dim as usize - 1;
+    let mut rng = Rng(seed);
+    let mat = ElasticMaterial {
+        density: 2500.0,
+        ..material()
+    };
+    // Boxes along x from `x0` to `x1`, `y0` to `y0 + height` in the up direction; 0.06 deep in 3D.
+    let block = |x0: f64, x1: f64, y0: f64, height: f64| {
+        let (mut lo, mut hi) = ([0.1; 3], [0.16; 3]);
+        lo[0] = x0;
+        hi[0] = x1;
+        lo[up] = y0;
+        hi[up] = y0 + height;
+        if dim == 2 {
+            lo[2] = 0.0;
+            hi[2] = 0.0;
+        }
+        lattice(dim, dx, lo, hi)
+    };
+    let floor_top = 0.03;
+    let mut parts: Vec<Particle> = block(0.06, 0.3, floor_top - 3.0 * dx, 3.0 * dx)
+        .into_iter()
+        .map(|pos| Particle {
+            pos,
+            vel: [0.0; 3],
+            rho: 1000.0,
+            kind: Kind::Wall,
+        })
+        .collect();
+    let mut body = vec![0; parts.len()];
+    let mut tau0 = vec![[0.0; 6]; parts.len()];
+    // Solid 0 from x = 0.1, solid 1 from 0.8 dx after it, the rigid body 0.8 dx after that.
+    let y0 = floor_top - 0.2 * dx;
+    let x1 = 0.1 + 6.0 * dx - 0.2 * dx;
+    for (k, (a, b)) in [(0.1, 0.1 + 6.0 * dx), (x1, x1 + 6.0 * dx)]
+        .into_iter()
+        .enumerate()
+    {
+        for p in block(a, b, y0, 6.0 * dx) {
+            let mut pos = p;
+            let mut vel = [0.0; 3];
+            for c in 0..dim as usize {
+                pos[c] += rng.range(-0.1, 0.1) * dx;
+                vel[c] = rng.range(-0.5, 0.5);
+            }
+            parts.push(Particle {
+                pos,
+                vel,
+                rho: mat.density,
+                kind: Kind::Solid,
+            });
+            body.push(k as u32);
+            tau0.push([0.0; 6]);
+        }
+    }
+    let x2 = x1 + 6.0 * dx - 0.2 * dx;
+    let start = parts.len();
+    let rigid = block(x2, x2 + 4.0 * dx, y0, 6.0 * dx);
+    let n = rigid.len() as f64;
+    let mut center = [0.0; 3];
+    for p in &rigid {
+        for a in 0..3 {
+            center[a] += p[a] / n;
+        }
+    }
+    for pos in rigid {
+        parts.push(Particle {
+            pos,
+            vel: [0.0; 3],
+            rho: 1000.0,
+            kind: Kind::Wall,
+        });
+    }
+    body.resize(parts.len(), 0);
+    tau0.resize(parts.len(), [0.0; 6]);
+    let mass = 1000.0 * dx.powi(dim as i32) * n;
+    let mut sc = with_solids(ph, parts, mat, body, tau0);
+    sc.bodies = vec![Body {
+        name: "rigid".into(),
+        particles: start..sc.particles.len(),
+        mass,
+        center,
+        inertia: [
+            [mass * 1e-3, 0.0, 0.0],
+            [0.0, mass * 1e-3, 0.0],
+            [0.0, 0.0, mass * 1e-3],
+        ],
+        motion: Motion::Free {
+            velocity: [0.0; 3],
+            omega: [0.0; 3],
+        },
+    }];
+    sc
+}
+
+/// Layer 1 for contact: elastic particles against a floor, another elastic body and a rigid
+/// body, 2D and 3D. Each particle's GPU rate (the interaction pass with its contact terms, then
+/// the elastic pass) against the reference's solid rates plus `elastic::contact_rates` for
+/// solid particles and `interaction::rates` (with the solids' reaction) for the rigid body's.
+/// Rows in contact and rows without are compared each against their own RMS (the repulsive law
+/// is much stronger than the elastic forces here).
+#[test]
+fn solid_contact_matches_reference() {
+    for dim in [2, 3] {
+        let sc = solids_in_contact(dim, 40 + dim as u64);
+        let ph = &sc.physics;
+        let mat = sc.solids.as_ref().unwrap().material;
+        let solver = Solver::new(gpu(), &sc).unwrap();
+        let parts = gpu_particles(&solver);
+        let solid = solid_refs(&solver);
+        let gpu_rate = solver.rerun_interaction(true).unwrap();
+        let space = Space::of(&sc);
+        let solids = elastic::rates(ph, &mat, &space, &parts, &solid);
+        let contact = elastic::contact_rates(ph, &mat, &sc.walls, &space, &parts, &solid);
+        let boundary = wgsph::reference::interaction::rates(ph, &sc.walls, &space, &parts);
+        let mut groups: [Vec<(usize, [f64; 3])>; 4] = Default::default();
+        for i in 0..parts.len() {
+            let (want, group) = if elastic::is_solid(parts[i].kind) {
+                let s = solids[i].expect("solid").rate;
+                let c = contact[i];
+                let touching = c.iter().any(|x| *x != 0.0);
+                ([0, 1, 2].map(|a| s[a] + c[a]), touching as usize)
+            } else if parts[i].body.is_some() {
+                let (b, c) = (boundary[i], contact[i]);
+                let want = [0, 1, 2].map(|a| b[a] + c[a]);
+                (want, 2 + want.iter().any(|x| *x != 0.0) as usize)
+            } else {
+                continue;
+            };
+            groups[group].push((i, want));
+        }
+        for (name, rows) in ["solid", "solid in contact", "rigid", "rigid in contact"]
+            .iter()
+            .zip(&groups)
+        {
+            if *name == "rigid" {
+                // Without fluid the rigid body's only force is contact (floor and solids).
+                assert!(rows.iter().all(|(_, w)| *w == [0.0; 3]));
+                continue;
+            }
+            assert!(rows.len() >= 5, "{dim}D: only {} {name} rows", rows.len());
+            let scale = rms(rows.iter().flat_map(|(_, w)| w.to_vec()));
+            let mut err = 0.0f64;
+            for (i, w) in rows {
+                let g = gpu_rate[*i];
+                assert!(g.iter().all(|x| x.is_finite()), "row {i}: {g:?}");
+                for a in 0..3 {
+                    err = err.max((g[a] as f64 - w[a]).abs() / scale);
+                }
+            }
+            println!(
+                "{dim}D {name}: {} rows, acceleration error {err:.1e} of RMS {scale:.3e}",
+                rows.len()
+            );
+            assert!(err < 2e-4, "{dim}D {name}: error {err}");
+        }
     }
 }
 

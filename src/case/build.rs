@@ -33,7 +33,8 @@ fn fmt_box(b: &Aabb, dim: usize) -> String {
 }
 
 pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Scenario, CaseError> {
-    if !case.solids.is_empty() && case.blocks.is_empty() {
+    let solids_alone = case.tank.is_none() && case.obstacles.is_empty() && case.bodies.is_empty();
+    if !case.solids.is_empty() && case.blocks.is_empty() && solids_alone {
         return super::solids::build_solid_case(ctx, case, max_particles);
     }
     let (dim, dx) = (case.dim, case.dx);
@@ -115,10 +116,13 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
 
     // The global lattice, continued by walls and obstacles.
     let lat = Lattice {
-        origin: case
-            .tank
-            .as_ref()
-            .map_or(case.blocks[0].bx.min, |t| t.inner.min),
+        // The tank's inner corner, else the first fluid block's, else (solids and walls without
+        // fluid) the first solid's.
+        origin: match (&case.tank, case.blocks.first()) {
+            (Some(t), _) => t.inner.min,
+            (None, Some(b)) => b.bx.min,
+            (None, None) => case.solids[0].bx.min,
+        },
         dx,
         dim,
     };
@@ -197,6 +201,9 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     // Speed of sound and the hydrostatic start.
     let g = case.gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
     let c0 = match case.sound {
+        // Without fluid c0 is unused (the solids have their own sound speed); that one keeps
+        // the checks below meaningful.
+        _ if case.blocks.is_empty() => elastic.as_ref().map_or(1.0, |e| e.0.sound_speed()),
         Sound::Speed(c) => c,
         Sound::Coef(k) => {
             let floor = |b: &Aabb| case.tank.as_ref().map_or(b.min[v], |t| t.inner.min[v]);
@@ -630,6 +637,7 @@ fn domain(
             let mut all: Vec<Aabb> = solid.iter().map(|(_, b)| *b).collect();
             if wall.is_none() {
                 all.extend(case.blocks.iter().map(|b| b.bx));
+                all.extend(case.solids.iter().map(|s| s.bx));
             }
             let mut d = all[0];
             for b in &all[1..] {
@@ -774,19 +782,29 @@ fn swept(b: &Aabb, motion: &Motion, end_s: f64, dim: usize) -> Aabb {
 }
 
 /// Height of the fluid from its lowest to its highest particle (+ dx), the H of the default
-/// repulsive-wall strength D = 5 g H.
+/// repulsive-wall strength D = 5 g H (Monaghan 1994: D of the order of the largest v², 2 g H
+/// for water falling H). Without fluid, the height of the highest elastic-solid particle above
+/// the lowest particle of any kind (the floor): what a solid falls at most.
 fn highest_column(particles: &[Particle], dim: usize, dx: f64) -> f64 {
     let up = dim - 1;
-    let (lo, hi) = particles
-        .iter()
-        .filter(|p| p.kind == Kind::Fluid)
-        .fold((f64::MAX, f64::MIN), |(lo, hi), p| {
-            (lo.min(p.pos[up]), hi.max(p.pos[up]))
-        });
-    if lo > hi {
-        dx
+    let span = |of: &dyn Fn(Kind) -> bool| {
+        particles
+            .iter()
+            .filter(|p| of(p.kind))
+            .fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+                (lo.min(p.pos[up]), hi.max(p.pos[up]))
+            })
+    };
+    let (lo, hi) = span(&|k| k == Kind::Fluid);
+    if lo <= hi {
+        return hi - lo + dx;
+    }
+    let (_, top) = span(&|k| matches!(k, Kind::Solid | Kind::SolidClamped));
+    let (floor, _) = span(&|_| true);
+    if floor <= top {
+        top - floor + dx
     } else {
-        hi - lo + dx
+        dx
     }
 }
 

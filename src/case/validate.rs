@@ -495,14 +495,17 @@ pub(super) fn validate(
         .map(|(i, s)| super::solids::validate_solid(ctx, i, s, dim))
         .collect::<Result<Vec<_>, _>>()?;
     if !solids.is_empty() {
-        // Solids are coupled to fluid (interaction.wgsl), not to walls or rigid bodies: a tank
-        // and obstacles only hold the fluid. Without fluid, solids come alone.
-        let alone = raw.fluid_block.is_empty();
-        let lonely = "without a [[fluid_block]] (walls hold fluid; solids alone take none)";
+        // Solids take the fluid's load and contact with walls, bodies and each other
+        // (interaction.wgsl); what they cannot yet be combined with:
         let other = [
-            ("tank", alone && raw.tank.is_some(), lonely),
-            ("obstacle", alone && !raw.obstacle.is_empty(), lonely),
-            ("body", !raw.body.is_empty(), "yet (no solid–body contact)"),
+            (
+                "tank.wall",
+                raw.tank
+                    .as_ref()
+                    .is_some_and(|t| t.wall == Some(WallName::Mirror)),
+                "= \"mirror\" (mirror planes have no particles for a solid to touch, and \
+                 their images carry no solid)",
+            ),
             (
                 "tank.motion",
                 raw.tank.as_ref().is_some_and(|t| t.motion.is_some()),
@@ -515,16 +518,11 @@ pub(super) fn validate(
             ),
         ];
         if let Some((what, _, why)) = other.iter().find(|(_, present, _)| *present) {
-            let fix = if alone && (*what == "tank" || *what == "obstacle") {
-                format!("add the fluid, or remove {what}")
-            } else {
-                format!("remove {what}, or the [[solid]] tables")
-            };
             return Err(ctx.err(
                 what,
                 None,
                 format!("a case with [[solid]] cannot have {what} {why}"),
-                fix,
+                format!("remove {what}, or the [[solid]] tables"),
             ));
         }
     }

@@ -303,6 +303,68 @@ pub fn interface_rates(
         .collect()
 }
 
+/// The factor of the contact law between a solid particle and a moving body's particle for
+/// the side whose partner has mass `m_other`: the pair force is 2 m_s m_f/(m_s + m_f) times
+/// the law per unit mass, m_f the fluid's particle mass that a body particle carries.
+pub fn solid_body_contact_weight(ph: &Physics, mat: &ElasticMaterial, m_other: f64) -> f64 {
+    let m_s = mat.density * ph.dx.powi(ph.dim as i32);
+    2.0 * m_other / (ph.particle_mass + m_s)
+}
+
+/// Contact accelerations of solid particles (as `solid_loads` in interaction.wgsl) and of the
+/// moving bodies' particles they touch; zero for the others. A solid particle feels the walls'
+/// repulsive law (`interaction::repulsion`, per unit mass) from every fixed wall particle,
+/// every moving body's particle (whatever its treatment; times `solid_body_contact_weight`)
+/// and every particle of another elastic body within 2h; a body's particle the reaction of
+/// the solid's (times its weight). `solid` is indexed like `parts`.
+pub fn contact_rates(
+    ph: &Physics,
+    mat: &ElasticMaterial,
+    walls: &crate::scenario::WallParams,
+    space: &Space,
+    parts: &[RefParticle],
+    solid: &[SolidRef],
+) -> Vec<[f64; 3]> {
+    let m_s = mat.density * ph.dx.powi(ph.dim as i32);
+    let on_solid = solid_body_contact_weight(ph, mat, ph.particle_mass);
+    let on_body = solid_body_contact_weight(ph, mat, m_s);
+    let support2 = 4.0 * ph.h * ph.h;
+    let fixed_wall = |p: &RefParticle| {
+        p.kind != super::FLUID && p.kind != super::EXCLUDED && !is_solid(p.kind) && p.body.is_none()
+    };
+    let on_a_body = |p: &RefParticle| p.body.is_some() && p.kind != super::EXCLUDED;
+    (0..parts.len())
+        .map(|i| {
+            let mut a = [0.0; 3];
+            let pi = &parts[i];
+            for (j, pj) in parts.iter().enumerate() {
+                let k = if is_solid(pi.kind) {
+                    if fixed_wall(pj) || (is_solid(pj.kind) && solid[j].body != solid[i].body) {
+                        1.0
+                    } else if on_a_body(pj) {
+                        on_solid
+                    } else {
+                        continue;
+                    }
+                } else if on_a_body(pi) && is_solid(pj.kind) {
+                    on_body
+                } else {
+                    continue;
+                };
+                let x_ij = space.sub(pi.pos, pj.pos);
+                if j == i || dot(x_ij, x_ij) >= support2 {
+                    continue;
+                }
+                let f = super::interaction::repulsion(ph, walls, x_ij);
+                for c in 0..3 {
+                    a[c] += k * f[c];
+                }
+            }
+            a
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

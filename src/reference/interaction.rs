@@ -117,7 +117,8 @@ fn add(a: &mut [f64; 4], b: [f64; 4]) {
 /// terms (`elastic::interface_rates`), dynamic walls only dρ/dt from fluid neighbours, fixed
 /// ghosts, repulsive and solid particles nothing. Body particles (of any wall treatment) also
 /// get the fluid's force, the opposite of what they exert on it, and the contact force of
-/// other solids' particles.
+/// fixed walls' and other bodies' particles (that of elastic solids:
+/// `elastic::contact_rates`).
 pub fn rates(
     ph: &Physics,
     walls: &WallParams,
@@ -193,7 +194,8 @@ pub fn rates_and_energy(
                         && !super::elastic::is_solid(pj.kind)
                         && pj.body != pi.body
                     {
-                        // Contact with a fixed wall or another body.
+                        // Contact with a fixed wall or another body (with elastic solids:
+                        // `elastic::contact_rates`).
                         let f = repulsion(ph, walls, x_ij);
                         add(&mut r, [f[0], f[1], f[2], 0.0]);
                     }

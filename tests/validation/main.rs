@@ -7,6 +7,7 @@ mod common;
 
 mod bodies;
 mod cases;
+mod contact;
 mod gate;
 mod lobovsky;
 mod plate;

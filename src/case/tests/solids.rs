@@ -95,12 +95,6 @@ fn solid_errors_name_the_field() {
         &["solid[0].clamped_max_m", "empty"],
     );
     assert_err(
-        &format!("{SOLID}\n[tank]\nmin_m = [0.0, 0.0]\nmax_m = [0.5, 0.5]\n"),
-        &[],
-        None,
-        &["tank", "without a [[fluid_block]]"],
-    );
-    assert_err(
         &format!("{SOLID}\n[[solid]]\nname = \"b\"\nmin_m = [0.3, 0.0]\nmax_m = [0.4, 0.04]\ndensity_kg_m3 = 1000.0\nyoungs_modulus_pa = 3.0e6\npoisson_ratio = 0.3975\n"),
         &[],
         None,
@@ -219,10 +213,44 @@ formulation = "total_lagrangian"
     );
 }
 
+/// A solid in a tank without fluid: the tank's walls on the lattice from its inner corner, the
+/// solid's particles, the solid's sound speed as c0 (the fluid's is unused) and the contact
+/// strength D = 5 g H from the floor's lowest particle to the solid's highest.
+#[test]
+fn a_solid_in_an_empty_tank_builds_with_the_walls() {
+    let case = format!(
+        "{}\n[tank]\nmin_m = [0.0, 0.0]\nmax_m = [0.5, 0.5]\n",
+        SOLID
+            .replace(
+                "[0.0, 0.0]\nmax_m = [0.2, 0.04]",
+                "[0.1, 0.1]\nmax_m = [0.3, 0.14]"
+            )
+            .replace(
+                "clamped_min_m = [0.0, 0.0]\nclamped_max_m = [0.05, 0.04]\n",
+                ""
+            )
+            .replace("[0.0, 0.0]", "[0.0, -9.81]")
+    );
+    let s = load_str(&case, "cases/t.toml", &[]).unwrap();
+    assert_eq!(s.count(Kind::Solid), 20 * 4);
+    assert_eq!(s.count(Kind::Fluid), 0);
+    // 3 layers around a 50 × 50 open box: floor 3 × 56, sides 2 × 3 × 50.
+    assert_eq!(s.count(Kind::Wall), 3 * 56 + 2 * 3 * 50);
+    let m = s.solids.as_ref().unwrap().material;
+    assert_eq!(s.physics.c0, m.sound_speed());
+    // Floor's lowest particle at −0.025, the solid's highest at 0.135.
+    let d = 5.0 * 9.81 * (0.135 + 0.025 + 0.01);
+    assert!(
+        (s.walls.repulsive_d - d).abs() < 1e-9,
+        "D = {}",
+        s.walls.repulsive_d
+    );
+}
+
 /// A gate of solid particles in a tank of water (the elastic gate's layout): fluid where the
 /// solid is not (at least a spacing from its particles), solid particles before the walls'
-/// end, a solid state for every particle; bodies, a moving tank and the energy equation are
-/// refused beside solids.
+/// end, a solid state for every particle; a rigid body after the solids; a moving tank and
+/// the energy equation are refused beside solids.
 #[test]
 fn fluid_and_solids_build_together() {
     let case = GATE_IN_WATER;
@@ -252,18 +280,36 @@ fn fluid_and_solids_build_together() {
         "the fluid's mass"
     );
 
-    for (extra, words) in [
-        (
-            "[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.5, 0.25]\nmax_m = [0.55, 0.3]\ndensity_kg_m3 = 500.0\n",
-            &["body", "solid–body contact"][..],
+    let with_body = format!(
+        "{case}[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.5, 0.25]\nmax_m = [0.55, 0.3]\ndensity_kg_m3 = 500.0\n"
+    );
+    let b = load_str(&with_body, "cases/t.toml", &[]).unwrap();
+    let solids = b.solids.as_ref().expect("solids");
+    assert_eq!(b.bodies.len(), 1);
+    assert_eq!(solids.body.len(), b.particles.len());
+    let first_body = b.bodies[0].particles.start;
+    assert!(b.particles[first_body..].iter().all(|p| !p.kind.is_solid()));
+    assert_eq!(
+        b.particles[..first_body]
+            .iter()
+            .filter(|p| p.kind.is_solid())
+            .count(),
+        gate.len()
+    );
+    assert_err(
+        &format!(
+            "{case}[tank.motion]\nkind = \"sine\"\nperiod_s = 1.0\ntranslation_m = [0.01, 0.0]\n"
         ),
-        (
-            "[tank.motion]\nkind = \"sine\"\nperiod_s = 1.0\ntranslation_m = [0.01, 0.0]\n",
-            &["tank.motion", "clamped"][..],
-        ),
-    ] {
-        assert_err(&format!("{case}{extra}"), &[], None, words);
-    }
+        &[],
+        None,
+        &["tank.motion", "clamped"],
+    );
+    assert_err(
+        &case.replace("[tank]\n", "[tank]\nwall = \"mirror\"\n"),
+        &[],
+        None,
+        &["tank.wall", "mirror planes have no particles"],
+    );
     assert_err(
         &case.replace("[physics]\n", "[physics]\nenergy = true\n"),
         &[],

@@ -1,0 +1,93 @@
+//! Layer 2 for contact: a soft elastic block dropped 3 cm onto the floor of an empty tank. The
+//! floor's particles stop it through the walls' repulsive law (interaction.wgsl, `solid_loads`):
+//! it must not pass through the floor, must bounce (its mean vertical velocity turns upward
+//! after the impact, slower than it came down) and must not gain energy.
+
+use crate::common::gpu;
+use wgsph::scenario::Kind;
+use wgsph::sph::Solver;
+
+const CASE: &str = r#"name = "elastic_drop_2d"
+dimension = 2
+[particles]
+dx_m = 0.004
+h_over_dx = 1.3
+kernel = "wendland_c2"
+[physics]
+gravity_m_s2 = [0.0, -9.81]
+[time]
+end_s = 0.3
+output_every_s = 0.1
+probe_every_s = 0.01
+[tank]
+min_m = [0.0, 0.0]
+max_m = [0.2, 0.12]
+[[solid]]
+name = "block"
+min_m = [0.08, 0.03]
+max_m = [0.12, 0.07]
+density_kg_m3 = 1000.0
+youngs_modulus_pa = 2.0e5
+poisson_ratio = 0.3
+"#;
+
+/// Lowest y, mean vertical velocity and mean ½|v|² + g y [J/kg] of the solid particles.
+fn solid_state(solver: &Solver) -> (f64, f64, f64) {
+    let p = solver.read_particles().unwrap();
+    let (mut low, mut vy, mut e, mut n) = (f64::MAX, 0.0, 0.0, 0.0);
+    for i in 0..p.pos.len() {
+        if p.kind[i] != Kind::Solid as u32 {
+            continue;
+        }
+        let v = p.vel[i].map(|c| c as f64);
+        low = low.min(p.pos[i][1]);
+        vy += v[1];
+        e += 0.5 * (v[0] * v[0] + v[1] * v[1]) + 9.81 * p.pos[i][1];
+        n += 1.0;
+    }
+    (low, vy / n, e / n)
+}
+
+#[test]
+fn an_elastic_block_dropped_on_the_floor_bounces_off_it() {
+    let sc = wgsph::case::load_str(CASE, "elastic_drop_2d.toml", &[]).unwrap();
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    let (_, _, e0) = solid_state(&solver);
+    let (mut lowest, mut e_max) = (f64::MAX, f64::MIN);
+    // The fastest mean downward velocity, then the fastest upward one of the first bounce.
+    let (mut impact, mut rebound, mut bounced) = (0.0f64, 0.0f64, false);
+    for k in 1..=300 {
+        solver.advance_to(1e-3 * k as f64).unwrap();
+        let (low, vy, e) = solid_state(&solver);
+        lowest = lowest.min(low);
+        e_max = e_max.max(e);
+        if !bounced && rebound == 0.0 {
+            impact = impact.min(vy);
+        }
+        if vy > 0.0 && !bounced {
+            rebound = rebound.max(vy);
+        } else if rebound > 0.0 {
+            bounced = true;
+        }
+    }
+    let fall: f64 = 9.81 * 0.03;
+    println!(
+        "impact at {impact:.3} m/s (free fall {:.3}); rebound at {rebound:.3} m/s; lowest \
+         particle {lowest:.2e} m above the floor's surface; largest ½v² + g y {:+.2e} of the \
+         drop's g·0.03 over the start",
+        -(2.0 * fall).sqrt(),
+        (e_max - e0) / fall
+    );
+    assert!(
+        lowest > 0.0,
+        "a particle reached {lowest} m, the floor is at 0"
+    );
+    assert!(
+        bounced && rebound > 0.0 && rebound < -impact,
+        "rebound {rebound} m/s against impact {impact} m/s"
+    );
+    assert!(
+        e_max - e0 < 0.01 * fall,
+        "the block gained energy: {e_max} against {e0}"
+    );
+}
