@@ -225,7 +225,49 @@ fn schedule(every: f64, end: f64) -> impl Iterator<Item = f64> {
     (1..=n).map(move |k| (k as f64 * every).min(end))
 }
 
-/// Runs `sc` on `ctx`, writing into `dir`; `progress` hears once per probe interval.
+/// Removes what an earlier run wrote into `dir` (the files this engine names: particle series,
+/// probe and body tables, snapshots, plots, summary, checkpoint), so that a new run into the
+/// same folder leaves no stale file beside its own (a longer earlier run's last VTU files, a
+/// removed probe's table). Other files stay.
+fn remove_previous_outputs(dir: &Path) -> Result<()> {
+    use crate::output::{PARTICLES_DIR, PROBES_DIR, PVD_FILE, RUN_SUMMARY_FILE};
+    use crate::plot::PLOTS_DIR;
+    let mut stale: Vec<std::path::PathBuf> = [PVD_FILE, RUN_SUMMARY_FILE, CHECKPOINT_FILE]
+        .iter()
+        .map(|f| dir.join(f))
+        .filter(|p| p.is_file())
+        .collect();
+    for (sub, ext) in [
+        (PARTICLES_DIR, "vtu"),
+        (PROBES_DIR, "csv"),
+        (SNAPSHOTS_DIR, "png"),
+        (PLOTS_DIR, "png"),
+        (PLOTS_DIR, "csv"),
+    ] {
+        let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_file() && p.extension().is_some_and(|x| x == ext) {
+                stale.push(p);
+            }
+        }
+    }
+    for p in stale {
+        std::fs::remove_file(&p).with_context(|| {
+            format!(
+                "cannot remove {}, an output of an earlier run in the same folder; remove it \
+                 or choose another --out",
+                p.display()
+            )
+        })?;
+    }
+    Ok(())
+}
+
+/// Runs `sc` on `ctx`, writing into `dir` (after removing an earlier run's outputs there);
+/// `progress` hears once per probe interval.
 pub fn run(
     ctx: &GpuContext,
     sc: &Scenario,
@@ -234,6 +276,7 @@ pub fn run(
     progress: &mut dyn Progress,
 ) -> Result<RunReport> {
     check_capacity(ctx, sc.particles.len())?;
+    remove_previous_outputs(dir)?;
     let mut runner = Runner::create(ctx, sc, dir, options)?;
     runner.outputs.write(&runner.solver)?;
     if !sc.probes.is_empty() {
@@ -552,7 +595,46 @@ impl<'a> Runner<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::{schedule, CheckpointPolicy};
+    use super::{remove_previous_outputs, schedule, CheckpointPolicy};
+
+    /// A new run into an old run's folder removes the old run's outputs (a longer run's last
+    /// VTU files, a removed probe's table, its plots, summary and checkpoint) and nothing else.
+    #[test]
+    fn a_new_run_removes_the_previous_runs_outputs_only() {
+        let d = std::env::temp_dir().join(format!("wgsph-previous-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        let stale = [
+            "particles.pvd",
+            "run.json",
+            "checkpoint.bin",
+            "particles/particles_000012.vtu",
+            "probes/old_probe.csv",
+            "snapshots/000003.png",
+            "plots/old_probe.png",
+            "plots/errors.csv",
+        ];
+        let kept = [
+            "notes.txt",
+            "particles/readme.md",
+            "probes/mine.txt",
+            "case.toml",
+        ];
+        for f in stale.iter().chain(&kept) {
+            let p = d.join(f);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(&p, "x").unwrap();
+        }
+        remove_previous_outputs(&d).unwrap();
+        for f in stale {
+            assert!(!d.join(f).exists(), "{f} was left");
+        }
+        for f in kept {
+            assert!(d.join(f).exists(), "{f} was removed");
+        }
+        // A folder that does not exist yet is fine.
+        remove_previous_outputs(&d.join("new")).unwrap();
+        std::fs::remove_dir_all(&d).unwrap();
+    }
 
     #[test]
     fn checkpoint_policy_parses_simulated_and_wall_intervals() {

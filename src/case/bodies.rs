@@ -467,7 +467,7 @@ fn series(
             ));
         }
     }
-    let text = std::fs::read_to_string(&full).map_err(|e| {
+    let text = super::read_bounded(&full, 256 << 20).map_err(|e| {
         ctx.err(
             path,
             Some(format!("{file:?}")),

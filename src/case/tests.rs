@@ -261,6 +261,16 @@ fn load_reads_files_and_reports_missing_ones() {
     assert_eq!(s.name, "my_case");
     let e = load(&dir.join("nope.toml"), &[]).unwrap_err().to_string();
     assert!(e.contains("nope.toml") && e.contains("cannot read"), "{e}");
+    // An endless file is refused after a bounded read (it used to hang).
+    if std::path::Path::new("/dev/zero").exists() {
+        let e = load(std::path::Path::new("/dev/zero"), &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("/dev/zero") && e.contains("longer than 16 MiB"),
+            "{e}"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
