@@ -388,6 +388,7 @@ mod tests {
         no_energy.solver.solid = None;
         no_energy.write(&path).unwrap();
         assert_eq!(Checkpoint::read(&path).unwrap(), no_energy);
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 
     #[test]
@@ -406,5 +407,6 @@ mod tests {
         std::fs::write(&path, &flipped).unwrap();
         let e = format!("{:#}", Checkpoint::read(&path).unwrap_err());
         assert!(e.contains("checksum"), "{e}");
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 }

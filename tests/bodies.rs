@@ -514,7 +514,7 @@ fn a_probe_attached_to_the_tank_moves_with_it() {
 /// `probe[].body` must name a moving body; the error names the field and the choices.
 #[test]
 fn a_probe_on_an_unknown_body_is_refused() {
-    let dir = std::env::temp_dir().join(format!("wgsph-probe-body-{}", std::process::id()));
+    let dir = Scratch::new("probe-body");
     std::fs::create_dir_all(&dir).unwrap();
     let text = std::fs::read_to_string("cases/sloshing_2d.toml")
         .unwrap()
@@ -573,8 +573,7 @@ fn tracked_points_follow_their_particles() {
             .fold(0.0, f64::max);
         assert!(moved > 1e-4, "{case}: the point moved only {moved} m");
 
-        let dir = std::env::temp_dir().join(format!("wgsph-points-{}-{point}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
+        let dir = Scratch::new(&format!("points-{point}"));
         let opts = wgsph::run::RunOptions::default();
         let mut quiet = wgsph::progress::LogLines::default();
         wgsph::run::run(gpu(), &sc, &dir, &opts, &mut quiet).unwrap();
@@ -588,6 +587,5 @@ fn tracked_points_follow_their_particles() {
             assert!((last[1 + a] - got[0][a]).abs() < 1e-12, "{csv}");
             assert!((last[3 + a] - (got[0][a] - x0[a])).abs() < 1e-12, "{csv}");
         }
-        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -1,17 +1,16 @@
 //! The `wgsph` command as a user runs it: a short real run writes every output; bad case files
 //! fail with a message naming file, line and field, never a panic.
 
-use std::path::PathBuf;
+mod common;
+
 use std::process::Command;
 
 fn wgsph() -> Command {
     Command::new(env!("CARGO_BIN_EXE_wgsph"))
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("wgsph-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn temp_dir(name: &str) -> common::Scratch {
+    common::Scratch::new(&format!("cli-{name}"))
 }
 
 #[test]
@@ -59,12 +58,15 @@ fn run_writes_snapshots_probes_and_summary() {
     assert!(summary["steps"].as_u64().unwrap() > 10);
     assert!(summary["particle_steps_per_s"].as_f64().unwrap() > 0.0);
     assert!(summary["gpu_bytes_per_particle"].as_f64().unwrap() > 0.0);
-    std::fs::remove_dir_all(&out).unwrap();
 }
 
 /// Runs `wgsph run cases/hydrostatic_2d.toml` to t = 0.04 s with outputs every 0.02 s, output
 /// captured (so off a terminal), RUST_LOG set to `rust_log`; returns (output, out dir).
-fn run_hydrostatic(name: &str, rust_log: &str, args: &[&str]) -> (std::process::Output, PathBuf) {
+fn run_hydrostatic(
+    name: &str,
+    rust_log: &str,
+    args: &[&str],
+) -> (std::process::Output, common::Scratch) {
     let out = temp_dir(name);
     let o = wgsph()
         .args(["run", "cases/hydrostatic_2d.toml"])
@@ -126,7 +128,6 @@ fn snapshots_are_pngs_and_log_lines_go_to_stderr_off_a_terminal() {
     assert!(sizes[0].0 > 400 && sizes[0].1 > 400, "{sizes:?}");
     assert!(sizes.iter().all(|s| *s == sizes[0]), "{sizes:?}");
     assert!(out.join("particles/particles_000002.vtu").is_file());
-    std::fs::remove_dir_all(&out).unwrap();
 }
 
 #[test]
@@ -145,7 +146,6 @@ fn quiet_prints_nothing_but_errors() {
     let summary = std::fs::read_to_string(out.join("run.json")).unwrap();
     assert!(summary.contains("\"completed\""));
     assert!(!out.join("snapshots").exists());
-    std::fs::remove_dir_all(&out).unwrap();
 }
 
 #[test]
@@ -300,7 +300,6 @@ fn validate_quick_writes_the_report_and_plots() {
     assert!(out.join("hydrostatic_2d/probes/p_bottom.csv").is_file());
     // The table is also printed.
     assert!(stdout.contains(row), "{stdout}");
-    std::fs::remove_dir_all(&out).unwrap();
 }
 
 /// An unknown case, or one its mode does not run, is refused before anything runs, naming the

@@ -34,8 +34,7 @@ fn unstable_run_stops_with_step_time_and_keeps_outputs() {
     sc.time.end_s = 0.5;
     sc.time.output_every_s = 0.01;
     sc.time.probe_every_s = 0.01;
-    let dir = std::env::temp_dir().join(format!("wgsph-unstable-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = common::Scratch::new("unstable");
     let report = wgsph::run::run(
         gpu(),
         &sc,
@@ -58,5 +57,4 @@ fn unstable_run_stops_with_step_time_and_keeps_outputs() {
     let pvd = std::fs::read_to_string(dir.join("particles.pvd")).unwrap();
     assert!(pvd.contains("particles_000000.vtu"));
     assert!(dir.join("particles/particles_000000.vtu").is_file());
-    std::fs::remove_dir_all(&dir).unwrap();
 }

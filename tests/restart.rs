@@ -16,10 +16,8 @@ use wgsph::progress::LogLines;
 use wgsph::run::RunOptions;
 use wgsph::scenario::Scenario;
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("wgsph-restart-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn temp_dir(name: &str) -> common::Scratch {
+    common::Scratch::new(&format!("restart-{name}"))
 }
 
 fn load(case: &str, set: &[&str]) -> Scenario {
@@ -190,7 +188,8 @@ fn reference_run() -> &'static Path {
             .output()
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        dir
+        // Shared by the process tests, so it stays (one small run).
+        dir.keep()
     })
 }
 

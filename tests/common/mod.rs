@@ -1,6 +1,7 @@
 //! Shared helpers of the GPU tests: one device per test binary, small scenarios built in code.
 #![allow(dead_code)]
 
+use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use wgsph::gpu::{AdapterChoice, GpuContext};
@@ -8,6 +9,54 @@ use wgsph::layout::{unpack_block, ID_MASK, KIND_SHIFT};
 use wgsph::reference::RefParticle;
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
+
+/// A test's output folder, `$TMP/wgsph-<name>-<pid>`, emptied when made and removed when the
+/// test passes (kept after a failure, to be looked at).
+pub struct Scratch(PathBuf);
+
+impl Scratch {
+    pub fn new(name: &str) -> Self {
+        let d = std::env::temp_dir().join(format!("wgsph-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        Scratch(d)
+    }
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Scratch {
+    /// The folder, no longer removed (for one shared by several tests of a binary).
+    pub fn keep(self) -> PathBuf {
+        let d = self.0.clone();
+        std::mem::forget(self);
+        d
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for Scratch {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.as_os_str()
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
 
 /// The adapter for tests: WGSPH_ADAPTER if set, else auto (lavapipe in CI). A missing adapter
 /// is a failure, not a skip.
@@ -144,19 +193,16 @@ pub fn gpu_particles(s: &Solver) -> Vec<RefParticle> {
 }
 
 /// Runs the validation case `name` (`wgsph validate`'s table) at the resolution of `resolution`
-/// into a temporary folder and judges it with the bounds of `bounds`; prints its rows.
+/// into a temporary folder (the returned `Scratch`, with the outcome's `dir`) and judges it
+/// with the bounds of `bounds`; prints its rows.
 pub fn validate_case(
     name: &str,
     resolution: wgsph::validation::Mode,
     bounds: wgsph::validation::Mode,
     tag: &str,
-) -> wgsph::validation::CaseOutcome {
+) -> (wgsph::validation::CaseOutcome, Scratch) {
     let case = wgsph::validation::find(name).expect("a validation case");
-    let dir = std::env::temp_dir().join(format!(
-        "wgsph-validate-{name}-{tag}-{}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = Scratch::new(&format!("validate-{name}-{tag}"));
     let overrides = case.overrides(resolution).expect("run in this mode");
     let o = wgsph::validation::run_case(
         gpu(),
@@ -167,7 +213,7 @@ pub fn validate_case(
         &mut wgsph::progress::LogLines::default(),
     );
     println!("{}", rows(&o));
-    o
+    (o, dir)
 }
 
 /// The outcome's table rows and each metric's detail, for messages.

@@ -30,8 +30,7 @@ fn sample(sc: &Scenario, every: f64, end: f64) -> Vec<(f64, Pose)> {
 fn floating_box_settles_near_the_archimedes_draft_coarse() {
     // dx = 0.02 m: the box is 5 particles high (fixed ghosts; measured −10.6 %, dynamic
     // particles ride higher, −19 %). Mean draft over 1-2 s within 25 % of Archimedes'.
-    let o = validate_case("floating_box_2d", Mode::Quick, Mode::Quick, "coarse");
-    let _ = std::fs::remove_dir_all(&o.dir);
+    let (o, _dir) = validate_case("floating_box_2d", Mode::Quick, Mode::Quick, "coarse");
     assert!(o.passed(), "{}", crate::common::rows(&o));
 }
 
@@ -39,8 +38,7 @@ fn floating_box_settles_near_the_archimedes_draft_coarse() {
 #[ignore = "fine run (dx = 0.01 m, 3 s, ~7 min on lavapipe); passes: measured draft -1.4 % with the fixed-ghost box (dynamic box -2.3 %)"]
 fn floating_box_draft_within_2_percent_fine() {
     // dx = 0.01 m, mean draft over 1.5-3 s within 2 %.
-    let o = validate_case("floating_box_2d", Mode::Full, Mode::Full, "fine");
-    let _ = std::fs::remove_dir_all(&o.dir);
+    let (o, _dir) = validate_case("floating_box_2d", Mode::Full, Mode::Full, "fine");
     assert!(o.passed(), "{}", crate::common::rows(&o));
 }
 
@@ -84,13 +82,12 @@ fn a_neutrally_buoyant_box_stays_put() {
 fn water_entry_penetration_within_30_percent_coarse() {
     // dx = D/11, fixed-ghost cylinder. Measured: +12.6 % at t* = 0.10, within 8.3 % after
     // (dynamic particles: −16 % to −24 %). Largest error at the reference times within 30 %.
-    let o = validate_case(
+    let (o, _dir) = validate_case(
         "water_entry_cylinder_2d",
         Mode::Quick,
         Mode::Quick,
         "coarse",
     );
-    let _ = std::fs::remove_dir_all(&o.dir);
     assert!(o.passed(), "{}", crate::common::rows(&o));
 }
 
@@ -99,8 +96,7 @@ fn water_entry_penetration_within_30_percent_coarse() {
 fn water_entry_penetration_within_10_percent_fine() {
     // dx = D/22, ρ = 500 and 1000 kg/m³, within 10 %.
     for case in ["water_entry_cylinder_2d", "water_entry_cylinder_2d_rho1000"] {
-        let o = validate_case(case, Mode::Full, Mode::Full, "fine");
-        let _ = std::fs::remove_dir_all(&o.dir);
+        let (o, _dir) = validate_case(case, Mode::Full, Mode::Full, "fine");
         assert!(o.passed(), "{}", crate::common::rows(&o));
     }
 }

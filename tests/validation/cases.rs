@@ -16,7 +16,10 @@ fn load(case: &str, set: &[&str]) -> wgsph::scenario::Scenario {
 
 /// The shipped 2D dam break to T = 3, judged with the bounds of `bounds`
 /// (`validation::dam_break`, the same code as `wgsph validate`).
-fn dam_break_front(tag: &str, bounds: Mode) -> wgsph::validation::CaseOutcome {
+fn dam_break_front(
+    tag: &str,
+    bounds: Mode,
+) -> (wgsph::validation::CaseOutcome, crate::common::Scratch) {
     crate::common::validate_case("dam_break_2d", Mode::Quick, bounds, tag)
 }
 
@@ -24,7 +27,7 @@ fn dam_break_front(tag: &str, bounds: Mode) -> wgsph::validation::CaseOutcome {
 /// wall at Z = 4) against Martin & Moyce: this is independent of the experiment's time origin.
 #[test]
 fn dam_break_2d_front_speed_matches_martin_moyce() {
-    let o = dam_break_front("speed", Mode::Quick);
+    let (o, _dir) = dam_break_front("speed", Mode::Quick);
     assert!(o.passed(), "{}", crate::common::rows(&o));
 }
 
@@ -33,7 +36,7 @@ fn dam_break_2d_front_speed_matches_martin_moyce() {
 #[test]
 #[ignore = "fails: the SPH front leads Martin & Moyce by 12-18 % for T < 3 (docs/validation.md); kept visible, not loosened"]
 fn dam_break_2d_front_position_within_15_percent_of_martin_moyce() {
-    let o = dam_break_front("position", Mode::Full);
+    let (o, _dir) = dam_break_front("position", Mode::Full);
     assert!(o.passed(), "{}", crate::common::rows(&o));
 }
 

@@ -55,15 +55,14 @@ fn compare(dir: &Path, probe: &str, transducer: u32, from: f64, to: f64) -> Comp
     }
 }
 
-fn run(case: &str, dx: &str, end: f64, tag: &str) -> std::path::PathBuf {
+fn run(case: &str, dx: &str, end: f64, tag: &str) -> crate::common::Scratch {
     let set = vec![
         format!("particles.dx_m={dx}"),
         format!("time.end_s={end}"),
         "time.output_every_s=1".to_string(),
     ];
     let sc = wgsph::case::load(Path::new(case), &set).unwrap();
-    let dir = std::env::temp_dir().join(format!("wgsph-sloshing-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = crate::common::Scratch::new(&format!("sloshing-{tag}"));
     let report = wgsph::run::run(
         crate::common::gpu(),
         &sc,
