@@ -589,6 +589,42 @@ fn total_lagrangian_rates_match_reference() {
             moved / sc.physics.dx
         );
         assert!(err < 5e-5, "acceleration error {err}");
+
+        // The particle outputs: Cauchy stress σ = P Fᵀ/J as τ and p, and ρ = ρs/J.
+        let want = total_lagrangian::cauchy(&setup, &sc.physics, m, &x);
+        let out = solver.read_particles().unwrap();
+        let stress = out
+            .stress
+            .as_ref()
+            .expect("TL particles output their stress");
+        let sigma_rms = rms(want.iter().flat_map(|(s, _)| s.iter().flatten().copied()));
+        let (mut e_sigma, mut e_rho) = (0.0f64, 0.0f64);
+        for (i, &id) in out.id.iter().enumerate() {
+            let k = id as usize - range.start;
+            let (s, j) = &want[k];
+            // Relative to the particle's own largest component (one random particle is
+            // squeezed to J ≈ 0.02, σ ≈ 30 × the RMS), at least the RMS.
+            let scale = s.iter().flatten().fold(sigma_rms, |m, v| m.max(v.abs()));
+            let (t, p) = (stress[i], out.pressure[i] as f64);
+            let got = [
+                [t[0] as f64 - p, t[3] as f64, t[4] as f64],
+                [t[3] as f64, t[1] as f64 - p, t[5] as f64],
+                [t[4] as f64, t[5] as f64, t[2] as f64 - p],
+            ];
+            for a in 0..3 {
+                for b in 0..3 {
+                    assert!(got[a][b].is_finite(), "TL particle {k}: σ {got:?}");
+                    e_sigma = e_sigma.max((got[a][b] - s[a][b]).abs() / scale);
+                }
+            }
+            e_rho = e_rho.max((out.rho[i] as f64 * j / m.density - 1.0).abs());
+        }
+        println!(
+            "TL {dim}D {kernel:?}: output σ error {e_sigma:.1e} (RMS {sigma_rms:.3e} Pa), \
+             ρ J/ρs − 1 up to {e_rho:.1e}"
+        );
+        assert!(e_sigma < 1e-4, "output stress error {e_sigma}");
+        assert!(e_rho < 1e-4, "output density error {e_rho}");
     }
 }
 

@@ -275,14 +275,10 @@ fn green(h: &M3) -> M3 {
     e
 }
 
-/// The first Piola–Kirchhoff stress P_i of every TL particle at current positions `x` (TL
-/// numbering), steps (1)–(3) of the header.
-pub fn first_piola(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64; 3]]) -> Vec<M3> {
-    let n = setup.len();
-    let dim = ph.dim as usize;
-    let (lam, g) = lame(m);
-    let k2 = ph.dx * ph.dx / 12.0;
-    let hs: Vec<M3> = (0..n)
+/// The displacement gradient H_i = F_i − I of every TL particle at current positions `x`,
+/// step (1) of the header.
+fn displacement_gradients(setup: &TlSetup, x: &[[f64; 3]]) -> Vec<M3> {
+    (0..setup.len())
         .map(|i| {
             let mut h = zero();
             for p in setup.pairs_of(i) {
@@ -295,7 +291,17 @@ pub fn first_piola(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64
             }
             h
         })
-        .collect();
+        .collect()
+}
+
+/// The first Piola–Kirchhoff stress P_i of every TL particle at current positions `x` (TL
+/// numbering), steps (1)–(3) of the header.
+pub fn first_piola(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64; 3]]) -> Vec<M3> {
+    let n = setup.len();
+    let dim = ph.dim as usize;
+    let (lam, g) = lame(m);
+    let k2 = ph.dx * ph.dx / 12.0;
+    let hs = displacement_gradients(setup, x);
     let e: Vec<M3> = hs.iter().map(green).collect();
     let t: Vec<[M3; 3]> = (0..n)
         .map(|i| {
@@ -330,6 +336,40 @@ pub fn first_piola(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64
             }
             mul(&f, &s)
         })
+        .collect()
+}
+
+/// The Cauchy stress σ = P Fᵀ / J and J = det F of a particle with displacement gradient
+/// H = F − I and first Piola–Kirchhoff stress P (also the GPU solver's particle outputs).
+pub fn cauchy_of(h: &M3, p: &M3) -> (M3, f64) {
+    let mut f = *h;
+    for a in 0..3 {
+        f[a][a] += 1.0;
+    }
+    let j = f[0][0] * (f[1][1] * f[2][2] - f[1][2] * f[2][1])
+        - f[0][1] * (f[1][0] * f[2][2] - f[1][2] * f[2][0])
+        + f[0][2] * (f[1][0] * f[2][1] - f[1][1] * f[2][0]);
+    let mut ft = zero();
+    for a in 0..3 {
+        for b in 0..3 {
+            ft[a][b] = f[b][a];
+        }
+    }
+    (mul(p, &ft).map(|r| r.map(|v| v / j)), j)
+}
+
+/// [`cauchy_of`] every TL particle at current positions `x` (TL numbering).
+pub fn cauchy(
+    setup: &TlSetup,
+    ph: &Physics,
+    m: &ElasticMaterial,
+    x: &[[f64; 3]],
+) -> Vec<(M3, f64)> {
+    let p = first_piola(setup, ph, m, x);
+    displacement_gradients(setup, x)
+        .iter()
+        .zip(&p)
+        .map(|(h, p)| cauchy_of(h, p))
         .collect()
 }
 

@@ -963,6 +963,10 @@ impl Solver {
             Some(_) => Some(self.read_solid()?),
             None => None,
         };
+        let tl = match &self.total_lagrangian {
+            Some(t) => Some(t.cauchy_stress(&self.device, &self.queue, self.parity)?),
+            None => None,
+        };
         let mut order: Vec<usize> = (0..pos.len()).collect();
         order.sort_unstable_by_key(|&i| code[i] & ID_MASK);
         let b = self.params.tait_b as f64;
@@ -975,7 +979,26 @@ impl Solver {
             out.vel.push([v[0], v[1], v[2]]);
             out.rho.push(v[3]);
             let kind = code[i] >> KIND_SHIFT;
-            if kind == Kind::Solid as u32 || kind == Kind::SolidClamped as u32 {
+            let id = code[i] & ID_MASK;
+            let solid_kind = kind == Kind::Solid as u32 || kind == Kind::SolidClamped as u32;
+            // τ of the particle (zeros for the others), when the case has solids.
+            let mut tau = solid.as_ref().map(|s| {
+                let (a, b) = (s[i].tau_a, s[i].tau_b);
+                [a[0], a[1], a[2], a[3], b[0], b[1]]
+            });
+            if let (true, Some((first, stress))) = (solid_kind, &tl) {
+                // Total-Lagrangian: ρ = ρs/J, p = −tr σ/3 and τ = σ + p I.
+                let c = stress[(id - first) as usize];
+                let p = -(c.sigma[0] + c.sigma[1] + c.sigma[2]) / 3.0;
+                *out.rho.last_mut().expect("pushed above") =
+                    (self.params.solid_rho0 as f64 / c.j) as f32;
+                out.pressure.push(p as f32);
+                let mut t = c.sigma;
+                for d in &mut t[..3] {
+                    *d += p;
+                }
+                tau = Some(t.map(|x| x as f32));
+            } else if solid_kind {
                 // p = c_s² (ρ − ρs).
                 out.pressure
                     .push(self.params.solid_c2 * (v[3] - self.params.solid_rho0));
@@ -988,11 +1011,10 @@ impl Solver {
             if let Some(e) = &energy {
                 out.energy.get_or_insert_with(Vec::new).push(e[i][0]);
             }
-            if let Some(s) = &solid {
-                let (a, b) = (s[i].tau_a, s[i].tau_b);
+            if tl.is_some() || solid.is_some() {
                 out.stress
                     .get_or_insert_with(Vec::new)
-                    .push([a[0], a[1], a[2], a[3], b[0], b[1]]);
+                    .push(tau.unwrap_or_default());
             }
         }
         Ok(out)

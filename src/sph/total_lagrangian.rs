@@ -10,10 +10,10 @@
 use anyhow::{bail, Result};
 
 use super::buffers::ParticleBuffers;
-use crate::gpu::buffers::{storage, storage_init, uniform_init};
+use crate::gpu::buffers::{read, storage, storage_init, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::layout::{TlPair, TlParams};
-use crate::reference::total_lagrangian::{lame, TlSetup};
+use crate::reference::total_lagrangian::{cauchy_of, lame, TlSetup};
 use crate::scenario::{Kind, Scenario};
 
 pub struct TotalLagrangian {
@@ -22,6 +22,11 @@ pub struct TotalLagrangian {
     gradient: ParityKernel,
     stress: ParityKernel,
     accel: ParityKernel,
+    /// H = F − I and the first Piola–Kirchhoff stress P of the last evaluation, by TL index.
+    tl_h: wgpu::Buffer,
+    tl_p: wgpu::Buffer,
+    /// The first TL particle's id.
+    first_id: u32,
     /// Particles (all kinds) and TL particles.
     n: u32,
     n_tl: u32,
@@ -130,6 +135,9 @@ impl TotalLagrangian {
             gradient: bound("tl_gradient")?,
             stress: bound("tl_stress")?,
             accel: bound("tl_accel")?,
+            tl_h,
+            tl_p,
+            first_id: range.start as u32,
             n: b.n,
             n_tl,
             bytes,
@@ -153,4 +161,55 @@ impl TotalLagrangian {
             b.dispatch(pass, p, self.n_tl);
         }
     }
+
+    /// The Cauchy stress σ = J⁻¹ P Fᵀ and J = det F of every TL particle at the positions of
+    /// the arrays of parity `p`, by TL index (id − `first_id`), for the particle outputs.
+    /// A step evaluates P at its predicted positions, so this re-runs the three stress passes
+    /// (not the acceleration, which would add to `rate` again) at the current ones; the next
+    /// step recomputes them before use, so outputs do not change the run.
+    pub fn cauchy_stress(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        p: usize,
+    ) -> Result<(u32, Vec<CauchyStress>)> {
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("tl stress output"),
+        });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("tl stress output"),
+                timestamp_writes: None,
+            });
+            for b in [&self.deform, &self.gradient, &self.stress] {
+                b.dispatch(&mut pass, p, self.n_tl);
+            }
+        }
+        queue.submit([encoder.finish()]);
+        // mat3x3<f32> in storage: three columns of vec3 padded to 16 bytes.
+        type Mat = [[f32; 4]; 3];
+        let h: Vec<Mat> = read(device, queue, &self.tl_h, self.n_tl as usize)?;
+        let pk: Vec<Mat> = read(device, queue, &self.tl_p, self.n_tl as usize)?;
+        // Row r, column c of a matrix read back.
+        let m3 = |m: &Mat| [0, 1, 2].map(|r| [0, 1, 2].map(|c| m[c][r] as f64));
+        let out = h
+            .iter()
+            .zip(&pk)
+            .map(|(h, pk)| {
+                let (s, j) = cauchy_of(&m3(h), &m3(pk));
+                CauchyStress {
+                    sigma: [s[0][0], s[1][1], s[2][2], s[0][1], s[0][2], s[1][2]],
+                    j,
+                }
+            })
+            .collect();
+        Ok((self.first_id, out))
+    }
+}
+
+/// The Cauchy stress (xx, yy, zz, xy, xz, yz) [Pa] of a TL particle and its volume ratio J.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CauchyStress {
+    pub sigma: [f64; 6],
+    pub j: f64,
 }

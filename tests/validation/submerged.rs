@@ -58,20 +58,34 @@ point_m = [0.2, 0.12]
 
 #[test]
 fn a_clamped_column_in_still_water_stays_put_and_takes_the_water_pressure() {
-    column_in_still_water(CASE);
+    column_in_still_water(CASE, true);
 }
 
-/// The same column of the total-Lagrangian formulation (no artificial stress, no solid stress
-/// output: the lateral-stress bands are not checked).
+/// The same column of the total-Lagrangian formulation (no artificial stress), without the
+/// lateral-stress bands (next test).
 #[test]
 fn a_total_lagrangian_column_in_still_water_stays_put() {
-    column_in_still_water(&CASE.replace(
-        "artificial_stress = 0.0",
-        "formulation = \"total_lagrangian\"",
-    ));
+    column_in_still_water(&tl_case(), false);
 }
 
-fn column_in_still_water(case: &str) {
+/// The total-Lagrangian column's lateral stress bands. Its nodal Cauchy stress (σ = P Fᵀ/J,
+/// the particle outputs) is near −ρ g (H − y) inside the column (+2 to +15 % on the two inner
+/// columns of particles) but a quarter of it on the particles at the interface (≈ −400 Pa
+/// against −1640 Pa): the band means are 34–44 % low.
+#[test]
+#[ignore = "fails: the TL column's band-mean lateral stress is 34-44 % under the water pressure (the interface particles' nodal stress is a quarter of it); docs/validation.md"]
+fn a_total_lagrangian_column_takes_the_water_pressure() {
+    column_in_still_water(&tl_case(), true);
+}
+
+fn tl_case() -> String {
+    CASE.replace(
+        "artificial_stress = 0.0",
+        "formulation = \"total_lagrangian\"",
+    )
+}
+
+fn column_in_still_water(case: &str, stress_bands: bool) {
     let sc = wgsph::case::load_str(case, "submerged_column_2d.toml", &[]).unwrap();
     let n_fluid = sc.count(Kind::Fluid);
     let mut solver = Solver::new(gpu(), &sc).unwrap();
@@ -136,8 +150,10 @@ fn column_in_still_water(case: &str) {
         disturbance.abs() < 0.02,
         "the water beside the column differs from the water far from it by {disturbance:+.3}"
     );
-    assert!(
-        worst_band < 0.05,
-        "solid lateral stress off by {worst_band:.3}"
-    );
+    if stress_bands {
+        assert!(
+            p.stress.is_some() && worst_band < 0.05,
+            "solid lateral stress off by {worst_band:.3}"
+        );
+    }
 }
