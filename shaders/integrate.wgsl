@@ -119,8 +119,10 @@ fn correct(
             }
             velrho[i] = v;
             if (all_finite(v) && all_finite(r) && v.w > 0.0) {
-                // The time step sees the solid sound speed c_s = sqrt(K/ρs).
-                speed = sqrt(params.solid_c2) + length(v.xyz);
+                // The time step sees the solid's fastest wave, the P wave:
+                // c_p = sqrt((K + 4μ/3)/ρs), above c_s = sqrt(K/ρs) by 13 % (ν = 0.4) to 27 %
+                // (ν = 0.3); with c_s the total-Lagrangian solid blew up at cfl 0.2.
+                speed = sqrt(params.solid_c2 + 4.0 / 3.0 * params.solid_mu / params.solid_rho0) + length(v.xyz);
                 accel = select(0.0, length(r.xyz), kind == KIND_SOLID);
             } else {
                 atomicAdd(&state.nan_count, 1u);

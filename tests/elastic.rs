@@ -633,9 +633,8 @@ fn total_lagrangian_rates_match_reference() {
 /// reference's discrete energy at the GPU positions), 2D and 3D, random initial velocities on
 /// a jittered lattice, no gravity. cfl 0.05: the error is velocity Verlet's O(dt²) oscillation
 /// of the highest modes, which random velocities excite (measured largest |E − E0|/E0 in 2D /
-/// 3D: 1.3e-3 / 2.0e-3 at cfl 0.05, 6.1e-3 / 9.1e-3 at 0.1, 1.2e-2 in 2D at 0.15; at 0.2 the
-/// 2D run blew up: past the stability limit of those modes on this jittered lattice; on the
-/// regular lattice 2D ran at 0.2 with 1.8e-2).
+/// 3D with the P-wave time step: 1.1e-3 / 1.8e-3 at cfl 0.05, 4.6e-3 / 6.9e-3 at 0.1, 2.2e-2 in
+/// 2D at 0.2; with the bulk sound speed in the time step the 2D run blew up at 0.2).
 #[test]
 fn total_lagrangian_conserves_energy() {
     use wgsph::reference::total_lagrangian;
