@@ -91,3 +91,83 @@ fn an_elastic_block_dropped_on_the_floor_bounces_off_it() {
         "the block gained energy: {e_max} against {e0}"
     );
 }
+
+/// A dense soft block falls 8 cm onto a box floating in water (fixed-ghost body, half
+/// submerged) and rides it down: solid–body contact in a fluid case. The block never sinks into
+/// the box (its lowest particle stays at least dx/2 above the box's highest), the box floats
+/// still until the impact, then the pair sinks (5.9 kg/m on 4.8 kg/m of buoyancy).
+#[test]
+fn an_elastic_block_lands_on_a_floating_box_and_rides_it_down() {
+    let case = r#"name = "block_on_box_2d"
+dimension = 2
+[particles]
+dx_m = 0.005
+h_over_dx = 1.3
+[physics]
+gravity_m_s2 = [0.0, -9.81]
+sound_speed_coef = 15.0
+alpha = 0.05
+[time]
+end_s = 0.2
+output_every_s = 0.1
+probe_every_s = 0.005
+[tank]
+min_m = [0.0, 0.0]
+max_m = [0.4, 0.3]
+[[fluid_block]]
+min_m = [0.0, 0.0]
+max_m = [0.4, 0.1]
+[[solid]]
+name = "block"
+min_m = [0.17, 0.2]
+max_m = [0.23, 0.24]
+density_kg_m3 = 1500.0
+youngs_modulus_pa = 5.0e5
+poisson_ratio = 0.3
+[[body]]
+name = "box"
+shape = "box"
+min_m = [0.14, 0.08]
+max_m = [0.26, 0.12]
+density_kg_m3 = 500.0
+wall = "fixed_ghost"
+"#;
+    let sc = wgsph::case::load_str(case, "block_on_box_2d.toml", &[]).unwrap();
+    let dx = sc.physics.dx;
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    let box_y = |s: &Solver| s.bodies().unwrap().pose(0).center.y;
+    let (mut closest, mut drift_before) = (f64::MAX, 0.0f64);
+    for k in 1..=40 {
+        let t = 0.005 * k as f64;
+        solver.advance_to(t).unwrap();
+        let p = solver.read_particles().unwrap();
+        let mut block_low = f64::MAX;
+        let mut box_high = f64::MIN;
+        for i in 0..p.pos.len() {
+            if p.kind[i] == Kind::Solid as u32 {
+                block_low = block_low.min(p.pos[i][1]);
+            } else if solver.body_of_id(p.id[i]) == Some(0) {
+                box_high = box_high.max(p.pos[i][1]);
+            }
+        }
+        closest = closest.min(block_low - box_high);
+        if t < 0.12 {
+            drift_before = drift_before.max((box_y(&solver) - 0.1).abs());
+        }
+    }
+    let sunk = 0.1 - box_y(&solver);
+    println!(
+        "box drift before the impact {drift_before:.2e} m; closest block-box particles \
+         {:.2} dx; box sunk {sunk:.4} m by 0.2 s",
+        closest / dx
+    );
+    assert!(
+        drift_before < 1e-3,
+        "the box moved {drift_before} m before the impact"
+    );
+    assert!(
+        closest > 0.5 * dx,
+        "the block came within {closest} m of the box"
+    );
+    assert!(sunk > 0.005, "the box sank only {sunk} m");
+}
