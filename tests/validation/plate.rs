@@ -15,11 +15,16 @@ const L: f64 = 0.2;
 const H: f64 = 0.02;
 const KL: f64 = 1.875;
 
-/// Euler–Bernoulli period of the first mode [s].
-fn theory_period(m: &ElasticMaterial) -> f64 {
+/// Euler–Bernoulli period of the first mode [s]: of a plate in 2D (plane strain, bending
+/// stiffness E H³/(12(1 − ν²))), of a beam of square cross-section H × H in 3D (E H⁴/12).
+fn theory_period(m: &ElasticMaterial, dim: u32) -> f64 {
     let k = KL / L;
-    let omega2 = m.youngs_modulus * H * H * k.powi(4)
-        / (12.0 * m.density * (1.0 - m.poisson_ratio * m.poisson_ratio));
+    let plate = if dim == 2 {
+        1.0 - m.poisson_ratio * m.poisson_ratio
+    } else {
+        1.0
+    };
+    let omega2 = m.youngs_modulus * H * H * k.powi(4) / (12.0 * m.density * plate);
     2.0 * std::f64::consts::PI / omega2.sqrt()
 }
 
@@ -27,6 +32,8 @@ fn theory_period(m: &ElasticMaterial) -> f64 {
 const UL: &str = "cases/oscillating_plate_2d.toml";
 /// The same plate with the total-Lagrangian formulation.
 const TL: &str = "cases/oscillating_plate_tl_2d.toml";
+/// A 3D beam of the plate's length and thickness, square cross-section, total-Lagrangian.
+const BEAM_3D: &str = "cases/oscillating_beam_tl_3d.toml";
 
 /// The plate case `file` with `--set` overrides.
 fn plate(file: &str, set: &[&str]) -> Scenario {
@@ -100,7 +107,7 @@ impl PlateRun {
 
     fn of(file: &str, set: &[&str]) -> Self {
         let sc = plate(file, set);
-        let t_theory = theory_period(&sc.solids.as_ref().unwrap().material);
+        let t_theory = theory_period(&sc.solids.as_ref().unwrap().material, sc.physics.dim);
         let history = tip_history(&sc, 1.65 * t_theory, t_theory / 200.0);
         let crossings = zero_crossings(&history);
         assert!(
@@ -207,8 +214,13 @@ fn tl_plate_period_within_5_percent_h_over_dx_5() {
 /// Runs the total-Lagrangian plate with `overrides` and asserts its period, the agreement of
 /// its half periods and the amplitude kept over the cycle.
 fn tl_plate(label: &str, overrides: &[&str]) {
+    tl_plate_of(TL, label, overrides);
+}
+
+/// [`tl_plate`] of the case `file`.
+fn tl_plate_of(file: &str, label: &str, overrides: &[&str]) {
     let start = std::time::Instant::now();
-    let run = PlateRun::of(TL, overrides);
+    let run = PlateRun::of(file, overrides);
     run.report(label);
     println!("{:.1} s", start.elapsed().as_secs_f64());
     assert!(
@@ -217,6 +229,37 @@ fn tl_plate(label: &str, overrides: &[&str]) {
         100.0 * run.error()
     );
     run.assert_steady(0.05);
+}
+
+/// The 3D beam (cases/oscillating_beam_tl_3d.toml, H/dx = 5, 1 625 particles) through half a
+/// period: the tip's first zero crossing, T/2, within 5 % of Euler–Bernoulli beam theory's
+/// (T = 0.2769 s). Half a period includes the start-up from the approximate mode shape; the
+/// full-cycle run is the next test (measured: crossings at 0.1436 / 0.2872 s, +3.7 % both ways,
+/// peaks ±0.0222 m).
+#[test]
+fn tl_beam_3d_half_period_within_5_percent() {
+    let sc = plate(BEAM_3D, &[]);
+    let t_theory = theory_period(&sc.solids.as_ref().unwrap().material, 3);
+    let history = tip_history(&sc, 0.6 * t_theory, t_theory / 200.0);
+    let first = zero_crossings(&history)[0];
+    let error = 2.0 * first / t_theory - 1.0;
+    println!(
+        "TL 3D beam: first crossing {first:.4} s, T/2 of theory {:.4} s, error {:+.1} %",
+        0.5 * t_theory,
+        100.0 * error
+    );
+    assert!(
+        error.abs() < 0.05,
+        "half-period error {:.1} %",
+        100.0 * error
+    );
+}
+
+/// The 3D beam through a cycle and a half: period and steadiness as for the 2D plate.
+#[test]
+#[ignore = "met but slow: period +3.7 %, about 4 min on lavapipe"]
+fn tl_beam_3d_period_within_5_percent() {
+    tl_plate_of(BEAM_3D, "TL 3D beam, H/dx = 5", &[]);
 }
 
 /// The same at H/dx = 10 (dx = 2 mm; about 8 times the work).
