@@ -143,12 +143,7 @@ fn scene(dim: u32, seed: u64, kind: Kind) -> Scenario {
         if p[up] < 0.04 || inside(p, free_min, free_max) || inside(p, press_min, press_max) {
             continue;
         }
-        let mut pos = p;
-        let mut vel = [0.0; 3];
-        for a in 0..dim as usize {
-            pos[a] += rng.range(-0.2, 0.2) * dx;
-            vel[a] = rng.range(-0.5, 0.5);
-        }
+        let (pos, vel) = rng.jittered(dim, p, 0.2, dx);
         parts.push(Particle {
             pos,
             vel,

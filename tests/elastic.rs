@@ -10,7 +10,7 @@
 mod common;
 use common::*;
 use wgsph::reference::elastic::{self, SolidRef};
-use wgsph::reference::Space;
+use wgsph::reference::{RefParticle, Space};
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
 
@@ -47,12 +47,7 @@ fn random_solid(dim: u32, kernel: KernelKind, seed: u64, mat: ElasticMaterial) -
     let mut body = Vec::new();
     let mut tau0 = Vec::new();
     for p in lattice(dim, dx, min, max) {
-        let mut pos = p;
-        let mut vel = [0.0; 3];
-        for a in 0..dim as usize {
-            pos[a] += rng.range(-0.2, 0.2) * dx;
-            vel[a] = rng.range(-0.5, 0.5);
-        }
+        let (mut pos, vel) = rng.jittered(dim, p, 0.2, dx);
         let mut t = [0.0; 6];
         let mut rho = mat.density;
         if ul {
@@ -127,6 +122,16 @@ fn solid_refs(solver: &Solver) -> Vec<SolidRef> {
         .collect()
 }
 
+/// The solver of `sc` with its particles and solid state as reference input (GPU order), and
+/// the rates of a re-run of the interaction and solid passes (outputs poisoned first).
+fn rerun(sc: &Scenario) -> (Solver, Vec<RefParticle>, Vec<SolidRef>, Vec<[f32; 4]>) {
+    let solver = Solver::new(gpu(), sc).unwrap();
+    let parts = gpu_particles(&solver);
+    let solid = solid_refs(&solver);
+    let rates = solver.rerun_interaction(true).unwrap();
+    (solver, parts, solid, rates)
+}
+
 fn rms(v: impl Iterator<Item = f64>) -> f64 {
     let (s, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x * x, n + 1));
     (s / n as f64).sqrt()
@@ -140,10 +145,7 @@ fn elastic_rates_match_reference() {
         (3, KernelKind::WendlandC2),
     ] {
         let sc = random_solid(dim, kernel, 11 + dim as u64, material());
-        let solver = Solver::new(gpu(), &sc).unwrap();
-        let parts = gpu_particles(&solver);
-        let solid = solid_refs(&solver);
-        let gpu_rate = solver.rerun_interaction(true).unwrap();
+        let (solver, parts, solid, gpu_rate) = rerun(&sc);
         let gpu_dtau = solver.read_stress_rates().unwrap();
         let cpu = elastic::rates(
             &sc.physics,
@@ -246,12 +248,7 @@ fn solids_in_contact(dim: u32, seed: u64) -> Scenario {
         .enumerate()
     {
         for p in block(a, b, y0, 6.0 * dx) {
-            let mut pos = p;
-            let mut vel = [0.0; 3];
-            for c in 0..dim as usize {
-                pos[c] += rng.range(-0.1, 0.1) * dx;
-                vel[c] = rng.range(-0.5, 0.5);
-            }
+            let (pos, vel) = rng.jittered(dim, p, 0.1, dx);
             parts.push(Particle {
                 pos,
                 vel,
@@ -314,10 +311,7 @@ fn solid_contact_matches_reference() {
         let sc = solids_in_contact(dim, 40 + dim as u64);
         let ph = &sc.physics;
         let mat = sc.solids.as_ref().unwrap().material;
-        let solver = Solver::new(gpu(), &sc).unwrap();
-        let parts = gpu_particles(&solver);
-        let solid = solid_refs(&solver);
-        let gpu_rate = solver.rerun_interaction(true).unwrap();
+        let (_solver, parts, solid, gpu_rate) = rerun(&sc);
         let space = Space::of(&sc);
         let solids = elastic::rates(ph, &mat, &space, &parts, &solid);
         let contact = elastic::contact_rates(ph, &mat, &sc.walls, &space, &parts, &solid);
@@ -389,12 +383,7 @@ fn fluid_on_solid(dim: u32, kernel: KernelKind, viscosity: Viscosity, seed: u64)
     let mut tau0 = Vec::new();
     for p in lattice(dim, dx, lo, hi) {
         let solid = p[up] < split;
-        let mut pos = p;
-        let mut vel = [0.0; 3];
-        for a in 0..dim as usize {
-            pos[a] += rng.range(-0.2, 0.2) * dx;
-            vel[a] = rng.range(-0.5, 0.5);
-        }
+        let (pos, vel) = rng.jittered(dim, p, 0.2, dx);
         let mut t = [0.0; 6];
         if solid {
             for (c, tc) in t.iter_mut().enumerate() {
@@ -453,10 +442,7 @@ fn fluid_solid_interface_matches_reference() {
         sc.walls.ghost_correction = correction;
         let ph = &sc.physics;
         let mat = sc.solids.as_ref().unwrap().material;
-        let solver = Solver::new(gpu(), &sc).unwrap();
-        let parts = gpu_particles(&solver);
-        let solid = solid_refs(&solver);
-        let gpu_rate = solver.rerun_interaction(true).unwrap();
+        let (_solver, parts, solid, gpu_rate) = rerun(&sc);
         let space = Space::of(&sc);
         let fluid = wgsph::reference::interaction::rates(ph, &sc.walls, &space, &parts);
         let p_g = wgsph::reference::ghost::interface_pressure(ph, &sc.walls, &space, &parts);

@@ -151,6 +151,23 @@ pub fn scenario(
 pub struct Rng(pub u64);
 
 impl Rng {
+    /// Lattice point `p` moved by up to ±`jitter`·dx on each of the first `dim` axes, and a
+    /// velocity of up to ±0.5 m/s on each: the random particles of the layer-1 tests.
+    pub fn jittered(
+        &mut self,
+        dim: u32,
+        p: [f64; 3],
+        jitter: f64,
+        dx: f64,
+    ) -> ([f64; 3], [f64; 3]) {
+        let (mut pos, mut vel) = (p, [0.0; 3]);
+        for a in 0..dim as usize {
+            pos[a] += self.range(-jitter, jitter) * dx;
+            vel[a] = self.range(-0.5, 0.5);
+        }
+        (pos, vel)
+    }
+
     pub fn next_f64(&mut self) -> f64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
