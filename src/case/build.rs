@@ -514,6 +514,10 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         });
     }
 
+    if let Some((_, solid_of)) = &solids_of_particles {
+        super::solids::check_clearance(ctx, &particles, solid_of, dim, dx)?;
+    }
+
     if let Some(p) = particles.iter().find(|p| !p.rho.is_finite()) {
         return Err(ctx.err(
             sound_path,

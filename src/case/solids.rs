@@ -557,3 +557,78 @@ pub(super) fn build_solid_case(
         }),
     })
 }
+
+/// Refuses a free solid particle that starts closer than a particle spacing to a wall, obstacle
+/// or body particle (the parts overlap): the contact law (interaction.wgsl, `solid_loads`)
+/// would throw it off at the first step. `solid_of` gives each particle's `[[solid]]` index
+/// (read for solid kinds). Touching parts, a spacing apart, are fine; clamped particles do not
+/// move and may sit anywhere.
+pub(super) fn check_clearance(
+    ctx: &Ctx<'_>,
+    particles: &[Particle],
+    solid_of: &[u32],
+    dim: usize,
+    dx: f64,
+) -> Result<(), CaseError> {
+    use std::collections::HashMap;
+    let cell = |p: &[f64; 3]| {
+        [0, 1, 2].map(|a| {
+            if a < dim {
+                (p[a] / dx).floor() as i64
+            } else {
+                0
+            }
+        })
+    };
+    let boundary = |k: Kind| !matches!(k, Kind::Fluid | Kind::Solid | Kind::SolidClamped);
+    let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    for (i, p) in particles.iter().enumerate() {
+        if boundary(p.kind) {
+            grid.entry(cell(&p.pos)).or_default().push(i);
+        }
+    }
+    let reach = dx * (1.0 - 1e-6);
+    let z = if dim == 3 { 1 } else { 0 };
+    for (i, p) in particles.iter().enumerate() {
+        if p.kind != Kind::Solid {
+            continue;
+        }
+        let c = cell(&p.pos);
+        for (ox, oy, oz) in
+            (-1..=1).flat_map(|x| (-1..=1).flat_map(move |y| (-z..=z).map(move |w| (x, y, w))))
+        {
+            let Some(near) = grid.get(&[c[0] + ox, c[1] + oy, c[2] + oz]) else {
+                continue;
+            };
+            for &j in near {
+                let q = particles[j].pos;
+                let d = (0..dim)
+                    .map(|a| (p.pos[a] - q[a]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                if d < reach {
+                    let s = solid_of[i];
+                    return Err(ctx.err(
+                        &format!("solid[{s}]"),
+                        None,
+                        format!(
+                            "overlaps a wall, obstacle or body: its particle at {:?} is {} m \
+                             from the boundary particle at {:?}, closer than the particle \
+                             spacing dx = {} m, and the contact law would throw it off at the \
+                             start",
+                            &p.pos[..dim],
+                            num(d),
+                            &q[..dim],
+                            num(dx)
+                        ),
+                        format!(
+                            "move solid[{s}] or the wall so that they touch without \
+                             overlapping, or clamp that part (clamped_min_m, clamped_max_m)"
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
