@@ -1,7 +1,7 @@
-//! Layer 2 for contact: a soft elastic block dropped 3 cm onto the floor of an empty tank. The
-//! floor's particles stop it through the walls' repulsive law (interaction.wgsl, `solid_loads`):
-//! it must not pass through the floor, must bounce (its mean vertical velocity turns upward
-//! after the impact, slower than it came down) and must not gain energy.
+//! Layer 2 for contact (the walls' repulsive law on solid particles, interaction.wgsl
+//! `solid_loads`): a soft elastic block dropped onto the floor of an empty tank, which must stop
+//! it, bounce it and not add energy; and a block dropped onto a box floating in water, which it
+//! must ride down without sinking into it.
 
 use crate::common::gpu;
 use wgsph::scenario::Kind;
