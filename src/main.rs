@@ -78,7 +78,8 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
-    /// Plot every probe time series of a finished run as PNG (DIR/plots/<probe>.png).
+    /// Plot every probe time series of a finished run as PNG (DIR/plots/<probe>.png), and every
+    /// column of a body's or tracked point's table (DIR/plots/<table>_<column>.png).
     Plot {
         /// The run's output directory (the --out of `wgsph run`).
         dir: PathBuf,
@@ -93,7 +94,8 @@ enum Command {
         /// Legend label of DIR's run (default: its case name).
         #[arg(long)]
         label: Option<String>,
-        /// Plot only this probe (repeatable; default: all).
+        /// Plot only this probe, or this column of a table: TABLE.COLUMN, e.g.
+        /// point_free_end.ux_m (repeatable; default: all).
         #[arg(long = "probe", value_name = "NAME")]
         probes: Vec<String>,
         /// Plot (and compare) only up to this time, in seconds.

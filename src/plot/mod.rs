@@ -1,6 +1,8 @@
 //! `wgsph plot DIR`: PNG plots of the probe time series of a finished run.
 //!
-//! One PNG per probe CSV (`DIR/probes/<name>.csv`) is written to `DIR/plots/<name>.png`,
+//! One PNG per probe CSV (`DIR/probes/<name>.csv`) is written to `DIR/plots/<name>.png`, and
+//! one per column of a table (a body's or a tracked point's `DIR/probes/<table>.csv`), named
+//! `<table>.<column>` and drawn to `DIR/plots/<table>_<column>.png`,
 //! atomically (rendered into memory, encoded and written with [`write_atomic`]). Reference data
 //! (`PROBE=FILE.csv[:xscale:yscale]`) is drawn over a probe after scaling its columns, and the
 //! simulation's error against it — simulation interpolated linearly at the reference's times —
@@ -309,7 +311,12 @@ fn case_name(dir: &Path) -> String {
         })
 }
 
-/// Probe names (file stems of DIR/probes/*.csv), sorted.
+/// Separates a table from one of its columns in a probe name: `body_box.y_m` is the column
+/// `y_m` of `probes/body_box.csv` (probe and body names have no dots).
+const TABLE_COLUMN: char = '.';
+
+/// Probe names, sorted: the file stems of DIR/probes/*.csv, and `<table>.<column>` for each
+/// value column of a table.
 fn probe_names(dir: &Path) -> Result<Vec<String>> {
     let pdir = dir.join(PROBES_DIR);
     let mut names = Vec::new();
@@ -323,13 +330,12 @@ fn probe_names(dir: &Path) -> Result<Vec<String>> {
         let p = e?.path();
         if p.extension().is_some_and(|x| x == "csv") && p.is_file() {
             if let Some(s) = p.file_stem().and_then(|s| s.to_str()) {
-                // Tables of several columns (a body's motion and loads) are not time series
-                // of one probe.
-                if is_table(&p) {
-                    log::info!("{}: a table of several columns, not plotted", p.display());
-                    continue;
+                match header_columns(&p) {
+                    Some(columns) if columns.len() > 2 => {
+                        names.extend(columns[1..].iter().map(|c| format!("{s}{TABLE_COLUMN}{c}")))
+                    }
+                    _ => names.push(s.to_string()),
                 }
-                names.push(s.to_string());
             }
         }
     }
@@ -337,17 +343,63 @@ fn probe_names(dir: &Path) -> Result<Vec<String>> {
     Ok(names)
 }
 
-/// True when the CSV's header names more than one value column (e.g. `probes/body_<name>.csv`).
-fn is_table(path: &Path) -> bool {
+/// The column names of the CSV's header (its first line that is not blank or a `#` comment).
+fn header_columns(path: &Path) -> Option<Vec<String>> {
     use std::io::BufRead;
-    let Ok(file) = std::fs::File::open(path) else {
-        return false;
-    };
+    let file = std::fs::File::open(path).ok()?;
     std::io::BufReader::new(file)
         .lines()
         .map_while(Result::ok)
         .find(|l| !l.trim().is_empty() && !l.starts_with('#'))
-        .is_some_and(|header| header.split(',').count() > 2)
+        .map(|header| header.split(',').map(|c| c.trim().to_string()).collect())
+}
+
+/// `(t, column)` of a CSV table with several columns (time first; `#` comments and blank lines
+/// skipped): a body's or a tracked point's. Errors name the file, line and column.
+pub fn read_table_column(path: &Path, column: &str) -> Result<Series> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'));
+    let header = lines
+        .next()
+        .ok_or_else(|| anyhow!("{}: no header line (and no data)", path.display()))?
+        .1;
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    let col = names
+        .iter()
+        .position(|c| *c == column)
+        .ok_or_else(|| anyhow!("{}: no column {column:?} in {header:?}", path.display()))?;
+    let points = lines
+        .map(|(i, l)| {
+            let fields: Vec<&str> = l.split(',').collect();
+            let num = |k: usize| -> Result<f64> {
+                let s = fields
+                    .get(k)
+                    .ok_or_else(|| anyhow!("{}:{}: too few columns", path.display(), i + 1))?;
+                s.trim()
+                    .parse()
+                    .map_err(|_| anyhow!("{}:{}: {s:?} is not a number", path.display(), i + 1))
+            };
+            Ok((num(0)?, num(col)?))
+        })
+        .collect::<Result<_>>()?;
+    Ok(Series {
+        columns: (names[0].to_string(), column.to_string()),
+        points,
+    })
+}
+
+/// The series of the probe `name` (see [`probe_names`]) in the run in `dir`.
+fn read_probe(dir: &Path, name: &str) -> Result<Series> {
+    match name.split_once(TABLE_COLUMN) {
+        Some((table, column)) => {
+            read_table_column(&dir.join(PROBES_DIR).join(format!("{table}.csv")), column)
+        }
+        None => read_csv(&dir.join(PROBES_DIR).join(format!("{name}.csv"))),
+    }
 }
 
 /// Centred moving average over a window of `width` (same units as t): each sample becomes the
@@ -422,14 +474,12 @@ pub fn plot_run(dir: &Path, opts: &PlotOptions) -> Result<PlotReport> {
         .with_context(|| format!("cannot create {}", plots.display()))?;
     let mut report = PlotReport::default();
     for name in &names {
-        let csv = dir.join(PROBES_DIR).join(format!("{name}.csv"));
-        let main = read_csv(&csv)?;
+        let main = read_probe(dir, name)?;
         let smooth = opts.smooth_s.unwrap_or(0.0);
         let prep = |points| moving_average(&clip(points, opts.t_max_s), smooth);
         let mut runs = vec![(main_label.clone(), prep(main.points))];
         for o in &opts.others {
-            let p = o.dir.join(PROBES_DIR).join(format!("{name}.csv"));
-            runs.push((o.label.clone(), prep(read_csv(&p)?.points)));
+            runs.push((o.label.clone(), prep(read_probe(&o.dir, name)?.points)));
         }
         let mut curves: Vec<Curve> = runs
             .iter()
@@ -472,7 +522,7 @@ pub fn plot_run(dir: &Path, opts: &PlotOptions) -> Result<PlotReport> {
                 reference: true,
             });
         }
-        let png = plots.join(format!("{name}.png"));
+        let png = plots.join(format!("{}.png", name.replace(TABLE_COLUMN, "_")));
         let title = if smooth > 0.0 {
             format!(
                 "{case}: {name} ({} ms moving average)",
@@ -782,12 +832,20 @@ mod tests {
         }
         std::fs::write(dir.join("probes/p1.csv"), p).unwrap();
         std::fs::write(dir.join("probes/gauge.csv"), h).unwrap();
-        // A body's table (several columns) is left out, not an error.
+        // A body's table: one plot per column.
         std::fs::write(
             dir.join("probes/body_box.csv"),
             "t_s,x_m,y_m,angle_deg\n0,0.5,0.3,0\n0.1,0.5,0.29,1\n",
         )
         .unwrap();
+        let y = read_probe(&dir, "body_box.y_m").unwrap();
+        assert_eq!(y.columns, ("t_s".to_string(), "y_m".to_string()));
+        assert_eq!(y.points, vec![(0.0, 0.3), (0.1, 0.29)]);
+        let err = read_probe(&dir, "body_box.z_m").unwrap_err().to_string();
+        assert!(
+            err.contains("body_box.csv") && err.contains("\"z_m\""),
+            "{err}"
+        );
         // Dimensionless reference: y = 2 t* with t* = t / 0.5, scaled back: x·0.5, y·250.
         let refp = dir.join("ref.csv");
         std::fs::write(
@@ -800,13 +858,21 @@ mod tests {
             ..Default::default()
         };
         let rep = plot_run(&dir, &opts).unwrap();
-        assert_eq!(rep.pngs.len(), 2);
+        assert_eq!(rep.pngs.len(), 5);
         for png in &rep.pngs {
             let bytes = std::fs::read(png).unwrap();
             assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{}", png.display());
             assert!(bytes.len() > 2000);
         }
-        assert!(dir.join("plots/p1.png").is_file() && dir.join("plots/gauge.png").is_file());
+        for png in [
+            "p1",
+            "gauge",
+            "body_box_x_m",
+            "body_box_y_m",
+            "body_box_angle_deg",
+        ] {
+            assert!(dir.join(format!("plots/{png}.png")).is_file(), "{png}");
+        }
         // Reference (0.1 s, 100 Pa), (0.5 s, 500 Pa), (0.9 s, 900 Pa): the simulation matches.
         assert_eq!(rep.errors.len(), 1);
         let e = &rep.errors[0];
@@ -823,7 +889,7 @@ mod tests {
             .unwrap()
             .map(|e| e.unwrap().file_name().into_string().unwrap())
             .collect();
-        assert_eq!(names.len(), 3, "{names:?}");
+        assert_eq!(names.len(), 6, "{names:?}");
         // A reference for an unknown probe is an error naming the probes.
         let bad = PlotOptions {
             references: vec!["nope=x.csv".parse().unwrap()],

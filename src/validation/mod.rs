@@ -438,32 +438,7 @@ pub fn body_series(dir: &Path, body: &str, column: &str) -> Result<Vec<(f64, f64
 /// body's or a tracked point's.
 pub fn table_series(dir: &Path, table: &str, column: &str) -> Result<Vec<(f64, f64)>> {
     let path = dir.join(PROBES_DIR).join(format!("{table}.csv"));
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("cannot read {}", path.display()))?;
-    let mut lines = text.lines().enumerate();
-    let header = lines
-        .next()
-        .ok_or_else(|| anyhow!("{}: empty", path.display()))?
-        .1;
-    let col = header
-        .split(',')
-        .position(|c| c == column)
-        .ok_or_else(|| anyhow!("{}: no column {column:?} in {header:?}", path.display()))?;
-    lines
-        .filter(|(_, l)| !l.trim().is_empty())
-        .map(|(i, l)| {
-            let fields: Vec<&str> = l.split(',').collect();
-            let num = |k: usize| -> Result<f64> {
-                let s = fields
-                    .get(k)
-                    .ok_or_else(|| anyhow!("{}:{}: too few columns", path.display(), i + 1))?;
-                s.trim()
-                    .parse()
-                    .map_err(|_| anyhow!("{}:{}: {s:?} is not a number", path.display(), i + 1))
-            };
-            Ok((num(0)?, num(col)?))
-        })
-        .collect()
+    Ok(plot::read_table_column(&path, column)?.points)
 }
 
 /// `DIR/run.json`.
