@@ -1,14 +1,32 @@
 //! Layer 3 for elastic solids in water: the dam break through a rubber gate (Antoci, Gallati &
 //! Sibilla 2007), `cases/elastic_gate_2d.toml` at its shipped resolution, the free end's
 //! displacement against the experiment and against three published SPH solutions
-//! (`wgsph validate --full --case elastic_gate_2d`).
+//! (`wgsph validate --full --case elastic_gate_2d`). Both run the whole case: 0.4 s is about
+//! 215 000 steps of 16 700 particles, hours on lavapipe (a GPU job).
 
 use crate::common::validate_case;
 use wgsph::validation::Mode;
 
 #[test]
-#[ignore = "fails, and 3.3 h on lavapipe (a GPU job): run to 0.36 s, the gate closes again from 100 ms while the measured one stays open (x -40 %, y -64 % of the measured peak), as the three published SPH solutions do, but further (outside their band by x -10 % at 185 ms, y -20 % at 165 ms; docs/validation.md)"]
+#[ignore = "fails (and hours on lavapipe): run to 0.2 s, the gate follows the experiment to 120 ms (x -9 %, y -15 % of the measured peak) and then closes again while the measured one stays open (x -23 %, y -41 % at 160 ms), as the three published SPH solutions do (docs/validation.md)"]
 fn elastic_gate_free_end_follows_antoci_2007() {
     let (o, _dir) = validate_case("elastic_gate_2d", Mode::Full, Mode::Full, "full");
     assert!(o.passed(), "{}", crate::common::rows(&o));
+}
+
+#[test]
+#[ignore = "hours on lavapipe (a GPU job); run to 0.2 s on lavapipe: within the published solutions' band by x +1.3 %, y -3.8 % of the measured peak (bound 10 %), the rest of the record not run (docs/validation.md)"]
+fn elastic_gate_free_end_stays_within_the_published_sph_solutions() {
+    let (o, _dir) = validate_case("elastic_gate_2d", Mode::Full, Mode::Full, "band");
+    let rows = crate::common::rows(&o);
+    assert!(o.failure.is_none(), "{rows}");
+    let band: Vec<_> = o
+        .metrics
+        .iter()
+        .filter(|m| m.name.contains("outside 3 published SPH solutions"))
+        .collect();
+    assert_eq!(band.len(), 2, "{rows}");
+    for m in band {
+        assert_eq!(m.verdict(), wgsph::validation::Verdict::Pass, "{rows}");
+    }
 }
