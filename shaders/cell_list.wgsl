@@ -22,8 +22,6 @@
 @group(0) @binding(17) var<storage, read_write> code_out: array<u32>;
 @group(0) @binding(18) var<storage, read> energy_in: array<vec2<f32>>;
 @group(0) @binding(19) var<storage, read_write> energy_out: array<vec2<f32>>;
-@group(0) @binding(20) var<storage, read> solid_in: array<SolidState>;
-@group(0) @binding(21) var<storage, read_write> solid_out: array<SolidState>;
 
 // Slot of each particle (excluded particles go to the extra slot `hash_mask + 1`) and its
 // provisional place in that slot.
@@ -96,14 +94,4 @@ fn reorder_energy(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
         return;
     }
     energy_out[p] = energy_in[perm[p]];
-}
-
-// Gathers the solid state (τ, body, last dτ/dt) into cell order; only when the case has solids.
-@compute @workgroup_size(WG)
-fn reorder_solid(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let p = linear_index(gid, nwg);
-    if (p >= params.n_particles) {
-        return;
-    }
-    solid_out[p] = solid_in[perm[p]];
 }

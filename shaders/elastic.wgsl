@@ -126,7 +126,7 @@ struct SolidParticle {
 fn solid_particle(k: u32) -> SolidParticle {
     let rho = velrho[k].w;
     let p = solid_pressure(rho);
-    let sigma = tau_of(solid[k]) - mat3x3<f32>(vec3<f32>(p, 0.0, 0.0), vec3<f32>(0.0, p, 0.0), vec3<f32>(0.0, 0.0, p));
+    let sigma = tau_of(solid[solid_slot(code[k])]) - mat3x3<f32>(vec3<f32>(p, 0.0, 0.0), vec3<f32>(0.0, p, 0.0), vec3<f32>(0.0, 0.0, p));
     return SolidParticle(sigma * (1.0 / (rho * rho)), artificial_stress(sigma, rho), velrho[k].xyz, rho);
 }
 
@@ -136,7 +136,8 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     if (i >= params.n_particles || !is_solid(code_kind(code[i]))) {
         return;
     }
-    let body_i = solid[i].body;
+    let slot_i = solid_slot(code[i]);
+    let body_i = solid[slot_i].body;
     let pi = solid_particle(i);
     let p_i = pos[i];
     let support2 = 4.0 * params.h * params.h;
@@ -150,7 +151,7 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     let n_slots = neighbour_slots(cell_of(p_i), &slots);
     for (var s = 0u; s < n_slots; s++) {
         for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
-            if (j == i || !is_solid(code_kind(code[j])) || solid[j].body != body_i) {
+            if (j == i || !is_solid(code_kind(code[j])) || solid[solid_slot(code[j])].body != body_i) {
                 continue;
             }
             let x_ij = rel_pos(p_i, pos[j]);
@@ -183,15 +184,15 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
 
     let eps = 0.5 * (grad_v + transpose(grad_v));
     let omega = 0.5 * (grad_v - transpose(grad_v));
-    let tau = tau_of(solid[i]);
+    let tau = tau_of(solid[slot_i]);
     let tr3 = (eps[0].x + eps[1].y + eps[2].z) / 3.0;
     let iso = mat3x3<f32>(vec3<f32>(tr3, 0.0, 0.0), vec3<f32>(0.0, tr3, 0.0), vec3<f32>(0.0, 0.0, tr3));
     let d = 2.0 * params.solid_mu * (eps - iso) + tau * transpose(omega) + omega * tau;
-    stress_rate[i] = SymRate(vec4<f32>(d[0].x, d[1].y, d[2].z, 0.5 * (d[1].x + d[0].y)),
+    stress_rate[slot_i] = SymRate(vec4<f32>(d[0].x, d[1].y, d[2].z, 0.5 * (d[1].x + d[0].y)),
                              vec4<f32>(0.5 * (d[2].x + d[0].z), 0.5 * (d[2].y + d[1].z), 0.0, 0.0));
 }
 
-// Predictor for τ (see integrate.wgsl): τ* = τ_n + dt (dτ/dt)_n, on the arrays before the sort.
+// Predictor for τ (see integrate.wgsl): τ* = τ_n + dt (dτ/dt)_n.
 @compute @workgroup_size(WG)
 fn stress_predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
@@ -199,9 +200,10 @@ fn stress_predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
         return;
     }
     let dt = state.dt;
-    let s = solid[i];
-    solid[i].tau_a = s.tau_a + dt * s.rate_a;
-    solid[i].tau_b = s.tau_b + dt * vec3<f32>(s.rate_b, 0.0);
+    let k = solid_slot(code[i]);
+    let s = solid[k];
+    solid[k].tau_a = s.tau_a + dt * s.rate_a;
+    solid[k].tau_b = s.tau_b + dt * vec3<f32>(s.rate_b, 0.0);
 }
 
 // Corrector for τ: τ_{n+1} = τ* + ½dt ((dτ/dt)_{n+1} − (dτ/dt)_n); keeps the new rate.
@@ -212,10 +214,11 @@ fn stress_correct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
         return;
     }
     let half_dt = 0.5 * state.dt;
-    let s = solid[i];
-    let r = stress_rate[i];
-    solid[i].tau_a = s.tau_a + half_dt * (r.a - s.rate_a);
-    solid[i].tau_b = s.tau_b + half_dt * vec3<f32>(r.b.xy - s.rate_b, 0.0);
-    solid[i].rate_a = r.a;
-    solid[i].rate_b = r.b.xy;
+    let k = solid_slot(code[i]);
+    let s = solid[k];
+    let r = stress_rate[k];
+    solid[k].tau_a = s.tau_a + half_dt * (r.a - s.rate_a);
+    solid[k].tau_b = s.tau_b + half_dt * vec3<f32>(r.b.xy - s.rate_b, 0.0);
+    solid[k].rate_a = r.a;
+    solid[k].rate_b = r.b.xy;
 }

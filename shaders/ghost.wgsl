@@ -111,5 +111,5 @@ fn solid_interface_pressure(@builtin(global_invocation_id) gid: vec3<u32>, @buil
         return;
     }
     // (Along g only: the solid's own acceleration is left out of the correction.)
-    solid[g].interface_p = fluid_at(pos[g], params.gravity).w;
+    solid[solid_slot(code[g])].interface_p = fluid_at(pos[g], params.gravity).w;
 }

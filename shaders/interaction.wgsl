@@ -148,8 +148,9 @@ fn solid_body_contact_weight(m_other: f32) -> f32 {
 fn solid_loads(i: u32) -> vec3<f32> {
     let p_i = pos[i];
     let vr_i = velrho[i];
-    let b_i = solid[i].interface_p / (vr_i.w * vr_i.w);
-    let body_i = solid[i].body;
+    let s_i = solid[solid_slot(code[i])];
+    let b_i = s_i.interface_p / (vr_i.w * vr_i.w);
+    let body_i = s_i.body;
     let support2 = 4.0 * params.h * params.h;
     var r = vec3<f32>(0.0);
     var slots: array<u32, 27>;
@@ -174,7 +175,7 @@ fn solid_loads(i: u32) -> vec3<f32> {
                     k = solid_body_contact_weight(params.mass);
                 }
                 r += k * repulsion(x_ij, r2);
-            } else if (solid[j].body != body_i) {
+            } else if (solid[solid_slot(code[j])].body != body_i) {
                 r += repulsion(x_ij, r2);
             }
         }
@@ -389,7 +390,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             }
             if (is_solid(kind_j)) {
                 let vr_j = velrho[j];
-                let b_j = solid[j].interface_p / (vr_j.w * vr_j.w);
+                let b_j = solid[solid_slot(code[j])].interface_p / (vr_j.w * vr_j.w);
                 r += interface_rates(pi.p_over_rho2, pi.v, pi.rho, b_j, vr_j.xyz, vr_j.w, params.solid_mass, x_ij, r2);
                 continue;
             }

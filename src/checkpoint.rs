@@ -13,15 +13,17 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::layout::{Pos, SimState, SolidState};
+use crate::layout::{Pos, SimState, SolidState, ID_MASK, KIND_SHIFT};
 use crate::output::write_atomic;
-use crate::scenario::Scenario;
+use crate::scenario::{Kind, Scenario};
 use crate::sph::state::SolverState;
 
 /// Name of the checkpoint file inside the output directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"WGSPHCKP";
-const FORMAT: u32 = 1;
+/// 2: the solid section holds the solid particles only, in id order. Format 1 (every particle,
+/// in the saved GPU order) is still read.
+const FORMAT: u32 = 2;
 
 /// The case file and `--set` overrides a run was started with, so `wgsph resume` can rebuild
 /// the scenario.
@@ -218,8 +220,8 @@ impl Checkpoint {
             bail!("damaged: its checksum does not match its content");
         }
         let format = u32::from_le_bytes(body[8..12].try_into().expect("4 bytes"));
-        if format != FORMAT {
-            bail!("format {format}; this wgsph reads format {FORMAT}");
+        if !(1..=FORMAT).contains(&format) {
+            bail!("format {format}; this wgsph reads formats 1 to {FORMAT}");
         }
         let json_len = u64::from_le_bytes(body[12..20].try_into().expect("8 bytes")) as usize;
         let json = body
@@ -252,7 +254,12 @@ impl Checkpoint {
             None
         };
         let solid = if h.sections.iter().any(|(n, _)| n == "solid") {
-            Some(pod_vec::<SolidState>(section("solid")?, "solid")?)
+            let solid = pod_vec::<SolidState>(section("solid")?, "solid")?;
+            Some(if format == 1 {
+                solid_by_id(&solid, &code)?
+            } else {
+                solid
+            })
         } else {
             None
         };
@@ -292,6 +299,27 @@ impl Checkpoint {
             },
         })
     }
+}
+
+/// A format-1 solid section (one state per particle, in the GPU order of `code`) as format 2
+/// has it: the solid particles' states in id order.
+fn solid_by_id(per_particle: &[SolidState], code: &[u32]) -> Result<Vec<SolidState>> {
+    if per_particle.len() != code.len() {
+        bail!(
+            "section 'solid' has {} states for {} particles",
+            per_particle.len(),
+            code.len()
+        );
+    }
+    let solid_kinds = [Kind::Solid as u32, Kind::SolidClamped as u32];
+    let mut by_id: Vec<(u32, SolidState)> = code
+        .iter()
+        .zip(per_particle)
+        .filter(|(c, _)| solid_kinds.contains(&(*c >> KIND_SHIFT)))
+        .map(|(c, s)| (c & ID_MASK, *s))
+        .collect();
+    by_id.sort_unstable_by_key(|(id, _)| *id);
+    Ok(by_id.into_iter().map(|(_, s)| s).collect())
 }
 
 fn pod_vec<T: bytemuck::Pod>(bytes: &[u8], name: &str) -> Result<Vec<T>> {
@@ -388,6 +416,35 @@ mod tests {
         no_energy.solver.solid = None;
         no_energy.write(&path).unwrap();
         assert_eq!(Checkpoint::read(&path).unwrap(), no_energy);
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+    }
+
+    /// A format-1 file (one solid state per particle, in the saved GPU order) reads as format 2:
+    /// the solid particles' states only, in id order.
+    #[test]
+    fn format_1_solid_sections_are_read_in_id_order() {
+        let path = temp("format1");
+        let mut c = sample();
+        let n = c.solver.code.len() as u32;
+        // GPU order: ids n−1 … 0; ids 1, 2 and 3 are solid (3 clamped), the rest fluid.
+        let kind = |id: u32| match id {
+            1 | 2 => Kind::Solid as u32,
+            3 => Kind::SolidClamped as u32,
+            _ => Kind::Fluid as u32,
+        };
+        c.solver.code = (0..n).rev().map(|id| kind(id) << KIND_SHIFT | id).collect();
+        c.write(&path).unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        bytes[8..12].copy_from_slice(&1u32.to_le_bytes());
+        let body = bytes.len() - 8;
+        let mut sum = Fnv::default();
+        sum.update(&bytes[..body]);
+        bytes[body..].copy_from_slice(&sum.finish().to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let read = Checkpoint::read(&path).unwrap();
+        // The sample's state at GPU index i has body i; id k sits at index n − 1 − k.
+        let bodies: Vec<u32> = read.solver.solid.unwrap().iter().map(|s| s.body).collect();
+        assert_eq!(bodies, [n - 2, n - 3, n - 4]);
         std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 

@@ -48,7 +48,7 @@ pub struct Params {
     pub solid_alpha: f32,
     pub solid_eps: f32,
     pub solid_inv_w_dx: f32,
-    pub solid_pad: u32,
+    pub solid_id_base: u32,
 }
 
 /// Mirrors `SolidState` in shaders/lib/common.wgsl: the deviatoric stress τ of a solid particle
@@ -283,7 +283,8 @@ mod tests {
                 solid_mass,
                 solid_alpha,
                 solid_eps,
-                solid_inv_w_dx
+                solid_inv_w_dx,
+                solid_id_base
             ]
         );
     }

@@ -9,6 +9,7 @@
 
 mod common;
 use common::*;
+use wgsph::layout::{SymRate, ID_MASK, KIND_SHIFT};
 use wgsph::reference::elastic::{self, SolidRef};
 use wgsph::reference::{RefParticle, Space};
 use wgsph::scenario::*;
@@ -106,9 +107,24 @@ fn with_solids(
     sc
 }
 
+/// Per-solid-particle values (id order, as `read_solid` gives them) in the GPU order of the
+/// particle arrays; `other` for the particles that are not solid.
+fn in_gpu_order<T: Copy>(solver: &Solver, by_id: &[T], other: T) -> Vec<T> {
+    let (_, _, code) = solver.read_raw().unwrap();
+    let base = solver.solid_id_base();
+    code.iter()
+        .map(|&c| match c >> KIND_SHIFT {
+            k if k == Kind::Solid as u32 || k == Kind::SolidClamped as u32 => {
+                by_id[((c & ID_MASK) - base) as usize]
+            }
+            _ => other,
+        })
+        .collect()
+}
+
 /// The solid state of the GPU arrays (GPU order) as reference input.
 fn solid_refs(solver: &Solver) -> Vec<SolidRef> {
-    solver
+    let by_id: Vec<SolidRef> = solver
         .read_solid()
         .unwrap()
         .iter()
@@ -119,7 +135,12 @@ fn solid_refs(solver: &Solver) -> Vec<SolidRef> {
             .map(|x| x as f64),
             body: s.body,
         })
-        .collect()
+        .collect();
+    let none = SolidRef {
+        tau: [0.0; 6],
+        body: 0,
+    };
+    in_gpu_order(solver, &by_id, none)
 }
 
 /// The solver of `sc` with its particles and solid state as reference input (GPU order), and
@@ -146,7 +167,11 @@ fn elastic_rates_match_reference() {
     ] {
         let sc = random_solid(dim, kernel, 11 + dim as u64, material());
         let (solver, parts, solid, gpu_rate) = rerun(&sc);
-        let gpu_dtau = solver.read_stress_rates().unwrap();
+        let gpu_dtau = in_gpu_order(
+            &solver,
+            &solver.read_stress_rates().unwrap(),
+            SymRate::default(),
+        );
         let cpu = elastic::rates(
             &sc.physics,
             &sc.solids.as_ref().unwrap().material,

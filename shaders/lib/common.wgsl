@@ -48,7 +48,7 @@ struct Params {
     solid_alpha: f32,           // Monaghan artificial viscosity α between solid particles
     solid_eps: f32,             // artificial stress ε (Monaghan 2000)
     solid_inv_w_dx: f32,        // 1/W(Δp), Δp the initial spacing
-    solid_pad: u32,
+    solid_id_base: u32,         // the first solid particle's id (solid ids are consecutive)
 }
 
 // Time-stepping state that lives on the GPU; read back once per batch of steps.
@@ -130,7 +130,8 @@ fn is_solid(kind: u32) -> bool {
     return kind == KIND_SOLID || kind == KIND_SOLID_CLAMPED;
 }
 
-// Per solid particle, sorted with it: deviatoric stress τ = (xx, yy, zz, xy | xz, yz) [Pa],
+// Per solid particle, indexed by solid_slot (id order, untouched by the sort, so only solid
+// particles pay for it): deviatoric stress τ = (xx, yy, zz, xy | xz, yz) [Pa],
 // its elastic body, dτ/dt of the last evaluation (for the corrector: xx, yy, zz, xy | xz, yz),
 // and the fluid pressure interpolated at it this step (ghost.wgsl), which is what the fluid
 // sees of the solid. Mirrored by `layout::SolidState`.
@@ -157,6 +158,11 @@ fn is_ghost(kind: u32) -> bool {
 
 fn code_kind(code: u32) -> u32 {
     return code >> KIND_SHIFT;
+}
+
+// Index of a solid particle (its code word) in the solid arrays: id − params.solid_id_base.
+fn solid_slot(code: u32) -> u32 {
+    return (code & ID_MASK) - params.solid_id_base;
 }
 
 fn with_kind(code: u32, kind: u32) -> u32 {

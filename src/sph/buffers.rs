@@ -42,9 +42,11 @@ pub struct ParticleBuffers {
     /// Each body's rigid motion for the step (uploaded by the host every step); one dummy
     /// element without bodies.
     pub body_motions: wgpu::Buffer,
-    /// Deviatoric stress, body and last dτ/dt of solid particles, 2 parities, and the new
-    /// dτ/dt: one element each when the case has no solids.
-    pub solid: [wgpu::Buffer; 2],
+    /// Deviatoric stress, body and last dτ/dt of the solid particles, and the new dτ/dt (in
+    /// `stress_rate`), indexed by id − `Params::solid_id_base`: the sort leaves them in place,
+    /// and fluid and wall particles take no room in them (one element when there are no
+    /// solids).
+    pub solid: wgpu::Buffer,
     pub stress_rate: wgpu::Buffer,
 }
 
@@ -63,7 +65,7 @@ pub struct InitialParticles<'a> {
     pub body_particles: &'a [BodyParticle],
     /// One per body (its particle range and workgroups; the motion comes with each step).
     pub body_motions: &'a [BodyMotion],
-    /// One per particle when the case has solids, else empty.
+    /// One per solid particle, in id order (from `Params::solid_id_base`), else empty.
     pub solid: &'a [SolidState],
 }
 
@@ -136,18 +138,9 @@ impl ParticleBuffers {
             }),
             energy_rate: storage(device, "energy rate", if energy { 4 * n as u64 } else { 4 }),
             solid: if init.solid.is_empty() {
-                [0, 1].map(|k| {
-                    storage(
-                        device,
-                        &format!("solid {k}"),
-                        std::mem::size_of::<SolidState>() as u64,
-                    )
-                })
+                storage(device, "solid", std::mem::size_of::<SolidState>() as u64)
             } else {
-                [
-                    storage_init(device, "solid 0", init.solid),
-                    storage(device, "solid 1", std::mem::size_of_val(init.solid) as u64),
-                ]
+                storage_init(device, "solid", init.solid)
             },
             stress_rate: storage(
                 device,
@@ -202,9 +195,9 @@ impl ParticleBuffers {
             &self.body_particles,
             &self.body_motions,
             &self.stress_rate,
+            &self.solid,
         ];
         all.extend(self.energy.iter());
-        all.extend(self.solid.iter());
         all.extend(
             self.pos
                 .iter()

@@ -13,7 +13,6 @@ pub struct CellList {
     rank_in_cell: Kernel,
     reorder: Kernel,
     reorder_energy: Option<(Kernel, [wgpu::BindGroup; 2])>,
-    reorder_solid: Option<(Kernel, [wgpu::BindGroup; 2])>,
     scan_blocks: Kernel,
     scan_add: Kernel,
     bind_key: [wgpu::BindGroup; 2],
@@ -33,7 +32,6 @@ impl CellList {
         scan: &ShaderModule,
         b: &ParticleBuffers,
         energy: bool,
-        solids: bool,
     ) -> Result<Self> {
         let cell_key = cells.kernel(device, "cell_key")?;
         let reorder_energy = if energy {
@@ -44,21 +42,6 @@ impl CellList {
                     (8, &b.local_perm),
                     (18, &b.energy[p]),
                     (19, &b.energy[1 - p]),
-                ]
-            };
-            let binds = [k.bind(device, &bufs(0))?, k.bind(device, &bufs(1))?];
-            Some((k, binds))
-        } else {
-            None
-        };
-        let reorder_solid = if solids {
-            let k = cells.kernel(device, "reorder_solid")?;
-            let bufs = |p: usize| {
-                [
-                    (0, &b.params),
-                    (8, &b.local_perm),
-                    (20, &b.solid[p]),
-                    (21, &b.solid[1 - p]),
                 ]
             };
             let binds = [k.bind(device, &bufs(0))?, k.bind(device, &bufs(1))?];
@@ -127,7 +110,6 @@ impl CellList {
             rank_in_cell,
             reorder,
             reorder_energy,
-            reorder_solid,
             scan_blocks,
             scan_add,
             bind_key,
@@ -153,9 +135,6 @@ impl CellList {
         self.rank_in_cell.dispatch(pass, &self.bind_rank, self.n);
         self.reorder.dispatch(pass, &self.bind_reorder[p], self.n);
         if let Some((k, bind)) = &self.reorder_energy {
-            k.dispatch(pass, &bind[p], self.n);
-        }
-        if let Some((k, bind)) = &self.reorder_solid {
             k.dispatch(pass, &bind[p], self.n);
         }
     }

@@ -24,7 +24,7 @@ impl Elastic {
                 (3, &b.code[p]),
                 (4, &b.cell_start),
                 (5, &b.rate),
-                (6, &b.solid[p]),
+                (6, &b.solid),
                 (7, &b.stress_rate),
                 (8, &b.state),
             ]
@@ -38,7 +38,7 @@ impl Elastic {
         })
     }
 
-    /// τ* = τ_n + dt (dτ/dt)_n on the arrays of parity `p` (before the sort).
+    /// τ* = τ_n + dt (dτ/dt)_n of the solid particles of parity `p`'s arrays (before the sort).
     pub fn encode_predict(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.predict.dispatch(pass, p, self.n);
     }

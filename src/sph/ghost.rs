@@ -33,7 +33,7 @@ impl Ghost {
                     (4, &b.cell_start),
                 ];
                 if with_solid {
-                    bufs.push((5, &b.solid[p]));
+                    bufs.push((5, &b.solid));
                 } else {
                     bufs.push((6, &b.body_particles));
                     bufs.push((7, &b.body_motions));

@@ -26,7 +26,7 @@ impl Interaction {
                 (6, &b.mirror_planes),
                 (7, &b.energy_rate),
                 (8, &b.body_particles),
-                (9, &b.solid[p]),
+                (9, &b.solid),
                 (10, &b.body_motions),
             ]
         };

@@ -185,6 +185,8 @@ pub struct Solver {
     integrate: Integrate,
     /// Elastic solid particles, if the case has any (updated-Lagrangian formulation).
     elastic: Option<Elastic>,
+    /// Solid particles (the length of the solid arrays).
+    n_solid: u32,
     /// Elastic solid particles of the total-Lagrangian formulation.
     total_lagrangian: Option<TotalLagrangian>,
     probes: Probes,
@@ -265,6 +267,7 @@ impl Solver {
             params.solid_eps = m.artificial_stress as f32;
             params.solid_inv_w_dx =
                 (1.0 / crate::reference::kernel::w(ph.kernel, ph.dim, ph.h, ph.dx)) as f32;
+            params.solid_id_base = solid_range(sc)?.start as u32;
         }
         let cfg = ShaderConfig {
             dim: ph.dim,
@@ -324,7 +327,6 @@ impl Solver {
             &module(Pass::PrefixScan)?,
             &buffers,
             ph.energy,
-            sc.solids.is_some(),
         )?;
         let interaction = Interaction::new(&device, &module(Pass::Interaction)?, &buffers)?;
         let has_kind = |k: &[Kind]| sc.particles.iter().any(|p| k.contains(&p.kind));
@@ -401,6 +403,7 @@ impl Solver {
             energy: ph.energy,
             integrate,
             elastic,
+            n_solid: solid.len() as u32,
             total_lagrangian,
             probes,
             points,
@@ -758,7 +761,7 @@ impl Solver {
             self.queue
                 .write_buffer(&self.buffers.rate, 0, bytemuck::cast_slice(&nan));
             if self.elastic.is_some() {
-                let nan = vec![f32::NAN; 8 * self.buffers.n as usize];
+                let nan = vec![f32::NAN; 8 * self.n_solid as usize];
                 self.queue
                     .write_buffer(&self.buffers.stress_rate, 0, bytemuck::cast_slice(&nan));
             }
@@ -785,8 +788,8 @@ impl Solver {
         self.read_rates()
     }
 
-    /// Test hook: the solid state (τ, body, last dτ/dt) of the current arrays, GPU order.
-    #[doc(hidden)]
+    /// The solid state (τ, body, last dτ/dt, interface pressure) of every solid particle, in
+    /// id order from `solid_id_base`.
     pub fn read_solid(&self) -> Result<Vec<crate::layout::SolidState>> {
         if self.elastic.is_none() {
             bail!("the case has no solids");
@@ -794,12 +797,17 @@ impl Solver {
         read(
             &self.device,
             &self.queue,
-            &self.buffers.solid[self.parity],
-            self.buffers.n as usize,
+            &self.buffers.solid,
+            self.n_solid as usize,
         )
     }
 
-    /// Test hook: dτ/dt of the last evaluation, GPU order.
+    /// The first solid particle's id (the index base of `read_solid`).
+    pub fn solid_id_base(&self) -> u32 {
+        self.params.solid_id_base
+    }
+
+    /// Test hook: dτ/dt of the last evaluation, by solid particle as `read_solid`.
     #[doc(hidden)]
     pub fn read_stress_rates(&self) -> Result<Vec<crate::layout::SymRate>> {
         if self.elastic.is_none() {
@@ -809,7 +817,7 @@ impl Solver {
             &self.device,
             &self.queue,
             &self.buffers.stress_rate,
-            self.buffers.n as usize,
+            self.n_solid as usize,
         )
     }
 
@@ -983,7 +991,11 @@ impl Solver {
             let solid_kind = kind == Kind::Solid as u32 || kind == Kind::SolidClamped as u32;
             // τ of the particle (zeros for the others), when the case has solids.
             let mut tau = solid.as_ref().map(|s| {
-                let (a, b) = (s[i].tau_a, s[i].tau_b);
+                if !solid_kind {
+                    return [0.0; 6];
+                }
+                let k = (id - self.params.solid_id_base) as usize;
+                let (a, b) = (s[k].tau_a, s[k].tau_b);
                 [a[0], a[1], a[2], a[3], b[0], b[1]]
             });
             if let (true, Some((first, stress))) = (solid_kind, &tl) {
@@ -1044,7 +1056,22 @@ fn body_id_base(sc: &Scenario) -> Result<u32> {
     Ok(base as u32)
 }
 
-/// The initial solid state of every particle (τ0, body), or nothing without solids.
+/// The solid particles' ids; they must be consecutive (the case loader builds them so), which
+/// lets the solid arrays be indexed by id − first id.
+pub(crate) fn solid_range(sc: &Scenario) -> Result<std::ops::Range<usize>> {
+    let ids: Vec<usize> = (0..sc.particles.len())
+        .filter(|&i| sc.particles[i].kind.is_solid())
+        .collect();
+    let (Some(&first), Some(&last)) = (ids.first(), ids.last()) else {
+        bail!("the elastic solids have no particles");
+    };
+    if last - first + 1 != ids.len() {
+        bail!("the elastic solids' particles must have consecutive ids");
+    }
+    Ok(first..last + 1)
+}
+
+/// The initial state (τ0, body) of every solid particle, in id order, or nothing without solids.
 fn solid_states(sc: &Scenario) -> Result<Vec<crate::layout::SolidState>> {
     let Some(solids) = &sc.solids else {
         return Ok(Vec::new());
@@ -1057,7 +1084,7 @@ fn solid_states(sc: &Scenario) -> Result<Vec<crate::layout::SolidState>> {
             solids.tau0.len()
         );
     }
-    Ok((0..n)
+    Ok(solid_range(sc)?
         .map(|i| {
             let t = solids.tau0[i].map(|x| x as f32);
             crate::layout::SolidState {

@@ -38,7 +38,8 @@ pub struct SolverState {
     pub rate: Vec<[f32; 4]>,
     /// (e, de/dt), with the energy equation on.
     pub energy: Option<Vec<[f32; 2]>>,
-    /// τ, body and last dτ/dt of every particle, with elastic solids.
+    /// τ, body and last dτ/dt of every solid particle (id order), with updated-Lagrangian
+    /// solids.
     pub solid: Option<Vec<SolidState>>,
     /// [`crate::body::BodySet::save`], empty without bodies.
     pub bodies: Vec<f64>,
@@ -120,13 +121,14 @@ impl Solver {
             bail!("the saved state and this case disagree on elastic solids");
         }
         if let Some(solid) = &s.solid {
-            if solid.len() != n {
+            let n_solid = self.n_solid as usize;
+            if solid.len() != n_solid {
                 bail!(
-                    "the saved state has {} solid states for {n} particles",
+                    "the saved state has {} solid states for {n_solid} solid particles",
                     solid.len()
                 );
             }
-            q.write_buffer(&self.buffers.solid[p], 0, bytemuck::cast_slice(solid));
+            q.write_buffer(&self.buffers.solid, 0, bytemuck::cast_slice(solid));
         }
         q.write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&s.sim));
         if let Some(f) = &self.density_filter {

@@ -7,14 +7,14 @@
 //! GPU memory only for the solid particles: the lists (48 bytes a pair) and 5 matrices a
 //! particle.
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
 use crate::gpu::buffers::{read, storage, storage_init, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::layout::{TlPair, TlParams};
 use crate::reference::total_lagrangian::{cauchy_of, lame, TlSetup};
-use crate::scenario::{Kind, Scenario};
+use crate::scenario::Scenario;
 
 pub struct TotalLagrangian {
     index: ParityKernel,
@@ -34,24 +34,9 @@ pub struct TotalLagrangian {
     bytes: u64,
 }
 
-/// The solid particles' first id and count; they must have consecutive ids (the case loader
-/// builds them so: a solid-only case is nothing else).
-fn solid_range(sc: &Scenario) -> Result<std::ops::Range<usize>> {
-    let ids: Vec<usize> = (0..sc.particles.len())
-        .filter(|&i| matches!(sc.particles[i].kind, Kind::Solid | Kind::SolidClamped))
-        .collect();
-    let (Some(&first), Some(&last)) = (ids.first(), ids.last()) else {
-        bail!("the total-Lagrangian solid has no particles");
-    };
-    if last - first + 1 != ids.len() {
-        bail!("the total-Lagrangian solid's particles must have consecutive ids");
-    }
-    Ok(first..last + 1)
-}
-
 /// The f64 setup of the scenario's solid particles (TL index = id − first solid id).
 pub fn setup(sc: &Scenario) -> Result<(std::ops::Range<usize>, TlSetup)> {
-    let range = solid_range(sc)?;
+    let range = super::solid_range(sc)?;
     let solids = sc.solids.as_ref().expect("a case with solids");
     let x0: Vec<[f64; 3]> = sc.particles[range.clone()].iter().map(|p| p.pos).collect();
     let setup =
