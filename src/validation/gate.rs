@@ -168,11 +168,14 @@ pub fn band_error(sim: &[(f64, f64)], solutions: &[Vec<(f64, f64)>]) -> Option<B
 }
 
 /// `column` (`ux_m` or `uy_m`) of the free end in the run in `dir` against `reference`.
+/// Reference samples before t = 0 (the digitised y series starts at −0.8 ms, the gate at rest)
+/// are not compared; every later one must be inside the run.
 pub fn displacement(dir: &Path, column: &str, reference: &Reference) -> Result<Displacement> {
     let sim = table_series(dir, &format!("point_{POINT}"), column)?;
     let experiment = reference.points()?;
     let points = experiment
         .iter()
+        .filter(|&&(t, _)| t >= 0.0)
         .map(|&(t, want)| {
             let got = interpolate(&sim, t)
                 .ok_or_else(|| anyhow!("no finite free-end displacement at t = {t} s"))?;

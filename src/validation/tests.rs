@@ -347,6 +347,8 @@ fn gate_evaluation(
     {
         times.extend(r.points().unwrap().iter().map(|p| p.0));
     }
+    // A run's table starts at t = 0, where the references may start earlier.
+    times.retain(|&t| t >= 0.0);
     times.sort_by(f64::total_cmp);
     times.dedup();
     let mut table = String::from("t_s,x_m,y_m,ux_m,uy_m\n");
