@@ -15,7 +15,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::layout::{Pos, SimState, SolidState, ID_MASK, KIND_SHIFT};
 use crate::output::write_atomic;
-use crate::scenario::{Kind, Scenario};
+use crate::reference::elastic::is_solid;
+use crate::scenario::Scenario;
 use crate::sph::state::SolverState;
 
 /// Name of the checkpoint file inside the output directory.
@@ -311,11 +312,10 @@ fn solid_by_id(per_particle: &[SolidState], code: &[u32]) -> Result<Vec<SolidSta
             code.len()
         );
     }
-    let solid_kinds = [Kind::Solid as u32, Kind::SolidClamped as u32];
     let mut by_id: Vec<(u32, SolidState)> = code
         .iter()
         .zip(per_particle)
-        .filter(|(c, _)| solid_kinds.contains(&(*c >> KIND_SHIFT)))
+        .filter(|(c, _)| is_solid(*c >> KIND_SHIFT))
         .map(|(c, s)| (c & ID_MASK, *s))
         .collect();
     by_id.sort_unstable_by_key(|(id, _)| *id);
@@ -342,6 +342,7 @@ fn pod_one<T: bytemuck::Pod>(bytes: &[u8], name: &str) -> Result<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scenario::Kind;
 
     fn sample() -> Checkpoint {
         let n = 5;

@@ -113,11 +113,12 @@ fn in_gpu_order<T: Copy>(solver: &Solver, by_id: &[T], other: T) -> Vec<T> {
     let (_, _, code) = solver.read_raw().unwrap();
     let base = solver.solid_id_base();
     code.iter()
-        .map(|&c| match c >> KIND_SHIFT {
-            k if k == Kind::Solid as u32 || k == Kind::SolidClamped as u32 => {
+        .map(|&c| {
+            if elastic::is_solid(c >> KIND_SHIFT) {
                 by_id[((c & ID_MASK) - base) as usize]
+            } else {
+                other
             }
-            _ => other,
         })
         .collect()
 }

@@ -988,7 +988,7 @@ impl Solver {
             out.rho.push(v[3]);
             let kind = code[i] >> KIND_SHIFT;
             let id = code[i] & ID_MASK;
-            let solid_kind = kind == Kind::Solid as u32 || kind == Kind::SolidClamped as u32;
+            let solid_kind = crate::reference::elastic::is_solid(kind);
             // τ of the particle (zeros for the others), when the case has solids.
             let mut tau = solid.as_ref().map(|s| {
                 if !solid_kind {
