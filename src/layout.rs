@@ -383,12 +383,15 @@ mod tests {
             for dim in [2, 3] {
                 for kernel in [0, 1] {
                     for viscosity in [0, 1] {
-                        for energy in [false, true] {
+                        for (energy, hydrostatic_diffusion) in
+                            [(false, false), (false, true), (true, false), (true, true)]
+                        {
                             let cfg = ShaderConfig {
                                 dim,
                                 kernel,
                                 viscosity,
                                 energy,
+                                hydrostatic_diffusion,
                             };
                             parse(&compose(pass, cfg), pass.name()).unwrap();
                         }

@@ -79,12 +79,26 @@ pub struct Physics {
     pub viscosity: Viscosity,
     /// δ-SPH density diffusion coefficient (Molteni & Colagrossi 2009); 0 disables it.
     pub delta_sph: f64,
+    /// What δ-SPH diffuses.
+    pub delta_sph_form: DeltaSphForm,
     /// Mass of every particle [kg] (ρ0·dx^dim).
     pub particle_mass: f64,
     /// Periodic density re-initialisation of the fluid (Shepard or MLS filter).
     pub density_filter: DensityFilter,
     /// Integrate the specific internal energy (the seed's energy equation); off by default.
     pub energy: bool,
+}
+
+/// The density difference that δ-SPH diffuses between two fluid particles.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DeltaSphForm {
+    /// ρ_j − ρ_i less its hydrostatic part ρ0((1 + ρ0 g·x_ji/B)^(1/γ) − 1) (Fourtakas et al.
+    /// 2019): a fluid at rest stays at rest.
+    #[default]
+    Fourtakas,
+    /// The whole ρ_j − ρ_i (Molteni & Colagrossi 2009): the fluid next to a floor loses density
+    /// to the lighter fluid above it, and a tank at rest sinks steadily.
+    MolteniColagrossi,
 }
 
 /// Density re-initialisation every `every` steps (Colagrossi & Landrini 2003): the fluid

@@ -543,6 +543,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         gravity: case.gravity,
         viscosity: case.viscosity,
         delta_sph: case.delta_sph,
+        delta_sph_form: case.delta_sph_form,
         particle_mass: mass,
         density_filter: case.density_filter,
         energy: case.energy,

@@ -98,9 +98,17 @@ pub(super) struct RawPhysics {
     pub alpha: Option<f64>,
     pub nu_m2_s: Option<f64>,
     pub delta_sph: Option<f64>,
+    pub delta_sph_form: Option<DeltaSphFormName>,
     pub density_filter: Option<DensityFilterName>,
     pub density_filter_every: Option<i64>,
     pub energy: Option<bool>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum DeltaSphFormName {
+    Fourtakas,
+    MolteniColagrossi,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -381,6 +389,11 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "physics.delta_sph",
         "the delta-SPH coefficient in [0, 1]",
         "delta_sph = 0.1",
+    ),
+    f(
+        "physics.delta_sph_form",
+        "what delta-SPH diffuses: fourtakas or molteni_colagrossi",
+        "delta_sph_form = \"fourtakas\"",
     ),
     f(
         "physics.density_filter",

@@ -531,6 +531,7 @@ pub(super) fn build_solid_case(
         gravity: case.gravity,
         viscosity: case.viscosity,
         delta_sph: case.delta_sph,
+        delta_sph_form: case.delta_sph_form,
         particle_mass: case.rho0 * dx.powi(dim as i32),
         density_filter: case.density_filter,
         energy: false,

@@ -609,6 +609,25 @@ fn bad_numbers_are_refused() {
         ),
         (
             "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\ndelta_sph = 0\ndelta_sph_form = \"fourtakas\"",
+            9,
+            &[
+                "physics.delta_sph_form",
+                "delta_sph = 0",
+                "remove delta_sph_form",
+            ],
+        ),
+        (
+            "sound_speed_coef = 10.0",
+            "sound_speed_coef = 10.0\ndelta_sph_form = \"antuono\"",
+            8,
+            &[
+                "physics.delta_sph_form = \"antuono\"",
+                "\"fourtakas\", \"molteni_colagrossi\"",
+            ],
+        ),
+        (
+            "sound_speed_coef = 10.0",
             "sound_speed_coef = 10.0\ngamma = 0.5",
             8,
             &["physics.gamma", "[1, 10]"],

@@ -3,15 +3,16 @@
 //! Geometric checks that need several fields at once live in `build.rs`.
 
 use crate::scenario::{
-    DensityFilter, GhostCorrection, KernelKind, Probe, RepulsiveForm, TimeControl, Viscosity,
+    DeltaSphForm, DensityFilter, GhostCorrection, KernelKind, Probe, RepulsiveForm, TimeControl,
+    Viscosity,
 };
 
 use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::probes::Checked;
 use super::schema::{
-    DensityFilterName, GhostCorrectionName, KernelName, RawCase, RawPhysics, RepulsiveFormName,
-    SlipName, ViscosityName, WallName,
+    DeltaSphFormName, DensityFilterName, GhostCorrectionName, KernelName, RawCase, RawPhysics,
+    RepulsiveFormName, SlipName, ViscosityName, WallName,
 };
 
 /// An axis-aligned box (3 components; in 2D the third is 0).
@@ -84,6 +85,7 @@ pub(super) struct Case {
     pub gamma: f64,
     pub viscosity: Viscosity,
     pub delta_sph: f64,
+    pub delta_sph_form: DeltaSphForm,
     pub density_filter: DensityFilter,
     pub energy: bool,
     pub time: TimeControl,
@@ -398,6 +400,7 @@ pub(super) fn validate(
         "the delta-SPH density diffusion coefficient; 0 disables it",
         "use 0.1, or 0 to disable",
     )?;
+    let delta_sph_form = delta_sph_form(ctx, ph, delta_sph)?;
     let density_filter = density_filter(ctx, ph)?;
 
     // [time]
@@ -668,6 +671,7 @@ pub(super) fn validate(
         gamma,
         viscosity,
         delta_sph,
+        delta_sph_form,
         density_filter,
         energy: ph.energy.unwrap_or(false),
         time,
@@ -717,6 +721,35 @@ fn attached_body(
             format!("use one of {}, or remove body", names.join(", "))
         },
     ))
+}
+
+/// `physics.delta_sph_form` (default Fourtakas; only with δ-SPH on).
+fn delta_sph_form(
+    ctx: &Ctx<'_>,
+    ph: &RawPhysics,
+    delta_sph: f64,
+) -> Result<DeltaSphForm, CaseError> {
+    let Some(name) = ph.delta_sph_form else {
+        return Ok(DeltaSphForm::Fourtakas);
+    };
+    if delta_sph == 0.0 {
+        return Err(ctx.err(
+            "physics.delta_sph_form",
+            Some(
+                match name {
+                    DeltaSphFormName::Fourtakas => "\"fourtakas\"",
+                    DeltaSphFormName::MolteniColagrossi => "\"molteni_colagrossi\"",
+                }
+                .to_string(),
+            ),
+            "is only used with delta-SPH on, but delta_sph = 0",
+            "remove delta_sph_form, or give delta_sph > 0 (e.g. 0.1)",
+        ));
+    }
+    Ok(match name {
+        DeltaSphFormName::Fourtakas => DeltaSphForm::Fourtakas,
+        DeltaSphFormName::MolteniColagrossi => DeltaSphForm::MolteniColagrossi,
+    })
 }
 
 /// `physics.density_filter` with `physics.density_filter_every` (default 30, only with a filter).

@@ -89,6 +89,9 @@ pub struct ShaderConfig {
     pub viscosity: u32,
     /// Whether the energy equation is integrated.
     pub energy: bool,
+    /// Whether δ-SPH diffuses only the density's departure from hydrostatics (Fourtakas et al.
+    /// 2019) rather than the whole density difference (Molteni & Colagrossi 2009).
+    pub hydrostatic_diffusion: bool,
 }
 
 impl Default for ShaderConfig {
@@ -98,6 +101,7 @@ impl Default for ShaderConfig {
             kernel: 1,
             viscosity: 0,
             energy: false,
+            hydrostatic_diffusion: true,
         }
     }
 }
@@ -107,12 +111,14 @@ pub fn compose(pass: Pass, cfg: ShaderConfig) -> String {
     format!(
         "// wgsph: {name}.wgsl composed with lib/common.wgsl\n\
          const DIM: u32 = {dim}u;\nconst KERNEL: u32 = {kernel}u;\n\
-         const VISCOSITY: u32 = {visc}u;\nconst ENERGY: bool = {energy};\nconst WG: u32 = {wg}u;\n\n{common}\n{libs}\n{pass}",
+         const VISCOSITY: u32 = {visc}u;\nconst ENERGY: bool = {energy};\n\
+         const HYDROSTATIC_DIFFUSION: bool = {hydro};\nconst WG: u32 = {wg}u;\n\n{common}\n{libs}\n{pass}",
         name = pass.name(),
         dim = cfg.dim,
         kernel = cfg.kernel,
         visc = cfg.viscosity,
         energy = cfg.energy,
+        hydro = cfg.hydrostatic_diffusion,
         wg = WORKGROUP_SIZE,
         common = COMMON,
         libs = pass.libs().concat(),

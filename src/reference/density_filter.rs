@@ -147,6 +147,7 @@ mod tests {
             gravity: [0.0; 3],
             viscosity: Viscosity::Artificial { alpha: 0.02 },
             delta_sph: 0.0,
+            delta_sph_form: Default::default(),
             particle_mass: 1000.0 * dx.powi(dim as i32),
             density_filter: DensityFilter::Mls { every: 1 },
             energy: false,

@@ -4,7 +4,7 @@ use super::{
     dot, kernel, laminar_nu, pressure, sub, RefParticle, Space, EXCLUDED, FLUID, GHOST_FREE_SLIP,
     GHOST_NO_SLIP, REPULSIVE, WALL,
 };
-use crate::scenario::{MirrorPlane, Physics, RepulsiveForm, Viscosity, WallParams};
+use crate::scenario::{DeltaSphForm, MirrorPlane, Physics, RepulsiveForm, Viscosity, WallParams};
 
 struct Pair<'a> {
     ph: &'a Physics,
@@ -13,9 +13,25 @@ struct Pair<'a> {
     nu: Option<f64>,
 }
 
+/// ρ_i − ρ_j less, with Fourtakas et al. (2019), its hydrostatic part ρ0((1 + ρ0 g·x_ij/B)^(1/γ)
+/// − 1), for fluid particles x_ij apart: what δ-SPH diffuses (`diffused_density` in
+/// interaction.wgsl).
+pub fn diffused_density(ph: &Physics, rho_i: f64, rho_j: f64, x_ij: [f64; 3]) -> f64 {
+    match ph.delta_sph_form {
+        DeltaSphForm::MolteniColagrossi => rho_i - rho_j,
+        DeltaSphForm::Fourtakas => {
+            let rho_h_ij = ph.rho0
+                * ((1.0 + ph.rho0 * dot(ph.gravity, x_ij) / ph.tait_b()).powf(1.0 / ph.gamma)
+                    - 1.0);
+            rho_i - rho_j - rho_h_ij
+        }
+    }
+}
+
 impl Pair<'_> {
     /// (dv/dt, dρ/dt) and de/dt on fluid particle i from a pressure-carrying neighbour at x_ij
-    /// whose velocity is `v_cont` in continuity and pressure work, `v_visc` in viscosity.
+    /// whose velocity is `v_cont` in continuity and pressure work, `v_visc` in viscosity;
+    /// δ-SPH diffuses `psi` ([`diffused_density`], 0 for pairs without it).
     #[allow(clippy::too_many_arguments)]
     fn rates(
         &self,
@@ -24,7 +40,7 @@ impl Pair<'_> {
         v_cont: [f64; 3],
         v_visc: [f64; 3],
         rho_j: f64,
-        diffuse: bool,
+        psi: f64,
         rho_ratio: f64,
     ) -> ([f64; 4], f64) {
         let (ph, m, h) = (self.ph, self.ph.particle_mass, self.ph.h);
@@ -33,13 +49,8 @@ impl Pair<'_> {
         let dw = x_ij.map(|x| x * f_ij);
         let v_ij = sub(pi.vel, v_cont);
         let w_ij = sub(pi.vel, v_visc);
-        let mut drho = m * dot(v_ij, dw) * rho_ratio;
-        if diffuse {
-            drho += ph.delta_sph * h * ph.c0 * 2.0 * (pi.rho - rho_j) * f_ij * r2
-                / (r2 + self.eta2)
-                * m
-                / rho_j;
-        }
+        let drho = m * dot(v_ij, dw) * rho_ratio
+            + ph.delta_sph * h * ph.c0 * 2.0 * psi * f_ij * r2 / (r2 + self.eta2) * m / rho_j;
         let mut acc = [0.0; 3];
         let mut pi_ij = 0.0;
         match self.nu {
@@ -178,8 +189,7 @@ pub fn rates_and_energy(
                         } else if pi.body.is_some() {
                             // A body particle: the fluid's force on it too (and a dynamic
                             // one its dρ/dt).
-                            let mut pr =
-                                pair.rates(&pb, x_ij, pj.vel, pj.vel, pj.rho, false, 1.0).0;
+                            let mut pr = pair.rates(&pb, x_ij, pj.vel, pj.vel, pj.rho, 0.0, 1.0).0;
                             if pi.kind != WALL {
                                 pr[3] = 0.0;
                             }
@@ -230,8 +240,12 @@ pub fn rates_and_energy(
                 } else {
                     (pj.vel, pj.vel)
                 };
-                let (pr, pe) =
-                    pair.rates(pi, x_ij, v_cont, v_visc, pj.rho, pj.kind == FLUID, ratio);
+                let psi = if pj.kind == FLUID {
+                    diffused_density(ph, pi.rho, pj.rho, x_ij)
+                } else {
+                    0.0
+                };
+                let (pr, pe) = pair.rates(pi, x_ij, v_cont, v_visc, pj.rho, psi, ratio);
                 add(&mut r, pr);
                 de += pe;
             }
@@ -271,7 +285,9 @@ pub fn rates_and_energy(
                     }
                     let x_ig = sub(pi.pos, x_g);
                     if dot(x_ig, x_ig) < support2 {
-                        let (pr, pe) = pair.rates(pi, x_ig, v_cont, v_visc, pj.rho, true, 1.0);
+                        // The ghost's hydrostatic part is that of its fluid particle, at x_j.
+                        let psi = diffused_density(ph, pi.rho, pj.rho, space.sub(pi.pos, pj.pos));
+                        let (pr, pe) = pair.rates(pi, x_ig, v_cont, v_visc, pj.rho, psi, 1.0);
                         add(&mut r, pr);
                         de += pe;
                     }

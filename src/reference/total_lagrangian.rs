@@ -465,6 +465,7 @@ mod tests {
             gravity: [0.0; 3],
             viscosity: Viscosity::Artificial { alpha: 0.0 },
             delta_sph: 0.0,
+            delta_sph_form: Default::default(),
             particle_mass: 0.1,
             density_filter: DensityFilter::None,
             energy: false,

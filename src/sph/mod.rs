@@ -26,7 +26,9 @@ use crate::gpu::GpuContext;
 use crate::layout::{
     pack_block, unpack_block, Params, Pos, SimState, ID_MASK, KIND_EXCLUDED, KIND_SHIFT,
 };
-use crate::scenario::{GhostCorrection, KernelKind, Kind, RepulsiveForm, Scenario, Viscosity};
+use crate::scenario::{
+    DeltaSphForm, GhostCorrection, KernelKind, Kind, RepulsiveForm, Scenario, Viscosity,
+};
 use bodies::Bodies;
 use buffers::{InitialParticles, ParticleBuffers};
 use cell_list::CellList;
@@ -277,6 +279,8 @@ impl Solver {
             },
             viscosity,
             energy: ph.energy,
+            hydrostatic_diffusion: ph.delta_sph > 0.0
+                && ph.delta_sph_form == DeltaSphForm::Fourtakas,
         };
         let mut pos = Vec::with_capacity(n);
         let mut velrho = Vec::with_capacity(n);

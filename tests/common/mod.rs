@@ -84,6 +84,7 @@ pub fn physics(dim: u32, dx: f64, c0: f64) -> Physics {
         gravity,
         viscosity: Viscosity::Artificial { alpha: 0.02 },
         delta_sph: 0.1,
+        delta_sph_form: Default::default(),
         particle_mass: 1000.0 * dx.powi(dim as i32),
         density_filter: DensityFilter::None,
         energy: false,
