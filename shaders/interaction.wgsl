@@ -5,7 +5,9 @@
 //   + δ-SPH diffusion between fluid particles (Molteni & Colagrossi 2009, eq. 8):
 //     δ h c0 Σ_j 2 (ρ_i − ρ_j − ρ^H_ij) (x_ij·∇_i W_ij)/(r² + η²) V_j
 //     with ρ^H_ij = ρ0((1 + ρ0 g·x_ij/B)^(1/γ) − 1), the hydrostatic part of ρ_i − ρ_j, when
-//     HYDROSTATIC_DIFFUSION (Fourtakas et al. 2019; 0 otherwise). Without it the term
+//     HYDROSTATIC_DIFFUSION (Fourtakas et al. 2019; 0 otherwise), g without its components
+//     along periodic axes (no pressure gradient can balance those: a body force driving a
+//     periodic channel is no hydrostatics). Without it the term
 //     drains the density of the fluid next to a floor, whose fluid neighbours all lie above it
 //     and are lighter, and a tank at rest sinks steadily (0.7 mm/s in 0.465 m of water).
 //   + the seed's density-rate correction between materials, m_j v_ij·∇_i W_ij (ρ_i/ρ_j), used
@@ -86,7 +88,9 @@ fn diffused_density(rho_i: f32, rho_j: f32, x_ij: vec3<f32>) -> f32 {
     if (!HYDROSTATIC_DIFFUSION) {
         return rho_i - rho_j;
     }
-    let rho_h_ij = params.rho0 * (pow(1.0 + params.rho0 * dot(params.gravity, x_ij) / params.tait_b, 1.0 / params.gamma) - 1.0);
+    let periodic = vec3<bool>((params.periodic & 1u) != 0u, (params.periodic & 2u) != 0u, (params.periodic & 4u) != 0u);
+    let g = select(params.gravity, vec3<f32>(0.0), periodic);
+    let rho_h_ij = params.rho0 * (pow(1.0 + params.rho0 * dot(g, x_ij) / params.tait_b, 1.0 / params.gamma) - 1.0);
     return rho_i - rho_j - rho_h_ij;
 }
 

@@ -88,7 +88,8 @@ enum Command {
         /// multiplied by the scales). Repeatable. Errors also go to DIR/plots/errors.csv.
         #[arg(long = "reference", value_name = "PROBE=FILE[:XSCALE:YSCALE]")]
         references: Vec<wgsph::plot::ReferenceSpec>,
-        /// Draw the same probes of another run on the same axes: LABEL=DIR. Repeatable.
+        /// Draw the same probes of another run on the same axes: LABEL=DIR, split at the last
+        /// '=' (the label may contain one, DIR may not). Repeatable.
         #[arg(long = "with", value_name = "LABEL=DIR")]
         others: Vec<wgsph::plot::OtherRun>,
         /// Legend label of DIR's run (default: its case name).

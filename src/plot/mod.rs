@@ -125,7 +125,8 @@ impl FromStr for ReferenceSpec {
     }
 }
 
-/// `LABEL=DIR`: another run drawn on the same axes.
+/// `LABEL=DIR`: another run drawn on the same axes. Split at the last '=', so that a label may
+/// say `dx=0.04` (a directory name with '=' cannot be given).
 #[derive(Clone, Debug, PartialEq)]
 pub struct OtherRun {
     pub label: String,
@@ -136,7 +137,7 @@ impl FromStr for OtherRun {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, String> {
-        match s.split_once('=') {
+        match s.rsplit_once('=') {
             Some((l, d)) if !l.is_empty() && !d.is_empty() => Ok(OtherRun {
                 label: l.to_string(),
                 dir: PathBuf::from(d),
@@ -770,6 +771,13 @@ mod tests {
             (o.label.as_str(), o.dir.to_str().unwrap()),
             ("mirror", "out/m")
         );
+        let o: OtherRun = "3D, dx=0.04=out/s3d".parse().unwrap();
+        assert_eq!(
+            (o.label.as_str(), o.dir.to_str().unwrap()),
+            ("3D, dx=0.04", "out/s3d")
+        );
+        assert!("out/m".parse::<OtherRun>().is_err());
+        assert!("dx=".parse::<OtherRun>().is_err());
     }
 
     #[test]

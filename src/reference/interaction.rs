@@ -14,15 +14,27 @@ struct Pair<'a> {
 }
 
 /// ρ_i − ρ_j less, with Fourtakas et al. (2019), its hydrostatic part ρ0((1 + ρ0 g·x_ij/B)^(1/γ)
-/// − 1), for fluid particles x_ij apart: what δ-SPH diffuses (`diffused_density` in
-/// interaction.wgsl).
-pub fn diffused_density(ph: &Physics, rho_i: f64, rho_j: f64, x_ij: [f64; 3]) -> f64 {
+/// − 1), g without its components along periodic axes, for fluid particles x_ij apart: what
+/// δ-SPH diffuses (`diffused_density` in interaction.wgsl).
+pub fn diffused_density(
+    ph: &Physics,
+    space: &Space,
+    rho_i: f64,
+    rho_j: f64,
+    x_ij: [f64; 3],
+) -> f64 {
     match ph.delta_sph_form {
         DeltaSphForm::MolteniColagrossi => rho_i - rho_j,
         DeltaSphForm::Fourtakas => {
-            let rho_h_ij = ph.rho0
-                * ((1.0 + ph.rho0 * dot(ph.gravity, x_ij) / ph.tait_b()).powf(1.0 / ph.gamma)
-                    - 1.0);
+            let g = [0, 1, 2].map(|a| {
+                if space.periodic[a] {
+                    0.0
+                } else {
+                    ph.gravity[a]
+                }
+            });
+            let rho_h_ij =
+                ph.rho0 * ((1.0 + ph.rho0 * dot(g, x_ij) / ph.tait_b()).powf(1.0 / ph.gamma) - 1.0);
             rho_i - rho_j - rho_h_ij
         }
     }
@@ -241,7 +253,7 @@ pub fn rates_and_energy(
                     (pj.vel, pj.vel)
                 };
                 let psi = if pj.kind == FLUID {
-                    diffused_density(ph, pi.rho, pj.rho, x_ij)
+                    diffused_density(ph, space, pi.rho, pj.rho, x_ij)
                 } else {
                     0.0
                 };
@@ -286,7 +298,8 @@ pub fn rates_and_energy(
                     let x_ig = sub(pi.pos, x_g);
                     if dot(x_ig, x_ig) < support2 {
                         // The ghost's hydrostatic part is that of its fluid particle, at x_j.
-                        let psi = diffused_density(ph, pi.rho, pj.rho, space.sub(pi.pos, pj.pos));
+                        let psi =
+                            diffused_density(ph, space, pi.rho, pj.rho, space.sub(pi.pos, pj.pos));
                         let (pr, pe) = pair.rates(pi, x_ig, v_cont, v_visc, pj.rho, psi, 1.0);
                         add(&mut r, pr);
                         de += pe;
