@@ -136,7 +136,8 @@ fn mirror_free_slip() {
 
 /// The shipped case as it is (dynamic boundary particles): also `wgsph validate`'s hydrostatic
 /// row. Dynamic walls let the fluid come within half a spacing of the first wall layer, not
-/// beyond it.
+/// beyond it. Its −0.3 % owes something to the default δ-SPH form, which drains the floor's
+/// density as the water sinks: see `dynamic_boundary_pressure_within_2_percent_fourtakas`.
 #[test]
 fn dynamic_boundary() {
     let o = hydrostatic(&[]);
@@ -229,6 +230,22 @@ fn every_treatment_runs_in_3d_from_the_case_file() {
             "{set:?}"
         );
     }
+}
+
+/// The same tank with δ-SPH that leaves hydrostatics alone (Fourtakas et al. 2019): the water
+/// stays put, and the pressure 0.45 m deep settles near +2.8 % (+3.4 % without δ-SPH), from
+/// the discretisation: on the starting lattice at h = 1.3 dx the SPH pressure gradient of a
+/// linear field is 2.6 % short, so equilibrium needs a steeper one.
+#[test]
+#[ignore = "fails: +2.97 % over t in (1, 2] s (+2.8 % settled by 6 s): the 2 % the default form meets comes with the water sinking 0.9 mm/s (docs/validation.md); kept visible, not loosened"]
+fn dynamic_boundary_pressure_within_2_percent_fourtakas() {
+    let o = hydrostatic(&["physics.delta_sph_form=\"fourtakas\""]);
+    report("dynamic, Fourtakas δ-SPH", &o);
+    assert!(
+        o.error.abs() < wgsph::validation::hydrostatic::BOUND,
+        "pressure error {:.2} %",
+        100.0 * o.error
+    );
 }
 
 /// Mean height of the fluid particles [m].

@@ -97,8 +97,10 @@ fn ghosts_repulsion_and_mirrors_match_reference() {
     for dim in [2, 3] {
         for correction in [GhostCorrection::Shepard, GhostCorrection::Mls] {
             let mut sc = wall_scenario(dim, correction, 11 + dim as u64);
-            // Both repulsive force laws, one with each ghost correction.
+            // Both repulsive force laws and both δ-SPH forms, one with each ghost correction
+            // (Fourtakas takes a mirror image's hydrostatic part at its own particle).
             if correction == GhostCorrection::Mls {
+                sc.physics.delta_sph_form = DeltaSphForm::Fourtakas;
                 sc.walls.repulsive_form = RepulsiveForm::MonaghanKajtar;
                 sc.walls.repulsive_k = 9.81 * L;
                 sc.walls.repulsive_beta = 1.0;
@@ -152,7 +154,7 @@ fn ghosts_repulsion_and_mirrors_match_reference() {
                 ea = ea.max(da / rms);
                 ed = ed.max((g[3] as f64 - c[3]).abs() / rms_d);
             }
-            println!("{dim}D {correction:?} {:?}: {ghosts} ghosts, ghost v err {ev:.1e}, ghost ρ err {er:.1e}; accel err {ea:.1e}, drho err {ed:.1e}", sc.walls.repulsive_form);
+            println!("{dim}D {correction:?} {:?} {:?}: {ghosts} ghosts, ghost v err {ev:.1e}, ghost ρ err {er:.1e}; accel err {ea:.1e}, drho err {ed:.1e}", sc.walls.repulsive_form, sc.physics.delta_sph_form);
             assert!(ghosts > 0);
             assert!(ev < 1e-4 && er < 1e-3, "ghost interpolation");
             assert!(ea < 2e-4 && ed < 2e-4, "rates");

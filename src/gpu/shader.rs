@@ -101,7 +101,7 @@ impl Default for ShaderConfig {
             kernel: 1,
             viscosity: 0,
             energy: false,
-            hydrostatic_diffusion: true,
+            hydrostatic_diffusion: false,
         }
     }
 }
