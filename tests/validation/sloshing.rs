@@ -117,7 +117,7 @@ fn sloshing_transducer_2_follows_the_experiment_coarse() {
 }
 
 #[test]
-#[ignore = "10 s of sloshing at dx = 0.01: 86 456 steps, about 36 min on lavapipe; passes (measured 18.8 % and 32.8 %, docs/validation.md)"]
+#[ignore = "10 s of sloshing at dx = 0.01: 86 456 steps, about 36 min on lavapipe; passed with the default delta-SPH form (18.8 % and 32.8 %), not run since the case took Fourtakas (docs/validation.md)"]
 fn sloshing_transducers_follow_the_experiment_fine() {
     let dir = run("cases/sloshing_2d.toml", "0.01", 10.0, "fine");
     // As in the PySPH comparison of this case: after the start-up, t in [3, 10] s.
@@ -129,7 +129,7 @@ fn sloshing_transducers_follow_the_experiment_fine() {
 /// The experiment's own geometry, 3D (`cases/sloshing_3d.toml`), at its shipped dx = 0.02 m,
 /// judged as the fine 2D run.
 #[test]
-#[ignore = "not run yet: 10 s of the 3D tank at dx = 0.02 m (43 000 particles) is about 8 h on lavapipe, a GPU job; at dx = 0.04 transducer 2 is 39.6 % off, 8 45.3 % (docs/validation.md)"]
+#[ignore = "not run yet: 10 s of the 3D tank at dx = 0.02 m (43 000 particles) is about 8 h on lavapipe, a GPU job; at dx = 0.04 transducer 2 is 16.1 % off, 8 35.9 % (docs/validation.md)"]
 fn sloshing_3d_transducers_follow_the_experiment() {
     let dir = run("cases/sloshing_3d.toml", "0.02", 10.0, "3d");
     let (p2, p8) = report(&dir, 3.0, 10.0);
