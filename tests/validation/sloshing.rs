@@ -117,7 +117,7 @@ fn sloshing_transducer_2_follows_the_experiment_coarse() {
 }
 
 #[test]
-#[ignore = "10 s of sloshing at dx = 0.01: 86 456 steps, about 36 min on lavapipe; passed with the default delta-SPH form (18.8 % and 32.8 %), not run since the case took Fourtakas (docs/validation.md)"]
+#[ignore = "10 s of sloshing at dx = 0.01: 86 635 steps, about 45 min on lavapipe; passes (measured 19.1 % and 18.1 %, docs/validation.md)"]
 fn sloshing_transducers_follow_the_experiment_fine() {
     let dir = run("cases/sloshing_2d.toml", "0.01", 10.0, "fine");
     // As in the PySPH comparison of this case: after the start-up, t in [3, 10] s.
