@@ -233,9 +233,10 @@ fn every_treatment_runs_in_3d_from_the_case_file() {
 }
 
 /// The same tank with δ-SPH that leaves hydrostatics alone (Fourtakas et al. 2019): the water
-/// stays put, and the pressure 0.45 m deep settles near +2.8 % (+3.4 % without δ-SPH), from
-/// the discretisation: on the starting lattice at h = 1.3 dx the SPH pressure gradient of a
-/// linear field is 2.6 % short, so equilibrium needs a steeper one.
+/// stays put, and the pressure 0.45 m deep settles near +2.8 % (+3.4 % without δ-SPH). Part of
+/// that is the discretisation (on the starting lattice at h = 1.3 dx the SPH pressure gradient
+/// of a linear field is 2.6 % short, so equilibrium needs a steeper one), not all: at
+/// h = 1.5 dx, where the lattice's shortfall is 0.3 %, the pressure is still +2.1 %.
 #[test]
 #[ignore = "fails: +2.97 % over t in (1, 2] s (+2.8 % settled by 6 s): the 2 % the default form meets comes with the water sinking 0.9 mm/s (docs/validation.md); kept visible, not loosened"]
 fn dynamic_boundary_pressure_within_2_percent_fourtakas() {
