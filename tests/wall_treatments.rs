@@ -10,7 +10,8 @@ use wgsph::sph::Solver;
 use wgsph::validation::hydrostatic;
 
 struct Outcome {
-    /// Relative error of the probe pressure averaged over t ∈ (1, 2] s.
+    /// Relative error of the probe pressure averaged over t > 1 s (to `time.end_s`, 2 s in the
+    /// case file).
     error: f64,
     /// Standard deviation of the pressure of the fluid particles within dx of the floor,
     /// relative to ρ0·g·H, at t = 2 s.
@@ -150,6 +151,22 @@ fn dynamic_boundary() {
     );
     assert_eq!((o.excluded, o.lost), (0, 0));
     assert!(o.margin > -0.5 * 0.02, "fluid crossed a wall: {}", o.margin);
+}
+
+/// The same comparison held to 4 s (mean over (1, 4] s): the default δ-SPH form drains the
+/// floor's density and the pressure falls about 2 % per second, through −5.2 % over (3, 4] s,
+/// with every wall treatment (docs/validation.md, "δ-SPH and water at rest"). Fourtakas δ-SPH
+/// is steady (+2.99 % over (1, 4] s, the discretisation's excess).
+#[test]
+#[ignore = "fails: -2.96 % over t in (1, 4] s, the default delta-SPH form's drain (docs/validation.md); kept visible, not loosened"]
+fn dynamic_boundary_pressure_within_2_percent_to_4_s() {
+    let o = hydrostatic(&["time.end_s=4"]);
+    report("dynamic, to 4 s", &o);
+    assert!(
+        o.error.abs() < wgsph::validation::hydrostatic::BOUND,
+        "pressure error {:.2} %",
+        100.0 * o.error
+    );
 }
 
 #[test]
