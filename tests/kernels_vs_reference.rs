@@ -186,14 +186,19 @@ fn interaction_matches_reference() {
     }
 }
 
+/// The setups with Fourtakas δ-SPH (2D and 3D).
+fn fourtakas_setups() -> Vec<Setup> {
+    setups()
+        .into_iter()
+        .filter(|s| s.delta_sph_form == DeltaSphForm::Fourtakas)
+        .collect()
+}
+
 /// Gravity along a periodic axis is a body force no pressure gradient balances: the
 /// hydrostatic part δ-SPH takes out (Fourtakas) leaves it out.
 #[test]
 fn interaction_with_gravity_along_a_periodic_axis_matches_reference() {
-    for s in setups()
-        .into_iter()
-        .filter(|s| s.delta_sph_form == DeltaSphForm::Fourtakas)
-    {
+    for s in fourtakas_setups() {
         let mut sc = random_scenario(&s);
         sc.periodic[0] = true;
         sc.physics.gravity[0] = 3.0;
@@ -216,10 +221,7 @@ fn interaction_with_gravity_along_a_periodic_axis_matches_reference() {
 /// densities of `interaction_matches_reference`.
 #[test]
 fn fourtakas_diffusion_at_hydrostatic_rest_matches_reference() {
-    for s in setups()
-        .into_iter()
-        .filter(|s| s.delta_sph_form == DeltaSphForm::Fourtakas)
-    {
+    for s in fourtakas_setups() {
         let mut sc = random_scenario(&s);
         sc.physics.c0 = 10.0;
         let (rho0, b, gamma) = (sc.physics.rho0, sc.physics.tait_b(), sc.physics.gamma);
