@@ -45,7 +45,8 @@
 //   particles of walls and bodies and from particles of other elastic bodies; elastic.wgsl
 //   (or total_lagrangian.wgsl) adds the forces within the body and gravity.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
-// get nothing here.
+// get nothing here; unless WALL_REACTIONS (a case with wall-pressure probes, probes.wgsl): then
+// every fixed boundary particle also gets the fluid's force on it, as a moving body's does.
 // Particles of moving bodies get the force per unit mass of their fluid neighbours, the opposite
 // of what the fluid receives from them: for dynamic and fixed-ghost body particles
 // −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (a ghost with its interpolated P_g and its
@@ -368,7 +369,9 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let fluid_i = kind_i == KIND_FLUID;
     let id_i = code[i] & ID_MASK;
     let on_body = !fluid_i && kind_i != KIND_EXCLUDED && is_body_particle(id_i);
-    if (!fluid_i && kind_i != KIND_WALL && !on_body) {
+    // Boundary particles that take the fluid's force: bodies', and fixed walls' for probes.
+    let reacts = on_body || (WALL_REACTIONS && !fluid_i && kind_i != KIND_EXCLUDED);
+    if (!fluid_i && kind_i != KIND_WALL && !reacts) {
         rate[i] = vec4<f32>(0.0);
         return;
     }
@@ -403,7 +406,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             if (!fluid_i) {
                 if (kind_j == KIND_FLUID) {
                     let vr_j = velrho[j];
-                    if (body_i == NO_BODY) {
+                    if (!reacts) {
                         // Fixed dynamic wall particle: continuity only.
                         r.w += params.mass * dot(pi.v - vr_j.xyz, x_ij * kernel_f(sqrt(r2) / params.h));
                     } else if (kind_i == KIND_REPULSIVE) {

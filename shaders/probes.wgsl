@@ -1,17 +1,19 @@
-// Probes, sampled on the GPU so that no particle data leaves it: pressure at a point and wave
-// gauges (one invocation per probe, walking the cell list), and the surge front (a max over
-// fluid particles). Results are f32 bit patterns in `probe_out`, read back by the host.
+// Probes, sampled on the GPU so that no particle data leaves it: pressure at a point, wave
+// gauges and wall pressure (one invocation per probe, walking the cell list), and the surge
+// front (a max over fluid particles). Results are f32 bit patterns in `probe_out`, read back
+// by the host.
 
 struct ProbeDef {
     point: vec3<f32>,   // domain coordinates (from the domain's min corner)
     kind: u32,          // PROBE_*
-    axis: vec3<f32>,    // unit vector (front probes)
-    pad: u32,
+    axis: vec3<f32>,    // unit vector: a front's direction, a wall patch's normal (into the fluid)
+    radius: f32,        // a wall patch's radius across its normal
 }
 
 const PROBE_PRESSURE: u32 = 0u;
 const PROBE_HEIGHT: u32 = 1u;
 const PROBE_FRONT: u32 = 2u;
+const PROBE_WALL_PRESSURE: u32 = 3u;
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;
@@ -19,6 +21,7 @@ const PROBE_FRONT: u32 = 2u;
 @group(0) @binding(4) var<storage, read> cell_start: array<u32>;
 @group(0) @binding(5) var<storage, read> probes: array<ProbeDef>;
 @group(0) @binding(6) var<storage, read_write> probe_out: array<atomic<u32>>;
+@group(0) @binding(9) var<storage, read> rate: array<vec4<f32>>;
 
 struct KernelSums {
     volume: f32,        // Σ_j W V_j over fluid (the Shepard denominator)
@@ -89,6 +92,51 @@ fn probe_height(x: vec3<f32>) -> f32 {
     return 0.0;
 }
 
+// Σ_j a_j·n over the boundary particles j of a wall patch, a_j their rate (the fluid's force per
+// unit fluid mass, interaction.wgsl with WALL_REACTIONS; for a body's particles also any contact
+// force); the host multiplies by −m/area. The rates are those of the last step's interaction,
+// at its predicted state, in the current cell order. The patch (WallPatch in scenario.rs): no
+// fluid or solid particle, (x_j − point)·n in [−3h, h], distance across n below the radius.
+// The cells of the patch's box are visited once each (a particle counts in its own cell only),
+// in a fixed order: the same state gives the same sum.
+fn probe_wall_force(def: ProbeDef) -> f32 {
+    let e = vec3<f32>(def.radius + 4.0 * params.h);
+    var lo = vec3<i32>(floor((def.point - e) * params.inv_cell_size));
+    var hi = vec3<i32>(floor((def.point + e) * params.inv_cell_size));
+    let n = vec3<i32>(params.grid_cells);
+    let periodic = periodic_axes();
+    // Each cell once: a periodic axis wraps (at most one period of cells), another is clamped.
+    lo = select(max(lo, vec3<i32>(0)), lo, periodic);
+    hi = select(min(hi, n - vec3<i32>(1)), min(hi, lo + n - vec3<i32>(1)), periodic);
+    if (DIM == 2u) {
+        lo.z = 0;
+        hi.z = 0;
+    }
+    var sum = 0.0;
+    for (var cz = lo.z; cz <= hi.z; cz++) {
+        for (var cy = lo.y; cy <= hi.y; cy++) {
+            for (var cx = lo.x; cx <= hi.x; cx++) {
+                var c = vec3<i32>(cx, cy, cz);
+                c = select(c, ((c % n) + n) % n, periodic);
+                let slot = slot_of_cell(c);
+                for (var j = cell_start[slot]; j < cell_start[slot + 1u]; j++) {
+                    let kind = code_kind(code[j]);
+                    if (kind == KIND_FLUID || kind == KIND_EXCLUDED || is_solid(kind) || any(cell_of(pos[j]) != c)) {
+                        continue;
+                    }
+                    let r = domain_pos(pos[j]) - def.point;
+                    let d = dot(r, def.axis);
+                    let t2 = dot(r, r) - d * d;
+                    if (d >= -3.0 * params.h && d <= params.h && t2 < def.radius * def.radius) {
+                        sum += dot(rate[j].xyz, def.axis);
+                    }
+                }
+            }
+        }
+    }
+    return sum;
+}
+
 @compute @workgroup_size(WG)
 fn probe_points(@builtin(global_invocation_id) gid: vec3<u32>) {
     let k = gid.x;
@@ -100,6 +148,8 @@ fn probe_points(@builtin(global_invocation_id) gid: vec3<u32>) {
         atomicStore(&probe_out[k], bitcast<u32>(probe_pressure(def.point)));
     } else if (def.kind == PROBE_HEIGHT) {
         atomicStore(&probe_out[k], bitcast<u32>(probe_height(def.point)));
+    } else if (def.kind == PROBE_WALL_PRESSURE) {
+        atomicStore(&probe_out[k], bitcast<u32>(probe_wall_force(def)));
     }
 }
 

@@ -105,7 +105,7 @@ pub struct ProbeDef {
     pub point: [f32; 3],
     pub kind: u32,
     pub axis: [f32; 3],
-    pub pad: u32,
+    pub radius: f32,
 }
 
 /// Mirrors `MirrorPlane` in shaders/interaction.wgsl.
@@ -339,7 +339,12 @@ mod tests {
     #[test]
     fn pos_and_probe_match_wgsl() {
         check_layout!(Pass::Interaction, "Pos", Pos, [off, block]);
-        check_layout!(Pass::Probes, "ProbeDef", ProbeDef, [point, kind, axis]);
+        check_layout!(
+            Pass::Probes,
+            "ProbeDef",
+            ProbeDef,
+            [point, kind, axis, radius]
+        );
         check_layout!(
             Pass::Interaction,
             "MirrorPlane",
@@ -383,15 +388,20 @@ mod tests {
             for dim in [2, 3] {
                 for kernel in [0, 1] {
                     for viscosity in [0, 1] {
-                        for (energy, hydrostatic_diffusion) in
-                            [(false, false), (false, true), (true, false), (true, true)]
-                        {
+                        // Each flag on and off (wall reactions with each of the others).
+                        for (energy, hydrostatic_diffusion, wall_reactions) in [
+                            (false, false, false),
+                            (false, true, true),
+                            (true, false, true),
+                            (true, true, false),
+                        ] {
                             let cfg = ShaderConfig {
                                 dim,
                                 kernel,
                                 viscosity,
                                 energy,
                                 hydrostatic_diffusion,
+                                wall_reactions,
                             };
                             parse(&compose(pass, cfg), pass.name()).unwrap();
                         }

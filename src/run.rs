@@ -21,7 +21,7 @@ use crate::sph::{check_capacity, Solver};
 /// Column name of a probe's CSV.
 pub fn probe_column(kind: &ProbeKind) -> &'static str {
     match kind {
-        ProbeKind::Pressure { .. } => "pressure_pa",
+        ProbeKind::Pressure { .. } | ProbeKind::WallPressure(_) => "pressure_pa",
         ProbeKind::Height { .. } => "height_m",
         ProbeKind::Front { .. } => "front_m",
     }

@@ -148,6 +148,26 @@ pub enum ProbeKind {
     Height { base: [f64; 3] },
     /// Surge front: largest (x − origin)·axis over fluid particles.
     Front { origin: [f64; 3], axis: [f64; 3] },
+    /// Pressure on a patch of wall, as a transducer reads it: the fluid's force on the wall's
+    /// boundary particles whose columns lie within `radius` of `point` (measured across
+    /// `normal`, any depth behind the face), along −`normal`, divided by the columns' area.
+    /// Needs [`WallParams::reactions`], which gives fixed boundary particles that force.
+    WallPressure(WallPatch),
+}
+
+/// The boundary particles a wall-pressure probe sums over (`wall_patch`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WallPatch {
+    /// A point on the wall's face.
+    pub point: [f64; 3],
+    /// Unit normal of the face, into the fluid.
+    pub normal: [f64; 3],
+    /// Radius across the normal within which a column's centre is taken; set halfway between
+    /// the farthest column taken and the nearest column left out, so that f32 positions on the
+    /// GPU select the same particles.
+    pub radius: f64,
+    /// Area of the columns taken [m² in 3D, m in 2D]: their number times dx^(dim − 1).
+    pub area: f64,
 }
 
 /// A tracked material point (`[[probe]] kind = "point"`): the particle of an elastic solid or
@@ -204,6 +224,10 @@ pub struct WallParams {
     /// Monaghan & Kajtar β: fluid spacing over boundary-particle spacing.
     pub repulsive_beta: f64,
     pub mirror_planes: Vec<MirrorPlane>,
+    /// Whether the boundary particles of fixed walls also get the fluid's force on them (as
+    /// moving bodies' always do): wall-pressure probes read it. Off otherwise, since it costs
+    /// every fixed boundary particle a full neighbour sum.
+    pub reactions: bool,
 }
 
 /// The force law of repulsive boundary particles.
@@ -214,6 +238,107 @@ pub enum RepulsiveForm {
     /// Monaghan & Kajtar (2009): (K/β) x/r² Φ(r/h) 2m_b/(m_a+m_b), Φ the Wendland C4 shape
     /// with Φ(0) = 1.77; smooth along the wall.
     MonaghanKajtar,
+}
+
+impl WallPatch {
+    /// The extent of the patch along its normal, from the face: boundary particles up to 3h
+    /// behind it (every one the fluid reaches, 2h from the nearest fluid, whatever the wall's
+    /// spacing) and h in front of it (a face given half a spacing off).
+    pub fn depth(h: f64) -> (f64, f64) {
+        (-3.0 * h, h)
+    }
+
+    /// The normal coordinate d = (x − point)·normal of `x` and its squared distance from the
+    /// normal line through `point`.
+    pub fn coordinates(point: [f64; 3], normal: [f64; 3], x: [f64; 3]) -> (f64, f64) {
+        let r: [f64; 3] = [0, 1, 2].map(|a| x[a] - point[a]);
+        let d = (0..3).map(|a| r[a] * normal[a]).sum::<f64>();
+        let r2 = (0..3).map(|a| r[a] * r[a]).sum::<f64>();
+        (d, (r2 - d * d).max(0.0))
+    }
+
+    /// The patch of the boundary particles among `particles` that lie within `radius` of
+    /// `point` across the unit `normal` (from 3h behind the face to h in front of it; a column
+    /// on the circle is left out); a sensor narrower than the spacing takes the nearest column
+    /// (all of them, between several). Its radius is
+    /// moved halfway to the next column left out, and its area is the number of distinct
+    /// columns (tangential positions to dx/4) times dx^(dim − 1). `None` when no boundary
+    /// particle lies within max(radius, dx) of `point` across the normal, or the nearest lie
+    /// more than dx behind it (`point` is not on the wall's face).
+    pub fn resolve(
+        particles: &[Particle],
+        point: [f64; 3],
+        normal: [f64; 3],
+        radius: f64,
+        dim: usize,
+        dx: f64,
+        h: f64,
+    ) -> Option<WallPatch> {
+        let (behind, front) = Self::depth(h);
+        // Every boundary particle in the slab.
+        struct Candidate {
+            /// Distance across the normal.
+            across: f64,
+            /// Tangential position in quarters of dx.
+            column: [i64; 3],
+            /// (x − point)·normal.
+            d: f64,
+        }
+        let candidates: Vec<Candidate> = particles
+            .iter()
+            .filter(|p| !p.kind.is_fluid() && !p.kind.is_solid())
+            .filter_map(|p| {
+                let (d, t2) = Self::coordinates(point, normal, p.pos);
+                let column = [0, 1, 2]
+                    .map(|a| ((p.pos[a] - point[a] - d * normal[a]) / (0.25 * dx)).round() as i64);
+                (d >= behind && d <= front).then_some(Candidate {
+                    across: t2.sqrt(),
+                    column,
+                    d,
+                })
+            })
+            .collect();
+        // A column within a millionth of dx of the circle is on it, and left out: f32 positions
+        // on the GPU could not tell which side it is on.
+        let tol = 1e-6 * dx;
+        let nearest = candidates
+            .iter()
+            .map(|c| c.across)
+            .fold(f64::INFINITY, f64::min);
+        if nearest > radius.max(dx) + tol {
+            return None;
+        }
+        // Within the radius, or as near as the nearest.
+        let reach = if nearest < radius - tol {
+            radius - tol
+        } else {
+            nearest + tol
+        };
+        let (taken, left_out): (Vec<&Candidate>, Vec<&Candidate>) =
+            candidates.iter().partition(|c| c.across < reach);
+        // The face must be within a spacing of the wall's first layer.
+        if taken.iter().map(|c| c.d).fold(f64::NEG_INFINITY, f64::max) < -dx - tol {
+            return None;
+        }
+        let farthest_taken = taken.iter().map(|c| c.across).fold(0.0, f64::max);
+        let nearest_left_out = left_out
+            .iter()
+            .map(|c| c.across)
+            .fold(f64::INFINITY, f64::min);
+        let mut columns: Vec<[i64; 3]> = taken.iter().map(|c| c.column).collect();
+        columns.sort_unstable();
+        columns.dedup();
+        Some(WallPatch {
+            point,
+            normal,
+            radius: if nearest_left_out.is_finite() {
+                0.5 * (farthest_taken + nearest_left_out)
+            } else {
+                reach
+            },
+            area: columns.len() as f64 * dx.powi(dim as i32 - 1),
+        })
+    }
 }
 
 impl WallParams {
@@ -227,6 +352,7 @@ impl WallParams {
             repulsive_k: gravity * height,
             repulsive_beta: 1.0,
             mirror_planes: Vec::new(),
+            reactions: false,
         }
     }
 }

@@ -415,7 +415,7 @@ fn hydrostatic_pressure(set: &[&str]) -> hydrostatic::BottomPressure {
         })
         .collect();
     assert_eq!(solver.excluded(), 0);
-    hydrostatic::bottom_pressure(&sc, &series).unwrap()
+    hydrostatic::mean_pressure(&sc, hydrostatic::PROBE, &series).unwrap()
 }
 
 #[test]

@@ -244,6 +244,64 @@ fn fourtakas_diffusion_at_hydrostatic_rest_matches_reference() {
     }
 }
 
+/// With wall reactions on, the fixed walls' particles take the fluid's force (as bodies' do), and
+/// a wall-pressure probe on the floor sums it: both against the reference, the probe on the
+/// GPU's own rates' state (the warm-up's), dense and sparse (hash-colliding) grids.
+#[test]
+fn wall_reactions_and_wall_pressure_match_reference() {
+    for s in setups() {
+        let mut sc = random_scenario(&s);
+        sc.walls.reactions = true;
+        let o = 0.5 * (s.domain - BLOCK);
+        let up = s.dim as usize - 1;
+        let mut point = [o + 0.5 * BLOCK; 3];
+        point[up] = o + 2.0 * sc.physics.dx;
+        if s.dim == 2 {
+            point[2] = 0.0;
+        }
+        let mut normal = [0.0; 3];
+        normal[up] = 1.0;
+        let (dim, dx, h) = (s.dim as usize, sc.physics.dx, sc.physics.h);
+        let patch = WallPatch::resolve(&sc.particles, point, normal, 0.05, dim, dx, h).unwrap();
+        // 5 columns across in 2D, the 21 within 2.5 dx of the centre in 3D.
+        let columns = if s.dim == 2 { 5.0 } else { 21.0 };
+        assert!((patch.area / dx.powi(s.dim as i32 - 1) - columns).abs() < 1e-9);
+        // And the whole floor: a patch whose box of cells reaches past the domain's edge (on
+        // the dense grids).
+        let whole = WallPatch::resolve(&sc.particles, point, normal, BLOCK, dim, dx, h).unwrap();
+        sc.probes = [("floor", patch), ("whole", whole)]
+            .map(|(name, p)| Probe {
+                name: name.into(),
+                kind: ProbeKind::WallPressure(p),
+                body: None,
+            })
+            .to_vec();
+        let solver = Solver::new(gpu(), &sc).unwrap();
+        let (parts, _) = gpu_particles_and_codes(&solver);
+        let gpu_p = solver.sample_probes().unwrap();
+        let cpu = reference::interaction::rates(
+            &sc.physics,
+            &sc.walls,
+            &reference::Space::of(&sc),
+            &parts,
+        );
+        let cpu_p =
+            [patch, whole].map(|p| reference::probes::wall_pressure(&sc.physics, &parts, &cpu, &p));
+        let (e_acc, e_rho) = interaction_errors(&sc);
+        let e_p = [0, 1].map(|k| (gpu_p[k] - cpu_p[k]).abs() / cpu_p[k].abs());
+        println!(
+            "dim {} {:?} domain {}: accel err {e_acc:.2e}, drho err {e_rho:.2e}, wall pressure \
+             GPU {gpu_p:.3?} CPU {cpu_p:.3?} Pa (err {e_p:?})",
+            s.dim, s.viscosity, s.domain
+        );
+        assert!(e_acc < 2e-4, "acceleration error {e_acc}");
+        assert!(e_rho < 2e-4, "density-rate error {e_rho}");
+        assert!(e_p.iter().all(|e| *e < 1e-4), "wall pressure error {e_p:?}");
+        // The fluid above presses on the floor.
+        assert!(cpu_p.iter().all(|p| *p > 0.0), "wall pressure {cpu_p:?}");
+    }
+}
+
 #[test]
 fn one_step_matches_reference() {
     for s in setups() {

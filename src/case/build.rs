@@ -532,10 +532,13 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     }
 
     let points = super::probes::resolve_points(ctx, &case.points, &particles, &bodies, dim, dx)?;
+    let mut probes = case.probes;
+    let h = case.h_over_dx * dx;
+    super::probes::resolve_wall_patches(ctx, &mut probes, &particles, dim, dx, h)?;
     let physics = Physics {
         dim: dim as u32,
         dx,
-        h: case.h_over_dx * dx,
+        h,
         kernel: case.kernel,
         rho0: case.rho0,
         c0,
@@ -563,6 +566,9 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     }
     walls.repulsive_beta = case.walls.repulsive_beta;
     walls.mirror_planes = mirror_planes;
+    walls.reactions = probes
+        .iter()
+        .any(|p| matches!(p.kind, ProbeKind::WallPressure(_)));
     let n_particles = particles.len();
     Ok(Scenario {
         name: case.name,
@@ -570,7 +576,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         time: case.time,
         domain,
         particles,
-        probes: case.probes,
+        probes,
         points,
         walls,
         periodic: [false; 3],
@@ -718,6 +724,7 @@ fn domain(
             ProbeKind::Pressure { point } => ("point_m", *point),
             ProbeKind::Height { base } => ("base_m", *base),
             ProbeKind::Front { origin, .. } => ("origin_m", *origin),
+            ProbeKind::WallPressure(patch) => ("point_m", patch.point),
         };
         if !point_inside(point, &d, dim) {
             // Say what the default domain encloses: removing the tank shrinks it to the fluid.

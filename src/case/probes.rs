@@ -2,7 +2,7 @@
 //! case's dimension (padded to 3 components), a non-zero front axis (normalised); and the
 //! choice of the particle a `"point"` probe follows.
 
-use crate::scenario::{Body, Particle, Probe, ProbeKind, TrackedPoint};
+use crate::scenario::{Body, Particle, Probe, ProbeKind, TrackedPoint, WallPatch};
 
 use super::error::CaseError;
 use super::locate::Ctx;
@@ -50,6 +50,7 @@ pub(super) fn probe(
         ProbeName::Height => ("height", &["base_m"]),
         ProbeName::Front => ("front", &["origin_m", "axis"]),
         ProbeName::Point => ("point", &["point_m"]),
+        ProbeName::WallPressure => ("wall_pressure", &["point_m", "normal", "radius_m"]),
     };
     if p.kind == ProbeName::Point && p.body.is_some() {
         return Err(ctx.err(
@@ -65,19 +66,29 @@ pub(super) fn probe(
         ("base_m", &p.base_m),
         ("origin_m", &p.origin_m),
         ("axis", &p.axis),
+        ("normal", &p.normal),
     ];
-    for (field, value) in fields {
+    let present = fields
+        .iter()
+        .map(|(field, value)| (*field, value.is_some()))
+        .chain([("radius_m", p.radius_m.is_some())]);
+    for (field, value) in present {
         let f = format!("{path}.{field}");
         match (needs.contains(&field), value) {
-            (true, None) => {
+            (true, false) => {
+                let add = if field == "radius_m" {
+                    format!("add {field} = ... (metres, e.g. half the sensor's diameter)")
+                } else {
+                    format!("add {field} = [...] ({dim} numbers)")
+                };
                 return Err(ctx.err(
                     &f,
                     None,
                     format!("is required for a \"{kind_name}\" probe"),
-                    format!("add {field} = [...] ({} numbers)", dim),
+                    add,
                 ));
             }
-            (false, Some(_)) => {
+            (false, true) => {
                 return Err(ctx.err(
                     &f,
                     None,
@@ -125,22 +136,46 @@ pub(super) fn probe(
                 &p.axis,
                 "the direction along which the front is measured",
             )?;
-            // Scale first so that huge components do not overflow the norm.
-            let big = axis.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
-            let scaled = axis.map(|a| if big > 0.0 { a / big } else { 0.0 });
-            let len = scaled.iter().map(|a| a * a).sum::<f64>().sqrt();
-            if !(len.is_finite() && len > 0.0) {
-                return Err(ctx.err(
-                    &format!("{path}.axis"),
-                    Some(format!("{:?}", p.axis.as_deref().unwrap_or(&[]))),
-                    "must be a non-zero direction (it is normalised)",
-                    "give the direction of the surge, e.g. [1.0, 0.0]",
-                ));
-            }
             ProbeKind::Front {
                 origin,
-                axis: scaled.map(|a| a / len),
+                axis: unit(
+                    ctx,
+                    &format!("{path}.axis"),
+                    axis,
+                    &p.axis,
+                    "the direction of the surge, e.g. [1.0, 0.0]",
+                )?,
             }
+        }
+        ProbeName::WallPressure => {
+            let point = get(
+                "point_m",
+                &p.point_m,
+                "the centre of the sensor's face in metres",
+            )?;
+            let normal = get("normal", &p.normal, "the face's normal, into the fluid")?;
+            let radius = p.radius_m.unwrap_or(f64::NAN);
+            if !(radius.is_finite() && radius > 0.0) {
+                return Err(ctx.err(
+                    &format!("{path}.radius_m"),
+                    Some(format!("{radius}")),
+                    "must be a positive number of metres",
+                    "give the sensor's radius, e.g. radius_m = 0.005",
+                ));
+            }
+            ProbeKind::WallPressure(WallPatch {
+                point,
+                normal: unit(
+                    ctx,
+                    &format!("{path}.normal"),
+                    normal,
+                    &p.normal,
+                    "the normal of a right-hand wall, e.g. [-1.0, 0.0]",
+                )?,
+                radius,
+                // Resolved against the particles (`resolve_wall_patches`).
+                area: 0.0,
+            })
         }
     };
     Ok(Checked::Sampled(Probe {
@@ -149,6 +184,89 @@ pub(super) fn probe(
         // Resolved against the bodies once they are known (validate.rs).
         body: None,
     }))
+}
+
+/// `v` normalised; an error at `path` (a direction) when it is zero or not finite.
+fn unit(
+    ctx: &Ctx<'_>,
+    path: &str,
+    v: [f64; 3],
+    given: &Option<Vec<f64>>,
+    example: &str,
+) -> Result<[f64; 3], CaseError> {
+    // Scale first so that huge components do not overflow the norm.
+    let big = v.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+    let scaled = v.map(|a| if big > 0.0 { a / big } else { 0.0 });
+    let len = scaled.iter().map(|a| a * a).sum::<f64>().sqrt();
+    if !(len.is_finite() && len > 0.0) {
+        return Err(ctx.err(
+            path,
+            Some(format!("{:?}", given.as_deref().unwrap_or(&[]))),
+            "must be a non-zero direction (it is normalised)",
+            format!("give {example}"),
+        ));
+    }
+    Ok(scaled.map(|a| a / len))
+}
+
+/// The largest wall-pressure patch radius, in smoothing lengths: its box then holds about 50³
+/// cells in 3D.
+const MAX_PATCH_RADIUS_H: f64 = 20.0;
+
+/// Each wall-pressure probe's patch among the built particles ([`WallPatch::resolve`]): an
+/// error when no boundary particle lies within its radius (or dx) of its point (mirror walls,
+/// whose images are not particles, or a point off the wall).
+pub(super) fn resolve_wall_patches(
+    ctx: &Ctx<'_>,
+    probes: &mut [Probe],
+    particles: &[Particle],
+    dim: usize,
+    dx: f64,
+    h: f64,
+) -> Result<(), CaseError> {
+    for (i, probe) in probes.iter_mut().enumerate() {
+        let ProbeKind::WallPressure(patch) = &mut probe.kind else {
+            continue;
+        };
+        if patch.radius > MAX_PATCH_RADIUS_H * h {
+            return Err(ctx.err(
+                &format!("probe[{i}].radius_m"),
+                Some(format!("{}", patch.radius)),
+                format!(
+                    "is more than {MAX_PATCH_RADIUS_H} h = {:.4} m: one GPU thread visits every \
+                     cell of a wall-pressure probe's box at every sample",
+                    MAX_PATCH_RADIUS_H * h
+                ),
+                "give the sensor's own radius (millimetres to centimetres), or several probes",
+            ));
+        }
+        match WallPatch::resolve(
+            particles,
+            patch.point,
+            patch.normal,
+            patch.radius,
+            dim,
+            dx,
+            h,
+        ) {
+            Some(resolved) => *patch = resolved,
+            None => {
+                return Err(ctx.err(
+                    &format!("probe[{i}].point_m"),
+                    Some(format!("{:?}", &patch.point[..dim])),
+                    format!(
+                        "has no wall particle within radius_m = {} (or dx = {dx}) across the \
+                         normal and within dx behind it: a wall-pressure probe sums the fluid's \
+                         force on the wall particles behind a face (mirror walls have none)",
+                        patch.radius
+                    ),
+                    "put point_m on the face of a particle wall (dynamic, fixed_ghost or \
+                     repulsive) with normal pointing into the fluid",
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The particle each point probe follows: the nearest particle of an elastic solid or a rigid

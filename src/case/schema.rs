@@ -287,6 +287,10 @@ pub(super) struct RawProbe {
     pub base_m: Option<Vec<f64>>,
     pub origin_m: Option<Vec<f64>>,
     pub axis: Option<Vec<f64>>,
+    /// A wall-pressure probe's face normal, into the fluid.
+    pub normal: Option<Vec<f64>>,
+    /// A wall-pressure probe's radius across its normal.
+    pub radius_m: Option<f64>,
     /// The body the probe moves with ("tank" for a moving tank).
     pub body: Option<String>,
 }
@@ -298,6 +302,7 @@ pub(super) enum ProbeName {
     Height,
     Front,
     Point,
+    WallPressure,
 }
 
 /// Help for one field: what it is and an example of a valid line.
@@ -706,7 +711,7 @@ pub(super) const FIELDS: &[FieldHelp] = &[
     ),
     f(
         "probe[].point_m",
-        "the sampling point of a pressure probe",
+        "the sampling point of a pressure probe, the centre of a wall-pressure probe's face",
         "point_m = [0.5, 0.05]",
     ),
     f(
@@ -723,6 +728,16 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "probe[].axis",
         "the direction of a front probe",
         "axis = [1.0, 0.0]",
+    ),
+    f(
+        "probe[].normal",
+        "the normal of a wall-pressure probe's wall face, into the fluid",
+        "normal = [-1.0, 0.0]",
+    ),
+    f(
+        "probe[].radius_m",
+        "the radius of a wall-pressure probe's patch across its normal",
+        "radius_m = 0.005",
     ),
     f(
         "probe[].body",

@@ -192,12 +192,90 @@ fn hydrostatic_2d_builds() {
         .iter()
         .filter(|p| p.kind == Kind::Wall && p.pos[1] > 0.5)
         .all(|p| p.rho == 1000.0));
-    assert_eq!(s.probes.len(), 2);
+    assert_eq!(s.probes.len(), 3);
     assert_eq!(
         s.probes[1].kind,
         ProbeKind::Height {
             base: [0.5, 0.0, 0.0]
         }
+    );
+    // The floor sensor: the 4 columns within 0.05 m of x = 0.5 (0.47 … 0.53), its radius
+    // moved halfway to the next ones (0.45 and 0.55, on the edge, left out).
+    let ProbeKind::WallPressure(patch) = s.probes[2].kind else {
+        panic!("{:?}", s.probes[2]);
+    };
+    assert!((patch.area - 0.08).abs() < 1e-12, "{patch:?}");
+    assert!((patch.radius - 0.04).abs() < 1e-12, "{patch:?}");
+    assert!(s.walls.reactions);
+}
+
+/// A wall-pressure probe: its fields, and a patch of wall particles to sum over. Narrower than
+/// the spacing, it takes the nearest column, or both when two are as near.
+#[test]
+fn wall_pressure_probes_are_checked() {
+    let wall = |rest: &str| {
+        base_with(
+            "kind = \"pressure\"\npoint_m = [0.5, 0.05]",
+            &format!("kind = \"wall_pressure\"\npoint_m = [0.5, 0.0]\n{rest}"),
+        )
+    };
+    let s = load_str(
+        &wall("normal = [0.0, 1.0]\nradius_m = 0.01"),
+        "cases/t.toml",
+        &[],
+    )
+    .unwrap();
+    let ProbeKind::WallPressure(patch) = s.probes[0].kind else {
+        panic!("{:?}", s.probes[0]);
+    };
+    // Columns at 0.45 and 0.55, both 0.05 from the point; the next at 0.15.
+    assert!((patch.area - 0.2).abs() < 1e-12, "{patch:?}");
+    assert!((patch.radius - 0.1).abs() < 1e-9, "{patch:?}");
+    assert!(s.walls.reactions);
+    assert_err(
+        &wall("radius_m = 0.01"),
+        &[],
+        None,
+        &["probe[0].normal", "required"],
+    );
+    assert_err(
+        &wall("normal = [0.0, 0.0]\nradius_m = 0.01"),
+        &[],
+        None,
+        &["probe[0].normal", "non-zero"],
+    );
+    assert_err(
+        &wall("normal = [0.0, 1.0]\nradius_m = -0.01"),
+        &[],
+        None,
+        &["probe[0].radius_m", "positive"],
+    );
+    assert_err(
+        &wall("normal = [0.0, 1.0]\nradius_m = 3.0"),
+        &[],
+        None,
+        &["probe[0].radius_m", "20 h"],
+    );
+    assert_err(
+        &wall("normal = [0.0, 1.0]\nradius_m = 0.01"),
+        &["tank.wall=\"mirror\""],
+        None,
+        &["probe[0].point_m", "no wall particle", "mirror"],
+    );
+    assert_err(
+        &wall("normal = [0.0, 1.0]\nradius_m = 0.01").replace("[0.5, 0.0]", "[0.5, 0.3]"),
+        &[],
+        None,
+        &["probe[0].point_m", "no wall particle"],
+    );
+    assert_err(
+        &base_with(
+            "point_m = [0.5, 0.05]",
+            "point_m = [0.5, 0.05]\nradius_m = 0.01",
+        ),
+        &[],
+        None,
+        &["probe[0].radius_m", "not used"],
     );
 }
 

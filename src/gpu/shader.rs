@@ -92,6 +92,8 @@ pub struct ShaderConfig {
     /// Whether δ-SPH diffuses only the density's departure from hydrostatics (Fourtakas et al.
     /// 2019) rather than the whole density difference (Molteni & Colagrossi 2009).
     pub hydrostatic_diffusion: bool,
+    /// Whether fixed walls' boundary particles get the fluid's force (wall-pressure probes).
+    pub wall_reactions: bool,
 }
 
 impl Default for ShaderConfig {
@@ -102,6 +104,7 @@ impl Default for ShaderConfig {
             viscosity: 0,
             energy: false,
             hydrostatic_diffusion: false,
+            wall_reactions: false,
         }
     }
 }
@@ -112,13 +115,15 @@ pub fn compose(pass: Pass, cfg: ShaderConfig) -> String {
         "// wgsph: {name}.wgsl composed with lib/common.wgsl\n\
          const DIM: u32 = {dim}u;\nconst KERNEL: u32 = {kernel}u;\n\
          const VISCOSITY: u32 = {visc}u;\nconst ENERGY: bool = {energy};\n\
-         const HYDROSTATIC_DIFFUSION: bool = {hydro};\nconst WG: u32 = {wg}u;\n\n{common}\n{libs}\n{pass}",
+         const HYDROSTATIC_DIFFUSION: bool = {hydro};\nconst WALL_REACTIONS: bool = {reactions};\n\
+         const WG: u32 = {wg}u;\n\n{common}\n{libs}\n{pass}",
         name = pass.name(),
         dim = cfg.dim,
         kernel = cfg.kernel,
         visc = cfg.viscosity,
         energy = cfg.energy,
         hydro = cfg.hydrostatic_diffusion,
+        reactions = cfg.wall_reactions,
         wg = WORKGROUP_SIZE,
         common = COMMON,
         libs = pass.libs().concat(),

@@ -138,8 +138,9 @@ fn add(a: &mut [f64; 4], b: [f64; 4]) {
 
 /// (dv/dt, dρ/dt) of every particle: fluid gets everything but its elastic-solid neighbours'
 /// terms (`elastic::interface_rates`), dynamic walls only dρ/dt from fluid neighbours, fixed
-/// ghosts, repulsive and solid particles nothing. Body particles (of any wall treatment) also
-/// get the fluid's force, the opposite of what they exert on it, and the contact force of
+/// ghosts, repulsive and solid particles nothing. Body particles (of any wall treatment), and
+/// with `walls.reactions` fixed walls' too, also get the fluid's force, the opposite of what
+/// they exert on it; body particles also the contact force of
 /// fixed walls' and other bodies' particles (that of elastic solids:
 /// `elastic::contact_rates`).
 pub fn rates(
@@ -178,7 +179,14 @@ pub fn rates_and_energy(
         .map(|(i, pi)| {
             let mut r = [0.0; 4];
             let on_body = pi.body.is_some() && pi.kind != FLUID && pi.kind != EXCLUDED;
-            if pi.kind == WALL || on_body {
+            // Boundary particles that take the fluid's force: bodies', and fixed walls' when
+            // wall-pressure probes read it.
+            let reacts = on_body
+                || (walls.reactions
+                    && pi.kind != FLUID
+                    && pi.kind != EXCLUDED
+                    && !super::elastic::is_solid(pi.kind));
+            if pi.kind == WALL || reacts {
                 // A body's ghost reacts with the velocity the fluid sees in viscosity.
                 let pb = match pi.kind {
                     GHOST_NO_SLIP | GHOST_FREE_SLIP => RefParticle {
@@ -194,13 +202,12 @@ pub fn rates_and_energy(
                         continue;
                     }
                     if pj.kind == FLUID {
-                        if pi.body.is_some() && pi.kind == REPULSIVE {
+                        if reacts && pi.kind == REPULSIVE {
                             // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
                             let f = repulsion(ph, walls, x_ij);
                             add(&mut r, [f[0], f[1], f[2], 0.0]);
-                        } else if pi.body.is_some() {
-                            // A body particle: the fluid's force on it too (and a dynamic
-                            // one its dρ/dt).
+                        } else if reacts {
+                            // The fluid's force on it too (and a dynamic particle's dρ/dt).
                             let mut pr = pair.rates(&pb, x_ij, pj.vel, pj.vel, pj.rho, 0.0, 1.0).0;
                             if pi.kind != WALL {
                                 pr[3] = 0.0;

@@ -1,7 +1,7 @@
 //! Twin of shaders/probes.wgsl.
 
-use super::{dot, kernel, pressure, sub, RefParticle, FLUID};
-use crate::scenario::Physics;
+use super::{dot, kernel, pressure, sub, RefParticle, EXCLUDED, FLUID};
+use crate::scenario::{Physics, WallPatch};
 
 /// (Σ W V, Σ P W V) over fluid particles at x.
 fn sums(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> (f64, f64) {
@@ -62,4 +62,26 @@ pub fn front(parts: &[RefParticle], origin: [f64; 3], axis: [f64; 3]) -> f64 {
         .filter(|p| p.kind == FLUID)
         .map(|p| dot(sub(p.pos, origin), axis) / n)
         .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// Pressure on a wall patch: −m Σ_j a_j·n / area over the patch's boundary particles j
+/// (`WallPatch`), a_j their rates from `interaction::rates` with `walls.reactions`.
+pub fn wall_pressure(
+    ph: &Physics,
+    parts: &[RefParticle],
+    rates: &[[f64; 4]],
+    patch: &WallPatch,
+) -> f64 {
+    let (behind, front) = WallPatch::depth(ph.h);
+    let sum: f64 = parts
+        .iter()
+        .zip(rates)
+        .filter(|(p, _)| p.kind != FLUID && p.kind != EXCLUDED && !super::elastic::is_solid(p.kind))
+        .filter(|(p, _)| {
+            let (d, t2) = WallPatch::coordinates(patch.point, patch.normal, p.pos);
+            d >= behind && d <= front && t2 < patch.radius * patch.radius
+        })
+        .map(|(_, r)| (0..3).map(|a| r[a] * patch.normal[a]).sum::<f64>())
+        .sum();
+    -ph.particle_mass * sum / patch.area
 }

@@ -55,7 +55,7 @@ const EMPTY_PROBES: [ProbeDef; 1] = [ProbeDef {
     point: [0.0; 3],
     kind: 0,
     axis: [0.0; 3],
-    pad: 0,
+    radius: 0.0,
 }];
 
 pub struct InitialParticles<'a> {

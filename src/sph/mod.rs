@@ -27,7 +27,7 @@ use crate::layout::{
     pack_block, unpack_block, Params, Pos, SimState, ID_MASK, KIND_EXCLUDED, KIND_SHIFT,
 };
 use crate::scenario::{
-    DeltaSphForm, GhostCorrection, KernelKind, Kind, RepulsiveForm, Scenario, Viscosity,
+    DeltaSphForm, GhostCorrection, KernelKind, Kind, ProbeKind, RepulsiveForm, Scenario, Viscosity,
 };
 use bodies::Bodies;
 use buffers::{InitialParticles, ParticleBuffers};
@@ -281,6 +281,7 @@ impl Solver {
             energy: ph.energy,
             hydrostatic_diffusion: ph.delta_sph > 0.0
                 && ph.delta_sph_form == DeltaSphForm::Fourtakas,
+            wall_reactions: sc.walls.reactions,
         };
         let mut pos = Vec::with_capacity(n);
         let mut velrho = Vec::with_capacity(n);
@@ -303,6 +304,17 @@ impl Solver {
         // Allocation failures are caught here to name what was being allocated; later ones
         // reach `faults`.
         let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        for p in &sc.probes {
+            if let ProbeKind::WallPressure(patch) = &p.kind {
+                if !sc.walls.reactions || patch.area.is_nan() || patch.area <= 0.0 {
+                    bail!(
+                        "wall-pressure probe {:?} needs walls.reactions and a patch resolved \
+                         by WallPatch::resolve",
+                        p.name
+                    );
+                }
+            }
+        }
         let defs = probes::probe_defs(&sc.probes, grid.origin);
         let planes = mirror_planes(sc, grid.origin);
         let body_particles = bodies::body_particles(sc);
@@ -364,7 +376,14 @@ impl Solver {
             None
         };
         let probe_module = module(Pass::Probes)?;
-        let probes = Probes::new(&device, &probe_module, &buffers, &defs)?;
+        let probes = Probes::new(
+            &device,
+            &probe_module,
+            &buffers,
+            &sc.probes,
+            &defs,
+            ph.particle_mass,
+        )?;
         let points = PointTracker::new(&device, &probe_module, &buffers, &sc.points)?;
         let bodies = if sc.bodies.is_empty() {
             None

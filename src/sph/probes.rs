@@ -9,12 +9,13 @@ use crate::gpu::buffers::{read, storage, storage_init};
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::Kernel;
 use crate::layout::{Pos, ProbeDef};
-use crate::scenario::{Probe, ProbeKind, TrackedPoint};
+use crate::scenario::{Probe, ProbeKind, TrackedPoint, WallPatch};
 use glam::DVec3;
 
 pub const PROBE_PRESSURE: u32 = 0;
 pub const PROBE_HEIGHT: u32 = 1;
 pub const PROBE_FRONT: u32 = 2;
+pub const PROBE_WALL_PRESSURE: u32 = 3;
 
 /// GPU definitions of the probes, in domain coordinates (from the domain's min corner).
 pub fn probe_defs(probes: &[Probe], origin: [f64; 3]) -> Vec<ProbeDef> {
@@ -38,15 +39,22 @@ pub fn probe_defs(probes: &[Probe], origin: [f64; 3]) -> Vec<ProbeDef> {
                     point: rel(o),
                     kind: PROBE_FRONT,
                     axis: axis.map(|a| (a / norm) as f32),
-                    pad: 0,
+                    radius: 0.0,
                 }
             }
+            ProbeKind::WallPressure(patch) => ProbeDef {
+                point: rel(&patch.point),
+                kind: PROBE_WALL_PRESSURE,
+                axis: patch.normal.map(|a| a as f32),
+                radius: patch.radius as f32,
+            },
         })
         .collect()
 }
 
 /// `probe` where its body has taken it: a point given at t = 0 goes to x_c + R (x0 − x_c0)
-/// (x_c0 the body's centre at t = 0, `pose` its current one) and a front's axis turns with R.
+/// (x_c0 the body's centre at t = 0, `pose` its current one) and a front's axis and a wall
+/// patch's normal turn with R.
 /// A height gauge's line stays vertical in the world frame.
 pub fn moved(probe: &Probe, center0: [f64; 3], pose: &Pose) -> Probe {
     let c0 = DVec3::from_array(center0);
@@ -61,6 +69,11 @@ pub fn moved(probe: &Probe, center0: [f64; 3], pose: &Pose) -> Probe {
             origin: place(origin),
             axis: (pose.rotation * DVec3::from_array(*axis)).to_array(),
         },
+        ProbeKind::WallPressure(patch) => ProbeKind::WallPressure(WallPatch {
+            point: place(&patch.point),
+            normal: (pose.rotation * DVec3::from_array(patch.normal)).to_array(),
+            ..*patch
+        }),
     };
     Probe {
         kind,
@@ -85,6 +98,9 @@ pub struct Probes {
     bind_points: [wgpu::BindGroup; 2],
     bind_front: [wgpu::BindGroup; 2],
     kinds: Vec<u32>,
+    /// What a probe's word is multiplied by: −m/area for wall pressures (the GPU sums the
+    /// boundary particles' rates along the normal), 1 otherwise.
+    scales: Vec<f64>,
     n: u32,
 }
 
@@ -93,7 +109,9 @@ impl Probes {
         device: &wgpu::Device,
         module: &ShaderModule,
         b: &ParticleBuffers,
+        probes: &[Probe],
         defs: &[ProbeDef],
+        particle_mass: f64,
     ) -> Result<Self> {
         let points = module.kernel(device, "probe_points")?;
         let front = module.kernel(device, "probe_front")?;
@@ -106,6 +124,7 @@ impl Probes {
                 (4, &b.cell_start),
                 (5, &b.probes),
                 (6, &b.probe_out),
+                (9, &b.rate),
             ]
         };
         Ok(Self {
@@ -117,6 +136,13 @@ impl Probes {
             points,
             front,
             kinds: defs.iter().map(|d| d.kind).collect(),
+            scales: probes
+                .iter()
+                .map(|p| match &p.kind {
+                    ProbeKind::WallPressure(patch) => -particle_mass / patch.area,
+                    _ => 1.0,
+                })
+                .collect(),
             n: b.n,
         })
     }
@@ -143,12 +169,13 @@ impl Probes {
     pub fn decode(&self, raw: &[u32]) -> Vec<f64> {
         self.kinds
             .iter()
+            .zip(&self.scales)
             .zip(raw)
-            .map(|(&k, &w)| {
+            .map(|((&k, &scale), &w)| {
                 if k == PROBE_FRONT {
                     decode_ordered(w) as f64
                 } else {
-                    f32::from_bits(w) as f64
+                    scale * f32::from_bits(w) as f64
                 }
             })
             .collect()
