@@ -398,7 +398,7 @@ fn the_filter_runs_every_n_steps() {
 
 /// Mean bottom pressure over t ∈ (1, 2] s of the shipped hydrostatic tank with `set`, sampled
 /// every 0.05 s, against ρ0 g (H − z) (`wgsph validate`'s metric).
-fn hydrostatic_pressure(set: &[&str]) -> hydrostatic::BottomPressure {
+fn hydrostatic_pressure(set: &[&str]) -> hydrostatic::MeanPressure {
     let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
     let sc = wgsph::case::load(Path::new("cases/hydrostatic_2d.toml"), &set).unwrap();
     let probe = sc

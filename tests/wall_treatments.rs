@@ -205,6 +205,7 @@ fn repulsive_holds_the_water() {
     let o = hydrostatic(&["tank.wall=\"repulsive\""]);
     report("repulsive (Lennard-Jones)", &o);
     assert_eq!(o.excluded, 0, "water leaked through the repulsive wall");
+    assert_floor_within_bound(&o);
 }
 
 #[test]
@@ -215,6 +216,7 @@ fn repulsive_monaghan_kajtar_holds_the_water() {
     ]);
     report("repulsive (Monaghan & Kajtar, K = g H, β = 1)", &o);
     assert_eq!(o.excluded, 0, "water leaked through the repulsive wall");
+    assert_floor_within_bound(&o);
 }
 
 #[test]
@@ -288,6 +290,7 @@ fn every_treatment_runs_in_3d_from_the_case_file() {
 fn dynamic_boundary_pressure_within_2_percent_fourtakas() {
     let o = hydrostatic(&["physics.delta_sph_form=\"fourtakas\""]);
     report("dynamic, Fourtakas δ-SPH", &o);
+    assert_floor_within_bound(&o);
     assert_pressure_within_bound(&o);
 }
 

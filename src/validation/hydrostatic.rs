@@ -36,9 +36,9 @@ pub fn overrides(mode: Mode) -> Option<Vec<String>> {
     Some(set)
 }
 
-/// The mean bottom pressure against the analytic one.
+/// A probe's mean pressure against the hydrostatic one at its point.
 #[derive(Clone, Debug)]
-pub struct BottomPressure {
+pub struct MeanPressure {
     pub mean_pa: f64,
     pub exact_pa: f64,
     /// Depth of the probe below the still surface, m.
@@ -46,7 +46,7 @@ pub struct BottomPressure {
     pub samples: usize,
 }
 
-impl BottomPressure {
+impl MeanPressure {
     /// Relative error of the mean.
     pub fn error(&self) -> f64 {
         (self.mean_pa - self.exact_pa) / self.exact_pa
@@ -55,7 +55,7 @@ impl BottomPressure {
 
 /// The mean of the samples of the pressure or wall-pressure probe `name` with
 /// t > [`SETTLED_AFTER_S`] (`series`: (t, p)) against ρ0 |g| (H − z) at the probe's point.
-pub fn mean_pressure(sc: &Scenario, name: &str, series: &[(f64, f64)]) -> Result<BottomPressure> {
+pub fn mean_pressure(sc: &Scenario, name: &str, series: &[(f64, f64)]) -> Result<MeanPressure> {
     let probe = sc
         .probes
         .iter()
@@ -77,7 +77,7 @@ pub fn mean_pressure(sc: &Scenario, name: &str, series: &[(f64, f64)]) -> Result
     if late.is_empty() {
         bail!("no {name} sample after t = {SETTLED_AFTER_S} s");
     }
-    Ok(BottomPressure {
+    Ok(MeanPressure {
         mean_pa: late.iter().sum::<f64>() / late.len() as f64,
         exact_pa,
         depth_m,
