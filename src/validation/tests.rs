@@ -52,8 +52,8 @@ fn write_probe(dir: &Path, name: &str, column: &str, dt: f64, end: f64, f: impl 
     std::fs::write(dir.join(PROBES_DIR).join(format!("{name}.csv")), s).unwrap();
 }
 
-/// A synthetic hydrostatic run whose bottom probe reads `factor` times the analytic pressure;
-/// evaluated with the quick bounds into an outcome.
+/// A synthetic hydrostatic run whose bottom probe and floor sensor read `factor` times their
+/// analytic pressures; evaluated with the quick bounds into an outcome.
 fn hydrostatic_outcome(tag: &str, factor: f64) -> CaseOutcome {
     let case = find("hydrostatic_2d").unwrap();
     let overrides = case.overrides(Mode::Quick).unwrap();
@@ -62,6 +62,9 @@ fn hydrostatic_outcome(tag: &str, factor: f64) -> CaseOutcome {
     let exact = 1000.0 * 9.81 * 0.45;
     write_probe(&dir, "p_bottom", "pressure_pa", 0.01, 2.0, |_| {
         factor * exact
+    });
+    write_probe(&dir, "p_floor", "pressure_pa", 0.01, 2.0, |_| {
+        factor * 1000.0 * 9.81 * 0.5
     });
     write_run_json(&dir, &summary(case.name, 0));
     let eval = case.evaluate(&sc, &dir, Mode::Quick).unwrap();
@@ -99,6 +102,11 @@ fn a_metric_over_its_bound_is_a_fail_row_and_a_nonzero_exit_status() {
         bad.metrics
     );
     assert_eq!(bad.metrics[0].verdict(), Verdict::Fail);
+    assert_eq!(
+        bad.metrics[1].verdict(),
+        Verdict::Fail,
+        "floor sensor, over its 1 %"
+    );
     assert!(!bad.passed());
     let r = report(vec![bad]);
     assert!(!r.passed());
@@ -117,7 +125,7 @@ fn a_metric_over_its_bound_is_a_fail_row_and_a_nonzero_exit_status() {
     assert!(md.contains("| hydrostatic_2d | bottom pressure"), "{md}");
     assert!(md.contains("| +10.00 % | ±2 % | FAIL |"), "{md}");
     assert!(
-        md.contains("result: **FAIL** (1 of 2 judged rows pass"),
+        md.contains("result: **FAIL** (1 of 3 judged rows pass"),
         "{md}"
     );
     std::fs::remove_dir_all(&r.cases[0].dir).unwrap();
@@ -125,7 +133,8 @@ fn a_metric_over_its_bound_is_a_fail_row_and_a_nonzero_exit_status() {
     // 0.5 % above: inside the bound, and the report passes.
     let good = hydrostatic_outcome("good", 1.005);
     assert_eq!(good.metrics[0].verdict(), Verdict::Pass);
-    assert_eq!(good.metrics[1].verdict(), Verdict::Pass, "no particle lost");
+    assert_eq!(good.metrics[1].verdict(), Verdict::Pass, "floor sensor");
+    assert_eq!(good.metrics[2].verdict(), Verdict::Pass, "no particle lost");
     let r = report(vec![good]);
     assert!(r.passed());
     assert_eq!(r.exit_status(), 0);
