@@ -323,7 +323,20 @@ fn dam_break_3d_builds() {
         })
         .count();
     assert_eq!(in_box, 8 * 20 * 8);
-    assert_eq!(s.probes.len(), 12);
+    assert_eq!(s.probes.len(), 14);
+    // The force sensors on the box, at y = 0.5 between the lattice's columns at 0.49 and 0.51:
+    // each takes both, equally near.
+    for (name, columns) in [("W1", 2.0), ("W5", 2.0)] {
+        let p = s.probes.iter().find(|p| p.name == name).unwrap();
+        let ProbeKind::WallPressure(patch) = p.kind else {
+            panic!("{p:?}");
+        };
+        assert!(
+            (patch.area - columns * 0.02 * 0.02).abs() < 1e-12,
+            "{name}: {patch:?}"
+        );
+    }
+    assert!(s.walls.reactions);
     assert_eq!(s.physics.gravity, [0.0, 0.0, -9.81]);
     assert!((s.physics.h - 0.03).abs() < 1e-12);
     assert!(s.particles.len() < 250_000);
