@@ -214,8 +214,8 @@ fn unit(
 const MAX_PATCH_RADIUS_H: f64 = 20.0;
 
 /// Each wall-pressure probe's patch among the built particles ([`WallPatch::resolve`]): an
-/// error when no boundary particle lies within its radius (or dx) of its point (mirror walls,
-/// whose images are not particles, or a point off the wall).
+/// error when the case has no wall particles (no tank, or mirror walls only) or none lies
+/// within its radius (or dx) of its point (a point off the wall).
 pub(super) fn resolve_wall_patches(
     ctx: &Ctx<'_>,
     probes: &mut [Probe],
@@ -240,6 +240,19 @@ pub(super) fn resolve_wall_patches(
                 "give the sensor's own radius (millimetres to centimetres), or several probes",
             ));
         }
+        if !particles
+            .iter()
+            .any(|p| !p.kind.is_fluid() && !p.kind.is_solid())
+        {
+            return Err(ctx.err(
+                &format!("probe[{i}].kind"),
+                Some("\"wall_pressure\"".into()),
+                "sums the fluid's force on wall particles, and the case has none (no [tank] or \
+                 [[obstacle]] of particles, or mirror walls only)",
+                "add a [tank] with wall = \"dynamic\", \"fixed_ghost\" or \"repulsive\", or use \
+                 a \"pressure\" probe",
+            ));
+        }
         match WallPatch::resolve(
             particles,
             patch.point,
@@ -260,8 +273,8 @@ pub(super) fn resolve_wall_patches(
                          force on the wall particles behind a face (mirror walls have none)",
                         patch.radius
                     ),
-                    "put point_m on the face of a particle wall (dynamic, fixed_ghost or \
-                     repulsive) with normal pointing into the fluid",
+                    "put point_m on the face of a particle wall (of the [tank] or an [[obstacle]], dynamic, \
+                     fixed_ghost or repulsive) with normal pointing into the fluid",
                 ));
             }
         }

@@ -260,7 +260,7 @@ fn wall_pressure_probes_are_checked() {
         &wall("normal = [0.0, 1.0]\nradius_m = 0.01"),
         &["tank.wall=\"mirror\""],
         None,
-        &["probe[0].point_m", "no wall particle", "mirror"],
+        &["probe[0].kind", "has none", "mirror walls only", "[tank]"],
     );
     assert_err(
         &wall("normal = [0.0, 1.0]\nradius_m = 0.01").replace("[0.5, 0.0]", "[0.5, 0.3]"),
