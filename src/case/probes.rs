@@ -224,6 +224,9 @@ pub(super) fn resolve_wall_patches(
     dx: f64,
     h: f64,
 ) -> Result<(), CaseError> {
+    let has_walls = particles
+        .iter()
+        .any(|p| !p.kind.is_fluid() && !p.kind.is_solid());
     for (i, probe) in probes.iter_mut().enumerate() {
         let ProbeKind::WallPressure(patch) = &mut probe.kind else {
             continue;
@@ -240,10 +243,7 @@ pub(super) fn resolve_wall_patches(
                 "give the sensor's own radius (millimetres to centimetres), or several probes",
             ));
         }
-        if !particles
-            .iter()
-            .any(|p| !p.kind.is_fluid() && !p.kind.is_solid())
-        {
+        if !has_walls {
             return Err(ctx.err(
                 &format!("probe[{i}].kind"),
                 Some("\"wall_pressure\"".into()),
@@ -273,8 +273,9 @@ pub(super) fn resolve_wall_patches(
                          force on the wall particles behind a face (mirror walls have none)",
                         patch.radius
                     ),
-                    "put point_m on the face of a particle wall (of the [tank] or an [[obstacle]], dynamic, \
-                     fixed_ghost or repulsive) with normal pointing into the fluid",
+                    "put point_m on the face of a particle wall (of the [tank] or an \
+                     [[obstacle]], dynamic, fixed_ghost or repulsive) with normal pointing into \
+                     the fluid",
                 ));
             }
         }
