@@ -150,12 +150,13 @@ pub enum ProbeKind {
     Front { origin: [f64; 3], axis: [f64; 3] },
     /// Pressure on a patch of wall, as a transducer reads it: the fluid's force on the wall's
     /// boundary particles whose columns lie within `radius` of `point` (measured across
-    /// `normal`, any depth behind the face), along −`normal`, divided by the columns' area.
+    /// `normal`, from 3h behind the face to h in front of it), along −`normal`, divided by the
+    /// columns' area.
     /// Needs [`WallParams::reactions`], which gives fixed boundary particles that force.
     WallPressure(WallPatch),
 }
 
-/// The boundary particles a wall-pressure probe sums over (`wall_patch`).
+/// The boundary particles a wall-pressure probe sums over ([`WallPatch::resolve`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WallPatch {
     /// A point on the wall's face.
@@ -225,8 +226,9 @@ pub struct WallParams {
     pub repulsive_beta: f64,
     pub mirror_planes: Vec<MirrorPlane>,
     /// Whether the boundary particles of fixed walls also get the fluid's force on them (as
-    /// moving bodies' always do): wall-pressure probes read it. Off otherwise, since it costs
-    /// every fixed boundary particle a full neighbour sum.
+    /// moving bodies' always do): wall-pressure probes read it. Off otherwise: fixed ghosts and
+    /// repulsive particles would pay a neighbour sum they otherwise skip (dynamic walls sum
+    /// over their neighbours for dρ/dt anyway).
     pub reactions: bool,
 }
 
@@ -260,9 +262,9 @@ impl WallPatch {
     /// The patch of the boundary particles among `particles` that lie within `radius` of
     /// `point` across the unit `normal` (from 3h behind the face to h in front of it; a column
     /// on the circle is left out); a sensor narrower than the spacing takes the nearest column
-    /// (all of them, between several). Its radius is
-    /// moved halfway to the next column left out, and its area is the number of distinct
-    /// columns (tangential positions to dx/4) times dx^(dim − 1). `None` when no boundary
+    /// (all of them, between several). Its radius is moved halfway to the next column left
+    /// out, and its area is the number of distinct columns (tangential positions to dx/4) times
+    /// dx^(dim − 1). `None` when no boundary
     /// particle lies within max(radius, dx) of `point` across the normal, or the nearest lie
     /// more than dx behind it (`point` is not on the wall's face).
     pub fn resolve(

@@ -301,9 +301,6 @@ impl Solver {
             code.push(((p.kind as u32) << KIND_SHIFT) | id as u32);
         }
         let device = ctx.device.clone();
-        // Allocation failures are caught here to name what was being allocated; later ones
-        // reach `faults`.
-        let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         for p in &sc.probes {
             if let ProbeKind::WallPressure(patch) = &p.kind {
                 if !sc.walls.reactions || patch.area.is_nan() || patch.area <= 0.0 {
@@ -315,6 +312,9 @@ impl Solver {
                 }
             }
         }
+        // Allocation failures are caught here to name what was being allocated; later ones
+        // reach `faults`.
+        let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let defs = probes::probe_defs(&sc.probes, grid.origin);
         let planes = mirror_planes(sc, grid.origin);
         let body_particles = bodies::body_particles(sc);
