@@ -5,7 +5,7 @@ use std::cell::Cell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use proptest::strategy::Strategy;
-use proptest::test_runner::{Config, TestCaseError, TestRunner};
+use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
 use toml::{Table, Value};
 use wgsph::case::{load_str_limited, CaseError};
 use wgsph::scenario::{Kind, Motion, RepulsiveForm, Scenario};
@@ -214,6 +214,24 @@ pub(crate) fn check_sane(sc: &Scenario) -> Result<(), String> {
 
 // ---------------------------------------------------------------- the runner
 
+/// The seed of a property's random inputs: `CASE_FUZZ_SEED` when set (to replay a failure),
+/// else a fresh one. Every run prints it, and a failure names it with the command to rerun.
+fn seed() -> u64 {
+    std::env::var("CASE_FUZZ_SEED")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| {
+            let nanos = std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_nanos());
+            // Fold the clock with the thread id: the properties start in the same instant.
+            let thread = format!("{:?}", std::thread::current().id());
+            thread.bytes().fold(nanos as u64, |h, b| {
+                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+            })
+        })
+}
+
 pub(crate) fn cases(default: u32) -> u32 {
     std::env::var("PROPTEST_CASES")
         .ok()
@@ -235,7 +253,11 @@ pub(crate) fn run<S: Strategy>(
         failure_persistence: None,
         ..Config::default()
     };
-    let mut runner = TestRunner::new(config.clone());
+    let seed = seed();
+    let mut key = [0u8; 32];
+    key[..8].copy_from_slice(&seed.to_le_bytes());
+    let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &key);
+    let mut runner = TestRunner::new_with_rng(config.clone(), rng);
     let tried = Cell::new(0usize);
     let started = std::time::Instant::now();
     let result = runner.run(&strategy, |v| {
@@ -244,14 +266,18 @@ pub(crate) fn run<S: Strategy>(
     });
     let (accepted, refused, unwritable) = TALLY.with(Cell::take);
     eprintln!(
-        "case_fuzz {name}: {} inputs tried ({} required) in {:.1} s; loads: {accepted} \
-         accepted, {refused} refused; {unwritable} edits not writable as TOML",
+        "case_fuzz {name} (seed {seed}): {} inputs tried ({} required) in {:.1} s; loads: \
+         {accepted} accepted, {refused} refused; {unwritable} edits not writable as TOML",
         tried.get(),
         config.cases,
         started.elapsed().as_secs_f64()
     );
     if let Err(e) = result {
-        panic!("{name}: {e}");
+        panic!(
+            "{name}: {e}\nreplay with: CASE_FUZZ_SEED={seed} PROPTEST_CASES={} cargo test \
+             --test case_fuzz {name}",
+            config.cases
+        );
     }
 }
 

@@ -60,15 +60,20 @@ fn every_seed_builds_and_survives_a_round_trip() {
 #[test]
 fn every_field_with_hostile_values() {
     let strategy = (any::<Index>(), any::<Index>(), change());
-    run("fields", CASES_FIELDS, strategy, |(s, f, change)| {
-        let seed = s.get(seeds());
-        let nodes = nodes(&seed.doc);
-        let node = f.get(&nodes);
-        let new = apply(&change, &node.value);
-        let expect = expectation(seed, node, new.as_ref());
-        let doc = edit(&seed.doc, &node.segs, new);
-        check(seed, &doc, &[], &node.segs, expect, &format!("{change:?}"))
-    });
+    run(
+        "every_field_with_hostile_values",
+        CASES_FIELDS,
+        strategy,
+        |(s, f, change)| {
+            let seed = s.get(seeds());
+            let nodes = nodes(&seed.doc);
+            let node = f.get(&nodes);
+            let new = apply(&change, &node.value);
+            let expect = expectation(seed, node, new.as_ref());
+            let doc = edit(&seed.doc, &node.segs, new);
+            check(seed, &doc, &[], &node.segs, expect, &format!("{change:?}"))
+        },
+    );
 }
 
 /// Vector fields with the wrong number of components (of any values) must be refused naming
@@ -80,18 +85,23 @@ fn vectors_of_every_length() {
         any::<Index>(),
         prop::collection::vec(number(), 0..7),
     );
-    run("vectors", CASES_VECTORS, strategy, |(s, f, items)| {
-        let seed = s.get(seeds());
-        let vectors: Vec<Node> = nodes(&seed.doc)
-            .into_iter()
-            .filter(|n| n.value.is_array() && vector_len(&n.path, seed.dim).is_some())
-            .collect();
-        let node = f.get(&vectors);
-        let new = Value::Array(items);
-        let expect = expectation(seed, node, Some(&new));
-        let doc = edit(&seed.doc, &node.segs, Some(new));
-        check(seed, &doc, &[], &node.segs, expect, "a vector")
-    });
+    run(
+        "vectors_of_every_length",
+        CASES_VECTORS,
+        strategy,
+        |(s, f, items)| {
+            let seed = s.get(seeds());
+            let vectors: Vec<Node> = nodes(&seed.doc)
+                .into_iter()
+                .filter(|n| n.value.is_array() && vector_len(&n.path, seed.dim).is_some())
+                .collect();
+            let node = f.get(&vectors);
+            let new = Value::Array(items);
+            let expect = expectation(seed, node, Some(&new));
+            let doc = edit(&seed.doc, &node.segs, Some(new));
+            check(seed, &doc, &[], &node.segs, expect, "a vector")
+        },
+    );
 }
 
 /// Deleting a field (required ones must be named as missing) and adding an unknown one to any
@@ -100,7 +110,7 @@ fn vectors_of_every_length() {
 fn deleted_and_unknown_fields() {
     let strategy = (any::<Index>(), any::<Index>(), any::<bool>(), any_value());
     run(
-        "delete_add",
+        "deleted_and_unknown_fields",
         CASES_DELETE_ADD,
         strategy,
         |(s, f, delete, value)| {
@@ -131,48 +141,53 @@ fn deleted_and_unknown_fields() {
 #[test]
 fn overrides_agree_with_editing_the_file() {
     let strategy = (any::<Index>(), any::<Index>(), any_value());
-    run("overrides", CASES_OVERRIDES, strategy, |(s, f, value)| {
-        let seed = s.get(seeds());
-        // --set addresses fields, not vector components.
-        let fields: Vec<Node> = nodes(&seed.doc)
-            .into_iter()
-            .filter(|n| matches!(n.segs.last(), Some(Seg::Key(_))))
-            .collect();
-        let node = f.get(&fields);
-        let doc = edit(&seed.doc, &node.segs, Some(value.clone()));
-        let Some(text) = write(&doc) else {
-            return Ok(());
-        };
-        let arg = format!("{}={value}", node.path);
-        let edited = load(&text, &seed.file, &[]).map_err(TestCaseError::fail)?;
-        let set = load(&seed.text, &seed.file, std::slice::from_ref(&arg))
-            .map_err(TestCaseError::fail)?;
-        match (&edited, &set) {
-            (Ok(a), Ok(b)) => prop_assert_eq!(a, b, "--set {}", arg),
-            (Err(a), Err(b)) => {
-                prop_assert_eq!(a.field(), b.field(), "--set {}: {:#} / {:#}", arg, a, b);
-                let msg = format!("{b:#}");
-                prop_assert!(
-                    msg.starts_with(&seed.file) && msg.contains("fix: "),
-                    "{}",
-                    msg
-                );
+    run(
+        "overrides_agree_with_editing_the_file",
+        CASES_OVERRIDES,
+        strategy,
+        |(s, f, value)| {
+            let seed = s.get(seeds());
+            // --set addresses fields, not vector components.
+            let fields: Vec<Node> = nodes(&seed.doc)
+                .into_iter()
+                .filter(|n| matches!(n.segs.last(), Some(Seg::Key(_))))
+                .collect();
+            let node = f.get(&fields);
+            let doc = edit(&seed.doc, &node.segs, Some(value.clone()));
+            let Some(text) = write(&doc) else {
+                return Ok(());
+            };
+            let arg = format!("{}={value}", node.path);
+            let edited = load(&text, &seed.file, &[]).map_err(TestCaseError::fail)?;
+            let set = load(&seed.text, &seed.file, std::slice::from_ref(&arg))
+                .map_err(TestCaseError::fail)?;
+            match (&edited, &set) {
+                (Ok(a), Ok(b)) => prop_assert_eq!(a, b, "--set {}", arg),
+                (Err(a), Err(b)) => {
+                    prop_assert_eq!(a.field(), b.field(), "--set {}: {:#} / {:#}", arg, a, b);
+                    let msg = format!("{b:#}");
+                    prop_assert!(
+                        msg.starts_with(&seed.file) && msg.contains("fix: "),
+                        "{}",
+                        msg
+                    );
+                }
+                _ => prop_assert!(
+                    false,
+                    "--set {} gives {:?}, editing the file gives {:?}",
+                    arg,
+                    set.as_ref()
+                        .map(|_| "a scenario")
+                        .map_err(|e| format!("{e:#}")),
+                    edited
+                        .as_ref()
+                        .map(|_| "a scenario")
+                        .map_err(|e| format!("{e:#}"))
+                ),
             }
-            _ => prop_assert!(
-                false,
-                "--set {} gives {:?}, editing the file gives {:?}",
-                arg,
-                set.as_ref()
-                    .map(|_| "a scenario")
-                    .map_err(|e| format!("{e:#}")),
-                edited
-                    .as_ref()
-                    .map(|_| "a scenario")
-                    .map_err(|e| format!("{e:#}"))
-            ),
-        }
-        Ok(())
-    });
+            Ok(())
+        },
+    );
 }
 
 /// Several changes at once, anywhere, plus `--set` arguments with arbitrary keys: nothing
@@ -194,7 +209,7 @@ fn compound_changes_and_arbitrary_overrides() {
         prop_oneof![3 => Just(Vec::new()), 1 => prop::collection::vec(set, 1..3)],
     );
     run(
-        "compound",
+        "compound_changes_and_arbitrary_overrides",
         CASES_COMPOUND,
         strategy,
         |(s, changes, sets)| {
@@ -261,7 +276,7 @@ fn arbitrary_text() {
             format!("{}{t}{}", &text[..cut], &text[cut..])
         }),
     ];
-    run("text", CASES_TEXT, text, |text| {
+    run("arbitrary_text", CASES_TEXT, text, |text| {
         let file = "fuzz/arbitrary.toml";
         match load(&text, file, &[]).map_err(TestCaseError::fail)? {
             Ok(sc) => check_sane(&sc).map_err(TestCaseError::fail),
