@@ -38,7 +38,7 @@ struct FilterCtl {
 
 // Neighbours whose density enters the filter.
 fn counts(kind: u32) -> bool {
-    return kind == KIND_FLUID || kind == KIND_WALL || is_ghost(kind);
+    return kind == KIND_FLUID || kind == KIND_WALL || kind == KIND_INLET || is_ghost(kind);
 }
 
 fn positive_finite(x: f32) -> bool {

@@ -44,6 +44,8 @@
 //   these fluid terms here and contact (the repulsive law below, per unit mass) from boundary
 //   particles of walls and bodies and from particles of other elastic bodies; elastic.wgsl
 //   (or total_lagrangian.wgsl) adds the forces within the body and gravity.
+// Inlet buffer particles (inlet.wgsl) enter a fluid particle's sums as dynamic boundary
+// particles do (their velocity, ρ0, no δ-SPH term) and get nothing here.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
 // get nothing here; unless WALL_REACTIONS (a case with wall-pressure probes, probes.wgsl): then
 // every fixed boundary particle also gets the fluid's force on it, as a moving body's does.
@@ -192,7 +194,8 @@ fn solid_loads(i: u32) -> vec3<f32> {
     for (var s = 0u; s < n_slots; s++) {
         for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
             let kind_j = code_kind(code[j]);
-            if (kind_j == KIND_EXCLUDED || j == i) {
+            // Inlet buffers are open flow, not walls: no contact.
+            if (kind_j == KIND_EXCLUDED || kind_j == KIND_INLET || j == i) {
                 continue;
             }
             let x_ij = rel_pos(p_i, pos[j]);
@@ -370,7 +373,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let id_i = code[i] & ID_MASK;
     let on_body = !fluid_i && kind_i != KIND_EXCLUDED && is_body_particle(id_i);
     // Boundary particles that take the fluid's force: bodies', and fixed walls' for probes.
-    let reacts = on_body || (WALL_REACTIONS && !fluid_i && kind_i != KIND_EXCLUDED);
+    let reacts = on_body || (WALL_REACTIONS && !fluid_i && kind_i != KIND_EXCLUDED && kind_i != KIND_INLET);
     if (!fluid_i && kind_i != KIND_WALL && !reacts) {
         rate[i] = vec4<f32>(0.0);
         return;
@@ -421,7 +424,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                 } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
                     // Contact with an elastic solid.
                     r += vec4<f32>(solid_body_contact_weight(params.solid_mass) * repulsion(x_ij, r2), 0.0);
-                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && other_solid(body_i, code[j] & ID_MASK)) {
+                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, code[j] & ID_MASK)) {
                     // Contact with a fixed wall or another body.
                     r += vec4<f32>(repulsion(x_ij, r2), 0.0);
                 }

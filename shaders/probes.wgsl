@@ -121,7 +121,7 @@ fn probe_wall_force(def: ProbeDef) -> f32 {
                 let slot = slot_of_cell(c);
                 for (var j = cell_start[slot]; j < cell_start[slot + 1u]; j++) {
                     let kind = code_kind(code[j]);
-                    if (kind == KIND_FLUID || kind == KIND_EXCLUDED || is_solid(kind) || any(cell_of(pos[j]) != c)) {
+                    if (kind == KIND_FLUID || kind == KIND_EXCLUDED || kind == KIND_INLET || is_solid(kind) || any(cell_of(pos[j]) != c)) {
                         continue;
                     }
                     let r = domain_pos(pos[j]) - def.point;

@@ -49,6 +49,11 @@ pub struct Params {
     pub solid_eps: f32,
     pub solid_inv_w_dx: f32,
     pub solid_id_base: u32,
+    /// Inlets: the ids of their particles, inlet after inlet, and how many inlets.
+    pub inlet_id_base: u32,
+    pub n_inlet_particles: u32,
+    pub n_inlets: u32,
+    pub pad_params: u32,
 }
 
 /// Mirrors `SolidState` in shaders/lib/common.wgsl: the deviatoric stress τ of a solid particle
@@ -87,7 +92,11 @@ pub struct SimState {
     pub nan_count: u32,
     pub excluded: u32,
     pub steps: u32,
-    pub pad: [u32; 3],
+    /// The host's base time as f32 (inlets place their particles at t_base + t_rel).
+    pub t_base: f32,
+    /// Dormant inlet particles that have joined a buffer since t = 0.
+    pub inlet_joined: u32,
+    pub pad: u32,
 }
 
 /// Mirrors `Pos`: offset from the block's lower corner + packed block coordinates.
@@ -164,6 +173,22 @@ pub fn pack_block(b: [u32; 3]) -> u32 {
 
 pub fn unpack_block(b: u32) -> [u32; 3] {
     [b & 0x7FF, (b >> 11) & 0x7FF, b >> 22]
+}
+
+/// Mirrors `InletDef` in shaders/inlet.wgsl: an inlet's plane normal, speed, buffer depth,
+/// layer spacing, and where its particles and columns start.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct InletDef {
+    pub normal: [f32; 3],
+    pub speed: f32,
+    pub thickness: f32,
+    pub spacing: f32,
+    pub first_id: u32,
+    pub n_columns: u32,
+    pub first_column: u32,
+    pub n_particles: u32,
+    pub pad: [u32; 2],
 }
 
 /// Mirrors `TlParams` in shaders/total_lagrangian.wgsl: the total-Lagrangian solid's
@@ -284,7 +309,10 @@ mod tests {
                 solid_alpha,
                 solid_eps,
                 solid_inv_w_dx,
-                solid_id_base
+                solid_id_base,
+                inlet_id_base,
+                n_inlet_particles,
+                n_inlets
             ]
         );
     }
@@ -331,7 +359,28 @@ mod tests {
                 max_accel_bits,
                 nan_count,
                 excluded,
-                steps
+                steps,
+                t_base,
+                inlet_joined
+            ]
+        );
+    }
+
+    #[test]
+    fn inlet_def_matches_wgsl() {
+        check_layout!(
+            Pass::Inlet,
+            "InletDef",
+            InletDef,
+            [
+                normal,
+                speed,
+                thickness,
+                spacing,
+                first_id,
+                n_columns,
+                first_column,
+                n_particles
             ]
         );
     }

@@ -386,8 +386,12 @@ impl<'a> Runner<'a> {
         let probes = out.probe_writer(&names)?;
         let solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
         let bodies = BodyOutputs::new(&out, sc)?;
+        let inlet = match sc.count(Kind::Inlet) {
+            0 => String::new(),
+            n => format!(", {n} inlet"),
+        };
         log::info!(
-            "{}: {} particles ({} fluid, {} wall) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
+            "{}: {} particles ({} fluid, {} wall{inlet}) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
             sc.name,
             sc.particles.len(),
             sc.count(Kind::Fluid),

@@ -23,6 +23,9 @@ pub enum Kind {
     Solid = 5,
     /// Clamped solid particle: part of its body's stress sums, but held fixed in place.
     SolidClamped = 6,
+    /// Particle of an inlet's buffer (`[[inlet]]`): moves at the inflow velocity with the
+    /// reference density and becomes fluid where it crosses the inlet plane.
+    Inlet = 7,
 }
 
 impl Kind {
@@ -32,6 +35,11 @@ impl Kind {
 
     pub fn is_solid(self) -> bool {
         matches!(self, Kind::Solid | Kind::SolidClamped)
+    }
+
+    /// A boundary particle of a wall, obstacle or body (of any wall treatment).
+    pub fn is_boundary(self) -> bool {
+        !self.is_fluid() && !self.is_solid() && self != Kind::Inlet
     }
 }
 
@@ -288,7 +296,7 @@ impl WallPatch {
         }
         let candidates: Vec<Candidate> = particles
             .iter()
-            .filter(|p| !p.kind.is_fluid() && !p.kind.is_solid())
+            .filter(|p| p.kind.is_boundary())
             .filter_map(|p| {
                 let (d, t2) = Self::coordinates(point, normal, p.pos);
                 let column = [0, 1, 2]
@@ -378,6 +386,55 @@ pub struct Scenario {
     pub bodies: Vec<Body>,
     /// Elastic bodies, when the case has solid particles.
     pub solids: Option<Solids>,
+    /// Velocity inlets. Their particles come right after the fluid blocks', inlet after inlet.
+    pub inlets: Vec<Inlet>,
+}
+
+/// A velocity inlet (`[[inlet]]`, docs/cases.md "Inlets"): a buffer of particles on the
+/// fluid's lattice, `thickness` deep behind a plane, marching along `normal` at `speed` with
+/// the reference density (zero pressure). A buffer particle that crosses the plane becomes
+/// fluid; behind the buffer wait as many further layers (dormant, in no cell) as the inflow
+/// takes until its stop time, each joining the buffer when it reaches the buffer's back.
+/// A particle's place is a function of time alone (`distance`), so no state is integrated and
+/// a restart is exact.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Inlet {
+    pub name: String,
+    /// Unit normal of the plane, the direction of the inflow.
+    pub normal: [f64; 3],
+    /// Inflow speed [m/s] (> 0).
+    pub speed: f64,
+    /// Buffer depth L behind the plane [m]: a whole number of layers, at least the kernel
+    /// support 2h.
+    pub thickness: f64,
+    /// Distance between layers [m] (the particle spacing).
+    pub spacing: f64,
+    /// Each column's point on the plane [m].
+    pub columns: Vec<[f64; 3]>,
+    /// Its particles, layer after layer (column order within a layer): `particles[range]` of
+    /// the scenario (ids are indices).
+    pub particles: std::ops::Range<usize>,
+}
+
+impl Inlet {
+    /// Signed distance from the plane along the normal at time `t` of the inlet's particle
+    /// `k` (index within the inlet): −(layer + ½) spacing + speed t.
+    pub fn distance(&self, k: usize, t: f64) -> f64 {
+        let layer = (k / self.columns.len()) as f64;
+        -(layer + 0.5) * self.spacing + self.speed * t
+    }
+
+    /// Whether particle `k` waits behind the buffer at t = 0.
+    pub fn dormant(&self, k: usize) -> bool {
+        self.distance(k, 0.0) < -self.thickness
+    }
+
+    /// Where particle `k` is at time `t` (if it is still in the inlet's hands).
+    pub fn position(&self, k: usize, t: f64) -> [f64; 3] {
+        let s = self.distance(k, t);
+        let c = self.columns[k % self.columns.len()];
+        [0, 1, 2].map(|a| c[a] + s * self.normal[a])
+    }
 }
 
 /// A linear hypoelastic material (Gray, Monaghan & Swift 2001, section 2).
@@ -500,6 +557,17 @@ impl Scenario {
 
     /// Particles of every boundary kind.
     pub fn boundary_count(&self) -> usize {
-        self.particles.iter().filter(|p| !p.kind.is_fluid()).count()
+        self.particles
+            .iter()
+            .filter(|p| p.kind.is_boundary())
+            .count()
+    }
+
+    /// Inlet particles that wait behind their buffers at t = 0.
+    pub fn dormant_count(&self) -> usize {
+        self.inlets
+            .iter()
+            .map(|i| (0..i.particles.len()).filter(|&k| i.dormant(k)).count())
+            .sum()
     }
 }

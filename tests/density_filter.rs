@@ -70,9 +70,11 @@ fn random_scenario(
         let kind = if !wall {
             Kind::Fluid
         } else {
-            match (rng.next_f64() * 4.0) as u32 {
+            // Inlet buffer particles enter the sums as walls do.
+            match (rng.next_f64() * 5.0) as u32 {
                 0 => Kind::GhostNoSlip,
                 1 => Kind::Repulsive,
+                2 => Kind::Inlet,
                 _ => Kind::Wall,
             }
         };

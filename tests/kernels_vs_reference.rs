@@ -20,7 +20,9 @@ struct Setup {
 
 const BLOCK: f64 = 0.3;
 
-/// A jittered lattice of fluid over a two-layer wall floor, random velocities and densities.
+/// A jittered lattice of fluid over a two-layer wall floor, random velocities and densities;
+/// about one fluid particle in ten is an inlet buffer particle instead (seen like a dynamic
+/// boundary particle, integrated by nobody: the case has no inlet to place it).
 fn random_scenario(s: &Setup) -> Scenario {
     let dx = 0.02;
     let mut ph = physics(s.dim, dx, 15.0);
@@ -50,11 +52,18 @@ fn random_scenario(s: &Setup) -> Scenario {
         } else {
             1000.0 * (1.0 + rng.range(-0.005, 0.02))
         };
+        let kind = if wall {
+            Kind::Wall
+        } else if rng.range(0.0, 1.0) < 0.1 {
+            Kind::Inlet
+        } else {
+            Kind::Fluid
+        };
         parts.push(Particle {
             pos,
             vel,
             rho,
-            kind: if wall { Kind::Wall } else { Kind::Fluid },
+            kind,
         });
     }
     let mut dmax = [s.domain; 3];
@@ -434,5 +443,140 @@ fn probes_match_reference() {
         assert!((gpu_values[1] - cpu[1]).abs() < 1e-4, "height");
         assert!((gpu_values[2] - cpu[2]).abs() < 1e-5, "front");
         assert!(cpu[1] > 0.5 * BLOCK, "the gauge must see the block");
+    }
+}
+
+/// Two inlets of different speeds, along +x and against the vertical axis, in an open domain
+/// without gravity (2D: 4 columns each; 3D: 3 × 3), 3 layers of buffer and 10 or 11 in all.
+fn inlet_case(dim: u32) -> Scenario {
+    let vec = |c: [f64; 3]| {
+        if dim == 2 {
+            format!("[{}, {}]", c[0], c[1])
+        } else {
+            format!("[{}, {}, {}]", c[0], c[1], c[2])
+        }
+    };
+    // (jet box, drop box, drop direction)
+    let (jet, drop, down) = if dim == 2 {
+        (
+            ([0.1, 0.5, 0.0], [0.16, 0.58, 0.0]),
+            ([0.6, 0.7, 0.0], [0.68, 0.76, 0.0]),
+            [0.0, -1.0, 0.0],
+        )
+    } else {
+        (
+            ([0.1, 0.5, 0.5], [0.16, 0.56, 0.56]),
+            ([0.6, 0.6, 0.7], [0.66, 0.66, 0.76]),
+            [0.0, 0.0, -1.0],
+        )
+    };
+    let text = format!(
+        r#"dimension = {dim}
+[particles]
+dx_m = 0.02
+h_over_dx = 1.3
+[physics]
+gravity_m_s2 = {zero}
+sound_speed_m_s = 20.0
+[time]
+end_s = 0.05
+output_every_s = 0.01
+[domain]
+min_m = {zero}
+max_m = {one}
+[[inlet]]
+name = "jet"
+min_m = {jmin}
+max_m = {jmax}
+direction = {jd}
+velocity_m_s = 13.0
+stop_s = 0.016
+[[inlet]]
+name = "drop"
+min_m = {pmin}
+max_m = {pmax}
+direction = {pd}
+velocity_m_s = 7.0
+stop_s = 0.031
+"#,
+        zero = vec([0.0; 3]),
+        one = vec([1.0; 3]),
+        jmin = vec(jet.0),
+        jmax = vec(jet.1),
+        jd = vec([1.0, 0.0, 0.0]),
+        pmin = vec(drop.0),
+        pmax = vec(drop.1),
+        pd = vec(down),
+    );
+    wgsph::case::load_str(&text, "inlets.toml", &[]).unwrap()
+}
+
+/// The inlet pass against `reference::inlet::place` over steps of random size: every inlet
+/// particle's kind, place, velocity and density after the pass, and the count of particles that
+/// joined a buffer. A particle that became fluid in the step is compared by place only (the
+/// corrector then moves its velocity and density on).
+#[test]
+fn inlet_flow_matches_reference() {
+    for dim in [2, 3] {
+        let sc = inlet_case(dim);
+        let columns: Vec<usize> = sc.inlets.iter().map(|i| i.columns.len()).collect();
+        let layers: Vec<usize> = sc
+            .inlets
+            .iter()
+            .map(|i| i.particles.len() / i.columns.len())
+            .collect();
+        assert_eq!(columns, if dim == 2 { [4, 4] } else { [9, 9] });
+        // The jet: 13 m/s for 0.016 s is 10.4 dx, 10 layers; the drop 7 m/s for 0.031 s, 10.85
+        // dx, 11 layers.
+        assert_eq!(layers, [10, 11]);
+        let mut solver = Solver::new(gpu(), &sc).unwrap();
+        let mut rng = Rng(11 + dim as u64);
+        let (mut joined, mut fluid_seen) = (0u32, 0usize);
+        let mut worst = 0.0f64;
+        for step in 0..16 {
+            let before = solver.read_particles().unwrap();
+            let dt = rng.range(0.5, 1.0) as f32 * solver.dt() as f32;
+            let state = solver.single_step(dt).unwrap();
+            let t = solver.time();
+            let after = solver.read_particles().unwrap();
+            for inlet in &sc.inlets {
+                for (k, id) in inlet.particles.clone().enumerate() {
+                    let kind0 = before.kind[id];
+                    let (g_pos, g_vel, g_rho, g_kind) =
+                        (after.pos[id], after.vel[id], after.rho[id], after.kind[id]);
+                    match reference::inlet::place(inlet, k, kind0, t, sc.physics.rho0) {
+                        None => {
+                            if kind0 != reference::FLUID {
+                                assert_eq!(g_kind, kind0, "step {step} {} {k}", inlet.name);
+                            }
+                        }
+                        Some(p) => {
+                            assert_eq!(g_kind, p.kind, "step {step} {} {k} (t {t})", inlet.name);
+                            joined += p.joined as u32;
+                            let e = reference::sub(g_pos, p.pos);
+                            let e = reference::dot(e, e).sqrt();
+                            assert!(e.is_finite());
+                            worst = worst.max(e / sc.physics.dx);
+                            if p.kind == reference::INLET {
+                                let v = g_vel.map(|c| c as f64);
+                                assert_eq!(v, p.vel.map(|c| c as f32 as f64), "velocity");
+                                assert_eq!(g_rho as f64, p.rho as f32 as f64, "density");
+                            } else {
+                                fluid_seen += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            assert_eq!(state.inlet_joined, joined, "joined by step {step}");
+        }
+        println!(
+            "{dim}D inlets: {joined} joined, {fluid_seen} became fluid, place error {worst:.1e} dx"
+        );
+        assert!(
+            joined > 0 && fluid_seen > 0,
+            "the steps cover both transitions"
+        );
+        assert!(worst < 1e-5, "place error {worst} dx");
     }
 }

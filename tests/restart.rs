@@ -1,5 +1,6 @@
 //! Restart and crash safety: a run split by a checkpoint and resumed is bit-identical to an
-//! uninterrupted one (fluid with density filter and energy equation; a floating body); a real
+//! uninterrupted one (fluid with density filter and energy equation; a floating body; elastic
+//! plates; an injection through a velocity inlet); a real
 //! run killed with SIGKILL leaves only complete files behind and resumes from its last
 //! checkpoint to the same result; Ctrl-C (SIGINT) checkpoints and stops; a lost GPU device and
 //! a case too large for the adapter give clear errors instead of panics.
@@ -155,6 +156,22 @@ fn resume_is_bit_identical_for_a_total_lagrangian_plate() {
         ],
     );
     split_run_matches("plate-tl", &sc, 0.02);
+}
+
+/// Velocity inlets place their particles from the time alone (and count the joined ones in
+/// the checkpointed state), so a resumed injection continues exactly.
+#[test]
+fn resume_is_bit_identical_for_an_injection() {
+    let sc = load(
+        "cases/water_injection_2d.toml",
+        &[
+            "particles.dx_m=0.01",
+            "time.end_s=0.2",
+            "time.output_every_s=0.05",
+            "time.probe_every_s=0.01",
+        ],
+    );
+    split_run_matches("injection", &sc, 0.1);
 }
 
 fn wgsph() -> Command {

@@ -34,7 +34,7 @@ fn fmt_box(b: &Aabb, dim: usize) -> String {
 
 pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Scenario, CaseError> {
     let solids_alone = case.tank.is_none() && case.obstacles.is_empty() && case.bodies.is_empty();
-    if !case.solids.is_empty() && case.blocks.is_empty() && solids_alone {
+    if !case.solids.is_empty() && case.blocks.is_empty() && case.inlets.is_empty() && solids_alone {
         return super::solids::build_solid_case(ctx, case, max_particles);
     }
     let (dim, dx) = (case.dim, case.dx);
@@ -116,12 +116,13 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
 
     // The global lattice, continued by walls and obstacles.
     let lat = Lattice {
-        // The tank's inner corner, else the first fluid block's, else (solids and walls without
-        // fluid) the first solid's.
-        origin: match (&case.tank, case.blocks.first()) {
-            (Some(t), _) => t.inner.min,
-            (None, Some(b)) => b.bx.min,
-            (None, None) => case.solids[0].bx.min,
+        // The tank's inner corner, else the first fluid block's, else the first inlet's, else
+        // (solids and walls without fluid) the first solid's.
+        origin: match (&case.tank, case.blocks.first(), case.inlets.first()) {
+            (Some(t), _, _) => t.inner.min,
+            (None, Some(b), _) => b.bx.min,
+            (None, None, Some(i)) => i.bx.min,
+            (None, None, None) => case.solids[0].bx.min,
         },
         dx,
         dim,
@@ -132,6 +133,50 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             return Err(ctx.err(&format!("obstacle[{i}].max_m"), None, format!("the obstacle ({}) is too thin to hold one wall particle on the particle lattice (spacing dx = {} m)", fmt_box(o, dim), num(dx)), "make it at least dx thick along every axis, or decrease particles.dx_m"));
         };
         obstacle_ranges.push(r);
+    }
+
+    // Inlets: inside the tank, clear of fluid blocks and obstacles, on the lattice.
+    let h = case.h_over_dx * dx;
+    let mut inlet_layouts = Vec::with_capacity(case.inlets.len());
+    for (i, s) in case.inlets.iter().enumerate() {
+        let path = format!("inlet[{i}]");
+        if let Some((t, _)) = &tank {
+            if let Some(a) = inside(&s.bx, &t.inner, dim) {
+                return Err(ctx.err(&path, None, format!("the buffer box ({}) leaves the tank's inner box ({}) along {}", fmt_box(&s.bx, dim), fmt_box(&t.inner, dim), AXES[a]), "keep inlets inside the tank: a nozzle through a wall is a gap in an obstacle, with the buffer inside the tank"));
+            }
+        }
+        let overlaps = |b: &Aabb| {
+            (0..dim).all(|a| s.bx.max[a].min(b.max[a]) - s.bx.min[a].max(b.min[a]) > TOL)
+        };
+        let other = case
+            .blocks
+            .iter()
+            .position(|b| overlaps(&b.bx))
+            .map(|j| format!("fluid_block[{j}]"))
+            .or_else(|| {
+                case.obstacles
+                    .iter()
+                    .position(overlaps)
+                    .map(|j| format!("obstacle[{j}]"))
+            })
+            .or_else(|| {
+                case.inlets[..i]
+                    .iter()
+                    .position(|o| overlaps(&o.bx))
+                    .map(|j| format!("inlet[{j}]"))
+            });
+        if let Some(other) = other {
+            return Err(ctx.err(
+                &path,
+                None,
+                format!(
+                    "the buffer box ({}) overlaps {other}; particles would be created twice",
+                    fmt_box(&s.bx, dim)
+                ),
+                "make the buffer box touch other parts without overlapping them",
+            ));
+        }
+        inlet_layouts.push(super::inlets::layout(ctx, i, s, &lat, h)?);
     }
 
     // Particle budget, before anything is allocated: every part's count (for a body, the
@@ -145,6 +190,9 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     let mut parts: Vec<(String, f64)> = Vec::new();
     for (i, n) in block_cells.iter().enumerate() {
         parts.push((format!("fluid_block[{i}]"), n.iter().product()));
+    }
+    for (i, l) in inlet_layouts.iter().enumerate() {
+        parts.push((format!("inlet[{i}]"), l.n_columns * l.layers as f64));
     }
     let n_fluid_parts = parts.len();
     if let Some((_, n)) = tank {
@@ -203,7 +251,9 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     let c0 = match case.sound {
         // Without fluid c0 is unused (the solids have their own sound speed); that one keeps
         // the checks below meaningful.
-        _ if case.blocks.is_empty() => elastic.as_ref().map_or(1.0, |e| e.0.sound_speed()),
+        _ if case.blocks.is_empty() && case.inlets.is_empty() => {
+            elastic.as_ref().map_or(1.0, |e| e.0.sound_speed())
+        }
         Sound::Speed(c) => c,
         Sound::Coef(k) => {
             let floor = |b: &Aabb| case.tank.as_ref().map_or(b.min[v], |t| t.inner.min[v]);
@@ -212,9 +262,11 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
                 .iter()
                 .map(|b| b.bx.max[v] - floor(&b.bx))
                 .fold(0.0, f64::max);
-            let c = k * (g * depth).sqrt();
+            // Inflow faster than the fall speed sets the scale instead.
+            let inflow = case.inlets.iter().map(|s| s.speed).fold(0.0, f64::max);
+            let c = k * (g * depth).sqrt().max(inflow);
             if !c.is_finite() || c <= 0.0 {
-                return Err(ctx.err("physics.sound_speed_coef", Some(num(k)), format!("gives c0 = coef * sqrt(|g| * H) = {} m/s with |g| = {} m/s² (physics.gravity_m_s2) and H = {} m (the deepest fluid block)", num(c), num(g), num(depth)), "give physics.sound_speed_m_s instead"));
+                return Err(ctx.err("physics.sound_speed_coef", Some(num(k)), format!("gives c0 = coef * max(sqrt(|g| * H), inlet speed) = {} m/s with |g| = {} m/s² (physics.gravity_m_s2) and H = {} m (the deepest fluid block)", num(c), num(g), num(depth)), "give physics.sound_speed_m_s instead"));
             }
             c
         }
@@ -227,6 +279,20 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     let tait_b = c0 * c0 * case.rho0 / case.gamma;
     if !(tait_b.is_finite() && tait_b > 0.0) {
         return Err(ctx.err(sound_path, Some(num(sound_value)), format!("gives a Tait stiffness B = c0² rho0 / gamma = {} Pa that cannot be computed with (c0 = {} m/s, physics.rho0_kg_m3 = {}, physics.gamma = {})", num(tait_b), num(c0), num(case.rho0), num(case.gamma)), "use a realistic speed of sound, about 10 times the largest flow speed, and a realistic physics.rho0_kg_m3"));
+    }
+    if let Some((i, s)) = case.inlets.iter().enumerate().find(|(_, s)| s.speed >= c0) {
+        return Err(ctx.err(
+            &format!("inlet[{i}].velocity_m_s"),
+            Some(num(s.speed)),
+            format!(
+                "is not below the speed of sound c0 = {} m/s: weakly compressible SPH needs \
+                 flow speeds of about c0 / 10 or less",
+                num(c0)
+            ),
+            format!(
+                "lower the inflow speed, or raise {sound_path} so that c0 is about 10 times it"
+            ),
+        ));
     }
     let mass = case.rho0 * dx.powi(dim as i32);
     if !(mass.is_finite() && mass > 0.0) {
@@ -336,6 +402,14 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             ));
         }
     }
+
+    // Inlets right after the fluid blocks (their particles become fluid).
+    let inlets: Vec<_> = case
+        .inlets
+        .iter()
+        .zip(inlet_layouts)
+        .map(|(s, l)| super::inlets::build(s, l, &lat, case.rho0, &mut particles))
+        .collect();
 
     // Walls: tank, then obstacles (each lattice point once).
     let reach = layers as f64 * dx + dx;
@@ -533,7 +607,6 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
 
     let points = super::probes::resolve_points(ctx, &case.points, &particles, &bodies, dim, dx)?;
     let mut probes = case.probes;
-    let h = case.h_over_dx * dx;
     super::probes::resolve_wall_patches(ctx, &mut probes, &particles, dim, dx, h)?;
     let physics = Physics {
         dim: dim as u32,
@@ -589,6 +662,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
                 body,
             }
         }),
+        inlets,
     })
 }
 
@@ -649,6 +723,7 @@ fn domain(
             if wall.is_none() {
                 all.extend(case.blocks.iter().map(|b| b.bx));
                 all.extend(case.solids.iter().map(|s| s.bx));
+                all.extend(case.inlets.iter().map(|s| s.bx));
             }
             let mut d = all[0];
             for b in &all[1..] {
@@ -701,6 +776,21 @@ fn domain(
                     AXES[a]
                 ),
                 fix(&b.bx, a),
+            ));
+        }
+    }
+    for (i, s) in case.inlets.iter().enumerate() {
+        if let Some(a) = inside(&s.bx, &d, dim) {
+            return Err(ctx.err(
+                &format!("inlet[{i}]"),
+                None,
+                format!(
+                    "the buffer box ({}) leaves the domain ({}) along {}",
+                    fmt_box(&s.bx, dim),
+                    fmt_box(&d, dim),
+                    AXES[a]
+                ),
+                fix(&s.bx, a),
             ));
         }
     }

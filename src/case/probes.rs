@@ -224,9 +224,7 @@ pub(super) fn resolve_wall_patches(
     dx: f64,
     h: f64,
 ) -> Result<(), CaseError> {
-    let has_walls = particles
-        .iter()
-        .any(|p| !p.kind.is_fluid() && !p.kind.is_solid());
+    let has_walls = particles.iter().any(|p| p.kind.is_boundary());
     for (i, probe) in probes.iter_mut().enumerate() {
         let ProbeKind::WallPressure(patch) = &mut probe.kind else {
             continue;

@@ -26,6 +26,20 @@ pub(super) struct RawCase {
     pub body: Vec<RawBody>,
     #[serde(default)]
     pub solid: Vec<RawSolid>,
+    #[serde(default)]
+    pub inlet: Vec<RawInlet>,
+}
+
+/// A velocity inlet: `[[inlet]]` (`docs/cases.md`, "Inlets").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawInlet {
+    pub name: String,
+    pub min_m: Vec<f64>,
+    pub max_m: Vec<f64>,
+    pub direction: Vec<f64>,
+    pub velocity_m_s: f64,
+    pub stop_s: Option<f64>,
 }
 
 /// An elastic body: `[[solid]]` (`docs/cases.md`, "Elastic solids").
@@ -489,6 +503,46 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "velocity_m_s = [0.0, 0.0]",
     ),
     f(
+        "inlet",
+        "a list of [[inlet]] tables",
+        "[[inlet]] with name, min_m, max_m, direction and velocity_m_s",
+    ),
+    f(
+        "inlet[]",
+        "an [[inlet]] table",
+        "[[inlet]] with name, min_m, max_m, direction and velocity_m_s",
+    ),
+    f(
+        "inlet[].name",
+        "the inlet's name, unique among the inlets",
+        "name = \"nozzle\"",
+    ),
+    f(
+        "inlet[].min_m",
+        "the lower corner of the inlet's buffer box in metres",
+        "min_m = [0.0, 0.3]",
+    ),
+    f(
+        "inlet[].max_m",
+        "the upper corner of the inlet's buffer box in metres",
+        "max_m = [0.04, 0.35]",
+    ),
+    f(
+        "inlet[].direction",
+        "the inflow direction, an axis: the fluid leaves the box through the face it points at",
+        "direction = [1.0, 0.0]",
+    ),
+    f(
+        "inlet[].velocity_m_s",
+        "the inflow speed in m/s, along direction",
+        "velocity_m_s = 1.0",
+    ),
+    f(
+        "inlet[].stop_s",
+        "when the inflow stops, in seconds (default: time.end_s)",
+        "stop_s = 0.5",
+    ),
+    f(
         "obstacle",
         "a list of [[obstacle]] tables",
         "[[obstacle]] with min_m and max_m",
@@ -852,7 +906,9 @@ impl FieldHelp {
         let value = self.example.split_once('=').map_or("", |(_, v)| v.trim());
         match self.path {
             "dimension" | "tank.layers" | "physics.density_filter_every" => "an integer",
-            "fluid_block" | "obstacle" | "probe" | "body" | "solid" => "an array of tables",
+            "fluid_block" | "obstacle" | "probe" | "body" | "solid" | "inlet" => {
+                "an array of tables"
+            }
             "body[].layers" => "an integer",
             _ if self.example.starts_with('[') => "a table",
             _ if value.starts_with('"') => "a string",

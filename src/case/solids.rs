@@ -556,6 +556,7 @@ pub(super) fn build_solid_case(
             body,
             tau0: vec![[0.0; 6]; n],
         }),
+        inlets: Vec::new(),
     })
 }
 

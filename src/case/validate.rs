@@ -102,6 +102,7 @@ pub(super) struct Case {
     pub bodies: Vec<super::bodies::BodySpec>,
     /// Elastic solids, alone or in fluid (held by a fixed tank and obstacles).
     pub solids: Vec<super::solids::SolidSpec>,
+    pub inlets: Vec<super::inlets::InletSpec>,
 }
 
 /// Allowed range of a number.
@@ -247,11 +248,11 @@ pub(super) fn validate(
         }
     };
     // Before the physics: without fluid or solids nothing else of the case matters.
-    if raw.fluid_block.is_empty() && raw.solid.is_empty() {
+    if raw.fluid_block.is_empty() && raw.solid.is_empty() && raw.inlet.is_empty() {
         return Err(ctx.err(
             "fluid_block",
             None,
-            "no fluid: at least one [[fluid_block]] (or [[solid]]) is required",
+            "no fluid: at least one [[fluid_block]] (or [[inlet]] or [[solid]]) is required",
             "add a [[fluid_block]] table with min_m and max_m",
         ));
     }
@@ -643,6 +644,7 @@ pub(super) fn validate(
         ));
     }
     let bodies = super::bodies::validate(ctx, &raw.body, dim, case_dir)?;
+    let inlets = super::inlets::validate(ctx, &raw.inlet, dim, time.end_s)?;
     let tank_moves = tank.as_ref().is_some_and(|t| t.motion.is_some());
     let mut probes: Vec<Probe> = Vec::with_capacity(raw.probe.len());
     let mut points = Vec::new();
@@ -685,6 +687,7 @@ pub(super) fn validate(
         points,
         bodies,
         solids,
+        inlets,
     })
 }
 

@@ -24,10 +24,11 @@ pub enum Pass {
     Bodies,
     Elastic,
     TotalLagrangian,
+    Inlet,
 }
 
 impl Pass {
-    pub const ALL: [Pass; 10] = [
+    pub const ALL: [Pass; 11] = [
         Pass::CellList,
         Pass::PrefixScan,
         Pass::Interaction,
@@ -38,6 +39,7 @@ impl Pass {
         Pass::Bodies,
         Pass::Elastic,
         Pass::TotalLagrangian,
+        Pass::Inlet,
     ];
 
     pub fn name(self) -> &'static str {
@@ -52,6 +54,7 @@ impl Pass {
             Pass::Bodies => "bodies",
             Pass::Elastic => "elastic",
             Pass::TotalLagrangian => "total_lagrangian",
+            Pass::Inlet => "inlet",
         }
     }
 
@@ -67,6 +70,7 @@ impl Pass {
             Pass::Bodies => include_str!("../../shaders/bodies.wgsl"),
             Pass::Elastic => include_str!("../../shaders/elastic.wgsl"),
             Pass::TotalLagrangian => include_str!("../../shaders/total_lagrangian.wgsl"),
+            Pass::Inlet => include_str!("../../shaders/inlet.wgsl"),
         }
     }
 

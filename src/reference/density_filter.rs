@@ -9,12 +9,12 @@
 //! pivot of A is below `MLS_MIN_PIVOT`·A00 or when the MLS density is not positive and finite.
 
 use super::ghost::{basis, mls_beta};
-use super::{dot, kernel, RefParticle, Space, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP, WALL};
+use super::{dot, kernel, RefParticle, Space, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP, INLET, WALL};
 use crate::scenario::Physics;
 
 /// Whether a neighbour of this kind enters the filter's sums.
 pub fn counts(kind: u32) -> bool {
-    matches!(kind, FLUID | WALL | GHOST_NO_SLIP | GHOST_FREE_SLIP)
+    matches!(kind, FLUID | WALL | INLET | GHOST_NO_SLIP | GHOST_FREE_SLIP)
 }
 
 /// (j, x_ij, W_ij V_j) of every counted particle within 2h of particle `i` (i itself included);

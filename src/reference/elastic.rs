@@ -330,7 +330,9 @@ pub fn contact_rates(
     let on_body = solid_body_contact_weight(ph, mat, m_s);
     let support2 = 4.0 * ph.h * ph.h;
     let fixed_wall = |p: &RefParticle| {
-        p.kind != super::FLUID && p.kind != super::EXCLUDED && !is_solid(p.kind) && p.body.is_none()
+        !matches!(p.kind, super::FLUID | super::EXCLUDED | super::INLET)
+            && !is_solid(p.kind)
+            && p.body.is_none()
     };
     let on_a_body = |p: &RefParticle| p.body.is_some() && p.kind != super::EXCLUDED;
     (0..parts.len())

@@ -1,6 +1,6 @@
 //! Twin of shaders/integrate.wgsl: predictor, corrector and the time-step choice.
 
-use super::{laminar_nu, sound_speed, RefParticle, FLUID, WALL};
+use super::{laminar_nu, sound_speed, RefParticle, FLUID, INLET, WALL};
 use crate::scenario::Physics;
 
 /// x_{n+1} = x + dt v + ½dt² a, v* = v + dt a, ρ* = ρ + dt Dρ (walls: only ρ, ≥ ρ0).
@@ -69,8 +69,8 @@ pub fn timestep(ph: &Physics, cfl: f64, parts: &[RefParticle], rates: &[[f64; 4]
         if p.kind == FLUID {
             max_speed = max_speed.max(sound_speed(ph, p.rho) + v);
             max_accel = max_accel.max((r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt());
-        } else if p.kind == WALL {
-            // Moving walls (bodies) count with their speed.
+        } else if p.kind == WALL || p.kind == INLET {
+            // Moving walls (bodies) and inlet buffers count with their speed.
             max_speed = max_speed.max(sound_speed(ph, p.rho) + v);
         }
     }

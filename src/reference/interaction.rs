@@ -2,7 +2,7 @@
 
 use super::{
     dot, kernel, laminar_nu, pressure, sub, RefParticle, Space, EXCLUDED, FLUID, GHOST_FREE_SLIP,
-    GHOST_NO_SLIP, REPULSIVE, WALL,
+    GHOST_NO_SLIP, INLET, REPULSIVE, WALL,
 };
 use crate::scenario::{DeltaSphForm, MirrorPlane, Physics, RepulsiveForm, Viscosity, WallParams};
 
@@ -183,8 +183,7 @@ pub fn rates_and_energy(
             // wall-pressure probes read it.
             let reacts = on_body
                 || (walls.reactions
-                    && pi.kind != FLUID
-                    && pi.kind != EXCLUDED
+                    && !matches!(pi.kind, FLUID | EXCLUDED | INLET)
                     && !super::elastic::is_solid(pi.kind));
             if pi.kind == WALL || reacts {
                 // A body's ghost reacts with the velocity the fluid sees in viscosity.
@@ -220,6 +219,7 @@ pub fn rates_and_energy(
                         }
                     } else if pi.body.is_some()
                         && pj.kind != EXCLUDED
+                        && pj.kind != INLET
                         && !super::elastic::is_solid(pj.kind)
                         && pj.body != pi.body
                     {

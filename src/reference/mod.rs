@@ -9,6 +9,7 @@ pub mod cell_list;
 pub mod density_filter;
 pub mod elastic;
 pub mod ghost;
+pub mod inlet;
 pub mod integrate;
 pub mod interaction;
 pub mod kernel;
@@ -41,6 +42,7 @@ pub const WALL: u32 = 1;
 pub const GHOST_NO_SLIP: u32 = 2;
 pub const GHOST_FREE_SLIP: u32 = 3;
 pub const REPULSIVE: u32 = 4;
+pub const INLET: u32 = crate::scenario::Kind::Inlet as u32;
 pub const EXCLUDED: u32 = crate::layout::KIND_EXCLUDED;
 
 /// Tait equation of state, P = B((ρ/ρ0)^γ − 1).

@@ -1,6 +1,6 @@
 //! Twin of shaders/probes.wgsl.
 
-use super::{dot, kernel, pressure, sub, RefParticle, EXCLUDED, FLUID};
+use super::{dot, kernel, pressure, sub, RefParticle, EXCLUDED, FLUID, INLET};
 use crate::scenario::{Physics, WallPatch};
 
 /// (Σ W V, Σ P W V) over fluid particles at x.
@@ -76,7 +76,9 @@ pub fn wall_pressure(
     let sum: f64 = parts
         .iter()
         .zip(rates)
-        .filter(|(p, _)| p.kind != FLUID && p.kind != EXCLUDED && !super::elastic::is_solid(p.kind))
+        .filter(|(p, _)| {
+            !matches!(p.kind, FLUID | EXCLUDED | INLET) && !super::elastic::is_solid(p.kind)
+        })
         .filter(|(p, _)| {
             let (d, t2) = WallPatch::coordinates(patch.point, patch.normal, p.pos);
             d >= behind && d <= front && t2 < patch.radius * patch.radius

@@ -9,6 +9,7 @@ pub mod density_filter;
 pub mod elastic;
 pub mod ghost;
 pub mod grid;
+pub mod inlet;
 pub mod integrate;
 pub mod interaction;
 pub mod probes;
@@ -36,6 +37,7 @@ use density_filter::DensityFilter;
 use elastic::Elastic;
 use ghost::Ghost;
 use grid::Grid;
+use inlet::Inlets;
 use integrate::Integrate;
 use interaction::Interaction;
 use probes::{PointTracker, Probes};
@@ -205,6 +207,10 @@ pub struct Solver {
     state: SimState,
     initial_dt: f32,
     n_fluid: u64,
+    /// Inlet particles behind their buffers at t = 0 (excluded until they join).
+    dormant_at_start: u32,
+    /// Velocity inlets, if the case has any.
+    inlets: Option<Inlets>,
     /// Stop when more than this fraction of the fluid has been excluded.
     pub max_excluded_fraction: f64,
 }
@@ -271,6 +277,11 @@ impl Solver {
                 (1.0 / crate::reference::kernel::w(ph.kernel, ph.dim, ph.h, ph.dx)) as f32;
             params.solid_id_base = solid_range(sc)?.start as u32;
         }
+        if let (Some(first), Some(last)) = (sc.inlets.first(), sc.inlets.last()) {
+            params.inlet_id_base = first.particles.start as u32;
+            params.n_inlet_particles = (last.particles.end - first.particles.start) as u32;
+            params.n_inlets = sc.inlets.len() as u32;
+        }
         let cfg = ShaderConfig {
             dim: ph.dim,
             kernel: match ph.kernel {
@@ -299,6 +310,14 @@ impl Solver {
                 p.rho as f32,
             ]);
             code.push(((p.kind as u32) << KIND_SHIFT) | id as u32);
+        }
+        // Inlet particles behind their buffers wait excluded (in no cell) until they join.
+        for inlet in &sc.inlets {
+            for (k, id) in inlet.particles.clone().enumerate() {
+                if inlet.dormant(k) {
+                    code[id] = (KIND_EXCLUDED << KIND_SHIFT) | id as u32;
+                }
+            }
         }
         let device = ctx.device.clone();
         for p in &sc.probes {
@@ -375,6 +394,17 @@ impl Solver {
         } else {
             None
         };
+        let inlets = if sc.inlets.is_empty() {
+            None
+        } else {
+            Some(Inlets::new(
+                &device,
+                &module(Pass::Inlet)?,
+                &buffers,
+                sc,
+                &grid,
+            )?)
+        };
         let probe_module = module(Pass::Probes)?;
         let probes = Probes::new(
             &device,
@@ -442,8 +472,11 @@ impl Solver {
             steps: 0,
             state: SimState::default(),
             initial_dt: 0.0,
-            // Fluid and free solid particles: the ones that move and can leave the domain.
-            n_fluid: (sc.count(Kind::Fluid) + sc.count(Kind::Solid)) as u64,
+            // Fluid (inlets' included) and free solid particles: the ones that move and can
+            // leave the domain.
+            n_fluid: (sc.count(Kind::Fluid) + sc.count(Kind::Inlet) + sc.count(Kind::Solid)) as u64,
+            dormant_at_start: sc.dormant_count() as u32,
+            inlets,
             max_excluded_fraction: 0.05,
         };
         // Warm-up: one step with dt = 0 sorts the particles, evaluates the initial rates and
@@ -470,8 +503,13 @@ impl Solver {
         self.state.dt_cfl as f64
     }
 
+    /// Particles that left the domain or became non-finite (not counting inlet particles that
+    /// still wait behind their buffers, which sit in the same excluded slot).
     pub fn excluded(&self) -> u64 {
-        self.state.excluded as u64
+        let dormant = self
+            .dormant_at_start
+            .saturating_sub(self.state.inlet_joined);
+        self.state.excluded.saturating_sub(dormant) as u64
     }
 
     pub fn particle_count(&self) -> u64 {
@@ -559,6 +597,9 @@ impl Solver {
             if let Some(b) = bodies {
                 b.encode_move(&mut pass, p);
             }
+            if let Some(i) = &self.inlets {
+                i.encode(&mut pass, p);
+            }
             self.cell_list.encode(&mut pass, p);
             if let Some(t) = &self.total_lagrangian {
                 t.encode_index(&mut pass, q);
@@ -588,13 +629,20 @@ impl Solver {
         encoder
     }
 
-    /// Advances to exactly `t_target` (the last step is shortened to land on it).
-    pub fn advance_to(&mut self, t_target: f64) -> Result<()> {
-        // Re-base the GPU's f32 clock on the host's f64 one, so it only ever counts a short span.
+    /// Re-bases the GPU's f32 clock on the host's f64 one, so that it only ever counts a short
+    /// span: the state to upload (with the time to run still to be set).
+    fn rebased_state(&mut self) -> SimState {
         self.t_base += self.state.t_rel as f64;
-        let remaining = t_target - self.t_base;
         let mut st = self.state;
         st.t_rel = 0.0;
+        st.t_base = self.t_base as f32;
+        st
+    }
+
+    /// Advances to exactly `t_target` (the last step is shortened to land on it).
+    pub fn advance_to(&mut self, t_target: f64) -> Result<()> {
+        let mut st = self.rebased_state();
+        let remaining = t_target - self.t_base;
         st.t_target_rel = remaining as f32;
         st.dt = if remaining > 1e-4 * st.dt_cfl as f64 {
             st.dt_cfl.min(remaining as f32)
@@ -623,9 +671,7 @@ impl Solver {
     /// Takes exactly `count` steps of CFL size (no target time), for benchmarks; waits for the
     /// GPU at the end and checks stability.
     pub fn run_steps(&mut self, count: u64) -> Result<()> {
-        self.t_base += self.state.t_rel as f64;
-        let mut st = self.state;
-        st.t_rel = 0.0;
+        let mut st = self.rebased_state();
         st.t_target_rel = f32::MAX;
         st.dt = st.dt_cfl;
         self.queue
@@ -702,10 +748,11 @@ impl Solver {
                 s.nan_count
             ));
         }
-        if s.excluded as f64 > self.max_excluded_fraction * self.n_fluid as f64 {
+        let excluded = self.excluded();
+        if excluded as f64 > self.max_excluded_fraction * self.n_fluid as f64 {
             return fail(format!(
                 "{} of {} fluid and solid particles left the domain (more than {:.0} %)",
-                s.excluded,
+                excluded,
                 self.n_fluid,
                 100.0 * self.max_excluded_fraction
             ));
@@ -921,9 +968,7 @@ impl Solver {
     /// Test hook: takes exactly one step of `dt` (no clipping) and returns the new state.
     #[doc(hidden)]
     pub fn single_step(&mut self, dt: f32) -> Result<SimState> {
-        self.t_base += self.state.t_rel as f64;
-        let mut st = self.state;
-        st.t_rel = 0.0;
+        let mut st = self.rebased_state();
         st.t_target_rel = f32::MAX;
         st.dt = dt;
         self.queue

@@ -144,9 +144,10 @@ pub(crate) fn check_sane(sc: &Scenario) -> Result<(), String> {
     if n == 0 || n as f64 > MAX_PARTICLES {
         return Err(format!("{n} particles"));
     }
-    // A case moves fluid or elastic solids (the oscillating plate has no fluid).
-    if sc.count(Kind::Fluid) + sc.count(Kind::Solid) == 0 {
-        return Err("no fluid or free solid particle".into());
+    // A case moves fluid (from blocks or inlets) or elastic solids (the oscillating plate has
+    // no fluid).
+    if sc.count(Kind::Fluid) + sc.count(Kind::Inlet) + sc.count(Kind::Solid) == 0 {
+        return Err("no fluid, inlet or free solid particle".into());
     }
     let positive = |name: &str, v: f64| {
         if v.is_finite() && v > 0.0 {
@@ -286,8 +287,9 @@ pub(crate) fn expectation(seed: &Seed, node: &Node, new: Option<&Value>) -> Expe
     let old = &node.value;
     let Some(new) = new else {
         // Elastic solids may stand without fluid (alone, or in a tank, among obstacles and
-        // bodies, which they touch): then the fluid is not required.
-        let solids_without_fluid = node.path == "fluid_block" && seed.doc.contains_key("solid");
+        // bodies, which they touch), and inlets bring their own: then the fluid is not required.
+        let solids_without_fluid = node.path == "fluid_block"
+            && (seed.doc.contains_key("solid") || seed.doc.contains_key("inlet"));
         return if required(&node.path) && !solids_without_fluid {
             Expect::Reject
         } else if matches!(generic(&node.path).as_str(), "name" | "probe" | "probe[]") {

@@ -141,6 +141,7 @@ pub fn scenario(
         periodic: [false; 3],
         bodies: Vec::new(),
         solids: None,
+        inlets: Vec::new(),
         domain,
         particles,
         probes,

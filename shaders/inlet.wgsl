@@ -1,0 +1,75 @@
+// Velocity inlets (`[[inlet]]`, docs/cases.md "Inlets"): the buffer particles' place, velocity
+// and kind at the time the predictor has just moved to, t + dt. Runs after the predictor and
+// before the cell-list sort, on the arrays the predictor wrote.
+//
+// An inlet is a lattice of columns on its plane and layers behind it, laid out layer-major:
+// particle k = id − first_id is column k mod n_columns of layer k / n_columns, at the signed
+// distance s(t) = −(layer + ½) spacing + speed t from the plane along its normal. By s:
+//   s < −thickness  dormant: excluded, in no cell (the excluded slot), waiting;
+//   −thickness ≤ s < 0  buffer (KIND_INLET): at its place, velocity speed n, density ρ0 (zero
+//     pressure), seen by the fluid as a neighbour (interaction.wgsl, as a dynamic boundary
+//     particle), getting no rates;
+//   s ≥ 0  fluid, from then on integrated as any fluid particle.
+// s is a function of time alone, so nothing accumulates and a restart is exact. The rule is
+// stateless: a dormant particle joins when s is in the buffer's range (one step moves a
+// particle by speed dt, far less than the thickness ≥ 2h, so none is skipped), and an excluded
+// particle whose s is past the plane has been fluid and left the domain: it stays excluded.
+
+struct InletDef {
+    normal: vec3<f32>,          // unit, the direction of the inflow
+    speed: f32,                 // [m/s] > 0
+    thickness: f32,             // buffer depth behind the plane [m]
+    spacing: f32,               // between layers [m]
+    first_id: u32,              // its first particle's id
+    n_columns: u32,
+    first_column: u32,          // its first entry in `inlet_columns`
+    n_particles: u32,
+    pad0: u32,
+    pad1: u32,
+}
+
+@group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
+@group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> code: array<u32>;
+@group(0) @binding(4) var<storage, read_write> state: SimState;
+@group(0) @binding(5) var<storage, read> inlets: array<InletDef>;
+// Each column's point on its inlet's plane.
+@group(0) @binding(6) var<storage, read> inlet_columns: array<Pos>;
+
+// Signed distance of inlet particle k (of `inlet`) from the plane at time t.
+fn inlet_distance(inlet: InletDef, k: u32, t: f32) -> f32 {
+    let layer = f32(k / inlet.n_columns);
+    return -(layer + 0.5) * inlet.spacing + inlet.speed * t;
+}
+
+@compute @workgroup_size(WG)
+fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles) {
+        return;
+    }
+    let c = code[i];
+    let id = c & ID_MASK;
+    let kind = code_kind(c);
+    if (id < params.inlet_id_base || id - params.inlet_id_base >= params.n_inlet_particles
+        || (kind != KIND_INLET && kind != KIND_EXCLUDED)) {
+        return;
+    }
+    var n = 0u;
+    while (n + 1u < params.n_inlets && id >= inlets[n + 1u].first_id) {
+        n++;
+    }
+    let inlet = inlets[n];
+    let k = id - inlet.first_id;
+    let s = inlet_distance(inlet, k, state.t_base + state.t_rel + state.dt);
+    if (kind == KIND_EXCLUDED) {
+        if (s < -inlet.thickness || s >= 0.0) {
+            return;
+        }
+        atomicAdd(&state.inlet_joined, 1u);
+    }
+    let column = inlet_columns[inlet.first_column + k % inlet.n_columns];
+    pos[i] = move_by(column, s * inlet.normal).pos;
+    velrho[i] = vec4<f32>(inlet.speed * inlet.normal, params.rho0);
+    code[i] = with_kind(c, select(KIND_INLET, KIND_FLUID, s >= 0.0));
+}

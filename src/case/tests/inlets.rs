@@ -1,0 +1,105 @@
+//! `[[inlet]]`: the water-injection case's nozzle, and the loader's errors.
+
+use super::*;
+
+const INJECTION: &str = include_str!("../../../cases/water_injection_2d.toml");
+
+#[test]
+fn the_injection_nozzle_is_a_buffer_of_layers_behind_its_plane() {
+    let s = load_str(INJECTION, "cases/water_injection_2d.toml", &[]).unwrap();
+    assert_eq!(s.inlets.len(), 1);
+    let inlet = &s.inlets[0];
+    // 0.04 m high at dx = 0.005: 8 columns on the plane x = 0.03 m, 6 layers of buffer
+    // (0.03 m ≥ 2h = 0.013 m); 1.5 m/s for 1 s is 300 layers.
+    assert_eq!(inlet.columns.len(), 8);
+    assert!(inlet.columns.iter().all(|c| (c[0] - 0.03).abs() < 1e-12));
+    assert!((inlet.columns[0][1] - 0.3025).abs() < 1e-12);
+    assert_eq!(inlet.normal, [1.0, 0.0, 0.0]);
+    assert!((inlet.thickness - 0.03).abs() < 1e-12);
+    assert_eq!(inlet.particles.len(), 8 * 300);
+    assert_eq!(s.count(Kind::Inlet), 8 * 300);
+    assert_eq!(s.dormant_count(), 8 * 294);
+    // Right after the fluid blocks, which are the first particles.
+    assert_eq!(inlet.particles.start, s.count(Kind::Fluid));
+    // The buffer's front layer half a spacing behind the plane; the waiting layers stacked at
+    // the buffer's back.
+    let first = s.particles[inlet.particles.start];
+    assert!((first.pos[0] - 0.0275).abs() < 1e-12, "{:?}", first.pos);
+    assert_eq!(first.vel, [1.5, 0.0, 0.0]);
+    assert_eq!(first.rho, 1000.0);
+    let last = s.particles[inlet.particles.end - 1];
+    assert!((last.pos[0] - 0.0).abs() < 1e-12, "{:?}", last.pos);
+    // Stopping earlier makes fewer layers; the inflow sets the speed of sound's scale.
+    let short = load_str(INJECTION, "x.toml", &sets(&["inlet[0].stop_s=0.2"])).unwrap();
+    assert_eq!(short.inlets[0].particles.len(), 8 * 60);
+    let coef = load_str(
+        INJECTION,
+        "x.toml",
+        &sets(&["physics.sound_speed_coef=10", "inlet[0].velocity_m_s=4"]),
+    );
+    // sound_speed_m_s and sound_speed_coef together are refused; the coefficient alone with
+    // a fast inlet gives 10 × 4 m/s.
+    assert!(coef.is_err());
+    let text = INJECTION.replace("sound_speed_m_s = 30.0", "sound_speed_coef = 10.0");
+    let fast = load_str(&text, "x.toml", &sets(&["inlet[0].velocity_m_s=4"])).unwrap();
+    assert!((fast.physics.c0 - 40.0).abs() < 1e-9, "{}", fast.physics.c0);
+}
+
+#[test]
+fn inlet_errors_name_the_field_and_the_fix() {
+    assert_err(
+        INJECTION,
+        &["inlet[0].direction=[1.0, 1.0]"],
+        None,
+        &[
+            "inlet[0].direction",
+            "unit vector along an axis",
+            "direction = [1.0, 0.0]",
+        ],
+    );
+    assert_err(
+        INJECTION,
+        &["inlet[0].velocity_m_s=0"],
+        None,
+        &["inlet[0].velocity_m_s", "> 0"],
+    );
+    assert_err(
+        INJECTION,
+        &["inlet[0].max_m=[0.01, 0.34]"],
+        None,
+        &[
+            "inlet[0].max_m",
+            "2 layer(s)",
+            "2h",
+            "at least 0.015 m deep along x",
+        ],
+    );
+    assert_err(
+        INJECTION,
+        &["inlet[0].min_m=[0.0, 0.05]"],
+        None,
+        &["inlet[0]", "overlaps fluid_block[0]"],
+    );
+    assert_err(
+        INJECTION,
+        &["inlet[0].max_m=[0.03, 0.55]"],
+        None,
+        &["inlet[0]", "leaves the tank's inner box"],
+    );
+    let twice = format!(
+        "{INJECTION}\n[[inlet]]\nname = \"nozzle\"\nmin_m = [0.2, 0.3]\nmax_m = [0.23, 0.34]\n\
+         direction = [1.0, 0.0]\nvelocity_m_s = 1.0\n"
+    );
+    assert_err(
+        &twice,
+        &[],
+        None,
+        &["inlet[1].name", "also the name of inlet[0]"],
+    );
+    assert_err(
+        INJECTION,
+        &["inlet[0].stop_s=-1"],
+        None,
+        &["inlet[0].stop_s", "> 0"],
+    );
+}

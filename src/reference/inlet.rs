@@ -1,0 +1,74 @@
+//! f64 reference of shaders/inlet.wgsl: where a velocity inlet puts its particles.
+
+use super::{EXCLUDED, FLUID, INLET};
+use crate::scenario::Inlet;
+
+/// An inlet particle as the inlet pass leaves it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placed {
+    pub pos: [f64; 3],
+    pub vel: [f64; 3],
+    pub rho: f64,
+    pub kind: u32,
+    /// It was dormant and joined the buffer in this pass.
+    pub joined: bool,
+}
+
+/// What the pass makes at time `t` of particle `k` of `inlet`, whose kind is `kind`: `None`
+/// where it leaves the particle alone (fluid already, or excluded and not due: still dormant,
+/// or past the plane, i.e. fluid that left the domain).
+pub fn place(inlet: &Inlet, k: usize, kind: u32, t: f64, rho0: f64) -> Option<Placed> {
+    let s = inlet.distance(k, t);
+    let joined = match kind {
+        INLET => false,
+        EXCLUDED if (-inlet.thickness..0.0).contains(&s) => true,
+        _ => return None,
+    };
+    Some(Placed {
+        pos: inlet.position(k, t),
+        vel: inlet.normal.map(|n| inlet.speed * n),
+        rho: rho0,
+        kind: if s >= 0.0 { FLUID } else { INLET },
+        joined,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn inlet() -> Inlet {
+        Inlet {
+            name: "jet".into(),
+            normal: [1.0, 0.0, 0.0],
+            speed: 2.0,
+            thickness: 0.04,
+            spacing: 0.01,
+            columns: vec![[0.1, 0.2, 0.0], [0.1, 0.21, 0.0]],
+            particles: 10..30,
+        }
+    }
+
+    #[test]
+    fn layers_join_the_buffer_as_the_front_layer_leaves_it() {
+        let inlet = inlet();
+        // Layers 0..3 are the buffer at t = 0; layer 4 (particles 8, 9) waits.
+        assert!((0..8).all(|k| !inlet.dormant(k)));
+        assert!((8..20).all(|k| inlet.dormant(k)));
+        // At t = 0.003 s every particle has moved 6 mm: layer 0 (s = 1 mm) is fluid, layer 4
+        // (s = −39 mm) has joined.
+        let t = 0.003;
+        let first = place(&inlet, 1, INLET, t, 1000.0).unwrap();
+        assert_eq!(first.kind, FLUID);
+        assert!((first.pos[0] - 0.101).abs() < 1e-12 && (first.pos[1] - 0.21).abs() < 1e-12);
+        assert_eq!(first.vel, [2.0, 0.0, 0.0]);
+        let joined = place(&inlet, 8, EXCLUDED, t, 1000.0).unwrap();
+        assert!(joined.joined && joined.kind == INLET);
+        assert!((joined.pos[0] - (0.1 - 0.039)).abs() < 1e-12);
+        // Layer 5 still waits; a fluid particle is left alone, and so is an excluded one past
+        // the plane (it was fluid and left the domain).
+        assert_eq!(place(&inlet, 10, EXCLUDED, t, 1000.0), None);
+        assert_eq!(place(&inlet, 3, FLUID, t, 1000.0), None);
+        assert_eq!(place(&inlet, 0, EXCLUDED, t, 1000.0), None);
+    }
+}
