@@ -134,7 +134,7 @@ fn correct(
             // Moving walls (bodies) count with their speed.
             speed = sound_speed_of(rho) + length(vr.xyz);
         } else if (kind == KIND_INLET || (kind != KIND_EXCLUDED && is_body_particle(code[i] & ID_MASK))) {
-            // An inlet particle counts with its inflow velocity (inlet.wgsl), a body's ghost or
+            // An inlet particle counts with its inflow velocity (open_boundaries.wgsl), a body's ghost or
             // repulsive particle with its own (a ghost's is the fluid's interpolated at it,
             // which follows the body it touches).
             speed = sound_speed_of(vr.w) + length(vr.xyz);

@@ -44,7 +44,7 @@
 //   these fluid terms here and contact (the repulsive law below, per unit mass) from boundary
 //   particles of walls and bodies and from particles of other elastic bodies; elastic.wgsl
 //   (or total_lagrangian.wgsl) adds the forces within the body and gravity.
-// Inlet buffer particles (inlet.wgsl) enter a fluid particle's sums as dynamic boundary
+// Inlet buffer particles (open_boundaries.wgsl) enter a fluid particle's sums as dynamic boundary
 // particles do (their velocity, ρ0, no δ-SPH term) and get nothing here.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
 // get nothing here; unless WALL_REACTIONS (a case with wall-pressure probes, probes.wgsl): then

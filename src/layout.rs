@@ -53,7 +53,7 @@ pub struct Params {
     pub inlet_id_base: u32,
     pub n_inlet_particles: u32,
     pub n_inlets: u32,
-    pub pad_params: u32,
+    pub n_outlets: u32,
 }
 
 /// Mirrors `SolidState` in shaders/lib/common.wgsl: the deviatoric stress τ of a solid particle
@@ -96,7 +96,8 @@ pub struct SimState {
     pub t_base: f32,
     /// Dormant inlet particles that have joined a buffer since t = 0.
     pub inlet_joined: u32,
-    pub pad: u32,
+    /// Fluid particles removed by outlets since t = 0.
+    pub drained: u32,
 }
 
 /// Mirrors `Pos`: offset from the block's lower corner + packed block coordinates.
@@ -175,7 +176,7 @@ pub fn unpack_block(b: u32) -> [u32; 3] {
     [b & 0x7FF, (b >> 11) & 0x7FF, b >> 22]
 }
 
-/// Mirrors `InletDef` in shaders/inlet.wgsl: an inlet's plane normal, speed, buffer depth,
+/// Mirrors `InletDef` in shaders/open_boundaries.wgsl: an inlet's plane normal, speed, buffer depth,
 /// layer spacing, and where its particles and columns start.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
@@ -189,6 +190,17 @@ pub struct InletDef {
     pub first_column: u32,
     pub n_particles: u32,
     pub pad: [u32; 2],
+}
+
+/// Mirrors `OutletDef` in shaders/open_boundaries.wgsl: an outlet's box in domain coordinates
+/// (from the grid's origin).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct OutletDef {
+    pub min: [f32; 3],
+    pub pad0: u32,
+    pub max: [f32; 3],
+    pub pad1: u32,
 }
 
 /// Mirrors `TlParams` in shaders/total_lagrangian.wgsl: the total-Lagrangian solid's
@@ -312,7 +324,8 @@ mod tests {
                 solid_id_base,
                 inlet_id_base,
                 n_inlet_particles,
-                n_inlets
+                n_inlets,
+                n_outlets
             ]
         );
     }
@@ -361,15 +374,21 @@ mod tests {
                 excluded,
                 steps,
                 t_base,
-                inlet_joined
+                inlet_joined,
+                drained
             ]
         );
     }
 
     #[test]
+    fn outlet_def_matches_wgsl() {
+        check_layout!(Pass::OpenBoundaries, "OutletDef", OutletDef, [min, max]);
+    }
+
+    #[test]
     fn inlet_def_matches_wgsl() {
         check_layout!(
-            Pass::Inlet,
+            Pass::OpenBoundaries,
             "InletDef",
             InletDef,
             [

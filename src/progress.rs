@@ -21,6 +21,8 @@ pub struct RunStatus {
     pub particles: u64,
     /// Particles that left the domain and are no longer integrated.
     pub excluded: u64,
+    /// Fluid particles the outlets removed.
+    pub drained: u64,
     /// Particle outputs written so far.
     pub outputs: usize,
     /// Wall time since the time loop started [s].
@@ -215,6 +217,7 @@ mod tests {
             steps: 5000,
             particles: 1000,
             excluded: 3,
+            drained: 0,
             outputs: 4,
             wall_s,
         }

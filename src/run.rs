@@ -425,6 +425,7 @@ impl<'a> Runner<'a> {
             steps: self.solver.steps(),
             particles: self.sc.particles.len() as u64,
             excluded: self.solver.excluded(),
+            drained: self.solver.drained(),
             outputs: self.outputs.out.snapshot_count(),
             wall_s: self.wall_before + self.started.elapsed().as_secs_f64(),
         }
@@ -481,7 +482,9 @@ impl<'a> Runner<'a> {
             dimension: sc.physics.dim,
             particles_fluid: sc.count(Kind::Fluid) as u64,
             particles_wall: sc.count(Kind::Wall) as u64,
+            particles_inlet: sc.count(Kind::Inlet) as u64,
             particles_excluded: end.excluded,
+            particles_drained: end.drained,
             steps: end.steps,
             simulated_time_s: end.time_s,
             wall_time_s: end.wall_s,

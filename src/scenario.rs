@@ -388,6 +388,24 @@ pub struct Scenario {
     pub solids: Option<Solids>,
     /// Velocity inlets. Their particles come right after the fluid blocks', inlet after inlet.
     pub inlets: Vec<Inlet>,
+    /// Outlets: boxes that remove the fluid entering them.
+    pub outlets: Vec<Outlet>,
+}
+
+/// An outlet (`[[outlet]]`, docs/cases.md "Outlets"): a box that removes every fluid particle
+/// entering it (a sink, counted apart from particles that escape the domain).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Outlet {
+    pub name: String,
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+impl Outlet {
+    /// Whether `x` lies in the box (faces included; 2D: z is not tested).
+    pub fn contains(&self, x: [f64; 3], dim: usize) -> bool {
+        (0..dim).all(|a| self.min[a] <= x[a] && x[a] <= self.max[a])
+    }
 }
 
 /// A velocity inlet (`[[inlet]]`, docs/cases.md "Inlets"): a buffer of particles on the

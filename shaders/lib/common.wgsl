@@ -49,11 +49,11 @@ struct Params {
     solid_eps: f32,             // artificial stress ε (Monaghan 2000)
     solid_inv_w_dx: f32,        // 1/W(Δp), Δp the initial spacing
     solid_id_base: u32,         // the first solid particle's id (solid ids are consecutive)
-    // Inlets (inlet.wgsl): their particles have the ids inlet_id_base .. + n_inlet_particles
+    // Inlets (open_boundaries.wgsl): their particles have the ids inlet_id_base .. + n_inlet_particles
     inlet_id_base: u32,
     n_inlet_particles: u32,
     n_inlets: u32,
-    pad_params: u32,
+    n_outlets: u32,             // open_boundaries.wgsl
 }
 
 // Time-stepping state that lives on the GPU; read back once per batch of steps.
@@ -70,7 +70,7 @@ struct SimState {
     steps: u32,                 // steps taken with dt > 0 since the host's base
     t_base: f32,                // the host's base time (f32): t = t_base + t_rel, for inlets
     inlet_joined: atomic<u32>,  // dormant inlet particles that joined a buffer (cumulative)
-    pad: u32,
+    drained: atomic<u32>,       // fluid particles removed by outlets (cumulative)
 }
 
 // Particle position: `off` is the offset from the lower corner of block `block`
@@ -90,7 +90,7 @@ const KIND_GHOST_FREE_SLIP: u32 = 3u; // fixed ghost, free-slip
 const KIND_REPULSIVE: u32 = 4u;       // repulsive-force boundary particle
 const KIND_SOLID: u32 = 5u;           // hypoelastic solid particle
 const KIND_SOLID_CLAMPED: u32 = 6u;   // solid particle held fixed (in the stress sums)
-const KIND_INLET: u32 = 7u;           // inlet buffer particle (inlet.wgsl)
+const KIND_INLET: u32 = 7u;           // inlet buffer particle (open_boundaries.wgsl)
 const KIND_EXCLUDED: u32 = 15u;
 
 // A particle of a moving body (rigid or prescribed): where it is in its body's frame.

@@ -176,7 +176,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
                 "make the buffer box touch other parts without overlapping them",
             ));
         }
-        inlet_layouts.push(super::inlets::layout(ctx, i, s, &lat, h)?);
+        inlet_layouts.push(super::open_boundaries::layout(ctx, i, s, &lat, h)?);
     }
 
     // Particle budget, before anything is allocated: every part's count (for a body, the
@@ -408,7 +408,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         .inlets
         .iter()
         .zip(inlet_layouts)
-        .map(|(s, l)| super::inlets::build(s, l, &lat, case.rho0, &mut particles))
+        .map(|(s, l)| super::open_boundaries::build(s, l, &lat, case.rho0, &mut particles))
         .collect();
 
     // Walls: tank, then obstacles (each lattice point once).
@@ -663,6 +663,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             }
         }),
         inlets,
+        outlets: case.outlets,
     })
 }
 
@@ -791,6 +792,50 @@ fn domain(
                     AXES[a]
                 ),
                 fix(&s.bx, a),
+            ));
+        }
+    }
+    // Outlets: reaching into the domain, clear of the fluid blocks and the inlets' buffers.
+    let overlap = |a: &Aabb, b: &Aabb| {
+        (0..dim).all(|k| a.max[k].min(b.max[k]) - a.min[k].max(b.min[k]) > TOL)
+    };
+    for (i, o) in case.outlets.iter().enumerate() {
+        let bx = Aabb {
+            min: o.min,
+            max: o.max,
+        };
+        if !overlap(&bx, &d) {
+            return Err(ctx.err(
+                &format!("outlet[{i}]"),
+                None,
+                format!(
+                    "the box ({}) lies outside the domain ({}): no fluid could reach it",
+                    fmt_box(&bx, dim),
+                    fmt_box(&d, dim)
+                ),
+                "place the outlet where the fluid leaves, inside the domain",
+            ));
+        }
+        let other = case
+            .blocks
+            .iter()
+            .position(|b| overlap(&bx, &b.bx))
+            .map(|j| format!("fluid_block[{j}]"))
+            .or_else(|| {
+                case.inlets
+                    .iter()
+                    .position(|s| overlap(&bx, &s.bx))
+                    .map(|j| format!("inlet[{j}]"))
+            });
+        if let Some(other) = other {
+            return Err(ctx.err(
+                &format!("outlet[{i}]"),
+                None,
+                format!(
+                    "the box ({}) overlaps {other}, whose fluid it would remove at once",
+                    fmt_box(&bx, dim)
+                ),
+                "move the outlet downstream, clear of fluid blocks and inlets",
             ));
         }
     }

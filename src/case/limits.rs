@@ -92,7 +92,15 @@ pub(super) fn budget(
             fmt_count(most),
             fmt_limit(max_particles)
         ),
-        format!("increase particles.dx_m (the count scales as 1/dx^{dim}) or shrink {largest}"),
+        if largest.starts_with("inlet") {
+            // An inlet makes the particles of its whole inflow: its length in time counts.
+            format!(
+                "increase particles.dx_m (the count scales as 1/dx^{dim}), shrink {largest}, or \
+                 stop it sooner ({largest}.stop_s, else time.end_s)"
+            )
+        } else {
+            format!("increase particles.dx_m (the count scales as 1/dx^{dim}) or shrink {largest}")
+        },
     ))
 }
 
@@ -112,7 +120,29 @@ pub(super) fn grid_fits(
     let a = (0..dim)
         .max_by(|&a, &b| extent(a).total_cmp(&extent(b)))
         .unwrap_or(0);
-    let fluid = 0.5 * (case.blocks[0].bx.min[a] + case.blocks[0].bx.max[a]);
+    // The fluid's parts: blocks and inlets' buffers (a case has one of them at least; the
+    // solids-only cases do not come here).
+    let fluid_parts: Vec<(String, Aabb)> = case
+        .blocks
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (format!("fluid_block[{i}]"), b.bx))
+        .chain(
+            case.inlets
+                .iter()
+                .enumerate()
+                .map(|(i, s)| (format!("inlet[{i}]"), s.bx)),
+        )
+        .collect();
+    let Some((first_path, first)) = fluid_parts.first().cloned() else {
+        return Err(ctx.err(
+            "domain",
+            None,
+            format!("is too large for the neighbour grid: {e}"),
+            "shrink [domain] or increase particles.dx_m",
+        ));
+    };
+    let fluid = 0.5 * (first.min[a] + first.max[a]);
     let reach = |b: &Aabb| (b.min[a] - fluid).abs().max((b.max[a] - fluid).abs());
     let (path, fix) = if case.domain.is_some() {
         let field = if (domain.min[a] - fluid).abs() > (domain.max[a] - fluid).abs() {
@@ -125,17 +155,12 @@ pub(super) fn grid_fits(
             "shrink [domain] to where the fluid can go, or increase particles.dx_m".to_string(),
         )
     } else {
-        let blocks = case
-            .blocks
-            .iter()
-            .enumerate()
-            .map(|(i, b)| (format!("fluid_block[{i}]"), b.bx));
         let (path, _) = solid
             .iter()
             .cloned()
-            .chain(blocks)
+            .chain(fluid_parts.iter().cloned())
             .max_by(|x, y| reach(&x.1).total_cmp(&reach(&y.1)))
-            .unwrap_or_else(|| ("fluid_block[0]".into(), case.blocks[0].bx));
+            .unwrap_or((first_path, first));
         let fix = format!(
             "bring {path} closer to the fluid or make it smaller (the default domain encloses \
              everything), or increase particles.dx_m"

@@ -28,6 +28,17 @@ pub(super) struct RawCase {
     pub solid: Vec<RawSolid>,
     #[serde(default)]
     pub inlet: Vec<RawInlet>,
+    #[serde(default)]
+    pub outlet: Vec<RawOutlet>,
+}
+
+/// An outlet: `[[outlet]]` (`docs/cases.md`, "Outlets").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawOutlet {
+    pub name: String,
+    pub min_m: Vec<f64>,
+    pub max_m: Vec<f64>,
 }
 
 /// A velocity inlet: `[[inlet]]` (`docs/cases.md`, "Inlets").
@@ -543,6 +554,31 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "stop_s = 0.5",
     ),
     f(
+        "outlet",
+        "a list of [[outlet]] tables",
+        "[[outlet]] with name, min_m and max_m",
+    ),
+    f(
+        "outlet[]",
+        "an [[outlet]] table",
+        "[[outlet]] with name, min_m and max_m",
+    ),
+    f(
+        "outlet[].name",
+        "the outlet's name, unique among the outlets",
+        "name = \"downstream\"",
+    ),
+    f(
+        "outlet[].min_m",
+        "the lower corner of the outlet's box in metres",
+        "min_m = [1.9, -0.1]",
+    ),
+    f(
+        "outlet[].max_m",
+        "the upper corner of the outlet's box in metres",
+        "max_m = [2.1, 0.5]",
+    ),
+    f(
         "obstacle",
         "a list of [[obstacle]] tables",
         "[[obstacle]] with min_m and max_m",
@@ -906,7 +942,7 @@ impl FieldHelp {
         let value = self.example.split_once('=').map_or("", |(_, v)| v.trim());
         match self.path {
             "dimension" | "tank.layers" | "physics.density_filter_every" => "an integer",
-            "fluid_block" | "obstacle" | "probe" | "body" | "solid" | "inlet" => {
+            "fluid_block" | "obstacle" | "probe" | "body" | "solid" | "inlet" | "outlet" => {
                 "an array of tables"
             }
             "body[].layers" => "an integer",

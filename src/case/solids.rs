@@ -557,6 +557,7 @@ pub(super) fn build_solid_case(
             tau0: vec![[0.0; 6]; n],
         }),
         inlets: Vec::new(),
+        outlets: Vec::new(),
     })
 }
 

@@ -102,7 +102,8 @@ pub(super) struct Case {
     pub bodies: Vec<super::bodies::BodySpec>,
     /// Elastic solids, alone or in fluid (held by a fixed tank and obstacles).
     pub solids: Vec<super::solids::SolidSpec>,
-    pub inlets: Vec<super::inlets::InletSpec>,
+    pub inlets: Vec<super::open_boundaries::InletSpec>,
+    pub outlets: Vec<crate::scenario::Outlet>,
 }
 
 /// Allowed range of a number.
@@ -644,7 +645,8 @@ pub(super) fn validate(
         ));
     }
     let bodies = super::bodies::validate(ctx, &raw.body, dim, case_dir)?;
-    let inlets = super::inlets::validate(ctx, &raw.inlet, dim, time.end_s)?;
+    let inlets = super::open_boundaries::validate(ctx, &raw.inlet, dim, time.end_s)?;
+    let outlets = super::open_boundaries::validate_outlets(ctx, &raw.outlet, dim)?;
     let tank_moves = tank.as_ref().is_some_and(|t| t.motion.is_some());
     let mut probes: Vec<Probe> = Vec::with_capacity(raw.probe.len());
     let mut points = Vec::new();
@@ -688,6 +690,7 @@ pub(super) fn validate(
         bodies,
         solids,
         inlets,
+        outlets,
     })
 }
 

@@ -24,7 +24,7 @@ pub enum Pass {
     Bodies,
     Elastic,
     TotalLagrangian,
-    Inlet,
+    OpenBoundaries,
 }
 
 impl Pass {
@@ -39,7 +39,7 @@ impl Pass {
         Pass::Bodies,
         Pass::Elastic,
         Pass::TotalLagrangian,
-        Pass::Inlet,
+        Pass::OpenBoundaries,
     ];
 
     pub fn name(self) -> &'static str {
@@ -54,7 +54,7 @@ impl Pass {
             Pass::Bodies => "bodies",
             Pass::Elastic => "elastic",
             Pass::TotalLagrangian => "total_lagrangian",
-            Pass::Inlet => "inlet",
+            Pass::OpenBoundaries => "open_boundaries",
         }
     }
 
@@ -70,7 +70,7 @@ impl Pass {
             Pass::Bodies => include_str!("../../shaders/bodies.wgsl"),
             Pass::Elastic => include_str!("../../shaders/elastic.wgsl"),
             Pass::TotalLagrangian => include_str!("../../shaders/total_lagrangian.wgsl"),
-            Pass::Inlet => include_str!("../../shaders/inlet.wgsl"),
+            Pass::OpenBoundaries => include_str!("../../shaders/open_boundaries.wgsl"),
         }
     }
 

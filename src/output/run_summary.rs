@@ -14,7 +14,14 @@ pub struct RunSummary {
     pub dimension: u32,
     pub particles_fluid: u64,
     pub particles_wall: u64,
+    /// Inlet particles (the buffers and the layers waiting behind them).
+    #[serde(default)]
+    pub particles_inlet: u64,
+    /// Particles that left the domain or became non-finite.
     pub particles_excluded: u64,
+    /// Fluid particles the outlets removed.
+    #[serde(default)]
+    pub particles_drained: u64,
     pub steps: u64,
     pub simulated_time_s: f64,
     pub wall_time_s: f64,
@@ -48,7 +55,9 @@ mod tests {
             dimension: 2,
             particles_fluid: 123_456,
             particles_wall: 7_890,
+            particles_inlet: 0,
             particles_excluded: 0,
+            particles_drained: 0,
             steps: 10_000,
             simulated_time_s: 0.1 + 0.2,
             wall_time_s: 12.5,

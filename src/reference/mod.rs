@@ -9,10 +9,10 @@ pub mod cell_list;
 pub mod density_filter;
 pub mod elastic;
 pub mod ghost;
-pub mod inlet;
 pub mod integrate;
 pub mod interaction;
 pub mod kernel;
+pub mod open_boundaries;
 pub mod probes;
 pub mod total_lagrangian;
 

@@ -9,9 +9,9 @@ pub mod density_filter;
 pub mod elastic;
 pub mod ghost;
 pub mod grid;
-pub mod inlet;
 pub mod integrate;
 pub mod interaction;
+pub mod open_boundaries;
 pub mod probes;
 pub mod state;
 pub mod total_lagrangian;
@@ -37,9 +37,9 @@ use density_filter::DensityFilter;
 use elastic::Elastic;
 use ghost::Ghost;
 use grid::Grid;
-use inlet::Inlets;
 use integrate::Integrate;
 use interaction::Interaction;
+use open_boundaries::OpenBoundaries;
 use probes::{PointTracker, Probes};
 use total_lagrangian::TotalLagrangian;
 
@@ -209,8 +209,8 @@ pub struct Solver {
     n_fluid: u64,
     /// Inlet particles behind their buffers at t = 0 (excluded until they join).
     dormant_at_start: u32,
-    /// Velocity inlets, if the case has any.
-    inlets: Option<Inlets>,
+    /// Velocity inlets and outlets, if the case has any.
+    open_boundaries: Option<OpenBoundaries>,
     /// Stop when more than this fraction of the fluid has been excluded.
     pub max_excluded_fraction: f64,
 }
@@ -282,6 +282,7 @@ impl Solver {
             params.n_inlet_particles = (last.particles.end - first.particles.start) as u32;
             params.n_inlets = sc.inlets.len() as u32;
         }
+        params.n_outlets = sc.outlets.len() as u32;
         let cfg = ShaderConfig {
             dim: ph.dim,
             kernel: match ph.kernel {
@@ -394,12 +395,12 @@ impl Solver {
         } else {
             None
         };
-        let inlets = if sc.inlets.is_empty() {
+        let open_boundaries = if sc.inlets.is_empty() && sc.outlets.is_empty() {
             None
         } else {
-            Some(Inlets::new(
+            Some(OpenBoundaries::new(
                 &device,
-                &module(Pass::Inlet)?,
+                &module(Pass::OpenBoundaries)?,
                 &buffers,
                 sc,
                 &grid,
@@ -476,7 +477,7 @@ impl Solver {
             // leave the domain.
             n_fluid: (sc.count(Kind::Fluid) + sc.count(Kind::Inlet) + sc.count(Kind::Solid)) as u64,
             dormant_at_start: sc.dormant_count() as u32,
-            inlets,
+            open_boundaries,
             max_excluded_fraction: 0.05,
         };
         // Warm-up: one step with dt = 0 sorts the particles, evaluates the initial rates and
@@ -504,12 +505,19 @@ impl Solver {
     }
 
     /// Particles that left the domain or became non-finite (not counting inlet particles that
-    /// still wait behind their buffers, which sit in the same excluded slot).
+    /// still wait behind their buffers, nor the fluid outlets removed, which sit in the same
+    /// excluded slot).
     pub fn excluded(&self) -> u64 {
         let dormant = self
             .dormant_at_start
             .saturating_sub(self.state.inlet_joined);
-        self.state.excluded.saturating_sub(dormant) as u64
+        let s = &self.state;
+        s.excluded.saturating_sub(dormant).saturating_sub(s.drained) as u64
+    }
+
+    /// Fluid particles the outlets have removed.
+    pub fn drained(&self) -> u64 {
+        self.state.drained as u64
     }
 
     pub fn particle_count(&self) -> u64 {
@@ -597,8 +605,8 @@ impl Solver {
             if let Some(b) = bodies {
                 b.encode_move(&mut pass, p);
             }
-            if let Some(i) = &self.inlets {
-                i.encode(&mut pass, p);
+            if let Some(o) = &self.open_boundaries {
+                o.encode(&mut pass, p);
             }
             self.cell_list.encode(&mut pass, p);
             if let Some(t) = &self.total_lagrangian {

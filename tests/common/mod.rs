@@ -142,6 +142,7 @@ pub fn scenario(
         bodies: Vec::new(),
         solids: None,
         inlets: Vec::new(),
+        outlets: Vec::new(),
         domain,
         particles,
         probes,

@@ -10,6 +10,7 @@ mod cases;
 mod contact;
 mod gate;
 mod lobovsky;
+mod overfall;
 mod plate;
 mod sloshing;
 mod submerged;

@@ -96,10 +96,69 @@ fn inlet_errors_name_the_field_and_the_fix() {
         None,
         &["inlet[1].name", "also the name of inlet[0]"],
     );
+    // The whole inflow's particles are made at the start: a long one is refused by the budget.
+    assert_err(
+        INJECTION,
+        &["time.end_s=1e6", "inlet[0].stop_s=1e6"],
+        None,
+        &[
+            "particles.dx_m",
+            "in inlet[0]",
+            "inlet[0].stop_s, else time.end_s",
+        ],
+    );
     assert_err(
         INJECTION,
         &["inlet[0].stop_s=-1"],
         None,
         &["inlet[0].stop_s", "> 0"],
+    );
+}
+
+const OVERFALL: &str = include_str!("../../../cases/free_overfall_2d.toml");
+
+#[test]
+fn the_overfall_has_a_critical_inlet_and_a_sump() {
+    let s = load_str(OVERFALL, "cases/free_overfall_2d.toml", &[]).unwrap();
+    // No fluid block: the inlet alone brings the water (10 columns, 0.04 m at dx = 4 mm).
+    assert_eq!(s.count(Kind::Fluid), 0);
+    let inlet = &s.inlets[0];
+    assert_eq!(inlet.columns.len(), 10);
+    assert!((inlet.columns[0][0] - 0.032).abs() < 1e-12);
+    // 0.6264 m/s for 2 s is 313 layers (8 of them the buffer).
+    assert_eq!(inlet.particles.len(), 10 * 313);
+    assert!((inlet.thickness - 0.032).abs() < 1e-12);
+    assert_eq!(s.outlets.len(), 1);
+    assert_eq!(s.outlets[0].name, "sump");
+    assert!(s.outlets[0].contains([0.6, -0.2, 0.0], 2));
+    assert!(!s.outlets[0].contains([0.6, -0.05, 0.0], 2));
+}
+
+#[test]
+fn outlet_errors_name_the_field_and_the_fix() {
+    assert_err(
+        OVERFALL,
+        &["outlet[0].min_m=[1.0, -0.4]", "outlet[0].max_m=[1.2, -0.1]"],
+        None,
+        &["outlet[0]", "outside the domain", "no fluid could reach it"],
+    );
+    assert_err(
+        OVERFALL,
+        &["outlet[0].min_m=[0.0, 0.0]", "outlet[0].max_m=[0.9, 0.1]"],
+        None,
+        &["outlet[0]", "overlaps inlet[0]"],
+    );
+    let drain = format!(
+        "{INJECTION}\n[[outlet]]\nname = \"drain\"\nmin_m = [0.1, 0.0]\nmax_m = [0.2, 0.05]\n"
+    );
+    assert_err(&drain, &[], None, &["outlet[0]", "overlaps fluid_block[0]"]);
+    let twice = format!(
+        "{OVERFALL}\n[[outlet]]\nname = \"sump\"\nmin_m = [0.5, -0.4]\nmax_m = [0.6, -0.3]\n"
+    );
+    assert_err(
+        &twice,
+        &[],
+        None,
+        &["outlet[1].name", "also the name of outlet[0]"],
     );
 }

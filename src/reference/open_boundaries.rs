@@ -1,4 +1,4 @@
-//! f64 reference of shaders/inlet.wgsl: where a velocity inlet puts its particles.
+//! f64 reference of shaders/open_boundaries.wgsl: where a velocity inlet puts its particles.
 
 use super::{EXCLUDED, FLUID, INLET};
 use crate::scenario::Inlet;

@@ -1,7 +1,9 @@
-// Velocity inlets (`[[inlet]]`, docs/cases.md "Inlets"): the buffer particles' place, velocity
-// and kind at the time the predictor has just moved to, t + dt. Runs after the predictor and
-// before the cell-list sort, on the arrays the predictor wrote.
+// Open boundaries, after the predictor and before the cell-list sort, on the arrays the
+// predictor wrote: velocity inlets place their particles (`inlet_flow`), outlets remove the
+// fluid that entered them (`outlet_drain`).
 //
+// Inlets (`[[inlet]]`, docs/cases.md "Inlets"): the buffer particles' place, velocity and kind
+// at the time the predictor has just moved to, t + dt.
 // An inlet is a lattice of columns on its plane and layers behind it, laid out layer-major:
 // particle k = id − first_id is column k mod n_columns of layer k / n_columns, at the signed
 // distance s(t) = −(layer + ½) spacing + speed t from the plane along its normal. By s:
@@ -31,10 +33,19 @@ struct InletDef {
 @group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> code: array<u32>;
+// An outlet's box, in domain coordinates (2D: z from −1 to 1).
+struct OutletDef {
+    min: vec3<f32>,
+    pad0: u32,
+    max: vec3<f32>,
+    pad1: u32,
+}
+
 @group(0) @binding(4) var<storage, read_write> state: SimState;
 @group(0) @binding(5) var<storage, read> inlets: array<InletDef>;
 // Each column's point on its inlet's plane.
 @group(0) @binding(6) var<storage, read> inlet_columns: array<Pos>;
+@group(0) @binding(7) var<storage, read> outlets: array<OutletDef>;
 
 // Signed distance of inlet particle k (of `inlet`) from the plane at time t.
 fn inlet_distance(inlet: InletDef, k: u32, t: f32) -> f32 {
@@ -72,4 +83,23 @@ fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     pos[i] = move_by(column, s * inlet.normal).pos;
     velrho[i] = vec4<f32>(inlet.speed * inlet.normal, params.rho0);
     code[i] = with_kind(c, select(KIND_INLET, KIND_FLUID, s >= 0.0));
+}
+
+// Outlets (`[[outlet]]`, docs/cases.md "Outlets"): a fluid particle inside an outlet's box is
+// excluded and counted as drained, apart from the particles that escape the domain.
+@compute @workgroup_size(WG)
+fn outlet_drain(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles || code_kind(code[i]) != KIND_FLUID) {
+        return;
+    }
+    let x = domain_pos(pos[i]);
+    for (var k = 0u; k < params.n_outlets; k++) {
+        let o = outlets[k];
+        if (all(x >= o.min) && all(x <= o.max)) {
+            code[i] = with_kind(code[i], KIND_EXCLUDED);
+            atomicAdd(&state.drained, 1u);
+            return;
+        }
+    }
 }

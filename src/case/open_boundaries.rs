@@ -1,15 +1,16 @@
-//! `[[inlet]]`: velocity inlets (docs/cases.md, "Inlets"). A box on the fluid's lattice is the
-//! buffer; the face its `direction` points at is the inlet plane. The particles are built
-//! layer after layer from the plane backwards, as many layers as the inflow takes until
-//! `stop_s` (at least the buffer's), so the GPU finds a particle's layer and column from its id
-//! (shaders/inlet.wgsl).
+//! `[[inlet]]` and `[[outlet]]`: velocity inlets and outlets (docs/cases.md, "Inlets",
+//! "Outlets"). An inlet's box on the fluid's lattice is its buffer; the face its `direction`
+//! points at is the inlet plane. Its particles are built layer after layer from the plane
+//! backwards, as many layers as the inflow takes until `stop_s` (at least the buffer's), so the
+//! GPU finds a particle's layer and column from its id (shaders/open_boundaries.wgsl). An
+//! outlet is a box that removes the fluid entering it.
 
 use super::error::{num, CaseError};
 use super::lattice::{range_points, Lattice};
 use super::locate::Ctx;
-use super::schema::RawInlet;
+use super::schema::{RawInlet, RawOutlet};
 use super::validate::{aabb, number, vector, Aabb, Bound};
-use crate::scenario::{Inlet, Kind, Particle};
+use crate::scenario::{Inlet, Kind, Outlet, Particle};
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
@@ -236,4 +237,31 @@ pub(super) fn build(
         });
     }
     inlet
+}
+
+/// `[[outlet]]` tables: unique names, boxes with min < max.
+pub(super) fn validate_outlets(
+    ctx: &Ctx<'_>,
+    raw: &[RawOutlet],
+    dim: usize,
+) -> Result<Vec<Outlet>, CaseError> {
+    let mut out: Vec<Outlet> = Vec::with_capacity(raw.len());
+    for (i, r) in raw.iter().enumerate() {
+        let path = format!("outlet[{i}]");
+        if let Some(j) = out.iter().position(|o| o.name == r.name) {
+            return Err(ctx.err(
+                &format!("{path}.name"),
+                Some(format!("{:?}", r.name)),
+                format!("is also the name of outlet[{j}]"),
+                "give every outlet its own name",
+            ));
+        }
+        let bx = aabb(ctx, &path, &r.min_m, &r.max_m, dim, "the outlet's box")?;
+        out.push(Outlet {
+            name: r.name.clone(),
+            min: bx.min,
+            max: bx.max,
+        });
+    }
+    Ok(out)
 }

@@ -1,0 +1,131 @@
+//! Open boundaries (shaders/open_boundaries.wgsl), after the predictor: velocity inlets place
+//! every inlet particle (its place, velocity and kind at the time the step moves to), outlets
+//! remove the fluid that entered them. The tables (one entry per inlet, one per column of an
+//! inlet's plane, one per outlet) are uploaded once; an inlet particle's layer and column
+//! follow from its id, so inlets add no per-particle memory.
+
+use anyhow::{ensure, Result};
+
+use super::buffers::ParticleBuffers;
+use super::grid::Grid;
+use crate::gpu::buffers::storage_init;
+use crate::gpu::kernel::{ParityKernel, ShaderModule};
+use crate::layout::{pack_block, InletDef, OutletDef, Pos};
+use crate::scenario::Scenario;
+
+pub struct OpenBoundaries {
+    inlet_flow: Option<ParityKernel>,
+    outlet_drain: Option<ParityKernel>,
+    n: u32,
+}
+
+/// The GPU tables of the scenario's inlets: their definitions and their columns' points (as
+/// positions in the grid's blocks).
+pub fn inlet_tables(sc: &Scenario, grid: &Grid) -> (Vec<InletDef>, Vec<Pos>) {
+    let mut defs = Vec::with_capacity(sc.inlets.len());
+    let mut columns = Vec::new();
+    for inlet in &sc.inlets {
+        defs.push(InletDef {
+            normal: inlet.normal.map(|c| c as f32),
+            speed: inlet.speed as f32,
+            thickness: inlet.thickness as f32,
+            spacing: inlet.spacing as f32,
+            first_id: inlet.particles.start as u32,
+            n_columns: inlet.columns.len() as u32,
+            first_column: columns.len() as u32,
+            n_particles: inlet.particles.len() as u32,
+            pad: [0; 2],
+        });
+        columns.extend(inlet.columns.iter().map(|&c| {
+            let (off, b) = grid.to_block(c);
+            Pos {
+                off,
+                block: pack_block(b),
+            }
+        }));
+    }
+    (defs, columns)
+}
+
+/// The outlets' boxes in domain coordinates (from the grid's origin); in 2D z spans [−1, 1].
+pub fn outlet_table(sc: &Scenario, grid: &Grid) -> Vec<OutletDef> {
+    let dim = sc.physics.dim as usize;
+    sc.outlets
+        .iter()
+        .map(|o| {
+            let rel = |x: [f64; 3], z: f32| {
+                [0, 1, 2].map(|a| {
+                    if a < dim {
+                        (x[a] - grid.origin[a]) as f32
+                    } else {
+                        z
+                    }
+                })
+            };
+            OutletDef {
+                min: rel(o.min, -1.0),
+                pad0: 0,
+                max: rel(o.max, 1.0),
+                pad1: 0,
+            }
+        })
+        .collect()
+}
+
+impl OpenBoundaries {
+    pub fn new(
+        device: &wgpu::Device,
+        module: &ShaderModule,
+        b: &ParticleBuffers,
+        sc: &Scenario,
+        grid: &Grid,
+    ) -> Result<Self> {
+        ensure!(
+            !sc.inlets.is_empty() || !sc.outlets.is_empty(),
+            "the case has no inlets or outlets"
+        );
+        let (mut defs, mut columns) = inlet_tables(sc, grid);
+        let mut outlets = outlet_table(sc, grid);
+        // A binding cannot be empty.
+        if defs.is_empty() {
+            defs.push(InletDef::default());
+            columns.push(Pos::default());
+        }
+        if outlets.is_empty() {
+            outlets.push(OutletDef::default());
+        }
+        let defs = storage_init(device, "inlets", &defs);
+        let columns = storage_init(device, "inlet columns", &columns);
+        let outlets = storage_init(device, "outlets", &outlets);
+        let bufs = |p: usize| {
+            vec![
+                (0, &b.params),
+                (1, &b.pos[p]),
+                (2, &b.velrho[p]),
+                (3, &b.code[p]),
+                (4, &b.state),
+                (5, &defs),
+                (6, &columns),
+                (7, &outlets),
+            ]
+        };
+        let kernel = |entry: &str| ParityKernel::new(device, module, entry, bufs);
+        Ok(Self {
+            inlet_flow: (!sc.inlets.is_empty())
+                .then(|| kernel("inlet_flow"))
+                .transpose()?,
+            outlet_drain: (!sc.outlets.is_empty())
+                .then(|| kernel("outlet_drain"))
+                .transpose()?,
+            n: b.n,
+        })
+    }
+
+    /// Places the inlet particles, then drains the outlets, on the arrays of parity `p` (after
+    /// the predictor).
+    pub fn encode(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        for k in [&self.inlet_flow, &self.outlet_drain].into_iter().flatten() {
+            k.dispatch(pass, p, self.n);
+        }
+    }
+}
