@@ -115,8 +115,8 @@ impl Fnv {
 }
 
 /// A hash of what a run's state depends on: the particles as built (positions, velocities,
-/// densities, kinds), the physics, walls, domain, probes and bodies. Time control is left
-/// out, so a resumed run may be given a later end time.
+/// densities, kinds), the physics, walls, domain, probes, bodies, inlets and outlets. Time
+/// control is left out, so a resumed run may be given a later end time.
 pub fn fingerprint(sc: &Scenario) -> u64 {
     let mut h = Fnv::default();
     let settings = format!(
@@ -127,6 +127,9 @@ pub fn fingerprint(sc: &Scenario) -> u64 {
     // Only when there are any, so checkpoints written before points existed still match.
     if !sc.points.is_empty() {
         h.update(format!("|{:?}", sc.points).as_bytes());
+    }
+    if !sc.inlets.is_empty() || !sc.outlets.is_empty() {
+        h.update(format!("|{:?}|{:?}", sc.inlets, sc.outlets).as_bytes());
     }
     for p in &sc.particles {
         for x in p.pos.iter().chain(&p.vel).chain([&p.rho]) {
@@ -404,6 +407,17 @@ mod tests {
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
         d.join(CHECKPOINT_FILE)
+    }
+
+    /// Moving an outlet changes no particle, but a run resumed with it would differ.
+    #[test]
+    fn the_fingerprint_sees_outlets() {
+        let text = include_str!("../cases/free_overfall_2d.toml");
+        let a = crate::case::load_str(text, "x.toml", &[]).unwrap();
+        let moved = ["outlet[0].min_m=[0.45, -0.4]".to_string()];
+        let b = crate::case::load_str(text, "x.toml", &moved).unwrap();
+        assert_eq!(a.particles, b.particles);
+        assert_ne!(fingerprint(&a), fingerprint(&b));
     }
 
     #[test]
