@@ -9,8 +9,9 @@
 // distance s(t) = −(layer + ½) spacing + speed t from the plane along its normal. By s:
 //   s < −thickness  dormant: excluded, in no cell (the excluded slot), waiting;
 //   −thickness ≤ s < 0  buffer (KIND_INLET): at its place, velocity speed n, density ρ0 (zero
-//     pressure), seen by the fluid as a neighbour (interaction.wgsl, as a dynamic boundary
-//     particle), getting no rates;
+//     pressure) or, for an open channel's inflow, the Tait density of the hydrostatic pressure
+//     below the buffer's top; seen by the fluid as a neighbour (interaction.wgsl, as a dynamic
+//     boundary particle), getting no rates;
 //   s ≥ 0  fluid, from then on integrated as any fluid particle.
 // s is a function of time alone, so nothing accumulates and a restart is exact. The rule is
 // stateless: a dormant particle joins when s is in the buffer's range (one step moves a
@@ -28,6 +29,8 @@ struct InletDef {
     n_particles: u32,
     pad0: u32,
     pad1: u32,
+    surface: vec3<f32>,         // the buffer's highest point (domain coordinates)
+    hydrostatic: u32,           // 1: density from ρ0 g·(x − surface) below it; 0: ρ0
 }
 
 @group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
@@ -80,8 +83,14 @@ fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         atomicAdd(&state.inlet_joined, 1u);
     }
     let column = inlet_columns[inlet.first_column + k % inlet.n_columns];
-    pos[i] = move_by(column, s * inlet.normal).pos;
-    velrho[i] = vec4<f32>(inlet.speed * inlet.normal, params.rho0);
+    let placed = move_by(column, s * inlet.normal).pos;
+    var rho = params.rho0;
+    if (inlet.hydrostatic == 1u) {
+        let p = params.rho0 * max(dot(params.gravity, domain_pos(placed) - inlet.surface), 0.0);
+        rho = params.rho0 * pow(1.0 + p / params.tait_b, 1.0 / params.gamma);
+    }
+    pos[i] = placed;
+    velrho[i] = vec4<f32>(inlet.speed * inlet.normal, rho);
     code[i] = with_kind(c, select(KIND_INLET, KIND_FLUID, s >= 0.0));
 }
 

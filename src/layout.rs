@@ -190,6 +190,9 @@ pub struct InletDef {
     pub first_column: u32,
     pub n_particles: u32,
     pub pad: [u32; 2],
+    /// The buffer's highest point in domain coordinates, read when `hydrostatic` is 1.
+    pub surface: [f32; 3],
+    pub hydrostatic: u32,
 }
 
 /// Mirrors `OutletDef` in shaders/open_boundaries.wgsl: an outlet's box in domain coordinates
@@ -399,7 +402,9 @@ mod tests {
                 first_id,
                 n_columns,
                 first_column,
-                n_particles
+                n_particles,
+                surface,
+                hydrostatic
             ]
         );
     }

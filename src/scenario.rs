@@ -432,6 +432,10 @@ pub struct Inlet {
     /// Its particles, layer after layer (column order within a layer): `particles[range]` of
     /// the scenario (ids are indices).
     pub particles: std::ops::Range<usize>,
+    /// `pressure = "hydrostatic"`: the highest point of the buffer, whose density then follows
+    /// the hydrostatic pressure ρ0 g·(x − surface) below it (an open channel's inflow); `None`:
+    /// zero pressure, ρ0 (a free jet).
+    pub surface: Option<[f64; 3]>,
 }
 
 impl Inlet {
@@ -440,6 +444,19 @@ impl Inlet {
     pub fn distance(&self, k: usize, t: f64) -> f64 {
         let layer = (k / self.columns.len()) as f64;
         -(layer + 0.5) * self.spacing + self.speed * t
+    }
+
+    /// The density of a buffer particle at `x`: ρ0, or the Tait density of the hydrostatic
+    /// pressure below the surface.
+    pub fn density(&self, x: [f64; 3], ph: &Physics) -> f64 {
+        match self.surface {
+            None => ph.rho0,
+            Some(s) => {
+                let head: f64 = (0..3).map(|a| ph.gravity[a] * (x[a] - s[a])).sum();
+                let p = ph.rho0 * head.max(0.0);
+                ph.rho0 * (1.0 + p / ph.tait_b()).powf(1.0 / ph.gamma)
+            }
+        }
     }
 
     /// Whether particle `k` waits behind the buffer at t = 0.

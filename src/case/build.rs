@@ -408,7 +408,9 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         .inlets
         .iter()
         .zip(inlet_layouts)
-        .map(|(s, l)| super::open_boundaries::build(s, l, &lat, case.rho0, &mut particles))
+        .map(|(s, l)| {
+            super::open_boundaries::build(s, l, &lat, case.gravity, &rho_at, &mut particles)
+        })
         .collect();
 
     // Walls: tank, then obstacles (each lattice point once).

@@ -8,7 +8,7 @@
 use super::error::{num, CaseError};
 use super::lattice::{range_points, Lattice};
 use super::locate::Ctx;
-use super::schema::{RawInlet, RawOutlet};
+use super::schema::{InletPressureName, RawInlet, RawOutlet};
 use super::validate::{aabb, number, vector, Aabb, Bound};
 use crate::scenario::{Inlet, Kind, Outlet, Particle};
 
@@ -24,6 +24,8 @@ pub(super) struct InletSpec {
     pub sense: f64,
     pub speed: f64,
     pub stop_s: f64,
+    /// `pressure = "hydrostatic"`.
+    pub hydrostatic: bool,
 }
 
 pub(super) fn validate(
@@ -100,6 +102,7 @@ pub(super) fn validate(
             sense: d[axis],
             speed,
             stop_s,
+            hydrostatic: r.pressure == Some(InletPressureName::Hydrostatic),
         });
     }
     Ok(out)
@@ -200,11 +203,13 @@ pub(super) fn layout(
 /// The inlet's particles (buffer layers at their places, the waiting ones stacked at the
 /// buffer's back, where the GPU keeps them excluded), appended to `particles`, and the
 /// scenario's inlet.
+/// `rho_at(depth)` is the hydrostatic start density `depth` below a free surface.
 pub(super) fn build(
     spec: &InletSpec,
     layout: Layout,
     lat: &Lattice,
-    rho0: f64,
+    gravity: [f64; 3],
+    rho_at: &dyn Fn(f64) -> f64,
     particles: &mut Vec<Particle>,
 ) -> Inlet {
     let dx = lat.dx;
@@ -221,6 +226,21 @@ pub(super) fn build(
         spacing: dx,
         columns,
         particles: start..start + n,
+        // The box's corner farthest up against gravity.
+        surface: spec.hydrostatic.then(|| {
+            [0, 1, 2].map(|a| {
+                if gravity[a] < 0.0 {
+                    spec.bx.max[a]
+                } else {
+                    spec.bx.min[a]
+                }
+            })
+        }),
+    };
+    let g = gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let depth = |x: [f64; 3]| match inlet.surface {
+        Some(s) if g > 0.0 => (0..3).map(|a| gravity[a] * (x[a] - s[a])).sum::<f64>() / g,
+        _ => 0.0,
     };
     for k in 0..n {
         let t0 = if inlet.dormant(k) {
@@ -229,10 +249,11 @@ pub(super) fn build(
         } else {
             0.0
         };
+        let pos = inlet.position(k, t0);
         particles.push(Particle {
-            pos: inlet.position(k, t0),
+            pos,
             vel: normal.map(|c| c * spec.speed),
-            rho: rho0,
+            rho: rho_at(depth(pos)),
             kind: Kind::Inlet,
         });
     }

@@ -51,6 +51,15 @@ pub(super) struct RawInlet {
     pub direction: Vec<f64>,
     pub velocity_m_s: f64,
     pub stop_s: Option<f64>,
+    pub pressure: Option<InletPressureName>,
+}
+
+/// The pressure of an inlet's buffer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum InletPressureName {
+    Zero,
+    Hydrostatic,
 }
 
 /// An elastic body: `[[solid]]` (`docs/cases.md`, "Elastic solids").
@@ -547,6 +556,11 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "inlet[].velocity_m_s",
         "the inflow speed in m/s, along direction",
         "velocity_m_s = 1.0",
+    ),
+    f(
+        "inlet[].pressure",
+        "the buffer's pressure: zero (a free jet) or hydrostatic below the box's top (an open channel's inflow)",
+        "pressure = \"hydrostatic\"",
     ),
     f(
         "inlet[].stop_s",

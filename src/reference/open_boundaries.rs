@@ -1,7 +1,7 @@
 //! f64 reference of shaders/open_boundaries.wgsl: where a velocity inlet puts its particles.
 
 use super::{EXCLUDED, FLUID, INLET};
-use crate::scenario::Inlet;
+use crate::scenario::{Inlet, Physics};
 
 /// An inlet particle as the inlet pass leaves it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,17 +17,18 @@ pub struct Placed {
 /// What the pass makes at time `t` of particle `k` of `inlet`, whose kind is `kind`: `None`
 /// where it leaves the particle alone (fluid already, or excluded and not due: still dormant,
 /// or past the plane, i.e. fluid that left the domain).
-pub fn place(inlet: &Inlet, k: usize, kind: u32, t: f64, rho0: f64) -> Option<Placed> {
+pub fn place(inlet: &Inlet, k: usize, kind: u32, t: f64, ph: &Physics) -> Option<Placed> {
     let s = inlet.distance(k, t);
     let joined = match kind {
         INLET => false,
         EXCLUDED if (-inlet.thickness..0.0).contains(&s) => true,
         _ => return None,
     };
+    let pos = inlet.position(k, t);
     Some(Placed {
-        pos: inlet.position(k, t),
+        pos,
         vel: inlet.normal.map(|n| inlet.speed * n),
-        rho: rho0,
+        rho: inlet.density(pos, ph),
         kind: if s >= 0.0 { FLUID } else { INLET },
         joined,
     })
@@ -46,29 +47,57 @@ mod tests {
             spacing: 0.01,
             columns: vec![[0.1, 0.2, 0.0], [0.1, 0.21, 0.0]],
             particles: 10..30,
+            surface: None,
         }
+    }
+
+    fn physics() -> Physics {
+        let text = include_str!("../../cases/water_injection_2d.toml");
+        crate::case::load_str(text, "x.toml", &[]).unwrap().physics
     }
 
     #[test]
     fn layers_join_the_buffer_as_the_front_layer_leaves_it() {
         let inlet = inlet();
+        let ph = &physics();
         // Layers 0..3 are the buffer at t = 0; layer 4 (particles 8, 9) waits.
         assert!((0..8).all(|k| !inlet.dormant(k)));
         assert!((8..20).all(|k| inlet.dormant(k)));
         // At t = 0.003 s every particle has moved 6 mm: layer 0 (s = 1 mm) is fluid, layer 4
         // (s = −39 mm) has joined.
         let t = 0.003;
-        let first = place(&inlet, 1, INLET, t, 1000.0).unwrap();
+        let first = place(&inlet, 1, INLET, t, ph).unwrap();
         assert_eq!(first.kind, FLUID);
         assert!((first.pos[0] - 0.101).abs() < 1e-12 && (first.pos[1] - 0.21).abs() < 1e-12);
         assert_eq!(first.vel, [2.0, 0.0, 0.0]);
-        let joined = place(&inlet, 8, EXCLUDED, t, 1000.0).unwrap();
+        let joined = place(&inlet, 8, EXCLUDED, t, ph).unwrap();
         assert!(joined.joined && joined.kind == INLET);
         assert!((joined.pos[0] - (0.1 - 0.039)).abs() < 1e-12);
         // Layer 5 still waits; a fluid particle is left alone, and so is an excluded one past
         // the plane (it was fluid and left the domain).
-        assert_eq!(place(&inlet, 10, EXCLUDED, t, 1000.0), None);
-        assert_eq!(place(&inlet, 3, FLUID, t, 1000.0), None);
-        assert_eq!(place(&inlet, 0, EXCLUDED, t, 1000.0), None);
+        assert_eq!(place(&inlet, 10, EXCLUDED, t, ph), None);
+        assert_eq!(place(&inlet, 3, FLUID, t, ph), None);
+        assert_eq!(place(&inlet, 0, EXCLUDED, t, ph), None);
+        assert_eq!(first.rho, ph.rho0);
+    }
+
+    /// An open channel's inflow: the buffer's density follows the hydrostatic pressure below
+    /// its top (ρ0 above it).
+    #[test]
+    fn a_hydrostatic_buffer_carries_the_weight_of_the_water_above() {
+        let ph = &physics();
+        let inlet = Inlet {
+            surface: Some([0.1, 0.215, 0.0]),
+            ..inlet()
+        };
+        let p = place(&inlet, 0, INLET, 0.0, ph).unwrap();
+        let expected = ph.rho0 * (1.0 + ph.rho0 * 9.81 * 0.015 / ph.tait_b()).powf(1.0 / ph.gamma);
+        assert!(
+            (p.rho - expected).abs() < 1e-9 * expected,
+            "{} {expected}",
+            p.rho
+        );
+        assert!(p.rho > ph.rho0);
+        assert_eq!(inlet.density([0.0, 0.3, 0.0], ph), ph.rho0);
     }
 }

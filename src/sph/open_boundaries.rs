@@ -35,6 +35,10 @@ pub fn inlet_tables(sc: &Scenario, grid: &Grid) -> (Vec<InletDef>, Vec<Pos>) {
             first_column: columns.len() as u32,
             n_particles: inlet.particles.len() as u32,
             pad: [0; 2],
+            surface: inlet.surface.map_or([0.0; 3], |s| {
+                [0, 1, 2].map(|a| (s[a] - grid.origin[a]) as f32)
+            }),
+            hydrostatic: inlet.surface.is_some() as u32,
         });
         columns.extend(inlet.columns.iter().map(|&c| {
             let (off, b) = grid.to_block(c);
