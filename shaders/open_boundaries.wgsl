@@ -26,9 +26,9 @@ struct InletDef {
     first_id: u32,              // its first particle's id
     n_columns: u32,
     first_column: u32,          // its first entry in `inlet_columns`
-    n_particles: u32,
     pad0: u32,
     pad1: u32,
+    pad2: u32,
     surface: vec3<f32>,         // the buffer's highest point (domain coordinates)
     hydrostatic: u32,           // 1: density from ρ0 g·(x − surface) below it; 0: ρ0
 }

@@ -176,8 +176,8 @@ pub fn unpack_block(b: u32) -> [u32; 3] {
     [b & 0x7FF, (b >> 11) & 0x7FF, b >> 22]
 }
 
-/// Mirrors `InletDef` in shaders/open_boundaries.wgsl: an inlet's plane normal, speed, buffer depth,
-/// layer spacing, and where its particles and columns start.
+/// Mirrors `InletDef` in shaders/open_boundaries.wgsl: an inlet's plane normal, speed, buffer
+/// depth, layer spacing, where its particles and columns start, and its buffer's top.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct InletDef {
@@ -188,8 +188,7 @@ pub struct InletDef {
     pub first_id: u32,
     pub n_columns: u32,
     pub first_column: u32,
-    pub n_particles: u32,
-    pub pad: [u32; 2],
+    pub pad: [u32; 3],
     /// The buffer's highest point in domain coordinates, read when `hydrostatic` is 1.
     pub surface: [f32; 3],
     pub hydrostatic: u32,
@@ -402,7 +401,6 @@ mod tests {
                 first_id,
                 n_columns,
                 first_column,
-                n_particles,
                 surface,
                 hydrostatic
             ]

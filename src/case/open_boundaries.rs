@@ -80,7 +80,7 @@ pub(super) fn validate(
             r.velocity_m_s,
             Bound::Positive,
             "the inflow speed in m/s along direction",
-            "give a positive speed; to let fluid out, point direction the other way",
+            "give a positive speed (fluid leaves through [[outlet]] boxes, not inlets)",
         )?;
         // Particles are made for the inflow within the run only (a later stop is the end).
         let stop_s = match r.stop_s {

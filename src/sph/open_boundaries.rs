@@ -33,8 +33,7 @@ pub fn inlet_tables(sc: &Scenario, grid: &Grid) -> (Vec<InletDef>, Vec<Pos>) {
             first_id: inlet.particles.start as u32,
             n_columns: inlet.columns.len() as u32,
             first_column: columns.len() as u32,
-            n_particles: inlet.particles.len() as u32,
-            pad: [0; 2],
+            pad: [0; 3],
             surface: inlet.surface.map_or([0.0; 3], |s| {
                 [0, 1, 2].map(|a| (s[a] - grid.origin[a]) as f32)
             }),
