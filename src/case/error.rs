@@ -95,9 +95,15 @@ impl From<Diagnostic> for CaseError {
     }
 }
 
-/// A number as a message writes it: as Rust displays it, but in exponent form when very large
-/// or small (`1e300`, not three hundred digits).
+/// A number as a message writes it: to 12 significant digits, so that a computed length reads
+/// `0.15` and not `0.15000000000000002`, and in exponent form when very large or small (`1e300`,
+/// not three hundred digits).
 pub(super) fn num(v: f64) -> String {
+    let v = if v.is_finite() {
+        format!("{v:.11e}").parse().unwrap_or(v)
+    } else {
+        v
+    };
     if v != 0.0 && v.is_finite() && !(1e-6..1e16).contains(&v.abs()) {
         format!("{v:e}")
     } else {

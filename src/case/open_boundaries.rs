@@ -151,7 +151,8 @@ pub(super) fn layout(
                 "the buffer box is too thin to hold one particle on the lattice (dx = {} m)",
                 num(dx)
             ),
-            "make it at least dx wide across the flow and 2h deep along it",
+            "make it at least dx wide across the flow and 2h deep along it, or make \
+             particles.dx_m finer",
         ));
     };
     let depth = hi[a] - lo[a] + 1.0;
@@ -167,7 +168,8 @@ pub(super) fn layout(
                 num(2.0 * h)
             ),
             format!(
-                "make the box at least {} m deep along {}",
+                "make the box at least {} m deep along {}, or make particles.dx_m finer or \
+                 particles.h_over_dx smaller, so that 2h fits within it",
                 num((2.0 * h / dx).ceil() * dx),
                 AXES[a]
             ),
