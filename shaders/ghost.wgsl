@@ -13,10 +13,8 @@
 // a_c + α × R r + ω × (ω × R r), so fluid accelerated with the body is carried correctly too).
 // Free-slip ghosts use the interpolated velocity itself in the viscous terms (no tangential
 // shear from the wall).
-// Only fluid particles count (the interpolation domain of the fixed-wall, rigid-body and
-// elastic-body ghosts alike).
-// Fallbacks: MLS → Shepard where the moment matrix is ill-conditioned; no fluid in reach →
-// P_g = 0 and an interpolated velocity of 0.
+// The interpolation itself (`fluid_at`, with its fallbacks) is lib/fluid_at.wgsl, shared with
+// the inlets' extrapolated buffer pressure (open_boundaries.wgsl).
 // ρ_g follows from P_g by the inverse Tait equation, so the interaction pass sees P_g.
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
@@ -25,58 +23,6 @@
 @group(0) @binding(4) var<storage, read> cell_start: array<u32>;
 @group(0) @binding(6) var<storage, read> body_particles: array<BodyParticle>;
 @group(0) @binding(7) var<storage, read> bodies: array<BodyMotion>;
-
-// ρ from P by the inverse Tait equation; the base is kept positive for any pressure.
-fn density_of(p: f32) -> f32 {
-    return params.rho0 * pow(max(1.0 + p / params.tait_b, 0.5), 1.0 / params.gamma);
-}
-
-// The fluid's velocity and pressure interpolated at `pg` with W^I (see the header), each fluid
-// pressure carried to `pg` along `g_eff` = g − a_w: (v, P).
-fn fluid_at(pg: Pos, g_eff: vec3<f32>) -> vec4<f32> {
-    let support2 = 4.0 * params.h * params.h;
-    // Moments Σ f_j W V [1, x_gj] of f = 1 (the MLS matrix), P and v.
-    var a = mls_zero();
-    var m_p = vec4<f32>(0.0);
-    var m_vx = vec4<f32>(0.0);
-    var m_vy = vec4<f32>(0.0);
-    var m_vz = vec4<f32>(0.0);
-    var slots: array<u32, 27>;
-    let n_slots = neighbour_slots(cell_of(pg), &slots);
-    for (var s = 0u; s < n_slots; s++) {
-        for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
-            if (code_kind(code[j]) != KIND_FLUID) {
-                continue;
-            }
-            let x_gj = rel_pos(pg, pos[j]);
-            let r2 = dot(x_gj, x_gj);
-            if (r2 >= support2) {
-                continue;
-            }
-            let vr = velrho[j];
-            let wv = kernel_w(sqrt(r2) / params.h) * params.mass / vr.w;
-            let basis = mls_basis(x_gj);
-            a = mls_add(a, x_gj, wv);
-            m_p += (pressure_of(vr.w) + vr.w * dot(g_eff, x_gj)) * wv * basis;
-            m_vx += vr.x * wv * basis;
-            m_vy += vr.y * wv * basis;
-            m_vz += vr.z * wv * basis;
-        }
-    }
-    let volume = a[0][0];
-    if (volume <= 1e-6) {
-        return vec4<f32>(0.0);
-    }
-    // Shepard: the zeroth moments over Σ W V.
-    var beta = vec4<f32>(1.0 / volume, 0.0, 0.0, 0.0);
-    if (params.ghost_mls != 0u) {
-        let sol = mls_solve(a);
-        if (sol.ok) {
-            beta = sol.beta;
-        }
-    }
-    return vec4<f32>(dot(beta, m_vx), dot(beta, m_vy), dot(beta, m_vz), dot(beta, m_p));
-}
 
 @compute @workgroup_size(WG)
 fn ghost_interpolate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {

@@ -10,8 +10,9 @@
 //   s < −thickness  dormant: excluded, in no cell (the excluded slot), waiting;
 //   −thickness ≤ s < 0  buffer (KIND_INLET): at its place, velocity speed n, density ρ0 (zero
 //     pressure) or, for an open channel's inflow, the Tait density of the hydrostatic pressure
-//     below the buffer's top; seen by the fluid as a neighbour (interaction.wgsl, as a dynamic
-//     boundary particle), getting no rates;
+//     below the buffer's top, or, extrapolated, the fluid's pressure at its mirror image
+//     (`inlet_pressure`, after the sort); seen by the fluid as a neighbour (interaction.wgsl,
+//     as a dynamic boundary particle), getting no rates;
 //   s ≥ 0  fluid, from then on integrated as any fluid particle.
 // s is a function of time alone, so nothing accumulates and a restart is exact. The rule is
 // stateless: a dormant particle joins when s is in the buffer's range (one step moves a
@@ -30,8 +31,13 @@ struct InletDef {
     pad1: u32,
     pad2: u32,
     surface: vec3<f32>,         // the buffer's highest point (domain coordinates)
-    hydrostatic: u32,           // 1: density from ρ0 g·(x − surface) below it; 0: ρ0
+    pressure: u32,              // INLET_ZERO, INLET_HYDROSTATIC or INLET_EXTRAPOLATED
 }
+
+// InletDef.pressure: ρ0; the density of ρ0 g·(x − surface) below the surface; the fluid's.
+const INLET_ZERO: u32 = 0u;
+const INLET_HYDROSTATIC: u32 = 1u;
+const INLET_EXTRAPOLATED: u32 = 2u;
 
 @group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
@@ -49,6 +55,16 @@ struct OutletDef {
 // Each column's point on its inlet's plane.
 @group(0) @binding(6) var<storage, read> inlet_columns: array<Pos>;
 @group(0) @binding(7) var<storage, read> outlets: array<OutletDef>;
+@group(0) @binding(8) var<storage, read> cell_start: array<u32>;
+
+// The inlet whose particle `id` is (ids are consecutive per inlet, inlets in id order).
+fn inlet_of(id: u32) -> u32 {
+    var n = 0u;
+    while (n + 1u < params.n_inlets && id >= inlets[n + 1u].first_id) {
+        n++;
+    }
+    return n;
+}
 
 // Signed distance of inlet particle k (of `inlet`) from the plane at time t.
 fn inlet_distance(inlet: InletDef, k: u32, t: f32) -> f32 {
@@ -69,11 +85,7 @@ fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         || (kind != KIND_INLET && kind != KIND_EXCLUDED)) {
         return;
     }
-    var n = 0u;
-    while (n + 1u < params.n_inlets && id >= inlets[n + 1u].first_id) {
-        n++;
-    }
-    let inlet = inlets[n];
+    let inlet = inlets[inlet_of(id)];
     let k = id - inlet.first_id;
     let s = inlet_distance(inlet, k, state.t_base + state.t_rel + state.dt);
     if (kind == KIND_EXCLUDED) {
@@ -85,13 +97,40 @@ fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let column = inlet_columns[inlet.first_column + k % inlet.n_columns];
     let placed = move_by(column, s * inlet.normal).pos;
     var rho = params.rho0;
-    if (inlet.hydrostatic == 1u) {
+    if (inlet.pressure == INLET_HYDROSTATIC) {
         let p = params.rho0 * max(dot(params.gravity, domain_pos(placed) - inlet.surface), 0.0);
         rho = params.rho0 * pow(1.0 + p / params.tait_b, 1.0 / params.gamma);
     }
     pos[i] = placed;
     velrho[i] = vec4<f32>(inlet.speed * inlet.normal, rho);
     code[i] = with_kind(c, select(KIND_INLET, KIND_FLUID, s >= 0.0));
+}
+
+// An extrapolated buffer's pressure (`pressure = "extrapolated"`), on the sorted arrays after
+// the cell-list sort: the fluid's pressure interpolated (lib/fluid_at.wgsl) at the particle's
+// mirror image across the plane, x_m = x_b − 2 s n (s < 0 its signed distance), carried back
+// hydrostatically, P_b = P(x_m) + ρ0 g·(x_b − x_m) = P(x_m) + 2 s ρ0 g·n. The buffer's values
+// come from ghost nodes mirrored into the fluid as in the open boundaries of Tafuni,
+// Domínguez, Vacondio & Crespo (2018, Comput. Methods Appl. Mech. Engrg. 342), here for the
+// pressure only (the velocity stays imposed) and with W^I as the ghosts use it. Not below zero: a buffer
+// particle above the water beside it (the free surface) stays at ρ0 rather than pulling on the
+// fluid. No fluid in reach of x_m (an empty domain at the start): zero pressure.
+@compute @workgroup_size(WG)
+fn inlet_pressure(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles || code_kind(code[i]) != KIND_INLET) {
+        return;
+    }
+    let id = code[i] & ID_MASK;
+    let inlet = inlets[inlet_of(id)];
+    if (inlet.pressure != INLET_EXTRAPOLATED) {
+        return;
+    }
+    let column = inlet_columns[inlet.first_column + (id - inlet.first_id) % inlet.n_columns];
+    let s = dot(rel_pos(pos[i], column), inlet.normal);
+    let mirror = move_by(pos[i], -2.0 * s * inlet.normal).pos;
+    let p = fluid_at(mirror, params.gravity).w + 2.0 * s * params.rho0 * dot(params.gravity, inlet.normal);
+    velrho[i].w = density_of(max(p, 0.0));
 }
 
 // Outlets (`[[outlet]]`, docs/cases.md "Outlets"): a fluid particle inside an outlet's box is

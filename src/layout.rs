@@ -189,10 +189,18 @@ pub struct InletDef {
     pub n_columns: u32,
     pub first_column: u32,
     pub pad: [u32; 3],
-    /// The buffer's highest point in domain coordinates, read when `hydrostatic` is 1.
+    /// The buffer's highest point in domain coordinates, read when `pressure` is
+    /// `INLET_HYDROSTATIC`.
     pub surface: [f32; 3],
-    pub hydrostatic: u32,
+    /// `INLET_ZERO`, `INLET_HYDROSTATIC` or `INLET_EXTRAPOLATED` (the scenario's `InletPressure`).
+    pub pressure: u32,
 }
+
+/// `InletDef::pressure` values, as the constants of the same names in
+/// shaders/open_boundaries.wgsl.
+pub const INLET_ZERO: u32 = 0;
+pub const INLET_HYDROSTATIC: u32 = 1;
+pub const INLET_EXTRAPOLATED: u32 = 2;
 
 /// Mirrors `OutletDef` in shaders/open_boundaries.wgsl: an outlet's box in domain coordinates
 /// (from the grid's origin).
@@ -382,6 +390,31 @@ mod tests {
         );
     }
 
+    /// The value of the u32 constant `name` in the composed `pass`.
+    fn wgsl_u32(pass: Pass, name: &str) -> u32 {
+        let (module, _) = parse(&compose(pass, ShaderConfig::default()), pass.name()).unwrap();
+        let (_, c) = module
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("{name} not in {}", pass.name()));
+        match module.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => v,
+            ref e => panic!("{name} is {e:?}"),
+        }
+    }
+
+    #[test]
+    fn inlet_pressure_modes_match_wgsl() {
+        for (name, v) in [
+            ("INLET_ZERO", INLET_ZERO),
+            ("INLET_HYDROSTATIC", INLET_HYDROSTATIC),
+            ("INLET_EXTRAPOLATED", INLET_EXTRAPOLATED),
+        ] {
+            assert_eq!(wgsl_u32(Pass::OpenBoundaries, name), v, "{name}");
+        }
+    }
+
     #[test]
     fn outlet_def_matches_wgsl() {
         check_layout!(Pass::OpenBoundaries, "OutletDef", OutletDef, [min, max]);
@@ -402,7 +435,7 @@ mod tests {
                 n_columns,
                 first_column,
                 surface,
-                hydrostatic
+                pressure
             ]
         );
     }

@@ -410,7 +410,7 @@ impl Outlet {
 
 /// A velocity inlet (`[[inlet]]`, docs/cases.md "Inlets"): a buffer of particles on the
 /// fluid's lattice, `thickness` deep behind a plane, marching along `normal` at `speed` with
-/// the reference density (zero pressure). A buffer particle that crosses the plane becomes
+/// the pressure `pressure` gives it. A buffer particle that crosses the plane becomes
 /// fluid; behind the buffer wait as many further layers (dormant, in no cell) as the inflow
 /// takes until its stop time, each joining the buffer when it reaches the buffer's back.
 /// A particle's place is a function of time alone (`distance`), so no state is integrated and
@@ -432,10 +432,22 @@ pub struct Inlet {
     /// Its particles, layer after layer (column order within a layer): `particles[range]` of
     /// the scenario (ids are indices).
     pub particles: std::ops::Range<usize>,
-    /// `pressure = "hydrostatic"`: the highest point of the buffer, whose density then follows
-    /// the hydrostatic pressure ρ0 g·(x − surface) below it (an open channel's inflow); `None`:
-    /// zero pressure, ρ0 (a free jet).
-    pub surface: Option<[f64; 3]>,
+    /// The buffer's pressure.
+    pub pressure: InletPressure,
+}
+
+/// The pressure (through the density) of an inlet's buffer particles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum InletPressure {
+    /// Zero, ρ0: a free jet, a nozzle in air.
+    Zero,
+    /// The hydrostatic pressure ρ0 g·(x − surface) below `surface`, the buffer's highest point:
+    /// an open channel's inflow.
+    Hydrostatic { surface: [f64; 3] },
+    /// Taken from the fluid each step: the pressure interpolated at the buffer particle's mirror
+    /// image across the plane, carried back hydrostatically (zero where no fluid is in reach):
+    /// an inflow that meets water piled above it or a submerged one.
+    Extrapolated,
 }
 
 impl Inlet {
@@ -446,12 +458,13 @@ impl Inlet {
         -(layer + 0.5) * self.spacing + self.speed * t
     }
 
-    /// The density of a buffer particle at `x`: ρ0, or the Tait density of the hydrostatic
-    /// pressure below the surface.
+    /// The density the inlet pass gives a buffer particle at `x`: the Tait density of the
+    /// hydrostatic pressure below the surface, or ρ0 (which an extrapolated buffer's pressure
+    /// then replaces, after the sort).
     pub fn density(&self, x: [f64; 3], ph: &Physics) -> f64 {
-        match self.surface {
-            None => ph.rho0,
-            Some(s) => {
+        match self.pressure {
+            InletPressure::Zero | InletPressure::Extrapolated => ph.rho0,
+            InletPressure::Hydrostatic { surface: s } => {
                 let head: f64 = (0..3).map(|a| ph.gravity[a] * (x[a] - s[a])).sum();
                 let p = ph.rho0 * head.max(0.0);
                 ph.rho0 * (1.0 + p / ph.tait_b()).powf(1.0 / ph.gamma)

@@ -10,7 +10,7 @@ use super::lattice::{range_points, Lattice};
 use super::locate::Ctx;
 use super::schema::{InletPressureName, RawInlet, RawOutlet};
 use super::validate::{aabb, number, vector, Aabb, Bound};
-use crate::scenario::{Inlet, Kind, Outlet, Particle};
+use crate::scenario::{Inlet, InletPressure, Kind, Outlet, Particle};
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
@@ -24,8 +24,8 @@ pub(super) struct InletSpec {
     pub sense: f64,
     pub speed: f64,
     pub stop_s: f64,
-    /// `pressure = "hydrostatic"`.
-    pub hydrostatic: bool,
+    /// `pressure`.
+    pub pressure: InletPressureName,
 }
 
 pub(super) fn validate(
@@ -102,7 +102,7 @@ pub(super) fn validate(
             sense: d[axis],
             speed,
             stop_s,
-            hydrostatic: r.pressure == Some(InletPressureName::Hydrostatic),
+            pressure: r.pressure.unwrap_or(InletPressureName::Zero),
         });
     }
     Ok(out)
@@ -228,20 +228,26 @@ pub(super) fn build(
         spacing: dx,
         columns,
         particles: start..start + n,
-        // The box's corner farthest up against gravity.
-        surface: spec.hydrostatic.then(|| {
-            [0, 1, 2].map(|a| {
-                if gravity[a] < 0.0 {
-                    spec.bx.max[a]
-                } else {
-                    spec.bx.min[a]
-                }
-            })
-        }),
+        pressure: match spec.pressure {
+            InletPressureName::Zero => InletPressure::Zero,
+            InletPressureName::Extrapolated => InletPressure::Extrapolated,
+            // The box's corner farthest up against gravity.
+            InletPressureName::Hydrostatic => InletPressure::Hydrostatic {
+                surface: [0, 1, 2].map(|a| {
+                    if gravity[a] < 0.0 {
+                        spec.bx.max[a]
+                    } else {
+                        spec.bx.min[a]
+                    }
+                }),
+            },
+        },
     };
     let g = gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
-    let depth = |x: [f64; 3]| match inlet.surface {
-        Some(s) if g > 0.0 => (0..3).map(|a| gravity[a] * (x[a] - s[a])).sum::<f64>() / g,
+    let depth = |x: [f64; 3]| match inlet.pressure {
+        InletPressure::Hydrostatic { surface: s } if g > 0.0 => {
+            (0..3).map(|a| gravity[a] * (x[a] - s[a])).sum::<f64>() / g
+        }
         _ => 0.0,
     };
     for k in 0..n {

@@ -60,6 +60,7 @@ pub(super) struct RawInlet {
 pub(super) enum InletPressureName {
     Zero,
     Hydrostatic,
+    Extrapolated,
 }
 
 /// An elastic body: `[[solid]]` (`docs/cases.md`, "Elastic solids").

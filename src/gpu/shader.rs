@@ -10,6 +10,8 @@ pub const WORKGROUP_SIZE: u32 = 128;
 pub const COMMON: &str = include_str!("../../shaders/lib/common.wgsl");
 /// First-order moving least squares (`shaders/lib/mls.wgsl`).
 pub const MLS: &str = include_str!("../../shaders/lib/mls.wgsl");
+/// The fluid interpolated at a point (`shaders/lib/fluid_at.wgsl`; needs `MLS`).
+pub const FLUID_AT: &str = include_str!("../../shaders/lib/fluid_at.wgsl");
 
 /// One shader file per pass, named like its Rust module in `src/sph`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,7 +79,8 @@ impl Pass {
     /// Library files (after common.wgsl) this pass uses.
     pub fn libs(self) -> &'static [&'static str] {
         match self {
-            Pass::Ghost | Pass::DensityFilter => &[MLS],
+            Pass::Ghost | Pass::OpenBoundaries => &[MLS, FLUID_AT],
+            Pass::DensityFilter => &[MLS],
             _ => &[],
         }
     }

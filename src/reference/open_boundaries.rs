@@ -1,7 +1,8 @@
-//! f64 reference of shaders/open_boundaries.wgsl: where a velocity inlet puts its particles.
+//! f64 reference of shaders/open_boundaries.wgsl: where a velocity inlet puts its particles,
+//! and an extrapolated buffer's density.
 
-use super::{EXCLUDED, FLUID, INLET};
-use crate::scenario::{Inlet, Physics};
+use super::{dot, ghost, RefParticle, Space, EXCLUDED, FLUID, INLET};
+use crate::scenario::{Inlet, Physics, WallParams};
 
 /// An inlet particle as the inlet pass leaves it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -34,9 +35,30 @@ pub fn place(inlet: &Inlet, k: usize, kind: u32, t: f64, ph: &Physics) -> Option
     })
 }
 
+/// The density of an extrapolated buffer particle at `x` of `inlet` (shaders/open_boundaries.wgsl
+/// `inlet_pressure`): the fluid's pressure interpolated at the mirror image across the plane,
+/// carried back along gravity, not below zero, by the inverse Tait equation.
+pub fn extrapolated_density(
+    inlet: &Inlet,
+    k: usize,
+    x: [f64; 3],
+    ph: &Physics,
+    walls: &WallParams,
+    space: &Space,
+    parts: &[RefParticle],
+) -> f64 {
+    let column = inlet.columns[k % inlet.columns.len()];
+    let s = dot(space.sub(x, column), inlet.normal);
+    let mirror = [0, 1, 2].map(|a| x[a] - 2.0 * s * inlet.normal[a]);
+    let (p_m, _) = ghost::fluid_at(ph, walls, space, parts, mirror, ph.gravity);
+    let p = p_m + 2.0 * s * ph.rho0 * dot(ph.gravity, inlet.normal);
+    ph.rho0 * (1.0 + p.max(0.0) / ph.tait_b()).powf(1.0 / ph.gamma)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scenario::InletPressure;
 
     fn inlet() -> Inlet {
         Inlet {
@@ -47,7 +69,7 @@ mod tests {
             spacing: 0.01,
             columns: vec![[0.1, 0.2, 0.0], [0.1, 0.21, 0.0]],
             particles: 10..30,
-            surface: None,
+            pressure: InletPressure::Zero,
         }
     }
 
@@ -87,7 +109,9 @@ mod tests {
     fn a_hydrostatic_buffer_carries_the_weight_of_the_water_above() {
         let ph = &physics();
         let inlet = Inlet {
-            surface: Some([0.1, 0.215, 0.0]),
+            pressure: InletPressure::Hydrostatic {
+                surface: [0.1, 0.215, 0.0],
+            },
             ..inlet()
         };
         let p = place(&inlet, 0, INLET, 0.0, ph).unwrap();

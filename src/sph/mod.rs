@@ -616,6 +616,9 @@ impl Solver {
                 b.encode_index(&mut pass, q);
             }
             self.ghost.encode(&mut pass, q);
+            if let Some(o) = &self.open_boundaries {
+                o.encode_pressure(&mut pass, q);
+            }
             self.interaction.encode(&mut pass, q);
             if let Some(e) = &self.elastic {
                 e.encode_rates(&mut pass, q);
@@ -829,7 +832,7 @@ impl Solver {
     }
 
     /// Test hook: re-runs the ghost interpolation (fixed ghosts and the solids' interface
-    /// pressure), the interaction pass and, with solids, the elastic rates on the current arrays
+    /// pressure, extrapolated inlet buffers' pressure), the interaction pass and, with solids, the elastic rates on the current arrays
     /// and returns the rates. With `poison`, `rate` (and the stress rates) are first filled with
     /// NaN so an entry the kernel skips cannot pass.
     #[doc(hidden)]
@@ -854,6 +857,9 @@ impl Solver {
             timestamp_writes: None,
         });
         self.ghost.encode(&mut pass, self.parity);
+        if let Some(o) = &self.open_boundaries {
+            o.encode_pressure(&mut pass, self.parity);
+        }
         self.interaction.encode(&mut pass, self.parity);
         if let Some(e) = &self.elastic {
             e.encode_rates(&mut pass, self.parity);

@@ -1,6 +1,7 @@
 //! Open boundaries (shaders/open_boundaries.wgsl), after the predictor: velocity inlets place
 //! every inlet particle (its place, velocity and kind at the time the step moves to), outlets
-//! remove the fluid that entered them. The tables (one entry per inlet, one per column of an
+//! remove the fluid that entered them; after the sort, buffers with `pressure =
+//! "extrapolated"` take their pressure from the fluid. The tables (one entry per inlet, one per column of an
 //! inlet's plane, one per outlet) are uploaded once; an inlet particle's layer and column
 //! follow from its id, so inlets add no per-particle memory.
 
@@ -10,12 +11,16 @@ use super::buffers::ParticleBuffers;
 use super::grid::Grid;
 use crate::gpu::buffers::storage_init;
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
-use crate::layout::{pack_block, InletDef, OutletDef, Pos};
-use crate::scenario::Scenario;
+use crate::layout::{
+    pack_block, InletDef, OutletDef, Pos, INLET_EXTRAPOLATED, INLET_HYDROSTATIC, INLET_ZERO,
+};
+use crate::scenario::{InletPressure, Scenario};
 
 pub struct OpenBoundaries {
     inlet_flow: Option<ParityKernel>,
     outlet_drain: Option<ParityKernel>,
+    /// Extrapolated buffer pressures, when an inlet has them.
+    inlet_pressure: Option<ParityKernel>,
     n: u32,
 }
 
@@ -34,10 +39,17 @@ pub fn inlet_tables(sc: &Scenario, grid: &Grid) -> (Vec<InletDef>, Vec<Pos>) {
             n_columns: inlet.columns.len() as u32,
             first_column: columns.len() as u32,
             pad: [0; 3],
-            surface: inlet.surface.map_or([0.0; 3], |s| {
-                [0, 1, 2].map(|a| (s[a] - grid.origin[a]) as f32)
-            }),
-            hydrostatic: inlet.surface.is_some() as u32,
+            surface: match inlet.pressure {
+                InletPressure::Hydrostatic { surface } => {
+                    [0, 1, 2].map(|a| (surface[a] - grid.origin[a]) as f32)
+                }
+                _ => [0.0; 3],
+            },
+            pressure: match inlet.pressure {
+                InletPressure::Zero => INLET_ZERO,
+                InletPressure::Hydrostatic { .. } => INLET_HYDROSTATIC,
+                InletPressure::Extrapolated => INLET_EXTRAPOLATED,
+            },
         });
         columns.extend(inlet.columns.iter().map(|&c| {
             let (off, b) = grid.to_block(c);
@@ -110,9 +122,14 @@ impl OpenBoundaries {
                 (5, &defs),
                 (6, &columns),
                 (7, &outlets),
+                (8, &b.cell_start),
             ]
         };
         let kernel = |entry: &str| ParityKernel::new(device, module, entry, bufs);
+        let extrapolated = sc
+            .inlets
+            .iter()
+            .any(|i| i.pressure == InletPressure::Extrapolated);
         Ok(Self {
             inlet_flow: (!sc.inlets.is_empty())
                 .then(|| kernel("inlet_flow"))
@@ -120,6 +137,7 @@ impl OpenBoundaries {
             outlet_drain: (!sc.outlets.is_empty())
                 .then(|| kernel("outlet_drain"))
                 .transpose()?,
+            inlet_pressure: extrapolated.then(|| kernel("inlet_pressure")).transpose()?,
             n: b.n,
         })
     }
@@ -128,6 +146,14 @@ impl OpenBoundaries {
     /// the predictor).
     pub fn encode(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         for k in [&self.inlet_flow, &self.outlet_drain].into_iter().flatten() {
+            k.dispatch(pass, p, self.n);
+        }
+    }
+
+    /// Takes the extrapolated buffers' pressures from the fluid, on the sorted arrays of parity
+    /// `p` (after the cell-list sort, before the interaction).
+    pub fn encode_pressure(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        if let Some(k) = &self.inlet_pressure {
             k.dispatch(pass, p, self.n);
         }
     }
