@@ -100,6 +100,11 @@ fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     if (inlet.pressure == INLET_HYDROSTATIC) {
         let p = params.rho0 * max(dot(params.gravity, domain_pos(placed) - inlet.surface), 0.0);
         rho = params.rho0 * pow(1.0 + p / params.tait_b, 1.0 / params.gamma);
+    } else if (inlet.pressure == INLET_EXTRAPOLATED && kind == KIND_INLET) {
+        // The density extrapolated in the last step: a particle that crosses the plane enters
+        // with the pressure of the water there (with ρ0 it would open a hole in the pressure
+        // field under water); one that just joined starts at ρ0 until `inlet_pressure`.
+        rho = velrho[i].w;
     }
     pos[i] = placed;
     velrho[i] = vec4<f32>(inlet.speed * inlet.normal, rho);

@@ -10,7 +10,7 @@ mod cases;
 mod contact;
 mod gate;
 mod lobovsky;
-mod overfall;
+mod open_channel;
 mod plate;
 mod sloshing;
 mod submerged;
