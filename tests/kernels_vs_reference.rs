@@ -450,13 +450,7 @@ fn probes_match_reference() {
 /// (zero pressure), in an open domain (2D: 4 columns each; 3D: 3 × 3), 3 layers of buffer and
 /// 10 or 11 in all.
 fn inlet_case(dim: u32) -> Scenario {
-    let vec = |c: [f64; 3]| {
-        if dim == 2 {
-            format!("[{}, {}]", c[0], c[1])
-        } else {
-            format!("[{}, {}, {}]", c[0], c[1], c[2])
-        }
-    };
+    let v = |c| toml_vector(dim, c);
     // (jet box, drop box, drop direction)
     let (jet, drop, down) = if dim == 2 {
         (
@@ -471,47 +465,62 @@ fn inlet_case(dim: u32) -> Scenario {
             [0.0, 0.0, -1.0],
         )
     };
+    let tables = format!(
+        r#"[[inlet]]
+name = "jet"
+min_m = {}
+max_m = {}
+direction = {}
+velocity_m_s = 13.0
+stop_s = 0.016
+pressure = "hydrostatic"
+[[inlet]]
+name = "drop"
+min_m = {}
+max_m = {}
+direction = {}
+velocity_m_s = 7.0
+stop_s = 0.031
+"#,
+        v(jet.0),
+        v(jet.1),
+        v([1.0, 0.0, 0.0]),
+        v(drop.0),
+        v(drop.1),
+        v(down),
+    );
+    unit_box_case(dim, down.map(|c| 9.81 * c), &tables)
+}
+
+/// `c`'s first `dim` components as a TOML array.
+fn toml_vector(dim: u32, c: [f64; 3]) -> String {
+    let parts: Vec<String> = c[..dim as usize].iter().map(|x| format!("{x:?}")).collect();
+    format!("[{}]", parts.join(", "))
+}
+
+/// A case in the unit box (dx = 0.02 m, h = 1.3 dx, c0 = 20 m/s, to 0.05 s) with gravity `g`
+/// and the tables `tables` ([[fluid_block]], [[inlet]] …).
+fn unit_box_case(dim: u32, g: [f64; 3], tables: &str) -> Scenario {
     let text = format!(
         r#"dimension = {dim}
 [particles]
 dx_m = 0.02
 h_over_dx = 1.3
 [physics]
-gravity_m_s2 = {down}
+gravity_m_s2 = {}
 sound_speed_m_s = 20.0
 [time]
 end_s = 0.05
 output_every_s = 0.01
 [domain]
-min_m = {zero}
-max_m = {one}
-[[inlet]]
-name = "jet"
-min_m = {jmin}
-max_m = {jmax}
-direction = {jd}
-velocity_m_s = 13.0
-stop_s = 0.016
-pressure = "hydrostatic"
-[[inlet]]
-name = "drop"
-min_m = {pmin}
-max_m = {pmax}
-direction = {pd}
-velocity_m_s = 7.0
-stop_s = 0.031
-"#,
-        zero = vec([0.0; 3]),
-        one = vec([1.0; 3]),
-        jmin = vec(jet.0),
-        jmax = vec(jet.1),
-        jd = vec([1.0, 0.0, 0.0]),
-        pmin = vec(drop.0),
-        pmax = vec(drop.1),
-        pd = vec(down),
-        down = vec(down.map(|c| 9.81 * c)),
+min_m = {}
+max_m = {}
+{tables}"#,
+        toml_vector(dim, g),
+        toml_vector(dim, [0.0; 3]),
+        toml_vector(dim, [1.0; 3]),
     );
-    wgsph::case::load_str(&text, "inlets.toml", &[]).unwrap()
+    wgsph::case::load_str(&text, "unit_box.toml", &[]).unwrap()
 }
 
 /// The inlet pass against `reference::open_boundaries::place` over steps of random size: every inlet
@@ -662,68 +671,48 @@ fn outlets_drain_what_enters_them() {
 /// with `pressure = "extrapolated"`: one through its side (along x) and one through its bottom
 /// (against gravity, so the carry back to the buffer adds pressure). 2D and 3D; Shepard and MLS.
 fn extrapolated_inlet_case(dim: u32, seed: u64) -> Scenario {
-    let vec = |c: [f64; 3]| {
-        if dim == 2 {
-            format!("[{}, {}]", c[0], c[1])
-        } else {
-            format!("[{}, {}, {}]", c[0], c[1], c[2])
-        }
-    };
     let up = dim as usize - 1;
-    // (min, max) with the vertical coordinate last used for `up`.
-    let b = |lo: [f64; 3], hi: [f64; 3]| {
-        let (mut l, mut u) = (lo, hi);
+    // A box's corners, written with the vertical coordinate last (moved to y in 2D).
+    let corner = |c: [f64; 3]| {
+        let mut x = c;
         if dim == 2 {
-            (l[1], u[1]) = (lo[2], hi[2]);
+            x[1] = c[2];
         }
-        (vec(l), vec(u))
+        toml_vector(dim, x)
     };
-    let (fmin, fmax) = b([0.2, 0.2, 0.1], [0.8, 0.8, 0.4]);
-    let (smin, smax) = b([0.12, 0.3, 0.15], [0.2, 0.5, 0.35]);
-    let (bmin, bmax) = b([0.4, 0.4, 0.02], [0.6, 0.6, 0.1]);
     let mut g = [0.0; 3];
     g[up] = -9.81;
     let mut n_up = [0.0; 3];
     n_up[up] = 1.0;
-    let text = format!(
-        r#"dimension = {dim}
-[particles]
-dx_m = 0.02
-h_over_dx = 1.3
-[physics]
-gravity_m_s2 = {g}
-sound_speed_m_s = 20.0
-[time]
-end_s = 0.05
-output_every_s = 0.01
-[domain]
-min_m = {zero}
-max_m = {one}
-[[fluid_block]]
-min_m = {fmin}
-max_m = {fmax}
+    let tables = format!(
+        r#"[[fluid_block]]
+min_m = {}
+max_m = {}
 [[inlet]]
 name = "side"
-min_m = {smin}
-max_m = {smax}
-direction = {x}
+min_m = {}
+max_m = {}
+direction = {}
 velocity_m_s = 0.5
 pressure = "extrapolated"
 [[inlet]]
 name = "bottom"
-min_m = {bmin}
-max_m = {bmax}
-direction = {n_up}
+min_m = {}
+max_m = {}
+direction = {}
 velocity_m_s = 0.3
 pressure = "extrapolated"
 "#,
-        g = vec(g),
-        zero = vec([0.0; 3]),
-        one = vec([1.0; 3]),
-        x = vec([1.0, 0.0, 0.0]),
-        n_up = vec(n_up),
+        corner([0.2, 0.2, 0.1]),
+        corner([0.8, 0.8, 0.4]),
+        corner([0.12, 0.3, 0.15]),
+        corner([0.2, 0.5, 0.35]),
+        toml_vector(dim, [1.0, 0.0, 0.0]),
+        corner([0.4, 0.4, 0.02]),
+        corner([0.6, 0.6, 0.1]),
+        toml_vector(dim, n_up),
     );
-    let mut sc = wgsph::case::load_str(&text, "extrapolated.toml", &[]).unwrap();
+    let mut sc = unit_box_case(dim, g, &tables);
     let mut rng = Rng(seed);
     for p in sc.particles.iter_mut().filter(|p| p.kind == Kind::Fluid) {
         let (pos, vel) = rng.jittered(dim, p.pos, 0.2, 0.02);
