@@ -176,14 +176,15 @@ fn weir_within(dx: f64, bound: f64) {
 
 /// dx = 10 mm (y_c = 3.4 dx): within 10 %.
 #[test]
-#[ignore = "slow: about 2 min on lavapipe"]
+#[ignore = "met but slow for CI: +8.6 %, about 4 min on lavapipe"]
 fn weir_upstream_depth_within_10_percent_coarse() {
     weir_within(0.01, 0.1);
 }
 
 /// dx = 5 mm (y_c = 6.9 dx): within 5 %.
 #[test]
-#[ignore = "slow: about 15 min on lavapipe"]
+#[ignore = "fails: +5.3 % at dx = 5 mm (+7.4 % at 8 mm, +8.6 % at 10 mm), converging from \
+            above; about 25 min on lavapipe (docs/validation.md 'Broad-crested weir')"]
 fn weir_upstream_depth_within_5_percent_fine() {
     weir_within(0.005, 0.05);
 }
@@ -249,7 +250,9 @@ fn street_flood_strikes_the_building_coarse() {
 /// the street's own critical depth (q_B²/g)^(1/3) = 0.063 m without it (a frictionless
 /// horizontal street ending in a drop runs critical). Both runs must drain what they take in.
 #[test]
-#[ignore = "slow: two 3D runs of 5 s, about 10 min on lavapipe"]
+#[ignore = "fails at dx = 0.04, 5 s: with the building 0.155 m (+7.1 % of the choke's 0.145 m), \
+            without 0.095 m (critical theory 0.063 m), ratio 0.61 against < 0.6; neither run \
+            is steady by 5 s; 25 min on lavapipe (docs/validation.md 'Street flood')"]
 fn street_flood_backs_up_behind_the_building_as_a_choke() {
     let q_b: f64 = 0.5 * 0.1 * 2.0;
     let theory = {
