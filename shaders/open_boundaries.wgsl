@@ -117,9 +117,9 @@ fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
 // hydrostatically, P_b = P(x_m) + ρ0 g·(x_b − x_m) = P(x_m) + 2 s ρ0 g·n. The buffer's values
 // come from ghost nodes mirrored into the fluid as in the open boundaries of Tafuni,
 // Domínguez, Vacondio & Crespo (2018, Comput. Methods Appl. Mech. Engrg. 342), here for the
-// pressure only (the velocity stays imposed) and with W^I as the ghosts use it. Not below zero: a buffer
-// particle above the water beside it (the free surface) stays at ρ0 rather than pulling on the
-// fluid. No fluid in reach of x_m (an empty domain at the start): zero pressure.
+// pressure only (the velocity stays imposed) and with W^I as the ghosts use it. Not below
+// zero: a buffer particle above the water beside it (the free surface) stays at ρ0 rather
+// than pulling on the fluid. No fluid in reach of x_m (an empty domain at the start): zero pressure.
 @compute @workgroup_size(WG)
 fn inlet_pressure(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);

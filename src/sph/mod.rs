@@ -832,7 +832,8 @@ impl Solver {
     }
 
     /// Test hook: re-runs the ghost interpolation (fixed ghosts and the solids' interface
-    /// pressure, extrapolated inlet buffers' pressure), the interaction pass and, with solids, the elastic rates on the current arrays
+    /// pressure, extrapolated inlet buffers' pressure), the interaction pass and, with solids,
+    /// the elastic rates on the current arrays
     /// and returns the rates. With `poison`, `rate` (and the stress rates) are first filled with
     /// NaN so an entry the kernel skips cannot pass.
     #[doc(hidden)]

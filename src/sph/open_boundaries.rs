@@ -1,9 +1,9 @@
 //! Open boundaries (shaders/open_boundaries.wgsl), after the predictor: velocity inlets place
 //! every inlet particle (its place, velocity and kind at the time the step moves to), outlets
 //! remove the fluid that entered them; after the sort, buffers with `pressure =
-//! "extrapolated"` take their pressure from the fluid. The tables (one entry per inlet, one per column of an
-//! inlet's plane, one per outlet) are uploaded once; an inlet particle's layer and column
-//! follow from its id, so inlets add no per-particle memory.
+//! "extrapolated"` take their pressure from the fluid. The tables (one entry per inlet, one
+//! per column of an inlet's plane, one per outlet) are uploaded once; an inlet particle's
+//! layer and column follow from its id, so inlets add no per-particle memory.
 
 use anyhow::{ensure, Result};
 
