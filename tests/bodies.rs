@@ -454,86 +454,90 @@ fn a_body_in_free_flight_follows_the_exact_trajectory() {
 /// at t1 = T/4 (θ = −4°); in 3D (rotation about −y, the same sense) at t1 = 0.25 s (θ = −1.9°),
 /// coarse.
 #[test]
-fn a_probe_attached_to_the_tank_moves_with_it() {
-    for (case, dx, t1, up) in [
-        (
-            "cases/sloshing_2d.toml",
-            "0.04",
-            std::f64::consts::FRAC_PI_4,
-            1,
-        ),
-        ("cases/sloshing_3d.toml", "0.04", 0.25, 2),
-    ] {
-        let set: Vec<String> = [format!("particles.dx_m={dx}"), "time.end_s=1".into()].into();
-        let mut sc = wgsph::case::load(std::path::Path::new(case), &set).unwrap();
-        let p2 = sc.probes.iter().find(|p| p.name == "p2").unwrap().clone();
-        assert_eq!(p2.body, Some(0), "p2 is attached to the tank");
-        let ProbeKind::Pressure { point: x0 } = p2.kind else {
-            panic!("p2 is a pressure probe")
+fn a_probe_attached_to_the_tank_moves_with_it_2d() {
+    probe_moves_with_the_tank(
+        "cases/sloshing_2d.toml",
+        "0.04",
+        std::f64::consts::FRAC_PI_4,
+        1,
+    );
+}
+
+#[test]
+fn a_probe_attached_to_the_tank_moves_with_it_3d() {
+    probe_moves_with_the_tank("cases/sloshing_3d.toml", "0.04", 0.25, 2);
+}
+
+fn probe_moves_with_the_tank(case: &str, dx: &str, t1: f64, up: usize) {
+    let set: Vec<String> = [format!("particles.dx_m={dx}"), "time.end_s=1".into()].into();
+    let mut sc = wgsph::case::load(std::path::Path::new(case), &set).unwrap();
+    let p2 = sc.probes.iter().find(|p| p.name == "p2").unwrap().clone();
+    assert_eq!(p2.body, Some(0), "p2 is attached to the tank");
+    let ProbeKind::Pressure { point: x0 } = p2.kind else {
+        panic!("p2 is a pressure probe")
+    };
+    // The cases' law: θ(t) = 4° sin(2t + π) about the pivot (0.46, ·, 0), no translation;
+    // positive θ lifts the right-hand end (+x) in the x–up plane.
+    let theta = 4f64.to_radians() * (2.0 * t1 + std::f64::consts::PI).sin();
+    let (s, c) = theta.sin_cos();
+    let r = [x0[0] - 0.46, x0[up]];
+    let mut x1 = x0;
+    x1[0] = 0.46 + c * r[0] - s * r[1];
+    x1[up] = s * r[0] + c * r[1];
+    assert!(
+        (x1[up] - x0[up]).abs() > 0.01,
+        "{case}: the probe must have moved noticeably"
+    );
+    for (name, point) in [("fixed_at_x1", x1), ("fixed_at_x0", x0)] {
+        sc.probes.push(Probe {
+            name: name.into(),
+            kind: ProbeKind::Pressure { point },
+            body: None,
+        });
+    }
+    // The force sensor w2 (2D case only): a fixed twin with the patch turned to the tank's
+    // pose at t1 must sum the same particles over the same area.
+    let w2 = sc.probes.iter().find(|p| p.name == "w2").cloned();
+    if let Some(Probe {
+        kind: ProbeKind::WallPressure(patch),
+        ..
+    }) = &w2
+    {
+        let turn = |v: [f64; 3], pivot: f64| {
+            let r = [v[0] - pivot, v[up]];
+            let mut out = v;
+            out[0] = pivot + c * r[0] - s * r[1];
+            out[up] = s * r[0] + c * r[1];
+            out
         };
-        // The cases' law: θ(t) = 4° sin(2t + π) about the pivot (0.46, ·, 0), no translation;
-        // positive θ lifts the right-hand end (+x) in the x–up plane.
-        let theta = 4f64.to_radians() * (2.0 * t1 + std::f64::consts::PI).sin();
-        let (s, c) = theta.sin_cos();
-        let r = [x0[0] - 0.46, x0[up]];
-        let mut x1 = x0;
-        x1[0] = 0.46 + c * r[0] - s * r[1];
-        x1[up] = s * r[0] + c * r[1];
-        assert!(
-            (x1[up] - x0[up]).abs() > 0.01,
-            "{case}: the probe must have moved noticeably"
-        );
-        for (name, point) in [("fixed_at_x1", x1), ("fixed_at_x0", x0)] {
-            sc.probes.push(Probe {
-                name: name.into(),
-                kind: ProbeKind::Pressure { point },
-                body: None,
-            });
-        }
-        // The force sensor w2 (2D case only): a fixed twin with the patch turned to the tank's
-        // pose at t1 must sum the same particles over the same area.
-        let w2 = sc.probes.iter().find(|p| p.name == "w2").cloned();
-        if let Some(Probe {
-            kind: ProbeKind::WallPressure(patch),
-            ..
-        }) = &w2
-        {
-            let turn = |v: [f64; 3], pivot: f64| {
-                let r = [v[0] - pivot, v[up]];
-                let mut out = v;
-                out[0] = pivot + c * r[0] - s * r[1];
-                out[up] = s * r[0] + c * r[1];
-                out
-            };
-            sc.probes.push(Probe {
-                name: "w2_fixed_at_x1".into(),
-                kind: ProbeKind::WallPressure(WallPatch {
-                    point: turn(patch.point, 0.46),
-                    normal: turn(patch.normal, 0.0),
-                    ..*patch
-                }),
-                body: None,
-            });
-        }
-        let mut solver = Solver::new(gpu(), &sc).unwrap();
-        solver.advance_to(t1).unwrap();
-        let v = solver.sample_probes().unwrap();
-        let value = |name: &str| v[sc.probes.iter().position(|p| p.name == name).unwrap()];
-        let (attached, at_x1, at_x0) = (value("p2"), value("fixed_at_x1"), value("fixed_at_x0"));
-        println!(
-            "{case}: attached {attached:.3} Pa, fixed at x1 {at_x1:.3} Pa, fixed at x0 {at_x0:.3} Pa"
-        );
-        assert!(
-            (attached - at_x1).abs() <= 1e-4 * at_x1.abs(),
-            "{case}: attached {attached} vs fixed at the moved point {at_x1}"
-        );
-        assert!((attached - at_x0).abs() > 0.03 * at_x0.abs(), "{case}");
-        if w2.is_some() {
-            let (w, twin) = (value("w2"), value("w2_fixed_at_x1"));
-            println!("{case}: force sensor attached {w:.3} Pa, fixed twin {twin:.3} Pa");
-            assert!(w > 0.5 * attached, "{case}: the force sensor reads {w} Pa");
-            assert_eq!(w, twin, "{case}: attached force sensor vs its fixed twin");
-        }
+        sc.probes.push(Probe {
+            name: "w2_fixed_at_x1".into(),
+            kind: ProbeKind::WallPressure(WallPatch {
+                point: turn(patch.point, 0.46),
+                normal: turn(patch.normal, 0.0),
+                ..*patch
+            }),
+            body: None,
+        });
+    }
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    solver.advance_to(t1).unwrap();
+    let v = solver.sample_probes().unwrap();
+    let value = |name: &str| v[sc.probes.iter().position(|p| p.name == name).unwrap()];
+    let (attached, at_x1, at_x0) = (value("p2"), value("fixed_at_x1"), value("fixed_at_x0"));
+    println!(
+        "{case}: attached {attached:.3} Pa, fixed at x1 {at_x1:.3} Pa, fixed at x0 {at_x0:.3} Pa"
+    );
+    assert!(
+        (attached - at_x1).abs() <= 1e-4 * at_x1.abs(),
+        "{case}: attached {attached} vs fixed at the moved point {at_x1}"
+    );
+    assert!((attached - at_x0).abs() > 0.03 * at_x0.abs(), "{case}");
+    if w2.is_some() {
+        let (w, twin) = (value("w2"), value("w2_fixed_at_x1"));
+        println!("{case}: force sensor attached {w:.3} Pa, fixed twin {twin:.3} Pa");
+        assert!(w > 0.5 * attached, "{case}: the force sensor reads {w} Pa");
+        assert_eq!(w, twin, "{case}: attached force sensor vs its fixed twin");
     }
 }
 
@@ -567,51 +571,55 @@ fn a_probe_on_an_unknown_body_is_refused() {
 /// tip), after it has moved; and `wgsph run` writes `probes/point_<name>.csv` with the
 /// position and displacement at every probe time.
 #[test]
-fn tracked_points_follow_their_particles() {
-    for (case, point, end) in [
-        ("cases/floating_box_2d.toml", "corner", 0.1),
-        ("cases/oscillating_plate_2d.toml", "tip", 0.02),
-    ] {
-        let set = vec![
-            format!("time.end_s={end}"),
-            format!("time.output_every_s={end}"),
-            format!("time.probe_every_s={end}"),
-        ];
-        let sc = wgsph::case::load(std::path::Path::new(case), &set).unwrap();
-        let tracked = sc.points.iter().find(|p| p.name == point).unwrap();
-        let id = tracked.particle as usize;
-        let x0 = sc.particles[id].pos;
-        let mut solver = Solver::new(gpu(), &sc).unwrap();
-        let start = solver.sample_points().unwrap();
-        assert!(
-            (0..3).all(|a| (start[0][a] - x0[a]).abs() < 1e-6),
-            "{case}: the point starts at {:?}, its particle at {x0:?}",
-            start[0]
-        );
-        solver.advance_to(end).unwrap();
-        let p = solver.read_particles().unwrap();
-        let k = p.id.iter().position(|&i| i as usize == id).unwrap();
-        let got = solver.sample_points().unwrap();
-        println!("{case}: {point} from {x0:?} to {:?}", got[0]);
-        assert_eq!(got, vec![p.pos[k]], "{case}");
-        let moved = (0..2)
-            .map(|a| (got[0][a] - x0[a]).abs())
-            .fold(0.0, f64::max);
-        assert!(moved > 1e-4, "{case}: the point moved only {moved} m");
+fn a_tracked_point_follows_its_particle_on_a_rigid_body() {
+    point_follows_its_particle("cases/floating_box_2d.toml", "corner", 0.1);
+}
 
-        let dir = Scratch::new(&format!("points-{point}"));
-        let opts = wgsph::run::RunOptions::default();
-        let mut quiet = wgsph::progress::LogLines::default();
-        wgsph::run::run(gpu(), &sc, &dir, &opts, &mut quiet).unwrap();
-        let csv = std::fs::read_to_string(dir.join(format!("probes/point_{point}.csv"))).unwrap();
-        let lines: Vec<&str> = csv.lines().collect();
-        assert_eq!(lines[0], "t_s,x_m,y_m,ux_m,uy_m", "{csv}");
-        assert_eq!(lines.len(), 3, "{csv}");
-        let last: Vec<f64> = lines[2].split(',').map(|v| v.parse().unwrap()).collect();
-        assert_eq!(last[0], end);
-        for a in 0..2 {
-            assert!((last[1 + a] - got[0][a]).abs() < 1e-12, "{csv}");
-            assert!((last[3 + a] - (got[0][a] - x0[a])).abs() < 1e-12, "{csv}");
-        }
+#[test]
+fn a_tracked_point_follows_its_particle_on_an_elastic_solid() {
+    point_follows_its_particle("cases/oscillating_plate_2d.toml", "tip", 0.02);
+}
+
+fn point_follows_its_particle(case: &str, point: &str, end: f64) {
+    let set = vec![
+        format!("time.end_s={end}"),
+        format!("time.output_every_s={end}"),
+        format!("time.probe_every_s={end}"),
+    ];
+    let sc = wgsph::case::load(std::path::Path::new(case), &set).unwrap();
+    let tracked = sc.points.iter().find(|p| p.name == point).unwrap();
+    let id = tracked.particle as usize;
+    let x0 = sc.particles[id].pos;
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    let start = solver.sample_points().unwrap();
+    assert!(
+        (0..3).all(|a| (start[0][a] - x0[a]).abs() < 1e-6),
+        "{case}: the point starts at {:?}, its particle at {x0:?}",
+        start[0]
+    );
+    solver.advance_to(end).unwrap();
+    let p = solver.read_particles().unwrap();
+    let k = p.id.iter().position(|&i| i as usize == id).unwrap();
+    let got = solver.sample_points().unwrap();
+    println!("{case}: {point} from {x0:?} to {:?}", got[0]);
+    assert_eq!(got, vec![p.pos[k]], "{case}");
+    let moved = (0..2)
+        .map(|a| (got[0][a] - x0[a]).abs())
+        .fold(0.0, f64::max);
+    assert!(moved > 1e-4, "{case}: the point moved only {moved} m");
+
+    let dir = Scratch::new(&format!("points-{point}"));
+    let opts = wgsph::run::RunOptions::default();
+    let mut quiet = wgsph::progress::LogLines::default();
+    wgsph::run::run(gpu(), &sc, &dir, &opts, &mut quiet).unwrap();
+    let csv = std::fs::read_to_string(dir.join(format!("probes/point_{point}.csv"))).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines[0], "t_s,x_m,y_m,ux_m,uy_m", "{csv}");
+    assert_eq!(lines.len(), 3, "{csv}");
+    let last: Vec<f64> = lines[2].split(',').map(|v| v.parse().unwrap()).collect();
+    assert_eq!(last[0], end);
+    for a in 0..2 {
+        assert!((last[1 + a] - got[0][a]).abs() < 1e-12, "{csv}");
+        assert!((last[3 + a] - (got[0][a] - x0[a])).abs() < 1e-12, "{csv}");
     }
 }

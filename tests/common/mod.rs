@@ -2,7 +2,6 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 use wgsph::gpu::{AdapterChoice, GpuContext};
 use wgsph::layout::{unpack_block, ID_MASK, KIND_SHIFT};
@@ -59,14 +58,19 @@ impl Drop for Scratch {
 }
 
 /// The adapter for tests: WGSPH_ADAPTER if set, else auto (lavapipe in CI). A missing adapter
-/// is a failure, not a skip.
+/// is a failure, not a skip. One device per test thread: the harness runs tests side by side,
+/// and one shared device would put them all on its single queue, one after the other (on
+/// lavapipe, two tests on a shared device took 2.8 times as long as on a device each). The
+/// device is leaked, a few MB per test.
 pub fn gpu() -> &'static GpuContext {
-    static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| {
-        let choice = AdapterChoice::resolve(None).expect("WGSPH_ADAPTER");
-        GpuContext::new(choice)
-            .expect("a GPU or software (lavapipe) adapter is required for the tests")
-    })
+    thread_local! {
+        static CTX: &'static GpuContext = Box::leak(Box::new({
+            let choice = AdapterChoice::resolve(None).expect("WGSPH_ADAPTER");
+            GpuContext::new(choice)
+                .expect("a GPU or software (lavapipe) adapter is required for the tests")
+        }));
+    }
+    CTX.with(|c| *c)
 }
 
 pub fn physics(dim: u32, dx: f64, c0: f64) -> Physics {

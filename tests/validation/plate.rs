@@ -237,6 +237,7 @@ fn tl_plate_of(file: &str, label: &str, overrides: &[&str]) {
 /// full-cycle run is the next test (measured: crossings at 0.1436 / 0.2872 s, +3.7 % both ways,
 /// peaks ±0.0222 m).
 #[test]
+#[ignore = "met but slow for CI: first crossing +3.7 %, about 7 min on lavapipe beside another test (1 625 particles, the TL passes cost 13 us per particle-step); the 2D TL plate's period runs in CI"]
 fn tl_beam_3d_half_period_within_5_percent() {
     let sc = plate(BEAM_3D, &[]);
     let t_theory = theory_period(&sc.solids.as_ref().unwrap().material, 3);
