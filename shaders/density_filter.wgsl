@@ -53,11 +53,11 @@ fn filter_density(i: u32, mls: bool) -> f32 {
     var sum_wv = 0.0;  // Σ W_ij V_j
     var a = mls_zero();
     var m_mw = vec4<f32>(0.0);  // Σ m_j W_ij [1, x_ij/h]: Σ m_j W^MLS_ij = β·m_mw
-    var slots: array<u32, 27>;
-    let n_slots = neighbour_slots(cell_of(p_i), &slots);
+    var ranges: array<vec2<u32>, 27>;
+    let n_ranges = neighbour_ranges(cell_of(p_i), &ranges);
     // One pass: the Shepard sums, the MLS moment matrix and the first moments of m W.
-    for (var s = 0u; s < n_slots; s++) {
-        for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
+    for (var s = 0u; s < n_ranges; s++) {
+        for (var j = ranges[s].x; j < ranges[s].y; j++) {
             if (j != i && !counts(code_kind(code[j]))) {
                 continue;
             }

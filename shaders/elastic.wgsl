@@ -147,10 +147,10 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     var acc = vec3<f32>(0.0);
     var drho = 0.0;
     var grad_v = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
-    var slots: array<u32, 27>;
-    let n_slots = neighbour_slots(cell_of(p_i), &slots);
-    for (var s = 0u; s < n_slots; s++) {
-        for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
+    var ranges: array<vec2<u32>, 27>;
+    let n_ranges = neighbour_ranges(cell_of(p_i), &ranges);
+    for (var s = 0u; s < n_ranges; s++) {
+        for (var j = ranges[s].x; j < ranges[s].y; j++) {
             if (j == i || !is_solid(code_kind(code[j])) || solid[solid_slot(code[j])].body != body_i) {
                 continue;
             }

@@ -189,10 +189,10 @@ fn solid_loads(i: u32) -> vec3<f32> {
     let body_i = s_i.body;
     let support2 = 4.0 * params.h * params.h;
     var r = vec3<f32>(0.0);
-    var slots: array<u32, 27>;
-    let n_slots = neighbour_slots(cell_of(p_i), &slots);
-    for (var s = 0u; s < n_slots; s++) {
-        for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
+    var ranges: array<vec2<u32>, 27>;
+    let n_ranges = neighbour_ranges(cell_of(p_i), &ranges);
+    for (var s = 0u; s < n_ranges; s++) {
+        for (var j = ranges[s].x; j < ranges[s].y; j++) {
             let kind_j = code_kind(code[j]);
             // Inlet buffers are open flow, not walls: no contact.
             if (kind_j == KIND_EXCLUDED || kind_j == KIND_INLET || j == i) {
@@ -287,10 +287,10 @@ fn image_rates(pi: Particle, p_i: Pos, image: vec3<f32>, chain: vec3<u32>, n: u3
     var out = PairRates(vec4<f32>(0.0), 0.0);
     let support2 = 4.0 * params.h * params.h;
     let at = pos_of_point(image);
-    var slots: array<u32, 27>;
-    let n_slots = neighbour_slots(cell_of(at), &slots);
-    for (var s = 0u; s < n_slots; s++) {
-        for (var j = cell_start[slots[s]]; j < cell_start[slots[s] + 1u]; j++) {
+    var ranges: array<vec2<u32>, 27>;
+    let n_ranges = neighbour_ranges(cell_of(at), &ranges);
+    for (var s = 0u; s < n_ranges; s++) {
+        for (var j = ranges[s].x; j < ranges[s].y; j++) {
             if (code_kind(code[j]) != KIND_FLUID) {
                 continue;
             }
@@ -394,12 +394,10 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
 
     var r = vec4<f32>(0.0);
     var de = 0.0;
-    var slots: array<u32, 27>;
-    let n_slots = neighbour_slots(cell_of(p_i), &slots);
-    for (var s = 0u; s < n_slots; s++) {
-        let start = cell_start[slots[s]];
-        let end = cell_start[slots[s] + 1u];
-        for (var j = start; j < end; j++) {
+    var ranges: array<vec2<u32>, 27>;
+    let n_ranges = neighbour_ranges(cell_of(p_i), &ranges);
+    for (var s = 0u; s < n_ranges; s++) {
+        for (var j = ranges[s].x; j < ranges[s].y; j++) {
             let x_ij = rel_pos(p_i, pos[j]);
             let r2 = dot(x_ij, x_ij);
             if (r2 >= support2 || j == i) {

@@ -54,6 +54,10 @@ pub struct Params {
     pub n_inlet_particles: u32,
     pub n_inlets: u32,
     pub n_outlets: u32,
+    /// 1 when every cell has a slot of its own and no axis is periodic (`Grid::dense`).
+    pub dense_grid: u32,
+    /// WGSL rounds the struct up to its 16-byte alignment.
+    pub pad: [u32; 3],
 }
 
 /// Mirrors `SolidState` in shaders/lib/common.wgsl: the deviatoric stress τ of a solid particle
@@ -335,7 +339,8 @@ mod tests {
                 inlet_id_base,
                 n_inlet_particles,
                 n_inlets,
-                n_outlets
+                n_outlets,
+                dense_grid
             ]
         );
     }

@@ -54,6 +54,8 @@ struct Params {
     n_inlet_particles: u32,
     n_inlets: u32,
     n_outlets: u32,             // open_boundaries.wgsl
+    // Neighbour grid again: 1 when every cell has a slot of its own and no axis is periodic
+    dense_grid: u32,
 }
 
 // Time-stepping state that lives on the GPU; read back once per batch of steps.
@@ -253,11 +255,10 @@ fn cell_of(p: Pos) -> vec3<i32> {
     let k = i32(params.cells_per_block);
     let local = clamp(vec3<i32>(floor(p.off * params.inv_cell_size)), vec3<i32>(0), vec3<i32>(k - 1));
     let c = unpack_block(p.block) * k + local;
-    if (params.periodic == 0u) {
-        return c;
-    }
-    // A particle wrapped to exactly the period's end belongs to cell 0.
-    return select(c, c % vec3<i32>(params.grid_cells), periodic_axes());
+    let g = vec3<i32>(params.grid_cells);
+    // A particle on the domain's far face belongs to the last cell, so every particle's cell is
+    // in the grid (neighbour_ranges' rows); one wrapped to exactly the period's end, to cell 0.
+    return select(min(c, g - 1), c % g, periodic_axes());
 }
 
 // Hash slot of a cell: its linear index in the domain grid, wrapped to the (power of two)
@@ -266,34 +267,6 @@ fn cell_of(p: Pos) -> vec3<i32> {
 fn slot_of_cell(c: vec3<i32>) -> u32 {
     let u = vec3<u32>(c);
     return (u.x + params.grid_cells.x * (u.y + params.grid_cells.y * u.z)) & params.hash_mask;
-}
-
-// The distinct slots of the 3^DIM cells around `c` (two neighbour cells can share a slot;
-// visiting it twice would count its particles twice).
-fn neighbour_slots(c: vec3<i32>, slots: ptr<function, array<u32, 27>>) -> u32 {
-    var n = 0u;
-    let zr = select(0, 1, DIM == 3u);
-    for (var dz = -zr; dz <= zr; dz++) {
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var dx = -1; dx <= 1; dx++) {
-                var cn = c + vec3<i32>(dx, dy, dz);
-                if (params.periodic != 0u) {
-                    let n = vec3<i32>(params.grid_cells);
-                    cn = select(cn, (cn + n) % n, periodic_axes());
-                }
-                let s = slot_of_cell(cn);
-                var seen = false;
-                for (var k = 0u; k < n; k++) {
-                    seen = seen || ((*slots)[k] == s);
-                }
-                if (!seen) {
-                    (*slots)[n] = s;
-                    n++;
-                }
-            }
-        }
-    }
-    return n;
 }
 
 // ---- mirror planes ---------------------------------------------------------------------

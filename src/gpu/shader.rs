@@ -8,6 +8,9 @@
 pub const WORKGROUP_SIZE: u32 = 128;
 
 pub const COMMON: &str = include_str!("../../shaders/lib/common.wgsl");
+/// Neighbour search over the cell list (`shaders/lib/neighbours.wgsl`; the pass declares
+/// `cell_start`).
+pub const NEIGHBOURS: &str = include_str!("../../shaders/lib/neighbours.wgsl");
 /// First-order moving least squares (`shaders/lib/mls.wgsl`).
 pub const MLS: &str = include_str!("../../shaders/lib/mls.wgsl");
 /// The fluid interpolated at a point (`shaders/lib/fluid_at.wgsl`; needs `MLS`).
@@ -79,8 +82,9 @@ impl Pass {
     /// Library files (after common.wgsl) this pass uses.
     pub fn libs(self) -> &'static [&'static str] {
         match self {
-            Pass::Ghost | Pass::OpenBoundaries => &[MLS, FLUID_AT],
-            Pass::DensityFilter => &[MLS],
+            Pass::Ghost | Pass::OpenBoundaries => &[NEIGHBOURS, MLS, FLUID_AT],
+            Pass::DensityFilter => &[NEIGHBOURS, MLS],
+            Pass::Interaction | Pass::Elastic | Pass::Probes => &[NEIGHBOURS],
             _ => &[],
         }
     }

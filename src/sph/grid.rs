@@ -107,13 +107,28 @@ impl Grid {
         [0, 1, 2].map(|a| self.origin[a] + b[a] as f64 * self.block_size[a] as f64 + off[a] as f64)
     }
 
-    /// The slot of a world position, as `slot_of_cell(cell_of(..))` computes it on the GPU.
+    /// Whether every cell has a slot of its own (its linear index) and no axis is periodic: the
+    /// cells of a row along x then have consecutive slots (`neighbour_ranges` in
+    /// shaders/lib/neighbours.wgsl).
+    pub fn dense(&self) -> bool {
+        let total: u64 = self.cells.iter().map(|&c| c as u64).product();
+        !self.periodic.iter().any(|&p| p) && total <= self.slots as u64
+    }
+
+    /// The slot of a world position, as `slot_of_cell(cell_of(..))` computes it on the GPU: a
+    /// position on the far face is in the last cell, one at a period's end in cell 0.
     pub fn slot_of(&self, off: [f32; 3], b: [u32; 3]) -> u32 {
         let k = self.cells_per_block as i64;
         let c: [u32; 3] = [0, 1, 2].map(|a| {
             let inv = (1.0 / self.cell_size[a]) as f32;
             let local = ((off[a] * inv).floor() as i64).clamp(0, k - 1);
-            (b[a] as i64 * k + local) as u32
+            let c = b[a] as i64 * k + local;
+            let n = self.cells[a] as i64;
+            (if self.periodic[a] {
+                c % n
+            } else {
+                c.min(n - 1)
+            }) as u32
         });
         let lin = c[0].wrapping_add(
             self.cells[0].wrapping_mul(c[1].wrapping_add(self.cells[1].wrapping_mul(c[2]))),
@@ -136,6 +151,27 @@ mod tests {
         assert_eq!(g.cells_per_block, 1);
         assert_eq!(g.cells[2], 1);
         assert!(g.slots as u64 >= g.cells.iter().map(|&c| c as u64).product::<u64>());
+        assert!(g.dense());
+        let periodic = Grid::new(
+            &domain([1.0, 0.5, 0.0]),
+            0.013,
+            2,
+            10_000,
+            [true, false, false],
+        );
+        assert!(!periodic.unwrap().dense());
+    }
+
+    #[test]
+    fn a_position_past_the_far_face_is_in_the_last_cell() {
+        // 5 000 cells along x in blocks of 3: the last block's last cell is beyond the grid,
+        // where only a position rounded past the face can fall.
+        let g = Grid::new(&domain([100.0, 100.0, 10.0]), 0.01, 3, 1000, [false; 3]).unwrap();
+        assert_eq!((g.cells[0], g.cells_per_block), (5000, 3));
+        assert!(g.blocks[0] * g.cells_per_block > g.cells[0]);
+        let past = [0.999 * g.block_size[0], 0.0, 0.0];
+        let last = (g.cells[0] - 1) & (g.slots - 1);
+        assert_eq!(g.slot_of(past, [g.blocks[0] - 1, 0, 0]), last);
     }
 
     #[test]
@@ -152,6 +188,7 @@ mod tests {
         assert!(g.blocks.iter().zip(MAX_BLOCK).all(|(b, m)| *b <= m + 1));
         assert!(g.block_size[0] < 0.1, "block {:?} m", g.block_size);
         assert_eq!(g.slots, 1 << 20);
+        assert!(!g.dense(), "a sparse domain shares slots");
         // f32 resolution of an offset is far below the particle spacing.
         let ulp = g.block_size[0] * f32::EPSILON;
         assert!((ulp as f64) < 1e-6 * 0.005 * 2.0);

@@ -232,6 +232,7 @@ impl Solver {
         let mut params = Params {
             grid_cells: grid.cells,
             hash_mask: grid.slots - 1,
+            dense_grid: grid.dense() as u32,
             block_size: grid.block_size,
             cells_per_block: grid.cells_per_block,
             inv_cell_size: grid.cell_size.map(|c| (1.0 / c) as f32),
