@@ -410,7 +410,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                     if (!reacts) {
                         // Fixed dynamic wall particle: continuity only.
                         r.w += params.mass * dot(pi.v - vr_j.xyz, x_ij * kernel_f(sqrt(r2) / params.h));
-                    } else if (kind_i == KIND_REPULSIVE) {
+                    } else if (is_repulsive(kind_i)) {
                         // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
                         r += vec4<f32>(repulsion(x_ij, r2), 0.0);
                     } else {
@@ -428,7 +428,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                 }
                 continue;
             }
-            if (kind_j == KIND_REPULSIVE) {
+            if (is_repulsive(kind_j)) {
                 r += vec4<f32>(repulsion(x_ij, r2), 0.0);
                 continue;
             }
@@ -459,7 +459,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         }
     }
     if (fluid_i) {
-        if (params.n_mirror_planes > 0u) {
+        if (MIRRORS && params.n_mirror_planes > 0u) {
             let m = mirror_rates(i, pi);
             r += m.rate;
             de += m.de;

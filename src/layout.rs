@@ -250,7 +250,7 @@ pub struct TlPair {
 mod tests {
     use super::*;
     use crate::gpu::kernel::parse;
-    use crate::gpu::shader::{compose, Pass, ShaderConfig};
+    use crate::gpu::shader::{compose, Pass, Present, ShaderConfig};
     use wgpu::naga;
 
     /// (size, [(member name, offset)]) of a struct type named `name` in the composed `pass`.
@@ -504,15 +504,18 @@ mod tests {
                             (true, false, true),
                             (true, true, false),
                         ] {
-                            let cfg = ShaderConfig {
-                                dim,
-                                kernel,
-                                viscosity,
-                                energy,
-                                hydrostatic_diffusion,
-                                wall_reactions,
-                            };
-                            parse(&compose(pass, cfg), pass.name()).unwrap();
+                            for present in [Present::ALL, Present::NONE] {
+                                let cfg = ShaderConfig {
+                                    dim,
+                                    kernel,
+                                    viscosity,
+                                    energy,
+                                    hydrostatic_diffusion,
+                                    wall_reactions,
+                                    present,
+                                };
+                                parse(&compose(pass, cfg), pass.name()).unwrap();
+                            }
                         }
                     }
                 }

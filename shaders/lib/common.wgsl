@@ -130,12 +130,18 @@ fn body_wall_motion(m: BodyMotion, r: vec3<f32>) -> WallMotion {
     return WallMotion(m.velocity + w_arm, m.accel + cross(m.alpha, arm) + cross(m.omega, w_arm));
 }
 
+// The kind tests fold to false, and the branches they guard compile out, where the composed
+// constants (SOLIDS, FIXED_GHOSTS, REPULSIVE, BODIES: `shader::Present`) say the case has none.
 fn is_body_particle(id: u32) -> bool {
-    return id >= params.body_id_base;
+    return BODIES && id >= params.body_id_base;
 }
 
 fn is_solid(kind: u32) -> bool {
-    return kind == KIND_SOLID || kind == KIND_SOLID_CLAMPED;
+    return SOLIDS && (kind == KIND_SOLID || kind == KIND_SOLID_CLAMPED);
+}
+
+fn is_repulsive(kind: u32) -> bool {
+    return REPULSIVE && kind == KIND_REPULSIVE;
 }
 
 // Per solid particle, indexed by solid_slot (id order, untouched by the sort, so only solid
@@ -161,7 +167,7 @@ struct SymRate {
 }
 
 fn is_ghost(kind: u32) -> bool {
-    return kind == KIND_GHOST_NO_SLIP || kind == KIND_GHOST_FREE_SLIP;
+    return FIXED_GHOSTS && (kind == KIND_GHOST_NO_SLIP || kind == KIND_GHOST_FREE_SLIP);
 }
 
 fn code_kind(code: u32) -> u32 {

@@ -1,8 +1,8 @@
 //! WGSL composition: generated constants + `shaders/lib/common.wgsl` + one pass file.
 //!
 //! The shaders are compiled into the binary (`include_str!`), so an installed `wgsph` needs no
-//! shader files at run time. Per-case choices (dimension, kernel, viscosity) are constants of
-//! the composed source, so the compiler removes the branches not taken.
+//! shader files at run time. Per-case choices (dimension, kernel, viscosity, which kinds of
+//! particle the case has) are constants of the composed source, so the compiler removes the branches not taken.
 
 /// Invocations per workgroup of every 1D kernel.
 pub const WORKGROUP_SIZE: u32 = 128;
@@ -105,6 +105,44 @@ pub struct ShaderConfig {
     pub hydrostatic_diffusion: bool,
     /// Whether fixed walls' boundary particles get the fluid's force (wall-pressure probes).
     pub wall_reactions: bool,
+    /// Which particles and walls the case has: a pass compiles out the pair terms of the others.
+    pub present: Present,
+}
+
+/// What a case holds, for the branches of the pair sums. On a GPU a branch no lane takes costs
+/// little, but llvmpipe runs both sides of every branch under a lane mask: a fluid-only case
+/// paid for the solid, repulsive, ghost and body terms on every pair (about 20 % of the 2D dam
+/// break's interaction pass). Every flag on is always correct, only slower.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Present {
+    /// Elastic solid particles (`Kind::Solid`, `Kind::SolidClamped`).
+    pub solids: bool,
+    /// Fixed ghost particles, of walls or of bodies.
+    pub fixed_ghosts: bool,
+    /// Repulsive boundary particles.
+    pub repulsive: bool,
+    /// Particles of moving bodies (ids from `params.body_id_base` on).
+    pub bodies: bool,
+    /// Mirror planes.
+    pub mirrors: bool,
+}
+
+impl Present {
+    pub const ALL: Present = Present {
+        solids: true,
+        fixed_ghosts: true,
+        repulsive: true,
+        bodies: true,
+        mirrors: true,
+    };
+    /// A fluid with dynamic boundary particles only.
+    pub const NONE: Present = Present {
+        solids: false,
+        fixed_ghosts: false,
+        repulsive: false,
+        bodies: false,
+        mirrors: false,
+    };
 }
 
 impl Default for ShaderConfig {
@@ -116,6 +154,7 @@ impl Default for ShaderConfig {
             energy: false,
             hydrostatic_diffusion: false,
             wall_reactions: false,
+            present: Present::ALL,
         }
     }
 }
@@ -127,7 +166,9 @@ pub fn compose(pass: Pass, cfg: ShaderConfig) -> String {
          const DIM: u32 = {dim}u;\nconst KERNEL: u32 = {kernel}u;\n\
          const VISCOSITY: u32 = {visc}u;\nconst ENERGY: bool = {energy};\n\
          const HYDROSTATIC_DIFFUSION: bool = {hydro};\nconst WALL_REACTIONS: bool = {reactions};\n\
-         const WG: u32 = {wg}u;\n\n{common}\n{libs}\n{pass}",
+         const SOLIDS: bool = {solids};\nconst FIXED_GHOSTS: bool = {ghosts};\n\
+         const REPULSIVE: bool = {repulsive};\nconst BODIES: bool = {bodies};\n\
+         const MIRRORS: bool = {mirrors};\nconst WG: u32 = {wg}u;\n\n{common}\n{libs}\n{pass}",
         name = pass.name(),
         dim = cfg.dim,
         kernel = cfg.kernel,
@@ -135,6 +176,11 @@ pub fn compose(pass: Pass, cfg: ShaderConfig) -> String {
         energy = cfg.energy,
         hydro = cfg.hydrostatic_diffusion,
         reactions = cfg.wall_reactions,
+        solids = cfg.present.solids,
+        ghosts = cfg.present.fixed_ghosts,
+        repulsive = cfg.present.repulsive,
+        bodies = cfg.present.bodies,
+        mirrors = cfg.present.mirrors,
         wg = WORKGROUP_SIZE,
         common = COMMON,
         libs = pass.libs().concat(),

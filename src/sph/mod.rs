@@ -22,7 +22,7 @@ use crate::body::BodySet;
 use crate::gpu::buffers::{map_read, read, readback_buffer};
 use crate::gpu::context::GpuFaults;
 use crate::gpu::kernel::ShaderModule;
-use crate::gpu::shader::{Pass, ShaderConfig};
+use crate::gpu::shader::{Pass, Present, ShaderConfig};
 use crate::gpu::GpuContext;
 use crate::layout::{
     pack_block, unpack_block, Params, Pos, SimState, ID_MASK, KIND_EXCLUDED, KIND_SHIFT,
@@ -295,6 +295,7 @@ impl Solver {
             hydrostatic_diffusion: ph.delta_sph > 0.0
                 && ph.delta_sph_form == DeltaSphForm::Fourtakas,
             wall_reactions: sc.walls.reactions,
+            present: present(sc, body_id_base),
         };
         let mut pos = Vec::with_capacity(n);
         let mut velrho = Vec::with_capacity(n);
@@ -1114,6 +1115,19 @@ impl Solver {
             }
         }
         Ok(out)
+    }
+}
+
+/// Which kinds of particle and wall `sc` has, for the composed shaders (`Present`): kinds do
+/// not appear during a run (inlet particles become fluid, any particle may become excluded).
+fn present(sc: &Scenario, body_id_base: u32) -> Present {
+    let has = |kinds: &[Kind]| sc.particles.iter().any(|p| kinds.contains(&p.kind));
+    Present {
+        solids: has(&[Kind::Solid, Kind::SolidClamped]),
+        fixed_ghosts: has(&[Kind::GhostNoSlip, Kind::GhostFreeSlip]),
+        repulsive: has(&[Kind::Repulsive]),
+        bodies: (body_id_base as usize) < sc.particles.len(),
+        mirrors: !sc.walls.mirror_planes.is_empty(),
     }
 }
 
