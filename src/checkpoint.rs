@@ -115,7 +115,8 @@ impl Fnv {
 }
 
 /// A hash of what a run's state depends on: the particles as built (positions, velocities,
-/// densities, kinds), the physics, walls, domain, probes, bodies, inlets and outlets. Time
+/// densities, kinds), the physics, walls, domain, probes, bodies, elastic solids (material,
+/// bodies, initial stress), inlets and outlets. Time
 /// control is left out, so a resumed run may be given a later end time.
 pub fn fingerprint(sc: &Scenario) -> u64 {
     let mut h = Fnv::default();
@@ -130,6 +131,15 @@ pub fn fingerprint(sc: &Scenario) -> u64 {
     }
     if !sc.inlets.is_empty() || !sc.outlets.is_empty() {
         h.update(format!("|{:?}|{:?}", sc.inlets, sc.outlets).as_bytes());
+    }
+    if let Some(solids) = &sc.solids {
+        h.update(format!("|{:?}", solids.material).as_bytes());
+        for (body, tau) in solids.body.iter().zip(&solids.tau0) {
+            h.update(&body.to_le_bytes());
+            for x in tau {
+                h.update(&x.to_bits().to_le_bytes());
+            }
+        }
     }
     for p in &sc.particles {
         for x in p.pos.iter().chain(&p.vel).chain([&p.rho]) {
@@ -417,6 +427,18 @@ mod tests {
         let moved = ["outlet[0].min_m=[0.45, -0.4]".to_string()];
         let b = crate::case::load_str(text, "x.toml", &moved).unwrap();
         assert_eq!(a.particles, b.particles);
+        assert_ne!(fingerprint(&a), fingerprint(&b));
+    }
+
+    /// A plate with more artificial viscosity has the same particles and physics, but a run
+    /// resumed with it would differ.
+    #[test]
+    fn the_fingerprint_sees_the_solid_material() {
+        let text = include_str!("../cases/oscillating_plate_2d.toml");
+        let a = crate::case::load_str(text, "x.toml", &[]).unwrap();
+        let damped = ["solid[0].alpha=0.2".to_string()];
+        let b = crate::case::load_str(text, "x.toml", &damped).unwrap();
+        assert_eq!((&a.particles, &a.physics), (&b.particles, &b.physics));
         assert_ne!(fingerprint(&a), fingerprint(&b));
     }
 
