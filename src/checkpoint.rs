@@ -116,8 +116,8 @@ impl Fnv {
 
 /// A hash of what a run's state depends on: the particles as built (positions, velocities,
 /// densities, kinds), the physics, walls, domain, probes, bodies, elastic solids (material,
-/// bodies, initial stress), inlets and outlets. Time
-/// control is left out, so a resumed run may be given a later end time.
+/// bodies, initial stress), inlets and outlets. Time control is left out, so a resumed run may
+/// be given a later end time.
 pub fn fingerprint(sc: &Scenario) -> u64 {
     let mut h = Fnv::default();
     let settings = format!(

@@ -2,7 +2,8 @@
 //!
 //! The shaders are compiled into the binary (`include_str!`), so an installed `wgsph` needs no
 //! shader files at run time. Per-case choices (dimension, kernel, viscosity, which kinds of
-//! particle the case has) are constants of the composed source, so the compiler removes the branches not taken.
+//! particle the case has) are constants of the composed source, so the compiler removes the
+//! branches not taken.
 
 /// Invocations per workgroup of every 1D kernel.
 pub const WORKGROUP_SIZE: u32 = 128;
@@ -109,10 +110,11 @@ pub struct ShaderConfig {
     pub present: Present,
 }
 
-/// What a case holds, for the branches of the pair sums. On a GPU a branch no lane takes costs
-/// little, but llvmpipe runs both sides of every branch under a lane mask: a fluid-only case
-/// paid for the solid, repulsive, ghost and body terms on every pair (about 20 % of the 2D dam
-/// break's interaction pass). Every flag on is always correct, only slower.
+/// What a case holds, for the branches of the pair sums: the kernels leave out the terms of the
+/// kinds it lacks. With every kind's branches compiled in, the interaction pass ran 15–40 %
+/// slower on lavapipe (docs/performance.md, "Only the kinds a case has"), most likely from the
+/// larger kernel's code and registers: lanes already skip a branch that none of them takes.
+/// Every flag on is always correct, only slower.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Present {
     /// Elastic solid particles (`Kind::Solid`, `Kind::SolidClamped`).
