@@ -266,14 +266,16 @@ pub(super) fn resolve_wall_patches(
                     &format!("probe[{i}].point_m"),
                     Some(format!("{:?}", &patch.point[..dim])),
                     format!(
-                        "has no wall particle within radius_m = {} (or dx = {dx}) across the \
-                         normal and within dx behind it: a wall-pressure probe sums the fluid's \
-                         force on the wall particles behind a face (mirror walls have none)",
+                        "has no wall particle within radius_m = {} (or particles.dx_m = {dx}, \
+                         if larger) across the normal and within dx behind it: a wall-pressure \
+                         probe sums the fluid's force on the wall particles behind a face \
+                         (mirror walls have none)",
                         patch.radius
                     ),
                     "put point_m on the face of a particle wall (of the [tank] or an \
                      [[obstacle]], dynamic, fixed_ghost or repulsive) with normal pointing into \
-                     the fluid",
+                     the fluid; a wall that particles.dx_m leaves without particles there needs \
+                     a smaller particles.dx_m",
                 ));
             }
         }
