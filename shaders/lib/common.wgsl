@@ -54,7 +54,8 @@ struct Params {
     n_inlet_particles: u32,
     n_inlets: u32,
     n_outlets: u32,             // open_boundaries.wgsl
-    // Neighbour grid again: 1 when every cell has a slot of its own and no axis is periodic
+    // 1 when every cell has a slot of its own and no axis is periodic (`Grid::dense`):
+    // neighbour_ranges then takes a row of cells as one range.
     dense_grid: u32,
 }
 

@@ -12,8 +12,8 @@ fn neighbour_slots(c: vec3<i32>, slots: ptr<function, array<u32, 27>>) -> u32 {
             for (var dx = -1; dx <= 1; dx++) {
                 var cn = c + vec3<i32>(dx, dy, dz);
                 if (params.periodic != 0u) {
-                    let n = vec3<i32>(params.grid_cells);
-                    cn = select(cn, (cn + n) % n, periodic_axes());
+                    let cells = vec3<i32>(params.grid_cells);
+                    cn = select(cn, (cn + cells) % cells, periodic_axes());
                 }
                 let s = slot_of_cell(cn);
                 var seen = false;
