@@ -24,6 +24,7 @@
 //     dτ^ab/dt = 2μ(ε̇^ab − ⅓δ^ab ε̇^cc) + τ^ac Ω^bc + Ω^ac τ^cb.
 //   In 2D this is plane strain: ε̇_zz = 0 but ⅓ tr(ε̇) still enters τ_zz, which is stored (the
 //   deviator stays trace-free) and does not act on the in-plane momentum.
+// The material (ρs, c_s, μ, α, ε, particle mass m) is the body's, params.solid_materials.
 // Clamped particles get all three rates; integrate.wgsl keeps their position and velocity fixed
 // and integrates their density and stress (stress_predict / stress_correct below).
 
@@ -46,8 +47,8 @@ fn tau_of(s: SolidState) -> mat3x3<f32> {
 }
 
 // p = c_s² (ρ − ρs).
-fn solid_pressure(rho: f32) -> f32 {
-    return params.solid_c2 * (rho - params.solid_rho0);
+fn solid_pressure(mat: SolidMaterial, rho: f32) -> f32 {
+    return mat.c2 * (rho - mat.rho0);
 }
 
 // One Jacobi rotation of the symmetric `a` in the plane (p, q), zeroing a_pq, with the
@@ -91,8 +92,8 @@ fn jacobi_rotate(a: ptr<function, mat3x3<f32>>, v: ptr<function, mat3x3<f32>>, p
 // off-diagonal is at f32 rounding after three). In 2D σ_xz = σ_yz = 0 and one rotation in
 // the xy-plane is exact: GMS's closed form, tan 2θ = 2σ_xy/(σ_xx − σ_yy); R_zz does not act on
 // the in-plane momentum.
-fn artificial_stress(sigma: mat3x3<f32>, rho: f32) -> mat3x3<f32> {
-    if (params.solid_eps == 0.0) {
+fn artificial_stress(eps: f32, sigma: mat3x3<f32>, rho: f32) -> mat3x3<f32> {
+    if (eps == 0.0) {
         return mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     }
     var a = sigma;
@@ -106,7 +107,7 @@ fn artificial_stress(sigma: mat3x3<f32>, rho: f32) -> mat3x3<f32> {
             jacobi_rotate(&a, &v, 1u, 2u);
         }
     }
-    let k = -params.solid_eps / (rho * rho);
+    let k = -eps / (rho * rho);
     var r = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     for (var e = 0u; e < 3u; e++) {
         let n = v[e];
@@ -123,11 +124,12 @@ struct SolidParticle {
     rho: f32,
 }
 
-fn solid_particle(k: u32) -> SolidParticle {
+// Particle k, of material `mat` (its body's).
+fn solid_particle(k: u32, mat: SolidMaterial) -> SolidParticle {
     let rho = velrho[k].w;
-    let p = solid_pressure(rho);
+    let p = solid_pressure(mat, rho);
     let sigma = tau_of(solid[solid_slot(code[k])]) - mat3x3<f32>(vec3<f32>(p, 0.0, 0.0), vec3<f32>(0.0, p, 0.0), vec3<f32>(0.0, 0.0, p));
-    return SolidParticle(sigma * (1.0 / (rho * rho)), artificial_stress(sigma, rho), velrho[k].xyz, rho);
+    return SolidParticle(sigma * (1.0 / (rho * rho)), artificial_stress(mat.eps, sigma, rho), velrho[k].xyz, rho);
 }
 
 @compute @workgroup_size(WG)
@@ -138,11 +140,13 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     }
     let slot_i = solid_slot(code[i]);
     let body_i = solid[slot_i].body;
-    let pi = solid_particle(i);
+    // Pairs are within the body, so of one material.
+    let mat = material_of(solid[slot_i]);
+    let pi = solid_particle(i, mat);
     let p_i = pos[i];
     let support2 = 4.0 * params.h * params.h;
-    let m = params.solid_mass;
-    let c_s = sqrt(params.solid_c2);
+    let m = mat.mass;
+    let c_s = sqrt(mat.c2);
 
     var acc = vec3<f32>(0.0);
     var drho = 0.0;
@@ -161,14 +165,14 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
             }
             let q = sqrt(r2) / params.h;
             let dw_ij = x_ij * kernel_f(q);
-            let pj = solid_particle(j);
+            let pj = solid_particle(j, mat);
             let v_ij = pi.v - pj.v;
             drho += m * dot(v_ij, dw_ij);
             var pi_ij = 0.0;
             let vx = dot(v_ij, x_ij);
             if (vx < 0.0) {
                 let mu = params.h * vx / (r2 + params.eta2);
-                pi_ij = -params.solid_alpha * c_s * mu / (0.5 * (pi.rho + pj.rho));
+                pi_ij = -mat.alpha * c_s * mu / (0.5 * (pi.rho + pj.rho));
             }
             let fw = kernel_w(q) * params.solid_inv_w_dx;
             let fn4 = fw * fw * fw * fw;
@@ -187,7 +191,7 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     let tau = tau_of(solid[slot_i]);
     let tr3 = (eps[0].x + eps[1].y + eps[2].z) / 3.0;
     let iso = mat3x3<f32>(vec3<f32>(tr3, 0.0, 0.0), vec3<f32>(0.0, tr3, 0.0), vec3<f32>(0.0, 0.0, tr3));
-    let d = 2.0 * params.solid_mu * (eps - iso) + tau * transpose(omega) + omega * tau;
+    let d = 2.0 * mat.mu * (eps - iso) + tau * transpose(omega) + omega * tau;
     stress_rate[slot_i] = SymRate(vec4<f32>(d[0].x, d[1].y, d[2].z, 0.5 * (d[1].x + d[0].y)),
                              vec4<f32>(0.5 * (d[2].x + d[0].z), 0.5 * (d[2].y + d[1].z), 0.0, 0.0));
 }

@@ -168,23 +168,25 @@ fn interface_rates(b_i: f32, v_i: vec3<f32>, rho_i: f32, b_j: f32, v_j: vec3<f32
     return vec4<f32>(acc, drho);
 }
 
-// Contact between a solid particle (mass m_s) and a moving body's particle, which carries the
-// fluid's mass m_f (bodies.wgsl sums m_f × its rate): the pair force is 2 m_s m_f/(m_s + m_f)
-// times the law per unit mass, equal and opposite; this is the acceleration factor of the side
-// whose partner has mass `m_other` (m_f for the solid particle, m_s for the body's).
-fn solid_body_contact_weight(m_other: f32) -> f32 {
-    return 2.0 * m_other / (params.mass + params.solid_mass);
+// Contact between particles of masses m_a and m_b that are not both fixed: a solid particle
+// (its material's mass m_s) with a moving body's particle, which carries the fluid's mass m_f
+// (bodies.wgsl sums m_f × its rate), or with a particle of another elastic body. The pair force
+// is 2 m_a m_b/(m_a + m_b) times the law per unit mass, equal and opposite (1 × the law between
+// equal masses); this is the acceleration factor of the side whose partner has mass `m_other`.
+fn contact_weight(m_self: f32, m_other: f32) -> f32 {
+    return 2.0 * m_other / (m_self + m_other);
 }
 
 // Acceleration of solid particle i by everything outside its own elastic body: the fluid's load
 // (interface_rates) and contact (the repulsive law of the walls, `repulsion`) with boundary
 // particles (fixed walls, as for fluid; moving bodies' particles of any wall treatment, with
-// solid_body_contact_weight) and with the particles of other elastic bodies (one material:
-// equal masses).
+// contact_weight) and with the particles of other elastic bodies (contact_weight of the two
+// materials' masses).
 fn solid_loads(i: u32) -> vec3<f32> {
     let p_i = pos[i];
     let vr_i = velrho[i];
     let s_i = solid[solid_slot(code[i])];
+    let m_i = material_of(s_i).mass;
     let b_i = s_i.interface_p / (vr_i.w * vr_i.w);
     let body_i = s_i.body;
     let support2 = 4.0 * params.h * params.h;
@@ -209,11 +211,14 @@ fn solid_loads(i: u32) -> vec3<f32> {
             } else if (!is_solid(kind_j)) {
                 var k = 1.0;
                 if (is_body_particle(code[j] & ID_MASK)) {
-                    k = solid_body_contact_weight(params.mass);
+                    k = contact_weight(m_i, params.mass);
                 }
                 r += k * repulsion(x_ij, r2);
-            } else if (solid[solid_slot(code[j])].body != body_i) {
-                r += repulsion(x_ij, r2);
+            } else {
+                let s_j = solid[solid_slot(code[j])];
+                if (s_j.body != body_i) {
+                    r += contact_weight(m_i, material_of(s_j).mass) * repulsion(x_ij, r2);
+                }
             }
         }
     }
@@ -421,7 +426,8 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                     }
                 } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
                     // Contact with an elastic solid.
-                    r += vec4<f32>(solid_body_contact_weight(params.solid_mass) * repulsion(x_ij, r2), 0.0);
+                    let m_j = material_of(solid[solid_slot(code[j])]).mass;
+                    r += vec4<f32>(contact_weight(params.mass, m_j) * repulsion(x_ij, r2), 0.0);
                 } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, code[j] & ID_MASK)) {
                     // Contact with a fixed wall or another body.
                     r += vec4<f32>(repulsion(x_ij, r2), 0.0);
@@ -434,8 +440,9 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             }
             if (is_solid(kind_j)) {
                 let vr_j = velrho[j];
-                let b_j = solid[solid_slot(code[j])].interface_p / (vr_j.w * vr_j.w);
-                r += interface_rates(pi.p_over_rho2, pi.v, pi.rho, b_j, vr_j.xyz, vr_j.w, params.solid_mass, x_ij, r2);
+                let s_j = solid[solid_slot(code[j])];
+                let b_j = s_j.interface_p / (vr_j.w * vr_j.w);
+                r += interface_rates(pi.p_over_rho2, pi.v, pi.rho, b_j, vr_j.xyz, vr_j.w, material_of(s_j).mass, x_ij, r2);
                 continue;
             }
             let vr_j = velrho[j];

@@ -32,11 +32,8 @@
 struct TlParams {
     n: u32,
     first_id: u32,
-    lambda: f32,
-    mu: f32,
     k2: f32,       // dx²/12
-    inv_rho0: f32,
-    pad: vec2<u32>,
+    pad: u32,
 }
 
 // One entry of particle i's reference list (w_ij, w_ji = V γ; d0 = X_j − X_i).
@@ -61,6 +58,9 @@ struct TlPair {
 @group(0) @binding(8) var<storage, read_write> tl_h: array<mat3x3<f32>>;
 @group(0) @binding(9) var<storage, read_write> tl_t: array<mat3x3<f32>>;
 @group(0) @binding(10) var<storage, read_write> tl_p: array<mat3x3<f32>>;
+// The solid state, for the material of TL particle k (solid[k]: TL and solid indices agree;
+// λ, G and ρ0 of params.solid_materials, per body).
+@group(0) @binding(11) var<storage, read> solid: array<SolidState>;
 
 fn zero3() -> mat3x3<f32> {
     return mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
@@ -80,9 +80,9 @@ fn green(h: mat3x3<f32>) -> mat3x3<f32> {
     return 0.5 * (h + transpose(h) + transpose(h) * h);
 }
 
-// λ tr M I + 2G M.
-fn svk(m: mat3x3<f32>) -> mat3x3<f32> {
-    return (tlp.lambda * (m[0].x + m[1].y + m[2].z)) * identity3() + (2.0 * tlp.mu) * m;
+// λ tr M I + 2G M, of material `mat`.
+fn svk(mat: SolidMaterial, m: mat3x3<f32>) -> mat3x3<f32> {
+    return (mat.lambda * (m[0].x + m[1].y + m[2].z)) * identity3() + (2.0 * mat.mu) * m;
 }
 
 @compute @workgroup_size(WG)
@@ -131,9 +131,10 @@ fn tl_gradient(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         d1 += de * p.w_ij.y;
         d2 += de * p.w_ij.z;
     }
-    tl_t[3u * k] = tlp.k2 * svk(d0);
-    tl_t[3u * k + 1u] = tlp.k2 * svk(d1);
-    tl_t[3u * k + 2u] = tlp.k2 * svk(d2);
+    let mat = material_of(solid[k]);
+    tl_t[3u * k] = tlp.k2 * svk(mat, d0);
+    tl_t[3u * k + 1u] = tlp.k2 * svk(mat, d1);
+    tl_t[3u * k + 2u] = tlp.k2 * svk(mat, d2);
 }
 
 @compute @workgroup_size(WG)
@@ -153,7 +154,7 @@ fn tl_stress(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     }
     s2 -= tl_t[3u * k] * w_sum.x + tl_t[3u * k + 1u] * w_sum.y + tl_t[3u * k + 2u] * w_sum.z;
     let h = tl_h[k];
-    tl_p[k] = (identity3() + h) * (svk(green(h)) + s2);
+    tl_p[k] = (identity3() + h) * (svk(material_of(solid[k]), green(h)) + s2);
 }
 
 @compute @workgroup_size(WG)
@@ -169,5 +170,5 @@ fn tl_accel(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
         f += p_i * p.w_ij - tl_p[p.j] * p.w_ji;
     }
     let i = tl_slot[k];
-    rate[i] += vec4<f32>(f * tlp.inv_rho0 + params.gravity, 0.0);
+    rate[i] += vec4<f32>(f / material_of(solid[k]).rho0 + params.gravity, 0.0);
 }

@@ -133,7 +133,7 @@ pub fn fingerprint(sc: &Scenario) -> u64 {
         h.update(format!("|{:?}|{:?}", sc.inlets, sc.outlets).as_bytes());
     }
     if let Some(solids) = &sc.solids {
-        h.update(format!("|{:?}", solids.material).as_bytes());
+        h.update(format!("|{:?}", solids.materials).as_bytes());
         for (body, tau) in solids.body.iter().zip(&solids.tau0) {
             h.update(&body.to_le_bytes());
             for x in tau {

@@ -39,14 +39,9 @@ pub struct Params {
     /// Id of the first body particle (bodies' particles come last); n_particles without bodies.
     pub body_id_base: u32,
     pub n_body_particles: u32,
-    /// Elastic solid (zeros without solids): reference density ρs, c_s², shear modulus μ,
-    /// particle mass, artificial viscosity α, artificial stress ε, 1/W(Δp).
-    pub solid_rho0: f32,
-    pub solid_c2: f32,
-    pub solid_mu: f32,
-    pub solid_mass: f32,
-    pub solid_alpha: f32,
-    pub solid_eps: f32,
+    /// Elastic solids (zeros without solids): the fastest P-wave speed of their materials (for
+    /// the time step), 1/W(Δp), the first solid particle's id.
+    pub solid_p_speed: f32,
     pub solid_inv_w_dx: f32,
     pub solid_id_base: u32,
     /// Inlets: the ids of their particles, inlet after inlet, and how many inlets.
@@ -56,13 +51,41 @@ pub struct Params {
     pub n_outlets: u32,
     /// 1 when every cell has a slot of its own and no axis is periodic (`Grid::dense`).
     pub dense_grid: u32,
-    /// WGSL rounds the struct up to its 16-byte alignment.
-    pub pad: [u32; 3],
+    /// The distinct materials of the elastic solids; a solid particle's is
+    /// `SolidState::material`.
+    pub solid_materials: [SolidMaterial; MAX_SOLID_MATERIALS],
+}
+
+/// How many different solid materials a case may hold (the length of
+/// `Params::solid_materials`; `MAX_SOLID_MATERIALS` in shaders/lib/common.wgsl).
+pub const MAX_SOLID_MATERIALS: usize = 8;
+
+/// Mirrors `SolidMaterial` in shaders/lib/common.wgsl: one elastic material as the kernels use
+/// it (Gray, Monaghan & Swift 2001; Lamé's λ for the total-Lagrangian solid).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct SolidMaterial {
+    /// Reference density ρs [kg/m³].
+    pub rho0: f32,
+    /// c_s² = K/ρs [m²/s²].
+    pub c2: f32,
+    /// Shear modulus μ [Pa].
+    pub mu: f32,
+    /// Particle mass ρs Δp^d [kg].
+    pub mass: f32,
+    /// Monaghan artificial viscosity α between solid particles.
+    pub alpha: f32,
+    /// Artificial stress ε (Monaghan 2000).
+    pub eps: f32,
+    /// Lamé's λ = K − 2μ/3 [Pa].
+    pub lambda: f32,
+    pub pad: f32,
 }
 
 /// Mirrors `SolidState` in shaders/lib/common.wgsl: the deviatoric stress τ of a solid particle
-/// (xx, yy, zz, xy | xz, yz) [Pa], its elastic body, dτ/dt of the last evaluation, and the
-/// fluid pressure interpolated at it (what the fluid sees of the solid) [Pa].
+/// (xx, yy, zz, xy | xz, yz) [Pa], its elastic body, dτ/dt of the last evaluation, the
+/// fluid pressure interpolated at it (what the fluid sees of the solid) [Pa] and its material
+/// (an index in `Params::solid_materials`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct SolidState {
@@ -72,7 +95,7 @@ pub struct SolidState {
     pub rate_a: [f32; 4],
     pub rate_b: [f32; 2],
     pub interface_p: f32,
-    pub pad: f32,
+    pub material: u32,
 }
 
 /// Mirrors `SymRate`: dτ/dt (xx, yy, zz, xy | xz, yz, 0, 0) [Pa/s].
@@ -218,18 +241,15 @@ pub struct OutletDef {
 }
 
 /// Mirrors `TlParams` in shaders/total_lagrangian.wgsl: the total-Lagrangian solid's
-/// particle count and first particle id (its particles have consecutive ids), Lamé's λ, the
-/// shear modulus G, the cell quadrature factor dx²/12 and 1/ρ0.
+/// particle count and first particle id (its particles have consecutive ids) and the cell
+/// quadrature factor dx²/12 (the materials are `Params::solid_materials`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct TlParams {
     pub n: u32,
     pub first_id: u32,
-    pub lambda: f32,
-    pub mu: f32,
     pub k2: f32,
-    pub inv_rho0: f32,
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 
 /// Mirrors `TlPair` in shaders/total_lagrangian.wgsl: one entry of particle i's fixed
@@ -328,20 +348,26 @@ mod tests {
                 repulsive_k_over_beta,
                 body_id_base,
                 n_body_particles,
-                solid_rho0,
-                solid_c2,
-                solid_mu,
-                solid_mass,
-                solid_alpha,
-                solid_eps,
+                solid_p_speed,
                 solid_inv_w_dx,
                 solid_id_base,
                 inlet_id_base,
                 n_inlet_particles,
                 n_inlets,
                 n_outlets,
-                dense_grid
+                dense_grid,
+                solid_materials
             ]
+        );
+        check_layout!(
+            Pass::Interaction,
+            "SolidMaterial",
+            SolidMaterial,
+            [rho0, c2, mu, mass, alpha, eps, lambda, pad]
+        );
+        assert_eq!(
+            wgsl_u32(Pass::Interaction, "MAX_SOLID_MATERIALS") as usize,
+            MAX_SOLID_MATERIALS
         );
     }
 
@@ -351,7 +377,7 @@ mod tests {
             Pass::Elastic,
             "SolidState",
             SolidState,
-            [tau_a, tau_b, body, rate_a, rate_b, interface_p, pad]
+            [tau_a, tau_b, body, rate_a, rate_b, interface_p, material]
         );
         check_layout!(Pass::Elastic, "SymRate", SymRate, [a, b]);
     }
@@ -362,7 +388,7 @@ mod tests {
             Pass::TotalLagrangian,
             "TlParams",
             TlParams,
-            [n, first_id, lambda, mu, k2, inv_rho0, pad]
+            [n, first_id, k2, pad]
         );
         check_layout!(
             Pass::TotalLagrangian,

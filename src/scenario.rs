@@ -530,19 +530,70 @@ impl ElasticMaterial {
     pub fn sound_speed(&self) -> f64 {
         (self.bulk_modulus() / self.density).sqrt()
     }
+
+    /// P-wave speed c_p = sqrt((K + 4μ/3)/ρs) [m/s], the solid's fastest wave.
+    pub fn p_wave_speed(&self) -> f64 {
+        ((self.bulk_modulus() + 4.0 / 3.0 * self.shear_modulus()) / self.density).sqrt()
+    }
+
+    /// Mass of a particle of this material at spacing `dx` in `dim` dimensions [kg].
+    pub fn particle_mass(&self, dx: f64, dim: u32) -> f64 {
+        self.density * dx.powi(dim as i32)
+    }
 }
 
-/// The solid particles of a case: one material, several bodies (solid particles interact only
-/// within their body).
+/// The solid particles of a case: several bodies (solid particles interact only within their
+/// body), each of its own material, all of one formulation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Solids {
-    pub material: ElasticMaterial,
+    /// The material of every elastic body, indexed by body (`[[solid]]` order); their
+    /// `formulation`s are equal.
+    pub materials: Vec<ElasticMaterial>,
     /// Elastic body of every particle, indexed like `Scenario::particles` (read for solid
     /// kinds only).
     pub body: Vec<u32>,
     /// Initial deviatoric stress τ (xx, yy, zz, xy, xz, yz) of every particle [Pa] (read for
     /// solid kinds only).
     pub tau0: Vec<[f64; 6]>,
+}
+
+impl Solids {
+    /// The formulation of every solid of the case.
+    pub fn formulation(&self) -> SolidFormulation {
+        self.materials[0].formulation
+    }
+
+    /// The material of particle `i` (a solid particle).
+    pub fn material_of(&self, i: usize) -> &ElasticMaterial {
+        &self.materials[self.body[i] as usize]
+    }
+
+    /// The distinct materials, in order of first appearance, and the index in that list of
+    /// every body's material (what the GPU stores: `Params::solid_materials`).
+    pub fn distinct_materials(&self) -> (Vec<ElasticMaterial>, Vec<u32>) {
+        let mut distinct: Vec<ElasticMaterial> = Vec::new();
+        let index = self
+            .materials
+            .iter()
+            .map(|m| match distinct.iter().position(|d| d == m) {
+                Some(k) => k as u32,
+                None => {
+                    distinct.push(*m);
+                    distinct.len() as u32 - 1
+                }
+            })
+            .collect();
+        (distinct, index)
+    }
+
+    /// The fastest P-wave speed c_p = sqrt((K + 4μ/3)/ρs) of the materials [m/s], which the
+    /// time step uses for every solid particle.
+    pub fn max_p_wave_speed(&self) -> f64 {
+        self.materials
+            .iter()
+            .map(ElasticMaterial::p_wave_speed)
+            .fold(0.0, f64::max)
+    }
 }
 
 /// A rigid set of boundary particles that moves as one: a free body (floating box, falling

@@ -1,7 +1,7 @@
 //! Layer 1 for elastic solids: the GPU elastic pass (dρ/dt, dv/dt, dτ/dt) against the f64
 //! reference (src/reference/elastic.rs) on jittered solid particle sets with random
-//! velocities, densities and stresses, two bodies (no pairs across them) and a clamped strip,
-//! 2D and 3D. The outputs are poisoned with NaN before the kernel runs, so a solid particle the
+//! velocities, densities and stresses, two bodies of different materials (no pairs across
+//! them) and a clamped strip, 2D and 3D. The outputs are poisoned with NaN before the kernel runs, so a solid particle the
 //! kernel skips fails.
 
 // Component loops written as in the equations read better than iterator chains here.
@@ -26,11 +26,28 @@ fn material() -> ElasticMaterial {
     }
 }
 
-/// A jittered solid with random velocities (two bodies side by side, a clamped strip) of
-/// `mat`: of the updated-Lagrangian formulation also with random stresses and densities (and g
-/// along −y); of the total-Lagrangian one at rest density and stress free (its state is F).
+/// A second material beside `mat`, of its formulation: denser, stiffer, another Poisson ratio
+/// and (updated-Lagrangian) other artificial viscosity and stress, so that a kernel that reads
+/// the wrong body's material fails.
+fn other_material(mat: ElasticMaterial) -> ElasticMaterial {
+    let ul = mat.formulation == SolidFormulation::UpdatedLagrangian;
+    ElasticMaterial {
+        density: 1.7 * mat.density,
+        youngs_modulus: 3.0 * mat.youngs_modulus,
+        poisson_ratio: 0.3,
+        alpha: if ul { 0.2 } else { 0.0 },
+        artificial_stress: if ul { 0.15 } else { 0.0 },
+        formulation: mat.formulation,
+    }
+}
+
+/// A jittered solid with random velocities (two bodies side by side, the lower of `mat`, the
+/// upper of `other_material(mat)`; a clamped strip): of the updated-Lagrangian formulation also
+/// with random stresses and densities (and g along −y); of the total-Lagrangian one at rest
+/// density and stress free (its state is F).
 fn random_solid(dim: u32, kernel: KernelKind, seed: u64, mat: ElasticMaterial) -> Scenario {
     let ul = mat.formulation == SolidFormulation::UpdatedLagrangian;
+    let mats = [mat, other_material(mat)];
     let dx = 0.01;
     let mut ph = physics(dim, dx, 20.0);
     ph.kernel = kernel;
@@ -50,7 +67,11 @@ fn random_solid(dim: u32, kernel: KernelKind, seed: u64, mat: ElasticMaterial) -
     for p in lattice(dim, dx, min, max) {
         let (mut pos, vel) = rng.jittered(dim, p, 0.2, dx);
         let mut t = [0.0; 6];
-        let mut rho = mat.density;
+        // Two bodies side by side: no pair across the line y = centre. The upper one sits
+        // 0.5 dx higher, so that no two particles across are within the contact law's reach
+        // r0 = dx (1.1 dx apart at least) but all are within the kernel's 2h.
+        let upper = p[1] > min[1] + 0.5 * side;
+        let mut rho = mats[upper as usize].density;
         if ul {
             for c in 0..6 {
                 // 2D: only xx, yy, zz, xy.
@@ -61,10 +82,6 @@ fn random_solid(dim: u32, kernel: KernelKind, seed: u64, mat: ElasticMaterial) -
             rho *= 1.0 + rng.range(-0.01, 0.01);
         }
         let clamped = p[0] < min[0] + 2.0 * dx;
-        // Two bodies side by side: no pair across the line y = centre. The upper one sits
-        // 0.5 dx higher, so that no two particles across are within the contact law's reach
-        // r0 = dx (1.1 dx apart at least) but all are within the kernel's 2h.
-        let upper = p[1] > min[1] + 0.5 * side;
         if upper {
             pos[1] += 0.5 * dx;
         }
@@ -81,7 +98,7 @@ fn random_solid(dim: u32, kernel: KernelKind, seed: u64, mat: ElasticMaterial) -
         body.push(upper as u32);
         tau0.push(t);
     }
-    with_solids(ph, parts, mat, body, tau0)
+    with_solids(ph, parts, mats.to_vec(), body, tau0)
 }
 
 /// The test scenario of `parts` in the domain these tests use (0.4 m square in 2D, 0.3 m cube
@@ -89,7 +106,7 @@ fn random_solid(dim: u32, kernel: KernelKind, seed: u64, mat: ElasticMaterial) -
 fn with_solids(
     ph: Physics,
     parts: Vec<Particle>,
-    material: ElasticMaterial,
+    materials: Vec<ElasticMaterial>,
     body: Vec<u32>,
     tau0: Vec<[f64; 6]>,
 ) -> Scenario {
@@ -100,7 +117,7 @@ fn with_solids(
     };
     let mut sc = scenario(ph, parts, Domain { min: [0.0; 3], max }, vec![]);
     sc.solids = Some(Solids {
-        material,
+        materials,
         body,
         tau0,
     });
@@ -173,19 +190,16 @@ fn elastic_rates_match_reference() {
             &solver.read_stress_rates().unwrap(),
             SymRate::default(),
         );
-        let cpu = elastic::rates(
-            &sc.physics,
-            &sc.solids.as_ref().unwrap().material,
-            &Space::of(&sc),
-            &parts,
-            &solid,
-        );
+        let mats = &sc.solids.as_ref().unwrap().materials;
+        let cpu = elastic::rates(&sc.physics, mats, &Space::of(&sc), &parts, &solid);
         let cpu: Vec<_> = cpu.into_iter().map(|c| c.expect("all solid")).collect();
         let acc_rms = rms(cpu.iter().flat_map(|c| c.rate[..3].to_vec()));
         // The artificial stress (ε = 0.3) must be a visible part of what is compared: the
         // random stresses have tensile principal parts.
-        let mut without = sc.solids.as_ref().unwrap().material;
-        without.artificial_stress = 0.0;
+        let mut without = mats.clone();
+        for m in &mut without {
+            m.artificial_stress = 0.0;
+        }
         let cpu0 = elastic::rates(&sc.physics, &without, &Space::of(&sc), &parts, &solid);
         let as_rms = rms(cpu.iter().zip(&cpu0).flat_map(|(c, c0)| {
             let c0 = c0.expect("all solid");
@@ -229,18 +243,24 @@ fn elastic_rates_match_reference() {
 
 /// Two elastic bodies side by side on a floor of dynamic wall particles, beside a rigid body
 /// (dynamic particles, free), each 0.8 dx (±0.1 dx of jitter) from the next: within the
-/// repulsive law's reach r0 = dx. The solid is denser than the fluid's particle mass that body
-/// particles carry, so the contact weights differ from 1.
+/// repulsive law's reach r0 = dx. The solids are of two materials, both denser than the
+/// fluid's particle mass that body particles carry, so every contact weight differs from 1.
 fn solids_in_contact(dim: u32, seed: u64) -> Scenario {
     let dx = 0.01;
     let mut ph = physics(dim, dx, 20.0);
     ph.gravity = [0.0; 3];
     let up = dim as usize - 1;
     let mut rng = Rng(seed);
-    let mat = ElasticMaterial {
-        density: 2500.0,
-        ..material()
-    };
+    let mats = [
+        ElasticMaterial {
+            density: 2500.0,
+            ..material()
+        },
+        other_material(ElasticMaterial {
+            density: 2500.0,
+            ..material()
+        }),
+    ];
     // Boxes along x from `x0` to `x1`, `y0` to `y0 + height` in the up direction; 0.06 deep in 3D.
     let block = |x0: f64, x1: f64, y0: f64, height: f64| {
         let (mut lo, mut hi) = ([0.1; 3], [0.16; 3]);
@@ -278,7 +298,7 @@ fn solids_in_contact(dim: u32, seed: u64) -> Scenario {
             parts.push(Particle {
                 pos,
                 vel,
-                rho: mat.density,
+                rho: mats[k].density,
                 kind: Kind::Solid,
             });
             body.push(k as u32);
@@ -306,7 +326,7 @@ fn solids_in_contact(dim: u32, seed: u64) -> Scenario {
     body.resize(parts.len(), 0);
     tau0.resize(parts.len(), [0.0; 6]);
     let mass = 1000.0 * dx.powi(dim as i32) * n;
-    let mut sc = with_solids(ph, parts, mat, body, tau0);
+    let mut sc = with_solids(ph, parts, mats.to_vec(), body, tau0);
     sc.bodies = vec![Body {
         name: "rigid".into(),
         particles: start..sc.particles.len(),
@@ -336,11 +356,11 @@ fn solid_contact_matches_reference() {
     for dim in [2, 3] {
         let sc = solids_in_contact(dim, 40 + dim as u64);
         let ph = &sc.physics;
-        let mat = sc.solids.as_ref().unwrap().material;
+        let mats = &sc.solids.as_ref().unwrap().materials;
         let (_solver, parts, solid, gpu_rate) = rerun(&sc);
         let space = Space::of(&sc);
-        let solids = elastic::rates(ph, &mat, &space, &parts, &solid);
-        let contact = elastic::contact_rates(ph, &mat, &sc.walls, &space, &parts, &solid);
+        let solids = elastic::rates(ph, mats, &space, &parts, &solid);
+        let contact = elastic::contact_rates(ph, mats, &sc.walls, &space, &parts, &solid);
         let boundary = wgsph::reference::interaction::rates(ph, &sc.walls, &space, &parts);
         let mut groups: [Vec<(usize, [f64; 3])>; 4] = Default::default();
         for i in 0..parts.len() {
@@ -433,7 +453,7 @@ fn fluid_on_solid(dim: u32, kernel: KernelKind, viscosity: Viscosity, seed: u64)
         tau0.push(t);
     }
     let body = vec![0; parts.len()];
-    with_solids(ph, parts, mat, body, tau0)
+    with_solids(ph, parts, vec![mat], body, tau0)
 }
 
 /// Layer 1 for the fluid–solid coupling: every particle's (dv/dt, dρ/dt) on the GPU (the solids'
@@ -467,7 +487,7 @@ fn fluid_solid_interface_matches_reference() {
         let mut sc = fluid_on_solid(dim, kernel, viscosity, 5 + dim as u64);
         sc.walls.ghost_correction = correction;
         let ph = &sc.physics;
-        let mat = sc.solids.as_ref().unwrap().material;
+        let mats = &sc.solids.as_ref().unwrap().materials;
         let (_solver, parts, solid, gpu_rate) = rerun(&sc);
         let space = Space::of(&sc);
         let fluid = wgsph::reference::interaction::rates(ph, &sc.walls, &space, &parts);
@@ -480,8 +500,8 @@ fn fluid_solid_interface_matches_reference() {
             on_solid.iter().any(|p| p.abs() > 100.0),
             "the interface pressures are all small: {on_solid:?}"
         );
-        let interface = elastic::interface_rates(ph, &mat, &space, &parts, &p_g);
-        let solids = elastic::rates(ph, &mat, &space, &parts, &solid);
+        let interface = elastic::interface_rates(ph, mats, &space, &parts, &solid, &p_g);
+        let solids = elastic::rates(ph, mats, &space, &parts, &solid);
         let cpu: Vec<[f64; 4]> = (0..parts.len())
             .map(|i| {
                 let s = solids[i].map_or([0.0; 4], |s| s.rate);
@@ -507,7 +527,7 @@ fn fluid_solid_interface_matches_reference() {
             e_rho = e_rho.max((g[3] as f64 - c[3]).abs() / rho_rms);
         }
         // Momentum: Σ m (a − g) against Σ m |a − g|.
-        let solid_mass = mat.density * ph.dx.powi(dim as i32);
+        let solid_mass = mats[0].particle_mass(ph.dx, dim);
         let (mut total, mut scale) = ([0.0f64; 3], 0.0f64);
         for (p, g) in parts.iter().zip(&gpu_rate) {
             let m = if p.kind == 0 {
@@ -572,8 +592,8 @@ fn total_lagrangian_rates_match_reference() {
             x[k] = parts[i].pos;
             slot[k] = i;
         }
-        let m = &sc.solids.as_ref().unwrap().material;
-        let cpu = total_lagrangian::accelerations(&setup, &sc.physics, m, &x);
+        let mats = &sc.solids.as_ref().unwrap().materials;
+        let cpu = total_lagrangian::accelerations(&setup, &sc.physics, mats, &x);
         let d = dim as usize;
         let acc_rms = rms(cpu.iter().flat_map(|a| a[..d].to_vec()));
         let mut moved = 0.0f64;
@@ -603,7 +623,7 @@ fn total_lagrangian_rates_match_reference() {
         assert!(err < 5e-5, "acceleration error {err}");
 
         // The particle outputs: Cauchy stress σ = P Fᵀ/J as τ and p, and ρ = ρs/J.
-        let want = total_lagrangian::cauchy(&setup, &sc.physics, m, &x);
+        let want = total_lagrangian::cauchy(&setup, &sc.physics, mats, &x);
         let out = solver.read_particles().unwrap();
         let stress = out
             .stress
@@ -629,7 +649,8 @@ fn total_lagrangian_rates_match_reference() {
                     e_sigma = e_sigma.max((got[a][b] - s[a][b]).abs() / scale);
                 }
             }
-            e_rho = e_rho.max((out.rho[i] as f64 * j / m.density - 1.0).abs());
+            let rho_s = mats[setup.body[k] as usize].density;
+            e_rho = e_rho.max((out.rho[i] as f64 * j / rho_s - 1.0).abs());
         }
         println!(
             "TL {dim}D {kernel:?}: output σ error {e_sigma:.1e} (RMS {sigma_rms:.3e} Pa), \
@@ -655,15 +676,19 @@ fn total_lagrangian_conserves_energy() {
         sc.physics.gravity = [0.0; 3];
         sc.time.cfl = 0.05;
         let (range, setup) = wgsph::sph::total_lagrangian::setup(&sc).unwrap();
-        let m = sc.solids.as_ref().unwrap().material;
-        let mass = m.density * sc.physics.dx.powi(dim as i32);
+        let solids = sc.solids.as_ref().unwrap();
+        let mats = &solids.materials;
         let total = |pos: &[[f64; 3]], vel: &[[f64; 3]]| -> (f64, f64) {
             let x: Vec<[f64; 3]> = pos[range.clone()].to_vec();
-            let ke: f64 = vel[range.clone()]
-                .iter()
-                .map(|v| 0.5 * mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
+            let ke: f64 = range
+                .clone()
+                .map(|i| {
+                    let (m, v) = (solids.material_of(i), vel[i]);
+                    0.5 * m.particle_mass(sc.physics.dx, dim)
+                        * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+                })
                 .sum();
-            (ke, total_lagrangian::energy(&setup, &sc.physics, &m, &x))
+            (ke, total_lagrangian::energy(&setup, &sc.physics, mats, &x))
         };
         let pos0: Vec<[f64; 3]> = sc.particles.iter().map(|p| p.pos).collect();
         let vel0: Vec<[f64; 3]> = sc.particles.iter().map(|p| p.vel).collect();

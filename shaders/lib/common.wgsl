@@ -40,13 +40,8 @@ struct Params {
     // Bodies: their particles have the ids body_id_base .. body_id_base + n_body_particles
     body_id_base: u32,          // n_particles when there are no bodies
     n_body_particles: u32,
-    // Elastic solid (Gray, Monaghan & Swift 2001); zeros when the case has no solids
-    solid_rho0: f32,            // reference density ρs [kg/m³]
-    solid_c2: f32,              // c_s² = K/ρs [m²/s²]
-    solid_mu: f32,              // shear modulus μ [Pa]
-    solid_mass: f32,            // solid particle mass [kg]
-    solid_alpha: f32,           // Monaghan artificial viscosity α between solid particles
-    solid_eps: f32,             // artificial stress ε (Monaghan 2000)
+    // Elastic solids (Gray, Monaghan & Swift 2001); zeros when the case has no solids
+    solid_p_speed: f32,         // the fastest P-wave speed of their materials [m/s] (time step)
     solid_inv_w_dx: f32,        // 1/W(Δp), Δp the initial spacing
     solid_id_base: u32,         // the first solid particle's id (solid ids are consecutive)
     // Inlets (open_boundaries.wgsl): their particles have the ids inlet_id_base .. + n_inlet_particles
@@ -57,6 +52,23 @@ struct Params {
     // 1 when every cell has a slot of its own and no axis is periodic (`Grid::dense`):
     // neighbour_ranges then takes a row of cells as one range.
     dense_grid: u32,
+    // The distinct materials of the solids; a solid particle's is SolidState.material.
+    solid_materials: array<SolidMaterial, MAX_SOLID_MATERIALS>,
+}
+
+// Mirrored by `layout::MAX_SOLID_MATERIALS`.
+const MAX_SOLID_MATERIALS: u32 = 8u;
+
+// One elastic material. Mirrored by `layout::SolidMaterial`.
+struct SolidMaterial {
+    rho0: f32,                  // reference density ρs [kg/m³]
+    c2: f32,                    // c_s² = K/ρs [m²/s²]
+    mu: f32,                    // shear modulus μ [Pa]
+    mass: f32,                  // particle mass [kg]
+    alpha: f32,                 // Monaghan artificial viscosity α between solid particles
+    eps: f32,                   // artificial stress ε (Monaghan 2000)
+    lambda: f32,                // Lamé's λ = K − 2μ/3 [Pa] (total-Lagrangian solid)
+    pad: f32,
 }
 
 // Time-stepping state that lives on the GPU; read back once per batch of steps.
@@ -148,8 +160,9 @@ fn is_repulsive(kind: u32) -> bool {
 // Per solid particle, indexed by solid_slot (id order, untouched by the sort, so only solid
 // particles pay for it): deviatoric stress τ = (xx, yy, zz, xy | xz, yz) [Pa],
 // its elastic body, dτ/dt of the last evaluation (for the corrector: xx, yy, zz, xy | xz, yz),
-// and the fluid pressure interpolated at it this step (ghost.wgsl), which is what the fluid
-// sees of the solid. Mirrored by `layout::SolidState`.
+// the fluid pressure interpolated at it this step (ghost.wgsl), which is what the fluid
+// sees of the solid, and its material (an index in params.solid_materials). Mirrored by
+// `layout::SolidState`.
 struct SolidState {
     tau_a: vec4<f32>,
     tau_b: vec3<f32>,
@@ -157,7 +170,7 @@ struct SolidState {
     rate_a: vec4<f32>,
     rate_b: vec2<f32>,
     interface_p: f32,
-    pad: f32,
+    material: u32,
 }
 
 // dτ/dt as written by the elastic pass: (xx, yy, zz, xy | xz, yz, 0, 0). Mirrored by
@@ -178,6 +191,11 @@ fn code_kind(code: u32) -> u32 {
 // Index of a solid particle (its code word) in the solid arrays: id − params.solid_id_base.
 fn solid_slot(code: u32) -> u32 {
     return (code & ID_MASK) - params.solid_id_base;
+}
+
+// The material of a solid particle.
+fn material_of(s: SolidState) -> SolidMaterial {
+    return params.solid_materials[s.material];
 }
 
 fn with_kind(code: u32, kind: u32) -> u32 {

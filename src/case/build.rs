@@ -5,8 +5,8 @@
 use std::collections::HashSet;
 
 use crate::scenario::{
-    Body, Domain, Kind, MirrorPlane, Motion, Particle, Physics, ProbeKind, Scenario, Solids,
-    WallParams,
+    Body, Domain, Kind, MirrorPlane, Motion, Particle, Physics, ProbeKind, RepulsiveForm, Scenario,
+    Solids, WallParams,
 };
 
 use super::bodies::Shape;
@@ -14,7 +14,7 @@ use super::error::{num, CaseError};
 use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
 use super::limits;
 use super::locate::Ctx;
-use super::validate::{Aabb, Case, Sound, Treatment};
+use super::validate::{Aabb, Case, Sound, Treatment, WallSettings};
 
 /// Tolerance for "inside" tests of user boxes [m].
 const TOL: f64 = 1e-9;
@@ -220,12 +220,12 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         max_particles,
     )?;
     let wall = tank.map(|(_, n)| wall_of(n));
-    // Elastic solids in the fluid: their particles, bodies and material, within what is left
+    // Elastic solids in the fluid: their particles, bodies and materials, within what is left
     // of the budget; and the box of each solid's particles.
     let elastic = if case.solids.is_empty() {
         None
     } else {
-        let (material, parts, body) =
+        let (materials, parts, body) =
             super::solids::solid_particles(ctx, &case.solids, dim, dx, max_particles - total)?;
         let mut extents = vec![
             Aabb {
@@ -241,7 +241,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
                 e.max[a] = e.max[a].max(p.pos[a]);
             }
         }
-        Some((material, parts, body, extents))
+        Some((materials, parts, body, extents))
     };
 
     let domain = domain(ctx, &case, &lat, wall.as_ref())?;
@@ -252,7 +252,11 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         // Without fluid c0 is unused (the solids have their own sound speed); that one keeps
         // the checks below meaningful.
         _ if case.blocks.is_empty() && case.inlets.is_empty() => {
-            elastic.as_ref().map_or(1.0, |e| e.0.sound_speed())
+            elastic.as_ref().map_or(1.0, |e| {
+                e.0.iter()
+                    .map(crate::scenario::ElasticMaterial::sound_speed)
+                    .fold(0.0, f64::max)
+            })
         }
         Sound::Speed(c) => c,
         Sound::Coef(k) => {
@@ -497,7 +501,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
 
     // Elastic solids after the fixed walls (bodies come last), each particle inside the domain.
     let mut solids_of_particles = None;
-    if let Some((material, mut parts, body, _)) = elastic {
+    if let Some((materials, mut parts, body, _)) = elastic {
         if let Some((p, &b)) = parts.iter().zip(&body).find(|(p, _)| {
             !(0..dim).all(|a| domain.min[a] <= p.pos[a] && p.pos[a] <= domain.max[a])
         }) {
@@ -517,7 +521,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         let mut of_particle = vec![0; start];
         of_particle.extend(body);
         particles.append(&mut parts);
-        solids_of_particles = Some((material, of_particle));
+        solids_of_particles = Some((materials, of_particle));
     }
 
     let mut bodies = Vec::with_capacity(case.bodies.len() + 1);
@@ -627,19 +631,13 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         energy: case.energy,
     };
     let g = case.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
-    let mut walls = WallParams::defaults(dx, highest_column(&particles, dim, dx), g);
-    walls.ghost_correction = case.walls.ghost_correction;
-    if let Some(d) = case.walls.repulsive_d {
-        walls.repulsive_d = d;
-    }
-    if let Some(r0) = case.walls.repulsive_r0 {
-        walls.repulsive_r0 = r0;
-    }
-    walls.repulsive_form = case.walls.repulsive_form;
-    if let Some(k) = case.walls.repulsive_k {
-        walls.repulsive_k = k;
-    }
-    walls.repulsive_beta = case.walls.repulsive_beta;
+    // The repulsive law acts on repulsive walls, on bodies and on solids (contact).
+    let contact = !bodies.is_empty()
+        || particles
+            .iter()
+            .any(|p| matches!(p.kind, Kind::Repulsive | Kind::Solid));
+    let height = highest_column(&particles, dim, dx);
+    let mut walls = wall_params(ctx, &case.walls, dx, height, g, contact)?;
     walls.mirror_planes = mirror_planes;
     walls.reactions = probes
         .iter()
@@ -656,10 +654,10 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         walls,
         periodic: [false; 3],
         bodies,
-        solids: solids_of_particles.map(|(material, mut body)| {
+        solids: solids_of_particles.map(|(materials, mut body)| {
             body.resize(n_particles, 0);
             Solids {
-                material,
+                materials,
                 tau0: vec![[0.0; 6]; n_particles],
                 body,
             }
@@ -928,6 +926,51 @@ fn swept(b: &Aabb, motion: &Motion, end_s: f64, dim: usize) -> Aabb {
         }
     }
     out
+}
+
+/// The wall parameters: `[walls]` over the defaults for spacing `dx`, height H = `height` and
+/// gravity |g| = `g`. Where the repulsive law acts (`contact`), its strength must not be zero,
+/// which the default 5|g|H (|g|H for Monaghan & Kajtar) is without gravity.
+pub(super) fn wall_params(
+    ctx: &Ctx<'_>,
+    set: &WallSettings,
+    dx: f64,
+    height: f64,
+    g: f64,
+    contact: bool,
+) -> Result<WallParams, CaseError> {
+    let mut walls = WallParams::defaults(dx, height, g);
+    walls.ghost_correction = set.ghost_correction;
+    if let Some(d) = set.repulsive_d {
+        walls.repulsive_d = d;
+    }
+    if let Some(r0) = set.repulsive_r0 {
+        walls.repulsive_r0 = r0;
+    }
+    walls.repulsive_form = set.repulsive_form;
+    if let Some(k) = set.repulsive_k {
+        walls.repulsive_k = k;
+    }
+    walls.repulsive_beta = set.repulsive_beta;
+    let (field, strength) = match walls.repulsive_form {
+        RepulsiveForm::LennardJones => ("walls.repulsive_d_m2_s2", walls.repulsive_d),
+        RepulsiveForm::MonaghanKajtar => ("walls.repulsive_k_m2_s2", walls.repulsive_k),
+    };
+    if contact && strength <= 0.0 {
+        return Err(ctx.err(
+            field,
+            None,
+            "defaults to a multiple of |g|·H, which is 0 without gravity: the repulsive law that \
+             keeps fluid off repulsive walls and bodies, solids and walls apart would have no \
+             strength",
+            format!(
+                "give {field}, of the order of the square of the fastest velocity expected \
+                 (Monaghan 1994), e.g. {} = 1.0",
+                field.trim_start_matches("walls.")
+            ),
+        ));
+    }
+    Ok(walls)
 }
 
 /// Height of the fluid from its lowest to its highest particle (+ dx), the H of the default

@@ -3,7 +3,6 @@
 
 use crate::scenario::{
     Domain, ElasticMaterial, Kind, Particle, Physics, Scenario, SolidFormulation, Solids,
-    WallParams,
 };
 
 use super::error::{num, CaseError};
@@ -11,6 +10,7 @@ use super::lattice::Lattice;
 use super::locate::Ctx;
 use super::schema::{RawSolid, SolidFormulationName, SolidVelocityName};
 use super::validate::{aabb, number, vector, Aabb, Bound, Case};
+use crate::layout::MAX_SOLID_MATERIALS;
 
 /// Initial velocity of a cantilever in its first bending mode (Gray, Monaghan & Swift 2001,
 /// section 6): v(x) = V f(s)/f(L) along `direction`, s = (x − root)·axis, zero for s < 0.
@@ -331,15 +331,18 @@ fn body_len(body: &[u32], i: usize) -> usize {
     body.iter().rev().take_while(|&&b| b == i as u32).count()
 }
 
+/// The material of each solid, the solids' particles and the body (solid index) of each.
+pub(super) type SolidParticles = (Vec<ElasticMaterial>, Vec<Particle>, Vec<u32>);
+
 /// The particles of the solids (on one lattice from the first solid's corner), their bodies
-/// (the solid's index) and the shared material; at most `max_particles` of them.
+/// (the solid's index) and the material of each solid; at most `max_particles` of them.
 pub(super) fn solid_particles(
     ctx: &Ctx<'_>,
     solids: &[SolidSpec],
     dim: usize,
     dx: f64,
     max_particles: f64,
-) -> Result<(ElasticMaterial, Vec<Particle>, Vec<u32>), CaseError> {
+) -> Result<SolidParticles, CaseError> {
     let first = &solids[0];
     let material = first.material;
     for (i, s) in solids.iter().enumerate().skip(1) {
@@ -351,46 +354,36 @@ pub(super) fn solid_particles(
                 "give every solid its own name",
             ));
         }
-        let fields = [
-            ("density_kg_m3", s.material.density, material.density),
-            (
-                "youngs_modulus_pa",
-                s.material.youngs_modulus,
-                material.youngs_modulus,
-            ),
-            (
-                "poisson_ratio",
-                s.material.poisson_ratio,
-                material.poisson_ratio,
-            ),
-            ("alpha", s.material.alpha, material.alpha),
-            (
-                "artificial_stress",
-                s.material.artificial_stress,
-                material.artificial_stress,
-            ),
-        ];
         if s.material.formulation != material.formulation {
             return Err(ctx.err(
                 &format!("solid[{i}].formulation"),
                 None,
                 format!(
-                    "differs from solid[0].formulation ({:?}): all solids of a case share one \
-                     material for now",
+                    "differs from solid[0].formulation ({:?}): all solids of a case use one \
+                     formulation",
                     material.formulation
                 ),
                 "give every solid the same formulation",
             ));
         }
-        for (f, v, v0) in fields {
-            if v != v0 {
-                return Err(ctx.err(
-                    &format!("solid[{i}].{f}"),
-                    Some(format!("{v}")),
-                    format!("differs from solid[0].{f} = {v0}: all solids of a case share one material for now"),
-                    format!("use {f} = {v0}"),
-                ));
+        let distinct = solids[..=i].iter().fold(Vec::new(), |mut d, o| {
+            if !d.contains(&o.material) {
+                d.push(o.material);
             }
+            d
+        });
+        if distinct.len() > MAX_SOLID_MATERIALS {
+            return Err(ctx.err(
+                &format!("solid[{i}]"),
+                None,
+                format!(
+                    "is of a {}th material: a case holds at most {MAX_SOLID_MATERIALS} different \
+                     solid materials (density, Young's modulus, Poisson ratio, alpha and \
+                     artificial_stress)",
+                    distinct.len()
+                ),
+                "give solids of nearly equal materials the same values",
+            ));
         }
     }
     let lat = Lattice {
@@ -476,7 +469,7 @@ pub(super) fn solid_particles(
             ));
         }
     }
-    Ok((material, particles, body))
+    Ok((solids.iter().map(|s| s.material).collect(), particles, body))
 }
 
 pub(super) fn build_solid_case(
@@ -486,7 +479,7 @@ pub(super) fn build_solid_case(
 ) -> Result<Scenario, CaseError> {
     let (dim, dx) = (case.dim, case.dx);
     let first = &case.solids[0];
-    let (material, particles, body) = solid_particles(ctx, &case.solids, dim, dx, max_particles)?;
+    let (materials, particles, body) = solid_particles(ctx, &case.solids, dim, dx, max_particles)?;
     // Default domain: the solids' box, with half its largest extent of room on every side.
     let mut bb = first.bx;
     for s in &case.solids {
@@ -525,8 +518,11 @@ pub(super) fn build_solid_case(
         h: case.h_over_dx * dx,
         kernel: case.kernel,
         rho0: case.rho0,
-        // Unused without fluid; the solid's sound speed enters through the material.
-        c0: material.sound_speed(),
+        // Unused without fluid; the solids' sound speeds enter through their materials.
+        c0: materials
+            .iter()
+            .map(ElasticMaterial::sound_speed)
+            .fold(0.0, f64::max),
         gamma: case.gamma,
         gravity: case.gravity,
         viscosity: case.viscosity,
@@ -537,6 +533,12 @@ pub(super) fn build_solid_case(
         energy: false,
     };
     let g = case.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
+    // Solids alone touch only one another. H: from the lowest particle to the highest.
+    let (lo, hi) = particles.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+        (lo.min(p.pos[dim - 1]), hi.max(p.pos[dim - 1]))
+    });
+    let walls =
+        super::build::wall_params(ctx, &case.walls, dx, hi - lo + dx, g, case.solids.len() > 1)?;
     Ok(Scenario {
         name: case.name,
         physics,
@@ -548,11 +550,11 @@ pub(super) fn build_solid_case(
         particles,
         probes: case.probes,
         points,
-        walls: WallParams::defaults(dx, dx, g),
+        walls,
         periodic: [false; 3],
         bodies: Vec::new(),
         solids: Some(Solids {
-            material,
+            materials,
             body,
             tau0: vec![[0.0; 6]; n],
         }),

@@ -126,29 +126,30 @@ fn stress_terms(mat: &ElasticMaterial, p: &RefParticle, s: &SolidRef) -> (M3, M3
 
 /// Rates of every solid particle (None for the others): continuity, momentum with σ = −pI + τ,
 /// artificial viscosity and artificial stress, and the Jaumann rate of τ, over the solid
-/// particles of the same body.
+/// particles of the same body, of the body's material (`mats` indexed by body).
 pub fn rates(
     ph: &Physics,
-    mat: &ElasticMaterial,
+    mats: &[ElasticMaterial],
     space: &Space,
     parts: &[RefParticle],
     solid: &[SolidRef],
 ) -> Vec<Option<ElasticRates>> {
     let h = ph.h;
-    let m = mat.density * ph.dx.powi(ph.dim as i32);
-    let c_s = mat.sound_speed();
-    let mu_shear = mat.shear_modulus();
     let eta2 = 0.01 * h * h;
     let w_dx = kernel::w(ph.kernel, ph.dim, h, ph.dx);
     let terms: Vec<Option<(M3, M3)>> = parts
         .iter()
         .zip(solid)
-        .map(|(p, s)| is_solid(p.kind).then(|| stress_terms(mat, p, s)))
+        .map(|(p, s)| is_solid(p.kind).then(|| stress_terms(&mats[s.body as usize], p, s)))
         .collect();
     (0..parts.len())
         .map(|i| {
             let pi = &parts[i];
             let (a_i, r_i) = terms[i]?;
+            let mat = &mats[solid[i].body as usize];
+            let m = mat.particle_mass(ph.dx, ph.dim);
+            let c_s = mat.sound_speed();
+            let mu_shear = mat.shear_modulus();
             let mut acc = [0.0; 3];
             let mut drho = 0.0;
             let mut grad_v = [[0.0; 3]; 3];
@@ -220,19 +221,21 @@ pub fn rates(
 /// The fluid–solid pair terms of interaction.wgsl (see its header): for every particle, the
 /// (dv/dt, dρ/dt) it gets from neighbours of the other material (fluid from solid particles,
 /// solid from fluid ones). A solid particle enters with its interface pressure `p_g`
-/// (`ghost::interface_pressure`), its own mass, density and velocity; with the fluid's
-/// viscosity, and on the fluid side the seed's density-rate correction ρ_i/ρ_j (a solid's
-/// density follows its own body only); zero for the others.
+/// (`ghost::interface_pressure`), its own mass (its body's material, `mats` indexed by
+/// `solid[k].body`), density and velocity; with the fluid's viscosity, and on the fluid side
+/// the seed's density-rate correction ρ_i/ρ_j (a solid's density follows its own body only);
+/// zero for the others.
 pub fn interface_rates(
     ph: &Physics,
-    mat: &ElasticMaterial,
+    mats: &[ElasticMaterial],
     space: &Space,
     parts: &[RefParticle],
+    solid: &[SolidRef],
     p_g: &[f64],
 ) -> Vec<[f64; 4]> {
     let h = ph.h;
     let eta2 = 0.01 * h * h;
-    let solid_mass = mat.density * ph.dx.powi(ph.dim as i32);
+    let solid_mass = |k: usize| mats[solid[k].body as usize].particle_mass(ph.dx, ph.dim);
     // P/ρ² and mass of each particle that takes part (fluid or solid).
     let side = |k: usize| -> Option<(f64, f64)> {
         let p = &parts[k];
@@ -242,7 +245,7 @@ pub fn interface_rates(
                 ph.particle_mass,
             ))
         } else if is_solid(p.kind) {
-            Some((p_g[k] / (p.rho * p.rho), solid_mass))
+            Some((p_g[k] / (p.rho * p.rho), solid_mass(k)))
         } else {
             None
         }
@@ -303,31 +306,30 @@ pub fn interface_rates(
         .collect()
 }
 
-/// The factor of the contact law between a solid particle and a moving body's particle for
-/// the side whose partner has mass `m_other`: the pair force is 2 m_s m_f/(m_s + m_f) times
-/// the law per unit mass, m_f the fluid's particle mass that a body particle carries.
-pub fn solid_body_contact_weight(ph: &Physics, mat: &ElasticMaterial, m_other: f64) -> f64 {
-    let m_s = mat.density * ph.dx.powi(ph.dim as i32);
-    2.0 * m_other / (ph.particle_mass + m_s)
+/// The factor of the contact law for the side of mass `m_self` whose partner has mass
+/// `m_other`: the pair force is 2 m_self m_other/(m_self + m_other) times the law per unit
+/// mass, equal and opposite (a moving body's particle carries the fluid's particle mass).
+pub fn contact_weight(m_self: f64, m_other: f64) -> f64 {
+    2.0 * m_other / (m_self + m_other)
 }
 
 /// Contact accelerations of solid particles (as `solid_loads` in interaction.wgsl) and of the
 /// moving bodies' particles they touch; zero for the others. A solid particle feels the walls'
-/// repulsive law (`interaction::repulsion`, per unit mass) from every fixed wall particle,
-/// every moving body's particle (whatever its treatment; times `solid_body_contact_weight`)
-/// and every particle of another elastic body within 2h; a body's particle the reaction of
-/// the solid's (times its weight). `solid` is indexed like `parts`.
+/// repulsive law (`interaction::repulsion`, per unit mass) from every fixed wall particle
+/// (times 1), every moving body's particle (whatever its treatment) and every particle of
+/// another elastic body within 2h (times `contact_weight` of the two masses, each solid's of
+/// its material, `mats` indexed by body); a body's particle the reaction of the solid's.
+/// `solid` is indexed like `parts`.
 pub fn contact_rates(
     ph: &Physics,
-    mat: &ElasticMaterial,
+    mats: &[ElasticMaterial],
     walls: &crate::scenario::WallParams,
     space: &Space,
     parts: &[RefParticle],
     solid: &[SolidRef],
 ) -> Vec<[f64; 3]> {
-    let m_s = mat.density * ph.dx.powi(ph.dim as i32);
-    let on_solid = solid_body_contact_weight(ph, mat, ph.particle_mass);
-    let on_body = solid_body_contact_weight(ph, mat, m_s);
+    let m_s = |k: usize| mats[solid[k].body as usize].particle_mass(ph.dx, ph.dim);
+    let m_f = ph.particle_mass;
     let support2 = 4.0 * ph.h * ph.h;
     let fixed_wall = |p: &RefParticle| {
         !matches!(p.kind, super::FLUID | super::EXCLUDED | super::INLET)
@@ -341,15 +343,17 @@ pub fn contact_rates(
             let pi = &parts[i];
             for (j, pj) in parts.iter().enumerate() {
                 let k = if is_solid(pi.kind) {
-                    if fixed_wall(pj) || (is_solid(pj.kind) && solid[j].body != solid[i].body) {
+                    if fixed_wall(pj) {
                         1.0
+                    } else if is_solid(pj.kind) && solid[j].body != solid[i].body {
+                        contact_weight(m_s(i), m_s(j))
                     } else if on_a_body(pj) {
-                        on_solid
+                        contact_weight(m_s(i), m_f)
                     } else {
                         continue;
                     }
                 } else if on_a_body(pi) && is_solid(pj.kind) {
-                    on_body
+                    contact_weight(m_f, m_s(j))
                 } else {
                     continue;
                 };

@@ -53,6 +53,8 @@ pub struct TlPairRef {
 pub struct TlSetup {
     pub start: Vec<usize>,
     pub pairs: Vec<TlPairRef>,
+    /// The elastic body of every particle (its material's index).
+    pub body: Vec<u32>,
 }
 
 /// Lamé's λ and the shear modulus G of `m` (the 3D material; plane strain in 2D).
@@ -215,7 +217,11 @@ impl TlSetup {
             }
             start.push(pairs.len());
         }
-        Ok(TlSetup { start, pairs })
+        Ok(TlSetup {
+            start,
+            pairs,
+            body: body.to_vec(),
+        })
     }
 
     pub fn len(&self) -> usize {
@@ -295,11 +301,17 @@ fn displacement_gradients(setup: &TlSetup, x: &[[f64; 3]]) -> Vec<M3> {
 }
 
 /// The first Piola–Kirchhoff stress P_i of every TL particle at current positions `x` (TL
-/// numbering), steps (1)–(3) of the header.
-pub fn first_piola(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64; 3]]) -> Vec<M3> {
+/// numbering), steps (1)–(3) of the header, each of its body's material (`mats` indexed by
+/// body).
+pub fn first_piola(
+    setup: &TlSetup,
+    ph: &Physics,
+    mats: &[ElasticMaterial],
+    x: &[[f64; 3]],
+) -> Vec<M3> {
     let n = setup.len();
     let dim = ph.dim as usize;
-    let (lam, g) = lame(m);
+    let lame_of = |i: usize| lame(&mats[setup.body[i] as usize]);
     let k2 = ph.dx * ph.dx / 12.0;
     let hs = displacement_gradients(setup, x);
     let e: Vec<M3> = hs.iter().map(green).collect();
@@ -315,11 +327,13 @@ pub fn first_piola(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64
                     }
                 }
             }
+            let (lam, g) = lame_of(i);
             d.map(|dk| svk(&dk, lam, g).map(|r| r.map(|v| k2 * v)))
         })
         .collect();
     (0..n)
         .map(|i| {
+            let (lam, g) = lame_of(i);
             let mut s = svk(&e[i], lam, g);
             for p in setup.pairs_of(i) {
                 for k in 0..dim {
@@ -362,10 +376,10 @@ pub fn cauchy_of(h: &M3, p: &M3) -> (M3, f64) {
 pub fn cauchy(
     setup: &TlSetup,
     ph: &Physics,
-    m: &ElasticMaterial,
+    mats: &[ElasticMaterial],
     x: &[[f64; 3]],
 ) -> Vec<(M3, f64)> {
-    let p = first_piola(setup, ph, m, x);
+    let p = first_piola(setup, ph, mats, x);
     displacement_gradients(setup, x)
         .iter()
         .zip(&p)
@@ -376,13 +390,12 @@ pub fn cauchy(
 /// The discrete elastic energy at current positions `x` (per metre of depth in 2D):
 /// Σ_i V [ψ(E_i) + dx²/24 Σ_k D_i^k : C : D_i^k], ψ(E) = ½λ (tr E)² + G E:E, V = dx^d; the
 /// accelerations are its negative gradient over the particle masses ρ0 V.
-pub fn energy(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64; 3]]) -> f64 {
+pub fn energy(setup: &TlSetup, ph: &Physics, mats: &[ElasticMaterial], x: &[[f64; 3]]) -> f64 {
     let n = setup.len();
     let dim = ph.dim as usize;
-    let (lam, g) = lame(m);
     let vol = ph.dx.powi(ph.dim as i32);
     let k2 = ph.dx * ph.dx / 12.0;
-    let dens = |e: &M3| -> f64 {
+    let dens = |(lam, g): (f64, f64), e: &M3| -> f64 {
         let t = e[0][0] + e[1][1] + e[2][2];
         let ee: f64 = (0..3)
             .flat_map(|a| (0..3).map(move |b| (a, b)))
@@ -405,7 +418,8 @@ pub fn energy(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64; 3]]
         .collect();
     (0..n)
         .map(|i| {
-            let mut u = dens(&e[i]);
+            let lg = lame(&mats[setup.body[i] as usize]);
+            let mut u = dens(lg, &e[i]);
             for k in 0..dim {
                 let mut d = zero();
                 for p in setup.pairs_of(i) {
@@ -416,7 +430,7 @@ pub fn energy(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64; 3]]
                     }
                 }
                 // ½ k2 D:C:D = k2 ψ(D)
-                u += k2 * dens(&d);
+                u += k2 * dens(lg, &d);
             }
             vol * u
         })
@@ -428,10 +442,10 @@ pub fn energy(setup: &TlSetup, ph: &Physics, m: &ElasticMaterial, x: &[[f64; 3]]
 pub fn accelerations(
     setup: &TlSetup,
     ph: &Physics,
-    m: &ElasticMaterial,
+    mats: &[ElasticMaterial],
     x: &[[f64; 3]],
 ) -> Vec<[f64; 3]> {
-    let p = first_piola(setup, ph, m, x);
+    let p = first_piola(setup, ph, mats, x);
     (0..setup.len())
         .map(|i| {
             let mut f = [0.0; 3];
@@ -442,7 +456,8 @@ pub fn accelerations(
                     f[c] += a[c] - b[c];
                 }
             }
-            [0, 1, 2].map(|c| f[c] / m.density + ph.gravity[c])
+            let rho0 = mats[setup.body[i] as usize].density;
+            [0, 1, 2].map(|c| f[c] / rho0 + ph.gravity[c])
         })
         .collect()
 }
@@ -596,7 +611,7 @@ mod tests {
             .iter()
             .map(|p| [c * p[0] - sn * p[1] + 0.3, sn * p[0] + c * p[1] - 0.1, 0.0])
             .collect();
-        let a = accelerations(&s, &ph, &m, &x);
+        let a = accelerations(&s, &ph, &[m], &x);
         let amax = a
             .iter()
             .flat_map(|v| v.iter())
@@ -630,7 +645,7 @@ mod tests {
                     .zip(d)
                     .map(|(p, q)| [p[0] + t * q[0], p[1] + t * q[1], 0.0])
                     .collect();
-                accelerations(&s, &ph, &m, &xt)
+                accelerations(&s, &ph, &[m], &xt)
                     .iter()
                     .zip(d)
                     .map(|(a, q)| m.density * v * (a[0] * q[0] + a[1] * q[1]))

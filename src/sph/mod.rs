@@ -267,13 +267,18 @@ impl Solver {
             ..Default::default()
         };
         if let Some(solids) = &sc.solids {
-            let m = &solids.material;
-            params.solid_rho0 = m.density as f32;
-            params.solid_c2 = (m.sound_speed() * m.sound_speed()) as f32;
-            params.solid_mu = m.shear_modulus() as f32;
-            params.solid_mass = (m.density * ph.dx.powi(ph.dim as i32)) as f32;
-            params.solid_alpha = m.alpha as f32;
-            params.solid_eps = m.artificial_stress as f32;
+            let (distinct, _) = solids.distinct_materials();
+            if distinct.len() > crate::layout::MAX_SOLID_MATERIALS {
+                bail!(
+                    "the solids have {} different materials, more than the {} a case may hold",
+                    distinct.len(),
+                    crate::layout::MAX_SOLID_MATERIALS
+                );
+            }
+            for (slot, m) in params.solid_materials.iter_mut().zip(&distinct) {
+                *slot = solid_material(m, ph);
+            }
+            params.solid_p_speed = solids.max_p_wave_speed() as f32;
             params.solid_inv_w_dx =
                 (1.0 / crate::reference::kernel::w(ph.kernel, ph.dim, ph.h, ph.dx)) as f32;
             params.solid_id_base = solid_range(sc)?.start as u32;
@@ -380,9 +385,10 @@ impl Solver {
             mode => DensityFilter::new(&device, &module(Pass::DensityFilter)?, &buffers, mode)?,
         };
         let integrate = Integrate::new(&device, &module(Pass::Integrate)?, &buffers)?;
-        let tl = sc.solids.as_ref().is_some_and(|s| {
-            s.material.formulation == crate::scenario::SolidFormulation::TotalLagrangian
-        });
+        let tl = sc
+            .solids
+            .as_ref()
+            .is_some_and(|s| s.formulation() == crate::scenario::SolidFormulation::TotalLagrangian);
         let elastic = match sc.solids {
             Some(_) if !tl => Some(Elastic::new(&device, &module(Pass::Elastic)?, &buffers)?),
             _ => None,
@@ -875,10 +881,11 @@ impl Solver {
         self.read_rates()
     }
 
-    /// The solid state (τ, body, last dτ/dt, interface pressure) of every solid particle, in
-    /// id order from `solid_id_base`.
+    /// The solid state (τ, body, last dτ/dt, interface pressure, material) of every solid
+    /// particle, in id order from `solid_id_base` (of a total-Lagrangian solid only its body
+    /// and material are in use).
     pub fn read_solid(&self) -> Result<Vec<crate::layout::SolidState>> {
-        if self.elastic.is_none() {
+        if self.elastic.is_none() && self.total_lagrangian.is_none() {
             bail!("the case has no solids");
         }
         read(
@@ -1052,9 +1059,11 @@ impl Solver {
         } else {
             None
         };
-        let solid = match &self.elastic {
-            Some(_) => Some(self.read_solid()?),
-            None => None,
+        // The solid state (τ, material) of either formulation.
+        let solid = if self.elastic.is_some() || self.total_lagrangian.is_some() {
+            Some(self.read_solid()?)
+        } else {
+            None
         };
         let tl = match &self.total_lagrangian {
             Some(t) => Some(t.cauchy_stress(&self.device, &self.queue, self.parity)?),
@@ -1074,21 +1083,25 @@ impl Solver {
             let kind = code[i] >> KIND_SHIFT;
             let id = code[i] & ID_MASK;
             let solid_kind = crate::reference::elastic::is_solid(kind);
-            // τ of the particle (zeros for the others), when the case has solids.
-            let mut tau = solid.as_ref().map(|s| {
+            // τ and material of the particle (zeros for the others), when the case has solids.
+            let state = solid.as_ref().map(|s| {
                 if !solid_kind {
-                    return [0.0; 6];
+                    return Default::default();
                 }
-                let k = (id - self.params.solid_id_base) as usize;
-                let (a, b) = (s[k].tau_a, s[k].tau_b);
+                s[(id - self.params.solid_id_base) as usize]
+            });
+            let mut tau = state.map(|s| {
+                let (a, b) = (s.tau_a, s.tau_b);
                 [a[0], a[1], a[2], a[3], b[0], b[1]]
+            });
+            let mat = state.map_or_else(Default::default, |s| {
+                self.params.solid_materials[s.material as usize]
             });
             if let (true, Some((first, stress))) = (solid_kind, &tl) {
                 // Total-Lagrangian: ρ = ρs/J, p = −tr σ/3 and τ = σ + p I.
                 let c = stress[(id - first) as usize];
                 let p = -(c.sigma[0] + c.sigma[1] + c.sigma[2]) / 3.0;
-                *out.rho.last_mut().expect("pushed above") =
-                    (self.params.solid_rho0 as f64 / c.j) as f32;
+                *out.rho.last_mut().expect("pushed above") = (mat.rho0 as f64 / c.j) as f32;
                 out.pressure.push(p as f32);
                 let mut t = c.sigma;
                 for d in &mut t[..3] {
@@ -1097,8 +1110,7 @@ impl Solver {
                 tau = Some(t.map(|x| x as f32));
             } else if solid_kind {
                 // p = c_s² (ρ − ρs).
-                out.pressure
-                    .push(self.params.solid_c2 * (v[3] - self.params.solid_rho0));
+                out.pressure.push(mat.c2 * (v[3] - mat.rho0));
             } else {
                 out.pressure
                     .push((b * ((v[3] as f64 / rho0).powf(gamma) - 1.0)) as f32);
@@ -1169,7 +1181,26 @@ pub(crate) fn solid_range(sc: &Scenario) -> Result<std::ops::Range<usize>> {
     Ok(first..last + 1)
 }
 
-/// The initial state (τ0, body) of every solid particle, in id order, or nothing without solids.
+/// What the kernels use of an elastic material.
+fn solid_material(
+    m: &crate::scenario::ElasticMaterial,
+    ph: &crate::scenario::Physics,
+) -> crate::layout::SolidMaterial {
+    let c_s = m.sound_speed();
+    crate::layout::SolidMaterial {
+        rho0: m.density as f32,
+        c2: (c_s * c_s) as f32,
+        mu: m.shear_modulus() as f32,
+        mass: m.particle_mass(ph.dx, ph.dim) as f32,
+        alpha: m.alpha as f32,
+        eps: m.artificial_stress as f32,
+        lambda: crate::reference::total_lagrangian::lame(m).0 as f32,
+        pad: 0.0,
+    }
+}
+
+/// The initial state (τ0, body, material) of every solid particle, in id order, or nothing
+/// without solids.
 fn solid_states(sc: &Scenario) -> Result<Vec<crate::layout::SolidState>> {
     let Some(solids) = &sc.solids else {
         return Ok(Vec::new());
@@ -1182,17 +1213,25 @@ fn solid_states(sc: &Scenario) -> Result<Vec<crate::layout::SolidState>> {
             solids.tau0.len()
         );
     }
-    Ok(solid_range(sc)?
+    let (_, material) = solids.distinct_materials();
+    solid_range(sc)?
         .map(|i| {
             let t = solids.tau0[i].map(|x| x as f32);
-            crate::layout::SolidState {
+            let body = solids.body[i];
+            Ok(crate::layout::SolidState {
                 tau_a: [t[0], t[1], t[2], t[3]],
                 tau_b: [t[4], t[5], 0.0],
-                body: solids.body[i],
+                body,
+                material: *material.get(body as usize).ok_or_else(|| {
+                    anyhow::anyhow!(
+                        "solid particle {i} is of body {body}, which has no material ({} given)",
+                        solids.materials.len()
+                    )
+                })?,
                 ..Default::default()
-            }
+            })
         })
-        .collect())
+        .collect()
 }
 
 /// Kind word of an excluded particle, for callers filtering outputs.

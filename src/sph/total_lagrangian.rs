@@ -13,7 +13,7 @@ use super::buffers::ParticleBuffers;
 use crate::gpu::buffers::{read, storage, storage_init, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::layout::{TlPair, TlParams};
-use crate::reference::total_lagrangian::{cauchy_of, lame, TlSetup};
+use crate::reference::total_lagrangian::{cauchy_of, TlSetup};
 use crate::scenario::Scenario;
 
 pub struct TotalLagrangian {
@@ -52,17 +52,12 @@ impl TotalLagrangian {
         sc: &Scenario,
     ) -> Result<Self> {
         let (range, setup) = setup(sc)?;
-        let m = &sc.solids.as_ref().expect("a case with solids").material;
-        let (lambda, mu) = lame(m);
         let n_tl = setup.len() as u32;
         let params = TlParams {
             n: n_tl,
             first_id: range.start as u32,
-            lambda: lambda as f32,
-            mu: mu as f32,
             k2: (sc.physics.dx * sc.physics.dx / 12.0) as f32,
-            inv_rho0: (1.0 / m.density) as f32,
-            pad: [0; 2],
+            pad: 0,
         };
         let start: Vec<u32> = setup.start.iter().map(|&s| s as u32).collect();
         let f3 = |v: [f64; 3]| v.map(|x| x as f32);
@@ -111,6 +106,7 @@ impl TotalLagrangian {
                 (8, &tl_h),
                 (9, &tl_t),
                 (10, &tl_p),
+                (11, &b.solid),
             ]
         };
         let bound = |entry: &str| ParityKernel::new(device, module, entry, |p| bufs(p).to_vec());

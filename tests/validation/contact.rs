@@ -171,3 +171,103 @@ wall = "fixed_ghost"
     );
     assert!(sunk > 0.005, "the box sank only {sunk} m");
 }
+
+/// Two elastic blocks of different materials collide in vacuum (no gravity, no walls): a light
+/// soft one (ρ = 1000, E = 0.2 MPa) at 0.5 m/s strikes a heavy stiff one (ρ = 3000, E = 1 MPa) at
+/// rest. Contact is the walls' repulsive law weighted by 2 m_j/(m_i + m_j) on particle i
+/// (interaction.wgsl `contact_weight`), equal and opposite per pair, so the total momentum
+/// Σ m v must hold through the collision (a weight of 1 on both sides, as one material had,
+/// would change it by the mass difference times the law); the heavy block must leave forward,
+/// the light one slower than it came, and the kinetic energy must not grow.
+#[test]
+fn blocks_of_two_materials_collide_and_keep_their_momentum() {
+    let case = r#"name = "two_blocks_2d"
+dimension = 2
+[particles]
+dx_m = 0.004
+h_over_dx = 1.3
+kernel = "wendland_c2"
+[physics]
+gravity_m_s2 = [0.0, 0.0]
+[time]
+end_s = 0.1
+output_every_s = 0.1
+[walls]
+repulsive_d_m2_s2 = 1.0
+[[solid]]
+name = "light"
+min_m = [0.0, 0.0]
+max_m = [0.04, 0.04]
+density_kg_m3 = 1000.0
+youngs_modulus_pa = 2.0e5
+poisson_ratio = 0.3
+[[solid]]
+name = "heavy"
+min_m = [0.048, 0.0]
+max_m = [0.088, 0.04]
+density_kg_m3 = 3000.0
+youngs_modulus_pa = 1.0e6
+poisson_ratio = 0.3
+"#;
+    let mut sc = wgsph::case::load_str(case, "two_blocks_2d.toml", &[]).unwrap();
+    let solids = sc.solids.clone().unwrap();
+    let n = sc.particles.len();
+    // The light block (body 0) starts towards the heavy one.
+    for (i, p) in sc.particles.iter_mut().enumerate() {
+        if solids.body[i] == 0 {
+            p.vel = [0.5, 0.0, 0.0];
+        }
+    }
+    let dx = sc.physics.dx;
+    let mass: Vec<f64> = (0..n)
+        .map(|i| solids.material_of(i).particle_mass(dx, 2))
+        .collect();
+    // Per body: momentum along x and mean x-velocity; and the kinetic energy.
+    let state = |vel: &[[f64; 3]]| {
+        let (mut px, mut ke) = ([0.0; 2], 0.0);
+        for i in 0..n {
+            let b = solids.body[i] as usize;
+            px[b] += mass[i] * vel[i][0];
+            ke += 0.5 * mass[i] * (vel[i][0] * vel[i][0] + vel[i][1] * vel[i][1]);
+        }
+        (px, ke)
+    };
+    let vel0: Vec<[f64; 3]> = sc.particles.iter().map(|p| p.vel).collect();
+    let (p0, ke0) = state(&vel0);
+    let m_body: Vec<f64> = (0..2)
+        .map(|b| {
+            (0..n)
+                .filter(|&i| solids.body[i] == b)
+                .map(|i| mass[i])
+                .sum()
+        })
+        .collect();
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    let (mut worst, mut ke_max) = (0.0f64, 0.0f64);
+    let mut last = p0;
+    for k in 1..=40 {
+        solver.advance_to(1e-3 * k as f64).unwrap();
+        let p = solver.read_particles().unwrap();
+        let vel: Vec<[f64; 3]> = p.vel.iter().map(|v| v.map(|c| c as f64)).collect();
+        // read_particles is in id order, as the scenario.
+        let (px, ke) = state(&vel);
+        worst = worst.max((px[0] + px[1] - (p0[0] + p0[1])).abs() / p0[0]);
+        ke_max = ke_max.max(ke);
+        last = px;
+    }
+    let v_light = last[0] / m_body[0];
+    let v_heavy = last[1] / m_body[1];
+    println!(
+        "after 40 ms: light block {v_light:+.4} m/s, heavy {v_heavy:+.4} m/s (rigid elastic \
+         collision: -0.25 / +0.25); largest |ΔΣ m v| {worst:.1e} of the initial momentum; \
+         largest kinetic energy {:.4} of the initial",
+        ke_max / ke0
+    );
+    assert!(v_heavy > 0.1, "the heavy block left at {v_heavy} m/s");
+    assert!(v_light < 0.4, "the light block kept {v_light} m/s");
+    assert!(worst < 1e-4, "momentum changed by {worst} of the initial");
+    assert!(
+        ke_max < 1.0 + 1e-3,
+        "kinetic energy grew to {ke_max} of the initial"
+    );
+}

@@ -15,7 +15,8 @@ fn oscillating_plate_builds_a_clamped_plate_in_its_first_mode() {
     assert_eq!(s.count(Kind::SolidClamped), 15 * 5);
     assert_eq!(s.count(Kind::Solid), 50 * 5);
     assert!(solids.body.iter().all(|&b| b == 0));
-    let m = &solids.material;
+    assert_eq!(solids.materials.len(), 1);
+    let m = &solids.materials[0];
     assert!(
         (m.sound_speed() - 57.0266).abs() < 1e-3,
         "{}",
@@ -95,10 +96,10 @@ fn solid_errors_name_the_field() {
         &["solid[0].clamped_max_m", "empty"],
     );
     assert_err(
-        &format!("{SOLID}\n[[solid]]\nname = \"b\"\nmin_m = [0.3, 0.0]\nmax_m = [0.4, 0.04]\ndensity_kg_m3 = 1000.0\nyoungs_modulus_pa = 3.0e6\npoisson_ratio = 0.3975\n"),
+        &format!("{SOLID}\n[[solid]]\nname = \"b\"\nmin_m = [0.3, 0.0]\nmax_m = [0.4, 0.04]\ndensity_kg_m3 = 1000.0\nyoungs_modulus_pa = 3.0e6\npoisson_ratio = 0.3975\nformulation = \"total_lagrangian\"\nalpha = 0.0\nartificial_stress = 0.0\n"),
         &[],
         None,
-        &["solid[1].youngs_modulus_pa", "one material"],
+        &["solid[1].formulation", "one formulation"],
     );
     assert_err(
         &format!("{SOLID}\n[solid.initial_velocity]\nkind = \"cantilever_mode\"\nroot_m = [0.05, 0.02]\naxis = [1.0, 0.0]\ndirection = [0.0, 1.0]\ntip_velocity_m_s = 0.5\n"),
@@ -113,6 +114,80 @@ fn solid_errors_name_the_field() {
         .unwrap()
         .replace("[physics]\n", "[physics]\nsound_speed_coef = 10.0\n");
     assert_err(&no_fluid, &[], None, &["fluid_block", "[[solid]]"]);
+}
+
+/// `[[solid]]` number `i` of Young's modulus `e`, a free block right of SOLID's plate.
+fn block_of_modulus(i: usize, e: f64) -> String {
+    let x = 0.3 + 0.1 * i as f64;
+    format!(
+        "\n[[solid]]\nname = \"b{i}\"\nmin_m = [{x}, 0.0]\nmax_m = [{}, 0.04]\n\
+         density_kg_m3 = 1000.0\nyoungs_modulus_pa = {e}\npoisson_ratio = 0.3975\n",
+        x + 0.05
+    )
+}
+
+/// Solids of different materials: each body keeps its own, equal materials are stored once on
+/// the GPU, and a ninth different one is refused naming the solid. `[walls]` applies to solids
+/// alone, and their contact needs a strength where gravity gives none.
+#[test]
+fn solids_keep_their_own_materials() {
+    // Without gravity the contact strength between solids must be given.
+    let solid = format!("{SOLID}\n[walls]\nrepulsive_d_m2_s2 = 1.0\n");
+    assert_err(
+        &(SOLID.to_string() + &block_of_modulus(0, 2.0e6)),
+        &[],
+        None,
+        &[
+            "walls.repulsive_d_m2_s2",
+            "without gravity",
+            "repulsive_d_m2_s2 = 1.0",
+        ],
+    );
+    // The plate (E = 2 MPa), then blocks of 3, 2 (the plate's) and 3 MPa.
+    let text = [3.0e6, 2.0e6, 3.0e6]
+        .iter()
+        .enumerate()
+        .fold(solid.clone(), |t, (i, &e)| t + &block_of_modulus(i, e));
+    let s = load_str(&text, "four.toml", &[]).unwrap();
+    assert_eq!(s.walls.repulsive_d, 1.0);
+    let solids = s.solids.as_ref().unwrap();
+    let e: Vec<f64> = solids.materials.iter().map(|m| m.youngs_modulus).collect();
+    assert_eq!(e, [2.0e6, 3.0e6, 2.0e6, 3.0e6]);
+    for (i, p) in s.particles.iter().enumerate() {
+        let want = if p.pos[0] > 0.25 {
+            e[1 + ((p.pos[0] - 0.3) / 0.1) as usize]
+        } else {
+            2.0e6
+        };
+        assert_eq!(solids.material_of(i).youngs_modulus, want, "particle {i}");
+    }
+    let (distinct, index) = solids.distinct_materials();
+    assert_eq!(distinct.len(), 2);
+    assert_eq!(index, [0, 1, 0, 1]);
+    assert_eq!(solids.max_p_wave_speed(), distinct[1].p_wave_speed());
+
+    let eight = (1..=8).fold(solid.clone(), |t, i| {
+        t + &block_of_modulus(i - 1, 2.0e6 + 1.0e5 * i as f64)
+    });
+    assert_err(
+        &eight,
+        &[],
+        None,
+        &["solid[8]", "9th material", "at most 8"],
+    );
+    let seven = (1..=7).fold(solid, |t, i| {
+        t + &block_of_modulus(i - 1, 2.0e6 + 1.0e5 * i as f64)
+    });
+    assert_eq!(
+        load_str(&seven, "eight.toml", &[])
+            .unwrap()
+            .solids
+            .unwrap()
+            .distinct_materials()
+            .0
+            .len(),
+        8
+    );
 }
 
 /// A gate of solid particles (2 particles thick) clamped at its top in a tank of water.
@@ -147,10 +222,10 @@ clamped_max_m = [0.22, 0.3]
 #[test]
 fn total_lagrangian_formulation_and_its_refusals() {
     let ul = load_str(PLATE, "cases/oscillating_plate_2d.toml", &[]).unwrap();
-    let m = ul.solids.unwrap().material;
+    let m = ul.solids.unwrap().materials[0];
     assert_eq!(m.formulation, SolidFormulation::UpdatedLagrangian);
     let tl = load_str(PLATE_TL, "cases/oscillating_plate_tl_2d.toml", &[]).unwrap();
-    let mt = tl.solids.unwrap().material;
+    let mt = tl.solids.unwrap().materials[0];
     assert_eq!(mt.formulation, SolidFormulation::TotalLagrangian);
     assert_eq!((mt.alpha, mt.artificial_stress), (0.0, 0.0));
     assert_eq!(tl.particles.len(), ul.particles.len());
@@ -198,7 +273,7 @@ formulation = "total_lagrangian"
 "#;
     let s3 = load_str(three_d, "cases/t.toml", &[]).unwrap();
     assert_eq!(
-        s3.solids.unwrap().material.formulation,
+        s3.solids.unwrap().formulation(),
         SolidFormulation::TotalLagrangian
     );
     let fluid = GATE_IN_WATER.replace(
@@ -208,7 +283,7 @@ formulation = "total_lagrangian"
     let sc = load_str(&fluid, "c.toml", &[]).unwrap();
     assert!(sc.count(Kind::Fluid) > 0 && sc.count(Kind::Solid) > 0);
     assert_eq!(
-        sc.solids.unwrap().material.formulation,
+        sc.solids.unwrap().formulation(),
         SolidFormulation::TotalLagrangian
     );
 }
@@ -236,7 +311,7 @@ fn a_solid_in_an_empty_tank_builds_with_the_walls() {
     assert_eq!(s.count(Kind::Fluid), 0);
     // 3 layers around a 50 × 50 open box: floor 3 × 56, sides 2 × 3 × 50.
     assert_eq!(s.count(Kind::Wall), 3 * 56 + 2 * 3 * 50);
-    let m = s.solids.as_ref().unwrap().material;
+    let m = s.solids.as_ref().unwrap().materials[0];
     assert_eq!(s.physics.c0, m.sound_speed());
     // Floor's lowest particle at −0.025, the solid's highest at 0.135.
     let d = 5.0 * 9.81 * (0.135 + 0.025 + 0.01);
