@@ -330,6 +330,9 @@ gravity_m_s2 = [0.0, 0.0]
 [time]
 end_s = 0.1
 output_every_s = 0.1
+# Solids that could touch need a contact strength without gravity (they do not touch).
+[walls]
+repulsive_d_m2_s2 = 1.0
 "#
     .to_string()
         // Tip velocities 0.01 c_s: c_s = 57.03 m/s for A, twice that for B.
