@@ -54,7 +54,7 @@
 // −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (a ghost with its interpolated P_g and its
 // viscous velocity), for repulsive ones Σ_j F(x_ij); and a contact force from boundary
 // particles of other bodies and of the fixed walls and from elastic solids' particles (the
-// repulsive law above, Monaghan 1994):
+// repulsive law above, Monaghan 1994, with Coulomb friction: `contact`):
 // bodies.wgsl sums both into the body's force and torque. A body's fixed ghosts move with it:
 // continuity sees the body's rigid velocity at the ghost, v_wall = u_c + ω × (R r), and the
 // no-slip viscous velocity is 2 v_wall − v_f.
@@ -187,6 +187,7 @@ fn solid_loads(i: u32) -> vec3<f32> {
     let vr_i = velrho[i];
     let s_i = solid[solid_slot(code[i])];
     let m_i = material_of(s_i).mass;
+    let v_i = vr_i.xyz;
     let b_i = s_i.interface_p / (vr_i.w * vr_i.w);
     let body_i = s_i.body;
     let support2 = 4.0 * params.h * params.h;
@@ -213,16 +214,48 @@ fn solid_loads(i: u32) -> vec3<f32> {
                 if (is_body_particle(code[j] & ID_MASK)) {
                     k = contact_weight(m_i, params.mass);
                 }
-                r += k * repulsion(x_ij, r2);
+                r += k * contact(x_ij, r2, v_i - contact_velocity(j));
             } else {
                 let s_j = solid[solid_slot(code[j])];
                 if (s_j.body != body_i) {
-                    r += contact_weight(m_i, material_of(s_j).mass) * repulsion(x_ij, r2);
+                    r += contact_weight(m_i, material_of(s_j).mass) * contact(x_ij, r2, v_i - velrho[j].xyz);
                 }
             }
         }
     }
     return r;
+}
+
+// Contact between particles of which at least one is a body's or a solid's (against walls,
+// bodies and solids; fluid against repulsive walls keeps `repulsion` alone), per unit mass:
+// the repulsive law as the normal force F_n, with regularised Coulomb friction,
+//   F = F_n − μ |F_n| v_t / sqrt(|v_t|² + ε²),
+// v_t the part of the relative velocity v_ij = v_i − v_j across x_ij (the velocities of
+// `contact_velocity`), ε = params.friction_slip. Equal and opposite for a pair (x_ji = −x_ij,
+// v_ji = −v_ij); friction acts only where the normal force does (r < r0 for Lennard-Jones).
+fn contact(x_ij: vec3<f32>, r2: f32, v_ij: vec3<f32>) -> vec3<f32> {
+    let f_n = repulsion(x_ij, r2);
+    if (params.friction == 0.0 || r2 <= 0.0) {
+        return f_n;
+    }
+    let n = x_ij * inverseSqrt(r2);
+    let v_t = v_ij - dot(v_ij, n) * n;
+    let e = params.friction_slip;
+    return f_n - (params.friction * length(f_n) * inverseSqrt(dot(v_t, v_t) + e * e)) * v_t;
+}
+
+// The velocity particle j presents in contact: a solid particle's own, a body particle's rigid
+// velocity u_c + ω × r (a fixed ghost stores the fluid's), zero for fixed walls.
+fn contact_velocity(j: u32) -> vec3<f32> {
+    if (is_solid(code_kind(code[j]))) {
+        return velrho[j].xyz;
+    }
+    let id = code[j] & ID_MASK;
+    if (is_body_particle(id)) {
+        let bp = body_particles[id - params.body_id_base];
+        return body_wall_motion(bodies[bp.body], bp.r).velocity;
+    }
+    return vec3<f32>(0.0);
 }
 
 // Force (per unit mass) of a repulsive boundary particle at x_ij: Lennard-Jones (Monaghan 1994)
@@ -396,6 +429,11 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     }
     let pi = Particle(v_i, vr_i.w, pressure_of(vr_i.w) / (vr_i.w * vr_i.w));
     let support2 = 4.0 * params.h * params.h;
+    // The rigid velocity a body particle presents in contact (friction only).
+    var v_contact_i = vec3<f32>(0.0);
+    if (on_body && params.friction != 0.0) {
+        v_contact_i = contact_velocity(i);
+    }
 
     var r = vec4<f32>(0.0);
     var de = 0.0;
@@ -427,10 +465,10 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                 } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
                     // Contact with an elastic solid.
                     let m_j = material_of(solid[solid_slot(code[j])]).mass;
-                    r += vec4<f32>(contact_weight(params.mass, m_j) * repulsion(x_ij, r2), 0.0);
+                    r += vec4<f32>(contact_weight(params.mass, m_j) * contact(x_ij, r2, v_contact_i - velrho[j].xyz), 0.0);
                 } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, code[j] & ID_MASK)) {
                     // Contact with a fixed wall or another body.
-                    r += vec4<f32>(repulsion(x_ij, r2), 0.0);
+                    r += vec4<f32>(contact(x_ij, r2, v_contact_i - contact_velocity(j)), 0.0);
                 }
                 continue;
             }

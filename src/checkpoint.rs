@@ -120,9 +120,21 @@ impl Fnv {
 /// be given a later end time.
 pub fn fingerprint(sc: &Scenario) -> u64 {
     let mut h = Fnv::default();
+    // Friction only when on, so checkpoints written before it existed still match (without
+    // it, its regularisation speed changes nothing).
+    let mut walls = format!("{:?}", sc.walls);
+    if sc.walls.friction == 0.0 {
+        walls = walls.replace(
+            &format!(
+                ", friction: {:?}, friction_slip: {:?}",
+                sc.walls.friction, sc.walls.friction_slip
+            ),
+            "",
+        );
+    }
     let settings = format!(
-        "{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
-        sc.name, sc.physics, sc.domain, sc.walls, sc.periodic, sc.probes, sc.bodies
+        "{}|{:?}|{:?}|{}|{:?}|{:?}|{:?}",
+        sc.name, sc.physics, sc.domain, walls, sc.periodic, sc.probes, sc.bodies
     );
     h.update(settings.as_bytes());
     // Only when there are any, so checkpoints written before points existed still match.
@@ -441,6 +453,23 @@ mod tests {
     fn the_fingerprint_sees_the_solid_material() {
         let text = include_str!("../cases/oscillating_plate_2d.toml");
         assert_fingerprint_sees(text, "solid[0].alpha=0.2");
+    }
+
+    /// Friction changes a run; without it, neither it nor its regularisation speed enters the
+    /// fingerprint, which is then that of a build from before friction existed.
+    #[test]
+    fn the_fingerprint_sees_friction_only_when_on() {
+        let text = include_str!("../cases/floating_box_2d.toml");
+        assert_fingerprint_sees(text, "walls.friction_coefficient=0.3");
+        let a = crate::case::load_str(text, "x.toml", &[]).unwrap();
+        let b = crate::case::load_str(text, "x.toml", &["walls.friction_slip_m_s=0.01".into()])
+            .unwrap();
+        assert_eq!(fingerprint(&a), fingerprint(&b));
+        let walls = format!("{:?}", a.walls);
+        assert!(
+            walls.contains(", friction: 0.0, friction_slip: 0.001,"),
+            "{walls}"
+        );
     }
 
     #[test]

@@ -51,6 +51,10 @@ pub struct Params {
     pub n_outlets: u32,
     /// 1 when every cell has a slot of its own and no axis is periodic (`Grid::dense`).
     pub dense_grid: u32,
+    /// Coulomb μ of contact and its regularisation speed ε [m/s] (`WallParams::friction`).
+    pub friction: f32,
+    pub friction_slip: f32,
+    pub pad: [u32; 2],
     /// The distinct materials of the elastic solids; a solid particle's is
     /// `SolidState::material`.
     pub solid_materials: [SolidMaterial; MAX_SOLID_MATERIALS],
@@ -356,6 +360,9 @@ mod tests {
                 n_inlets,
                 n_outlets,
                 dense_grid,
+                friction,
+                friction_slip,
+                pad,
                 solid_materials
             ]
         );

@@ -232,6 +232,12 @@ pub struct WallParams {
     pub repulsive_k: f64,
     /// Monaghan & Kajtar β: fluid spacing over boundary-particle spacing.
     pub repulsive_beta: f64,
+    /// Coulomb friction coefficient μ of contact (bodies and solids against walls, bodies and
+    /// solids); 0: frictionless.
+    pub friction: f64,
+    /// Regularisation speed ε [m/s] of the friction: the tangential force is
+    /// μ|F_n| v_t/sqrt(|v_t|² + ε²).
+    pub friction_slip: f64,
     pub mirror_planes: Vec<MirrorPlane>,
     /// Whether the boundary particles of fixed walls also get the fluid's force on them (as
     /// moving bodies' always do): wall-pressure probes read it. Off otherwise: fixed ghosts and
@@ -239,6 +245,9 @@ pub struct WallParams {
     /// over their neighbours for dρ/dt anyway).
     pub reactions: bool,
 }
+
+/// The default regularisation speed of contact friction [m/s].
+pub const DEFAULT_FRICTION_SLIP: f64 = 1e-3;
 
 /// The force law of repulsive boundary particles.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -361,6 +370,8 @@ impl WallParams {
             repulsive_form: RepulsiveForm::LennardJones,
             repulsive_k: gravity * height,
             repulsive_beta: 1.0,
+            friction: 0.0,
+            friction_slip: DEFAULT_FRICTION_SLIP,
             mirror_planes: Vec::new(),
             reactions: false,
         }

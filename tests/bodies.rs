@@ -283,7 +283,9 @@ fn body_rates_and_loads_match_reference() {
 }
 
 fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind) {
-    let sc = scene(dim, seed, kind);
+    let mut sc = scene(dim, seed, kind);
+    // Contact with friction: the pressed box slides on the floor (up to 0.14 m/s, ε = 1 mm/s).
+    sc.walls.friction = 0.5;
     let mut solver = Solver::new(gpu(), &sc).unwrap();
     solver.single_step(1e-3).unwrap();
     let gpu_rates = solver.rerun_interaction(true).unwrap();
@@ -333,11 +335,37 @@ fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind) {
             "the scene must have rows with contact = {contact}"
         );
         let (worst, _) = rate_errors(&rows, &cpu, &gpu_rates);
+        // The friction's part of these rows (against the same rates without it).
+        let frictionless = WallParams {
+            friction: 0.0,
+            ..sc.walls.clone()
+        };
+        let cpu0 = reference::interaction::rates(&sc.physics, &frictionless, &space, &parts);
+        let rms = |f: &dyn Fn(usize, usize) -> f64| {
+            let n = (rows.len() * 3) as f64;
+            (rows
+                .iter()
+                .flat_map(|&i| (0..3).map(move |a| (i, a)))
+                .map(|(i, a)| f(i, a).powi(2))
+                .sum::<f64>()
+                / n)
+                .sqrt()
+        };
+        let friction = rms(&|i, a| cpu[i][a] - cpu0[i][a]) / rms(&|i, a| cpu[i][a]);
         println!(
-            "dim {dim} {kind:?}, contact {contact}: {} rows, error {worst:.2e} of RMS",
+            "dim {dim} {kind:?}, contact {contact}: {} rows, error {worst:.2e} of RMS (friction \
+             {friction:.2} of it)",
             rows.len()
         );
         assert!(worst < 2e-4, "body-particle acceleration error {worst}");
+        if contact {
+            assert!(
+                friction > 0.05,
+                "friction is only {friction} of the contact rows"
+            );
+        } else {
+            assert_eq!(friction, 0.0, "friction away from contact");
+        }
     }
 
     let centers: Vec<DVec3> = (0..2)

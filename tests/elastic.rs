@@ -354,13 +354,20 @@ fn solids_in_contact(dim: u32, seed: u64) -> Scenario {
 #[test]
 fn solid_contact_matches_reference() {
     for dim in [2, 3] {
-        let sc = solids_in_contact(dim, 40 + dim as u64);
+        let mut sc = solids_in_contact(dim, 40 + dim as u64);
+        // With friction (random velocities of ±0.5 m/s slide the solids against everything).
+        sc.walls.friction = 0.5;
         let ph = &sc.physics;
         let mats = &sc.solids.as_ref().unwrap().materials;
         let (_solver, parts, solid, gpu_rate) = rerun(&sc);
         let space = Space::of(&sc);
         let solids = elastic::rates(ph, mats, &space, &parts, &solid);
         let contact = elastic::contact_rates(ph, mats, &sc.walls, &space, &parts, &solid);
+        let frictionless = WallParams {
+            friction: 0.0,
+            ..sc.walls.clone()
+        };
+        let contact0 = elastic::contact_rates(ph, mats, &frictionless, &space, &parts, &solid);
         let boundary = wgsph::reference::interaction::rates(ph, &sc.walls, &space, &parts);
         let mut groups: [Vec<(usize, [f64; 3])>; 4] = Default::default();
         for i in 0..parts.len() {
@@ -389,6 +396,15 @@ fn solid_contact_matches_reference() {
             }
             assert!(rows.len() >= 5, "{dim}D: only {} {name} rows", rows.len());
             let scale = rms(rows.iter().flat_map(|(_, w)| w.to_vec()));
+            // The friction's part of the compared rates.
+            let (with, without) = (&contact, &contact0);
+            let friction = rms(rows
+                .iter()
+                .flat_map(|&(i, _)| (0..3).map(move |a| with[i][a] - without[i][a])))
+                / scale;
+            if name.ends_with("in contact") {
+                assert!(friction > 0.05, "{dim}D {name}: friction only {friction}");
+            }
             let mut err = 0.0f64;
             for (i, w) in rows {
                 let g = gpu_rate[*i];
@@ -398,7 +414,8 @@ fn solid_contact_matches_reference() {
                 }
             }
             println!(
-                "{dim}D {name}: {} rows, acceleration error {err:.1e} of RMS {scale:.3e}",
+                "{dim}D {name}: {} rows, acceleration error {err:.1e} of RMS {scale:.3e} \
+                 (friction {friction:.2} of it)",
                 rows.len()
             );
             assert!(err < 2e-4, "{dim}D {name}: error {err}");

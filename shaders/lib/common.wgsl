@@ -52,6 +52,9 @@ struct Params {
     // 1 when every cell has a slot of its own and no axis is periodic (`Grid::dense`):
     // neighbour_ranges then takes a row of cells as one range.
     dense_grid: u32,
+    friction: f32,              // Coulomb μ of contact (interaction.wgsl `contact`); 0: none
+    friction_slip: f32,         // its regularisation speed ε [m/s]
+    pad: vec2<u32>,
     // The distinct materials of the solids; a solid particle's is SolidState.material.
     solid_materials: array<SolidMaterial, MAX_SOLID_MATERIALS>,
 }

@@ -282,6 +282,8 @@ pub(super) struct RawWalls {
     pub repulsive_form: Option<RepulsiveFormName>,
     pub repulsive_k_m2_s2: Option<f64>,
     pub repulsive_beta: Option<f64>,
+    pub friction_coefficient: Option<f64>,
+    pub friction_slip_m_s: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -667,6 +669,16 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "walls.repulsive_k_m2_s2",
         "the Monaghan & Kajtar strength K of repulsive walls in m²/s²",
         "repulsive_k_m2_s2 = 4.9",
+    ),
+    f(
+        "walls.friction_coefficient",
+        "the Coulomb friction coefficient of contact (bodies and solids), 0 for none",
+        "friction_coefficient = 0.3",
+    ),
+    f(
+        "walls.friction_slip_m_s",
+        "the regularisation speed of contact friction in m/s",
+        "friction_slip_m_s = 0.001",
     ),
     f(
         "walls.repulsive_beta",

@@ -4,7 +4,7 @@
 
 use crate::scenario::{
     DeltaSphForm, DensityFilter, GhostCorrection, KernelKind, Probe, RepulsiveForm, TimeControl,
-    Viscosity,
+    Viscosity, DEFAULT_FRICTION_SLIP,
 };
 
 use super::error::{num, CaseError};
@@ -63,6 +63,9 @@ pub(super) struct WallSettings {
     /// Monaghan & Kajtar K [m²/s²]; default |g| H.
     pub repulsive_k: Option<f64>,
     pub repulsive_beta: f64,
+    /// Coulomb μ of contact (0: frictionless) and its regularisation speed ε [m/s].
+    pub friction: f64,
+    pub friction_slip: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -570,6 +573,8 @@ pub(super) fn validate(
             repulsive_form: RepulsiveForm::LennardJones,
             repulsive_k: None,
             repulsive_beta: 1.0,
+            friction: 0.0,
+            friction_slip: DEFAULT_FRICTION_SLIP,
         },
         Some(w) => WallSettings {
             ghost_correction: match w.ghost_correction.unwrap_or(GhostCorrectionName::Mls) {
@@ -626,6 +631,22 @@ pub(super) fn validate(
                 Bound::Closed(0.1, 10.0),
                 "the ratio of fluid to boundary-particle spacing",
                 "use 1 for boundary particles on the fluid lattice (as wgsph builds them)",
+            )?,
+            friction: number(
+                ctx,
+                "walls.friction_coefficient",
+                w.friction_coefficient.unwrap_or(0.0),
+                Bound::Closed(0.0, 10.0),
+                "the Coulomb friction coefficient μ of contact",
+                "use 0 (frictionless) to about 1, e.g. 0.3",
+            )?,
+            friction_slip: number(
+                ctx,
+                "walls.friction_slip_m_s",
+                w.friction_slip_m_s.unwrap_or(DEFAULT_FRICTION_SLIP),
+                Bound::Positive,
+                "the regularisation speed of contact friction in m/s",
+                "use a speed well below the sliding speeds of interest, e.g. 0.001",
             )?,
         },
     };

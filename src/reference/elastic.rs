@@ -315,7 +315,7 @@ pub fn contact_weight(m_self: f64, m_other: f64) -> f64 {
 
 /// Contact accelerations of solid particles (as `solid_loads` in interaction.wgsl) and of the
 /// moving bodies' particles they touch; zero for the others. A solid particle feels the walls'
-/// repulsive law (`interaction::repulsion`, per unit mass) from every fixed wall particle
+/// repulsive law with friction (`interaction::contact`, per unit mass) from every fixed wall particle
 /// (times 1), every moving body's particle (whatever its treatment) and every particle of
 /// another elastic body within 2h (times `contact_weight` of the two masses, each solid's of
 /// its material, `mats` indexed by body); a body's particle the reaction of the solid's.
@@ -361,7 +361,11 @@ pub fn contact_rates(
                 if j == i || dot(x_ij, x_ij) >= support2 {
                     continue;
                 }
-                let f = super::interaction::repulsion(ph, walls, x_ij);
+                let v_ij = [0, 1, 2].map(|a| {
+                    super::interaction::contact_velocity(pi)[a]
+                        - super::interaction::contact_velocity(pj)[a]
+                });
+                let f = super::interaction::contact(ph, walls, x_ij, v_ij);
                 for c in 0..3 {
                     a[c] += k * f[c];
                 }

@@ -118,6 +118,32 @@ pub fn repulsion(ph: &Physics, walls: &WallParams, x_ij: [f64; 3]) -> [f64; 3] {
     x_ij.map(|x| f * x)
 }
 
+/// The contact force per unit mass between particles of which one is a body's or a solid's
+/// (as `contact` in interaction.wgsl): the repulsive law F_n at x_ij with regularised Coulomb
+/// friction, F_n − μ|F_n| v_t/sqrt(|v_t|² + ε²), v_t the part of v_ij across x_ij.
+pub fn contact(ph: &Physics, walls: &WallParams, x_ij: [f64; 3], v_ij: [f64; 3]) -> [f64; 3] {
+    let f_n = repulsion(ph, walls, x_ij);
+    let r2 = dot(x_ij, x_ij);
+    if walls.friction == 0.0 || r2 <= 0.0 {
+        return f_n;
+    }
+    let vn = dot(v_ij, x_ij) / r2;
+    let v_t = [0, 1, 2].map(|a| v_ij[a] - vn * x_ij[a]);
+    let k = walls.friction * dot(f_n, f_n).sqrt()
+        / (dot(v_t, v_t) + walls.friction_slip * walls.friction_slip).sqrt();
+    [0, 1, 2].map(|a| f_n[a] - k * v_t[a])
+}
+
+/// The velocity a particle presents in contact: a solid particle's own, a boundary particle's
+/// wall velocity (a body's rigid velocity at it; zero for fixed walls).
+pub fn contact_velocity(p: &RefParticle) -> [f64; 3] {
+    if super::elastic::is_solid(p.kind) {
+        p.vel
+    } else {
+        p.wall_vel
+    }
+}
+
 /// The velocities a fixed ghost presents (as `fixed_ghost_velocity` in interaction.wgsl): its
 /// wall's in continuity, and in viscosity 2 v_wall − v_f (no-slip) or v_f (free-slip), v_f the
 /// fluid velocity interpolated at it (its `vel`).
@@ -225,7 +251,8 @@ pub fn rates_and_energy(
                     {
                         // Contact with a fixed wall or another body (with elastic solids:
                         // `elastic::contact_rates`).
-                        let f = repulsion(ph, walls, x_ij);
+                        let v_ij = sub(contact_velocity(pi), contact_velocity(pj));
+                        let f = contact(ph, walls, x_ij, v_ij);
                         add(&mut r, [f[0], f[1], f[2], 0.0]);
                     }
                 }

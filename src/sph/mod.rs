@@ -262,6 +262,8 @@ impl Solver {
             repulsive_r0: sc.walls.repulsive_r0 as f32,
             repulsive_form: (sc.walls.repulsive_form == RepulsiveForm::MonaghanKajtar) as u32,
             repulsive_k_over_beta: (sc.walls.repulsive_k / sc.walls.repulsive_beta) as f32,
+            friction: sc.walls.friction as f32,
+            friction_slip: sc.walls.friction_slip as f32,
             body_id_base,
             n_body_particles: n as u32 - body_id_base,
             ..Default::default()
