@@ -37,13 +37,32 @@
 @group(0) @binding(7) var<storage, read_write> stress_rate: array<SymRate>;
 @group(0) @binding(8) var<storage, read_write> state: SimState;
 
-fn tau_of(s: SolidState) -> mat3x3<f32> {
-    // Columns of the symmetric τ.
+// What elastic_rates reads of a neighbour, written once per evaluation by solid_stress_terms
+// (by solid slot) rather than recomputed for every pair (the artificial stress alone is four
+// Jacobi sweeps in 3D): σ/ρ² and R, symmetric as (xx, yy, zz, xy | xz, yz), and the body (so
+// that a neighbour's SolidState is not read at all). Pass-local: the host never reads it.
+struct SolidTerms {
+    a_d: vec4<f32>,     // σ/ρ²: xx, yy, zz, xy
+    r_d: vec4<f32>,     // R: xx, yy, zz, xy
+    off: vec4<f32>,     // σ/ρ²: xz, yz; R: xz, yz
+    body: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+@group(0) @binding(9) var<storage, read_write> terms: array<SolidTerms>;
+
+// The symmetric matrix of diagonal and xy `d` = (xx, yy, zz, xy) and `o` = (xz, yz), by columns.
+fn sym3(d: vec4<f32>, o: vec2<f32>) -> mat3x3<f32> {
     return mat3x3<f32>(
-        vec3<f32>(s.tau_a.x, s.tau_a.w, s.tau_b.x),
-        vec3<f32>(s.tau_a.w, s.tau_a.y, s.tau_b.y),
-        vec3<f32>(s.tau_b.x, s.tau_b.y, s.tau_a.z),
+        vec3<f32>(d.x, d.w, o.x),
+        vec3<f32>(d.w, d.y, o.y),
+        vec3<f32>(o.x, o.y, d.z),
     );
+}
+
+fn tau_of(s: SolidState) -> mat3x3<f32> {
+    return sym3(s.tau_a, s.tau_b.xy);
 }
 
 // p = c_s² (ρ − ρs).
@@ -124,12 +143,35 @@ struct SolidParticle {
     rho: f32,
 }
 
-// Particle k, of material `mat` (its body's).
-fn solid_particle(k: u32, mat: SolidMaterial) -> SolidParticle {
-    let rho = velrho[k].w;
-    let p = solid_pressure(mat, rho);
-    let sigma = tau_of(solid[solid_slot(code[k])]) - mat3x3<f32>(vec3<f32>(p, 0.0, 0.0), vec3<f32>(0.0, p, 0.0), vec3<f32>(0.0, 0.0, p));
-    return SolidParticle(sigma * (1.0 / (rho * rho)), artificial_stress(mat.eps, sigma, rho), velrho[k].xyz, rho);
+// σ/ρ², R and the body of every solid particle, for elastic_rates (one invocation per
+// particle, before it).
+@compute @workgroup_size(WG)
+fn solid_stress_terms(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles || !is_solid(code_kind(code[i]))) {
+        return;
+    }
+    let s = solid[solid_slot(code[i])];
+    let rho = velrho[i].w;
+    let p = solid_pressure(material_of(s), rho);
+    let sigma = tau_of(s) - mat3x3<f32>(vec3<f32>(p, 0.0, 0.0), vec3<f32>(0.0, p, 0.0), vec3<f32>(0.0, 0.0, p));
+    let a = sigma * (1.0 / (rho * rho));
+    let r = artificial_stress(material_of(s).eps, sigma, rho);
+    terms[solid_slot(code[i])] = SolidTerms(
+        vec4<f32>(a[0].x, a[1].y, a[2].z, a[1].x),
+        vec4<f32>(r[0].x, r[1].y, r[2].z, r[1].x),
+        vec4<f32>(a[2].x, a[2].y, r[2].x, r[2].y),
+        s.body,
+        0u,
+        0u,
+        0u,
+    );
+}
+
+// Particle k with its terms `t` (solid_stress_terms).
+fn solid_particle(k: u32, t: SolidTerms) -> SolidParticle {
+    let vr = velrho[k];
+    return SolidParticle(sym3(t.a_d, t.off.xy), sym3(t.r_d, t.off.zw), vr.xyz, vr.w);
 }
 
 @compute @workgroup_size(WG)
@@ -142,7 +184,7 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     let body_i = solid[slot_i].body;
     // Pairs are within the body, so of one material.
     let mat = material_of(solid[slot_i]);
-    let pi = solid_particle(i, mat);
+    let pi = solid_particle(i, terms[slot_i]);
     let p_i = pos[i];
     let support2 = 4.0 * params.h * params.h;
     let m = mat.mass;
@@ -155,7 +197,8 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     let n_ranges = neighbour_ranges(cell_of(p_i), &ranges);
     for (var s = 0u; s < n_ranges; s++) {
         for (var j = ranges[s].x; j < ranges[s].y; j++) {
-            if (j == i || !is_solid(code_kind(code[j])) || solid[solid_slot(code[j])].body != body_i) {
+            let code_j = code[j];
+            if (j == i || !is_solid(code_kind(code_j))) {
                 continue;
             }
             let x_ij = rel_pos(p_i, pos[j]);
@@ -163,9 +206,13 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
             if (r2 >= support2) {
                 continue;
             }
+            let t_j = terms[solid_slot(code_j)];
+            if (t_j.body != body_i) {
+                continue;
+            }
             let q = sqrt(r2) / params.h;
             let dw_ij = x_ij * kernel_f(q);
-            let pj = solid_particle(j, mat);
+            let pj = solid_particle(j, t_j);
             let v_ij = pi.v - pj.v;
             drho += m * dot(v_ij, dw_ij);
             var pi_ij = 0.0;

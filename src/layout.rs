@@ -387,6 +387,11 @@ mod tests {
             [tau_a, tau_b, body, rate_a, rate_b, interface_p, material]
         );
         check_layout!(Pass::Elastic, "SymRate", SymRate, [a, b]);
+        // Pass-local, allocated by size only.
+        assert_eq!(
+            reflect(Pass::Elastic, "SolidTerms").0 as u64,
+            crate::sph::elastic::TERMS_BYTES
+        );
     }
 
     #[test]

@@ -5,17 +5,26 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
+use crate::gpu::buffers::storage;
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 
+/// Bytes of `SolidTerms` (shaders/elastic.wgsl) per solid particle: σ/ρ², R and the body.
+pub(crate) const TERMS_BYTES: u64 = 64;
+
 pub struct Elastic {
+    terms: ParityKernel,
     rates: ParityKernel,
     predict: ParityKernel,
     correct: ParityKernel,
     n: u32,
+    /// GPU memory of the terms buffer.
+    bytes: u64,
 }
 
 impl Elastic {
     pub fn new(device: &wgpu::Device, module: &ShaderModule, b: &ParticleBuffers) -> Result<Self> {
+        let n_solid = b.solid.size() / std::mem::size_of::<crate::layout::SolidState>() as u64;
+        let terms = storage(device, "solid stress terms", TERMS_BYTES * n_solid.max(1));
         let bufs = |p: usize| {
             [
                 (0, &b.params),
@@ -27,15 +36,23 @@ impl Elastic {
                 (6, &b.solid),
                 (7, &b.stress_rate),
                 (8, &b.state),
+                (9, &terms),
             ]
         };
         let bound = |entry: &str| ParityKernel::new(device, module, entry, |p| bufs(p).to_vec());
         Ok(Self {
+            terms: bound("solid_stress_terms")?,
             rates: bound("elastic_rates")?,
             predict: bound("stress_predict")?,
             correct: bound("stress_correct")?,
             n: b.n,
+            bytes: terms.size(),
         })
+    }
+
+    /// GPU memory of the pass's own buffer, in bytes.
+    pub fn bytes(&self) -> u64 {
+        self.bytes
     }
 
     /// τ* = τ_n + dt (dτ/dt)_n of the solid particles of parity `p`'s arrays (before the sort).
@@ -44,8 +61,10 @@ impl Elastic {
     }
 
     /// dρ/dt, dv/dt (into `rate`) and dτ/dt (into `stress_rate`) of the solid particles of the
-    /// sorted arrays of parity `p`; after the interaction pass.
+    /// sorted arrays of parity `p`; after the interaction pass. First σ/ρ² and R of every solid
+    /// particle, then the pair sums that read them.
     pub fn encode_rates(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.terms.dispatch(pass, p, self.n);
         self.rates.dispatch(pass, p, self.n);
     }
 

@@ -536,7 +536,9 @@ impl Solver {
 
     /// GPU memory of the run's buffers, in bytes.
     pub fn gpu_bytes(&self) -> u64 {
-        self.buffers.bytes() + self.total_lagrangian.as_ref().map_or(0, |t| t.bytes())
+        self.buffers.bytes()
+            + self.total_lagrangian.as_ref().map_or(0, |t| t.bytes())
+            + self.elastic.as_ref().map_or(0, |e| e.bytes())
     }
 
     fn read_state(&self) -> Result<SimState> {
