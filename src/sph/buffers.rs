@@ -3,7 +3,7 @@
 
 use crate::gpu::buffers::{storage, storage_init, uniform_init};
 use crate::layout::{
-    BodyMotion, BodyParticle, MirrorPlane, Params, Pos, ProbeDef, SimState, SolidState, SymRate,
+    BodyMotion, BodyParticle, MirrorPlane, Params, Pos, ProbeDef, SimState, SolidState,
 };
 
 pub struct ParticleBuffers {
@@ -42,12 +42,11 @@ pub struct ParticleBuffers {
     /// Each body's rigid motion for the step (uploaded by the host every step); one dummy
     /// element without bodies.
     pub body_motions: wgpu::Buffer,
-    /// Deviatoric stress, body and last dτ/dt of the solid particles, and the new dτ/dt (in
-    /// `stress_rate`), indexed by id − `Params::solid_id_base`: the sort leaves them in place,
-    /// and fluid and wall particles take no room in them (one element when there are no
-    /// solids).
+    /// Deviatoric stress, body, last dτ/dt, interface pressure and material of the solid
+    /// particles, indexed by id − `Params::solid_id_base`: the sort leaves them in place, and
+    /// fluid and wall particles take no room in it (one element when there are no solids).
+    /// The updated-Lagrangian pass (`Elastic`) owns the new dτ/dt.
     pub solid: wgpu::Buffer,
-    pub stress_rate: wgpu::Buffer,
 }
 
 /// Stand-in so a run without probes still binds a valid buffer.
@@ -142,11 +141,6 @@ impl ParticleBuffers {
             } else {
                 storage_init(device, "solid", init.solid)
             },
-            stress_rate: storage(
-                device,
-                "stress rate",
-                (std::mem::size_of::<SymRate>() * init.solid.len().max(1)) as u64,
-            ),
             body_particles: if init.body_particles.is_empty() {
                 storage(
                     device,
@@ -194,7 +188,6 @@ impl ParticleBuffers {
             &self.energy_rate,
             &self.body_particles,
             &self.body_motions,
-            &self.stress_rate,
             &self.solid,
         ];
         all.extend(self.energy.iter());

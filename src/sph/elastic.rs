@@ -11,13 +11,18 @@ use crate::gpu::kernel::{ParityKernel, ShaderModule};
 /// Bytes of `SolidTerms` (shaders/elastic.wgsl) per solid particle: σ/ρ², R and the body.
 pub(crate) const TERMS_BYTES: u64 = 64;
 
+/// The updated-Lagrangian solid's passes and their own buffers: the new dτ/dt (`SymRate`) and
+/// the per-evaluation stress terms of every solid particle (a total-Lagrangian case has
+/// neither).
 pub struct Elastic {
     terms: ParityKernel,
     rates: ParityKernel,
     predict: ParityKernel,
     correct: ParityKernel,
     n: u32,
-    /// GPU memory of the terms buffer.
+    /// dτ/dt of the last evaluation, by solid slot (read by tests).
+    pub stress_rate: wgpu::Buffer,
+    /// GPU memory of the pass's buffers.
     bytes: u64,
 }
 
@@ -25,6 +30,8 @@ impl Elastic {
     pub fn new(device: &wgpu::Device, module: &ShaderModule, b: &ParticleBuffers) -> Result<Self> {
         let n_solid = b.solid.size() / std::mem::size_of::<crate::layout::SolidState>() as u64;
         let terms = storage(device, "solid stress terms", TERMS_BYTES * n_solid.max(1));
+        let sym_rate = std::mem::size_of::<crate::layout::SymRate>() as u64;
+        let stress_rate = storage(device, "stress rate", sym_rate * n_solid.max(1));
         let bufs = |p: usize| {
             [
                 (0, &b.params),
@@ -34,7 +41,7 @@ impl Elastic {
                 (4, &b.cell_start),
                 (5, &b.rate),
                 (6, &b.solid),
-                (7, &b.stress_rate),
+                (7, &stress_rate),
                 (8, &b.state),
                 (9, &terms),
             ]
@@ -46,7 +53,8 @@ impl Elastic {
             predict: bound("stress_predict")?,
             correct: bound("stress_correct")?,
             n: b.n,
-            bytes: terms.size(),
+            bytes: terms.size() + stress_rate.size(),
+            stress_rate,
         })
     }
 

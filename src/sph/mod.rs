@@ -854,10 +854,10 @@ impl Solver {
             let nan = vec![f32::NAN; 4 * self.buffers.n as usize];
             self.queue
                 .write_buffer(&self.buffers.rate, 0, bytemuck::cast_slice(&nan));
-            if self.elastic.is_some() {
+            if let Some(e) = &self.elastic {
                 let nan = vec![f32::NAN; 8 * self.n_solid as usize];
                 self.queue
-                    .write_buffer(&self.buffers.stress_rate, 0, bytemuck::cast_slice(&nan));
+                    .write_buffer(&e.stress_rate, 0, bytemuck::cast_slice(&nan));
             }
         }
         let mut encoder = self
@@ -908,13 +908,13 @@ impl Solver {
     /// Test hook: dτ/dt of the last evaluation, by solid particle as `read_solid`.
     #[doc(hidden)]
     pub fn read_stress_rates(&self) -> Result<Vec<crate::layout::SymRate>> {
-        if self.elastic.is_none() {
-            bail!("the case has no solids");
-        }
+        let Some(e) = &self.elastic else {
+            bail!("the case has no updated-Lagrangian solids");
+        };
         read(
             &self.device,
             &self.queue,
-            &self.buffers.stress_rate,
+            &e.stress_rate,
             self.n_solid as usize,
         )
     }
