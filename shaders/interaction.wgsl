@@ -178,7 +178,7 @@ fn contact_weight(m_self: f32, m_other: f32) -> f32 {
 }
 
 // Acceleration of solid particle i by everything outside its own elastic body: the fluid's load
-// (interface_rates) and contact (the repulsive law of the walls, `repulsion`) with boundary
+// (interface_rates) and contact (the repulsive law of the walls with friction, `contact`) with boundary
 // particles (fixed walls, as for fluid; moving bodies' particles of any wall treatment, with
 // contact_weight) and with the particles of other elastic bodies (contact_weight of the two
 // materials' masses).
