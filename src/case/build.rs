@@ -962,12 +962,12 @@ pub(super) fn wall_params(
         return Err(ctx.err(
             field,
             None,
-            "defaults to a multiple of |g|·H, which is 0 without gravity: the repulsive law that \
-             keeps fluid off repulsive walls and bodies, solids and walls apart would have no \
-             strength",
+            "defaults to a multiple of |g|·H, which is 0 since physics.gravity_m_s2 is zero: the \
+             repulsive law that keeps fluid off repulsive walls and bodies, solids and walls apart \
+             would have no strength",
             format!(
                 "give {field}, of the order of the square of the fastest velocity expected \
-                 (Monaghan 1994), e.g. {} = 1.0",
+                 (Monaghan 1994), e.g. {} = 1.0, or a non-zero physics.gravity_m_s2",
                 field.trim_start_matches("walls.")
             ),
         ));

@@ -139,7 +139,7 @@ fn solids_keep_their_own_materials() {
         None,
         &[
             "walls.repulsive_d_m2_s2",
-            "without gravity",
+            "physics.gravity_m_s2 is zero",
             "repulsive_d_m2_s2 = 1.0",
         ],
     );
