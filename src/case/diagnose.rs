@@ -1,6 +1,9 @@
 //! Turns the TOML library's errors (syntax, and serde's unknown/missing/wrong-type field errors)
 //! into [`CaseError`]s that name the file, line, field path and a fix.
 
+use toml::de::{DeTable, DeValue};
+use toml::Spanned;
+
 use super::error::{CaseError, Diagnostic};
 use super::locate::{join, Ctx, Index};
 use super::schema::help;
@@ -118,6 +121,62 @@ pub(super) fn schema(ctx: &Ctx<'_>, text: &str, index: &Index, err: &toml::de::E
         msg.to_string(),
         "see docs/cases.md for the allowed fields and values",
     )
+}
+
+/// Refuses a table written as anything else, before deserialising. serde fills a struct from a
+/// sequence by position, so `time = [1.0, 0.02]` would silently become `end_s = 1.0` and
+/// `output_every_s = 0.02`; a case file names its fields. A path is a table when its help entry
+/// says so ([`FieldHelp::ty`](super::schema::FieldHelp::ty)), `[[...]]` elements included.
+pub(super) fn tables_are_tables(
+    ctx: &Ctx<'_>,
+    text: &str,
+    doc: &DeTable<'_>,
+) -> Result<(), CaseError> {
+    for (key, value) in doc.iter() {
+        check_table_shape(ctx, text, &join("", key.get_ref()), value)?;
+    }
+    Ok(())
+}
+
+fn check_table_shape(
+    ctx: &Ctx<'_>,
+    text: &str,
+    path: &str,
+    value: &Spanned<DeValue<'_>>,
+) -> Result<(), CaseError> {
+    let v = value.get_ref();
+    if let Some(h) = help(path).filter(|h| h.ty() == "a table") {
+        if v.as_table().is_none() {
+            let found = match v {
+                DeValue::String(_) => "a string",
+                DeValue::Integer(_) => "an integer",
+                DeValue::Float(_) => "a number with a fraction",
+                DeValue::Boolean(_) => "a boolean",
+                DeValue::Datetime(_) => "a date",
+                DeValue::Array(_) => "an array",
+                DeValue::Table(_) => "a table",
+            };
+            return Err(ctx.err(
+                path,
+                text.get(value.span()).map(|s| shorten(s.trim())),
+                format!(
+                    "wrong type: expected a table ({}), found {found}",
+                    h.meaning
+                ),
+                format!("write it as {}, each field by name", h.example),
+            ));
+        }
+    }
+    if let Some(t) = v.as_table() {
+        for (key, item) in t.iter() {
+            check_table_shape(ctx, text, &join(path, key.get_ref()), item)?;
+        }
+    } else if let Some(items) = v.as_array() {
+        for (i, item) in items.iter().enumerate() {
+            check_table_shape(ctx, text, &format!("{path}[{i}]"), item)?;
+        }
+    }
+    Ok(())
 }
 
 /// What the field at `path` should hold, and an example line.

@@ -97,8 +97,8 @@ pub fn load_str_limited(
     // With overrides, edit the document and deserialise its re-serialised text; error spans then
     // point into that text, and are mapped back to field paths (and so to the file's lines).
     let edited;
-    let (de_text, de_index) = if parsed.is_empty() {
-        (text, None)
+    let (de_text, de_index, de_doc) = if parsed.is_empty() {
+        (text, None, doc)
     } else {
         let mut table: toml::Table = text
             .parse()
@@ -124,8 +124,10 @@ pub fn load_str_limited(
                 "check the --set values",
             )
         })?;
-        (edited.as_str(), Some(Index::new(&edited, doc.get_ref())))
+        let edited_index = Index::new(&edited, doc.get_ref());
+        (edited.as_str(), Some(edited_index), doc)
     };
+    diagnose::tables_are_tables(&ctx, de_text, de_doc.get_ref())?;
     let raw: RawCase = toml::from_str(de_text)
         .map_err(|e| diagnose::schema(&ctx, de_text, de_index.as_ref().unwrap_or(&index), &e))?;
 

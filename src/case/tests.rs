@@ -616,6 +616,77 @@ fn wrong_types_are_named() {
 }
 
 #[test]
+fn tables_written_as_arrays_are_refused() {
+    // serde would fill a struct from an array by position; a case file must name its fields.
+    assert_err(
+        &format!(
+            "time = [1.0, 0.1]\n{}",
+            base_with("[time]\nend_s = 1.0\noutput_every_s = 0.1\n", "")
+        ),
+        &[],
+        Some(1),
+        &[
+            "time = [1.0, 0.1]",
+            "expected a table",
+            "found an array",
+            "[time] with end_s",
+        ],
+    );
+    assert_err(
+        &format!(
+            "probe = [[\"P1\", \"pressure\", [0.5, 0.05]]]\n{}",
+            base_with(
+                "[[probe]]\nname = \"P1\"\nkind = \"pressure\"\npoint_m = [0.5, 0.05]\n",
+                ""
+            )
+        ),
+        &[],
+        Some(1),
+        &[
+            "probe[0]",
+            "expected a table",
+            "found an array",
+            "[[probe]]",
+        ],
+    );
+    // The same through an override, and for tables nested in tables and in `[[...]]` elements.
+    assert_err(
+        BASE,
+        &["particles=[0.1, 2.0]"],
+        None,
+        &[
+            "particles",
+            "--set particles=[0.1, 2.0]",
+            "expected a table",
+        ],
+    );
+    assert_err(
+        FLOATING,
+        &["body[0].motion=[\"free\"]"],
+        None,
+        &[
+            "body[0].motion",
+            "expected a table",
+            "[body.motion] with kind",
+        ],
+    );
+    assert_err(
+        &format!(
+            "{BASE}[[solid]]\nname = \"s\"\nmin_m = [0.6, 0.0]\nmax_m = [0.7, 0.3]\n\
+                  density_kg_m3 = 1100.0\nyoungs_modulus_pa = 1e6\npoisson_ratio = 0.4\n\
+                  initial_velocity = [\"cantilever_mode\"]\n"
+        ),
+        &[],
+        Some(32),
+        &[
+            "solid[0].initial_velocity",
+            "expected a table",
+            "found an array",
+        ],
+    );
+}
+
+#[test]
 fn bad_numbers_are_refused() {
     let cases: &[(&str, &str, usize, &[&str])] = &[
         (
