@@ -152,11 +152,12 @@ fn solid_stress_terms(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(nu
         return;
     }
     let s = solid[solid_slot(code[i])];
+    let mat = material_of(s);
     let rho = velrho[i].w;
-    let p = solid_pressure(material_of(s), rho);
+    let p = solid_pressure(mat, rho);
     let sigma = tau_of(s) - mat3x3<f32>(vec3<f32>(p, 0.0, 0.0), vec3<f32>(0.0, p, 0.0), vec3<f32>(0.0, 0.0, p));
     let a = sigma * (1.0 / (rho * rho));
-    let r = artificial_stress(material_of(s).eps, sigma, rho);
+    let r = artificial_stress(mat.eps, sigma, rho);
     terms[solid_slot(code[i])] = SolidTerms(
         vec4<f32>(a[0].x, a[1].y, a[2].z, a[1].x),
         vec4<f32>(r[0].x, r[1].y, r[2].z, r[1].x),

@@ -568,6 +568,23 @@ pub struct Solids {
     pub tau0: Vec<[f64; 6]>,
 }
 
+/// The distinct materials of `materials`, in order of first appearance, and the index in that
+/// list of each of `materials`.
+pub fn distinct_materials(materials: &[ElasticMaterial]) -> (Vec<ElasticMaterial>, Vec<u32>) {
+    let mut distinct: Vec<ElasticMaterial> = Vec::new();
+    let index = materials
+        .iter()
+        .map(|m| match distinct.iter().position(|d| d == m) {
+            Some(k) => k as u32,
+            None => {
+                distinct.push(*m);
+                distinct.len() as u32 - 1
+            }
+        })
+        .collect();
+    (distinct, index)
+}
+
 impl Solids {
     /// The formulation of every solid of the case.
     pub fn formulation(&self) -> SolidFormulation {
@@ -582,19 +599,7 @@ impl Solids {
     /// The distinct materials, in order of first appearance, and the index in that list of
     /// every body's material (what the GPU stores: `Params::solid_materials`).
     pub fn distinct_materials(&self) -> (Vec<ElasticMaterial>, Vec<u32>) {
-        let mut distinct: Vec<ElasticMaterial> = Vec::new();
-        let index = self
-            .materials
-            .iter()
-            .map(|m| match distinct.iter().position(|d| d == m) {
-                Some(k) => k as u32,
-                None => {
-                    distinct.push(*m);
-                    distinct.len() as u32 - 1
-                }
-            })
-            .collect();
-        (distinct, index)
+        distinct_materials(&self.materials)
     }
 
     /// The fastest P-wave speed c_p = sqrt((K + 4μ/3)/ρs) of the materials [m/s], which the

@@ -2,7 +2,8 @@
 //! their particles, and the build of a solid-only case (with fluid, `build.rs` adds them).
 
 use crate::scenario::{
-    Domain, ElasticMaterial, Kind, Particle, Physics, Scenario, SolidFormulation, Solids,
+    distinct_materials, Domain, ElasticMaterial, Kind, Particle, Physics, Scenario,
+    SolidFormulation, Solids,
 };
 
 use super::error::{num, CaseError};
@@ -366,25 +367,24 @@ pub(super) fn solid_particles(
                 "give every solid the same formulation",
             ));
         }
-        let distinct = solids[..=i].iter().fold(Vec::new(), |mut d, o| {
-            if !d.contains(&o.material) {
-                d.push(o.material);
-            }
-            d
-        });
-        if distinct.len() > MAX_SOLID_MATERIALS {
-            return Err(ctx.err(
-                &format!("solid[{i}]"),
-                None,
-                format!(
-                    "is of a {}th material: a case holds at most {MAX_SOLID_MATERIALS} different \
-                     solid materials (density, Young's modulus, Poisson ratio, alpha and \
-                     artificial_stress)",
-                    distinct.len()
-                ),
-                "give solids of nearly equal materials the same values",
-            ));
-        }
+    }
+    let materials: Vec<ElasticMaterial> = solids.iter().map(|s| s.material).collect();
+    let (_, index) = distinct_materials(&materials);
+    if let Some(i) = index
+        .iter()
+        .position(|&k| k as usize >= MAX_SOLID_MATERIALS)
+    {
+        return Err(ctx.err(
+            &format!("solid[{i}]"),
+            None,
+            format!(
+                "is of a {}th material: a case holds at most {MAX_SOLID_MATERIALS} different \
+                 solid materials (density, Young's modulus, Poisson ratio, alpha and \
+                 artificial_stress)",
+                index[i] + 1
+            ),
+            "give solids of nearly equal materials the same values",
+        ));
     }
     let lat = Lattice {
         origin: first.bx.min,
@@ -469,7 +469,7 @@ pub(super) fn solid_particles(
             ));
         }
     }
-    Ok((solids.iter().map(|s| s.material).collect(), particles, body))
+    Ok((materials, particles, body))
 }
 
 pub(super) fn build_solid_case(
