@@ -144,6 +144,10 @@ enum Command {
         warmup: u64,
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         set: Vec<String>,
+        /// Then time each stage of the step on the GPU over as many steps (one submission per
+        /// step, each stage in a pass of its own; needs timestamp queries).
+        #[arg(long)]
+        stages: bool,
     },
 }
 
@@ -383,6 +387,7 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             steps,
             warmup,
             set,
+            stages,
         } => {
             let sc = wgsph::case::load(&case, &set)?;
             let ctx = context(cli.adapter)?;
@@ -403,7 +408,29 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                 "bytes/particle  {:.1}",
                 solver.gpu_bytes() as f64 / n as f64
             );
+            if stages {
+                print_stages(&solver.profile_steps(steps)?, steps, n);
+            }
             Ok(ExitCode::SUCCESS)
         }
+    }
+}
+
+/// The GPU time of each stage per step, its share of the stages' sum, and per particle.
+fn print_stages(times: &[wgsph::sph::profile::StageTime], steps: u64, particles: u64) {
+    let total: f64 = times.iter().map(|s| s.seconds).sum();
+    println!("stage                   ms/step   share  ns/particle");
+    for s in times.iter().chain([&wgsph::sph::profile::StageTime {
+        name: "all stages",
+        seconds: total,
+    }]) {
+        let per_step = s.seconds / steps as f64;
+        println!(
+            "{:<22} {:>8.4} {:>6.1} % {:>10.2}",
+            s.name,
+            1e3 * per_step,
+            100.0 * s.seconds / total.max(f64::MIN_POSITIVE),
+            1e9 * per_step / particles as f64
+        );
     }
 }

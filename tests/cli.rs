@@ -340,3 +340,49 @@ fn validate_refuses_unknown_cases_and_both_modes() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("cannot be used with"));
 }
+
+/// `bench` reports the throughput and memory; with `--stages`, a table of each stage's GPU time
+/// whose shares add up to the whole.
+#[test]
+fn bench_reports_throughput_and_the_stages() {
+    let o = wgsph()
+        .args([
+            "bench",
+            "cases/hydrostatic_2d.toml",
+            "--steps",
+            "10",
+            "--warmup",
+            "2",
+            "--stages",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let value = |key: &str| -> f64 {
+        let line = stdout.lines().find(|l| l.starts_with(key)).unwrap();
+        line[key.len()..].trim().parse().unwrap()
+    };
+    assert!(value("particle-steps/s") > 0.0, "{stdout}");
+    assert!(value("bytes/particle") > 0.0, "{stdout}");
+    // Rows after the table's header: name, ms/step, share, "%", ns/particle.
+    let rows: Vec<Vec<&str>> = stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("stage "))
+        .skip(1)
+        .map(|l| l.split_whitespace().collect())
+        .collect();
+    let share = |r: &Vec<&str>| -> f64 { r[r.len() - 3].parse().unwrap() };
+    let (all, stages) = rows.split_last().expect("a stage table");
+    assert_eq!(all[..2], ["all", "stages"], "{stdout}");
+    for name in ["predict", "cell_list", "interaction", "correct"] {
+        assert!(stages.iter().any(|r| r[0] == name), "{name}: {stdout}");
+    }
+    let sum: f64 = stages.iter().map(share).sum();
+    assert!((sum - 100.0).abs() < 0.05 * stages.len() as f64, "{stdout}");
+    assert_eq!(share(all), 100.0, "{stdout}");
+}

@@ -29,3 +29,63 @@ fn same_case_twice_is_bit_identical() {
     assert_eq!(bits(&va), bits(&vb), "velocities/densities differ");
     assert_eq!(bits(&ra), bits(&rb), "rates differ");
 }
+
+/// `bench --stages` records each stage of the step in a timed pass of its own: that must change
+/// the timing only. Run with and without profiling, the particles are bit-identical, and every
+/// stage of the step is timed, once per step, in the step's order.
+#[test]
+fn profiling_the_stages_changes_nothing_but_the_timing() {
+    let cases: [(&str, &[&str], &[&str]); 2] = [
+        (
+            "cases/floating_box_2d.toml",
+            &["particles.dx_m=0.04"],
+            &[
+                "predict",
+                "body_move",
+                "cell_list",
+                "body_index",
+                "ghost",
+                "interaction",
+                "body_force",
+                "correct",
+            ],
+        ),
+        (
+            "cases/oscillating_plate_2d.toml",
+            &[],
+            &[
+                "predict",
+                "elastic_predict",
+                "cell_list",
+                "ghost",
+                "interaction",
+                "elastic_rates",
+                "elastic_correct",
+                "correct",
+            ],
+        ),
+    ];
+    for (case, set, stages) in cases {
+        let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        let sc = wgsph::case::load(Path::new(case), &set).unwrap();
+        let mut plain = Solver::new(gpu(), &sc).unwrap();
+        plain.run_steps(12).unwrap();
+        let mut profiled = Solver::new(gpu(), &sc).unwrap();
+        let times = profiled.profile_steps(12).unwrap();
+        assert_eq!(plain.steps(), profiled.steps());
+        assert!(
+            plain.read_raw().unwrap() == profiled.read_raw().unwrap(),
+            "{case}: profiling changed the particles"
+        );
+        let names: Vec<&str> = times.iter().map(|s| s.name).collect();
+        assert_eq!(names, stages, "{case}");
+        assert!(
+            times
+                .iter()
+                .all(|s| s.seconds.is_finite() && s.seconds >= 0.0),
+            "{case}: {times:?}"
+        );
+        let interaction = times.iter().find(|s| s.name == "interaction").unwrap();
+        assert!(interaction.seconds > 0.0, "{case}: {times:?}");
+    }
+}

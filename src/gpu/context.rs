@@ -222,7 +222,8 @@ impl GpuContext {
         restrict(&mut limits);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("wgsph"),
-            required_features: wgpu::Features::empty(),
+            // Optional: only `bench --stages` uses timestamps.
+            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
             required_limits: limits.clone(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,

@@ -13,6 +13,7 @@ pub mod integrate;
 pub mod interaction;
 pub mod open_boundaries;
 pub mod probes;
+pub mod profile;
 pub mod state;
 pub mod total_lagrangian;
 
@@ -41,6 +42,7 @@ use integrate::Integrate;
 use interaction::Interaction;
 use open_boundaries::OpenBoundaries;
 use probes::{PointTracker, Probes};
+use profile::{Profiler, Recorder, StageTime};
 use total_lagrangian::TotalLagrangian;
 
 /// Most steps recorded into one submission before the host looks at the state again.
@@ -213,6 +215,8 @@ pub struct Solver {
     open_boundaries: Option<OpenBoundaries>,
     /// Stop when more than this fraction of the fluid has been excluded.
     pub max_excluded_fraction: f64,
+    /// Per-stage timestamps, while [`Solver::profile_steps`] runs.
+    profiler: Option<Profiler>,
 }
 
 impl Solver {
@@ -489,6 +493,7 @@ impl Solver {
             dormant_at_start: sc.dormant_count() as u32,
             open_boundaries,
             max_excluded_fraction: 0.05,
+            profiler: None,
         };
         // Warm-up: one step with dt = 0 sorts the particles, evaluates the initial rates and
         // chooses the first dt; it moves nothing and is not counted.
@@ -594,62 +599,85 @@ impl Solver {
         self.faults.check()
     }
 
-    /// Records `count` steps into one command encoder.
+    /// Records `count` steps into one command encoder (with the profiler on, each stage in a
+    /// timed pass of its own: one step per encoder).
     fn encode_steps(&mut self, count: u32) -> wgpu::CommandEncoder {
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("steps"),
             });
-        let bodies = self.bodies.as_ref().map(|(gpu, _, _)| gpu);
+        let mut profiler = self.profiler.take();
+        assert!(
+            profiler.is_none() || count == 1,
+            "profiling records one step per encoder"
+        );
         for _ in 0..count {
-            let p = self.parity;
-            let q = 1 - p;
             self.cell_list.clear(&mut encoder, &self.buffers);
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("step"),
-                timestamp_writes: None,
-            });
-            self.integrate.encode_predict(&mut pass, p);
-            if let Some(e) = &self.elastic {
-                e.encode_predict(&mut pass, p);
-            }
-            if let Some(b) = bodies {
-                b.encode_move(&mut pass, p);
-            }
-            if let Some(o) = &self.open_boundaries {
-                o.encode(&mut pass, p);
-            }
-            self.cell_list.encode(&mut pass, p);
-            if let Some(t) = &self.total_lagrangian {
-                t.encode_index(&mut pass, q);
-            }
-            if let Some(b) = bodies {
-                b.encode_index(&mut pass, q);
-            }
-            self.ghost.encode(&mut pass, q);
-            if let Some(o) = &self.open_boundaries {
-                o.encode_pressure(&mut pass, q);
-            }
-            self.interaction.encode(&mut pass, q);
-            if let Some(e) = &self.elastic {
-                e.encode_rates(&mut pass, q);
-                e.encode_correct(&mut pass, q);
-            }
-            if let Some(t) = &self.total_lagrangian {
-                t.encode_rates(&mut pass, q);
-            }
-            if let Some(b) = bodies {
-                b.encode_force(&mut pass, q);
-            }
-            self.integrate.encode_correct(&mut pass, q);
-            if let Some(f) = &self.density_filter {
-                f.encode(&mut pass, q);
-            }
-            drop(pass);
-            self.parity = q;
+            let recorder = match profiler.as_mut() {
+                Some(profiler) => Recorder::Timed {
+                    encoder: &mut encoder,
+                    profiler,
+                },
+                None => {
+                    Recorder::Shared(encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("step"),
+                        timestamp_writes: None,
+                    }))
+                }
+            };
+            self.record_step(recorder);
         }
+        if let Some(p) = &profiler {
+            p.resolve(&mut encoder);
+        }
+        self.profiler = profiler;
         encoder
+    }
+
+    /// The stages of one step, in order; flips the parity.
+    fn record_step(&mut self, mut r: Recorder<'_>) {
+        let p = self.parity;
+        let q = 1 - p;
+        let bodies = self.bodies.as_ref().map(|(gpu, _, _)| gpu);
+        r.stage("predict", |pass| self.integrate.encode_predict(pass, p));
+        if let Some(e) = &self.elastic {
+            r.stage("elastic_predict", |pass| e.encode_predict(pass, p));
+        }
+        if let Some(b) = bodies {
+            r.stage("body_move", |pass| b.encode_move(pass, p));
+        }
+        if let Some(o) = &self.open_boundaries {
+            r.stage("open_boundaries", |pass| o.encode(pass, p));
+        }
+        r.stage("cell_list", |pass| self.cell_list.encode(pass, p));
+        if let Some(t) = &self.total_lagrangian {
+            r.stage("total_lagrangian_index", |pass| t.encode_index(pass, q));
+        }
+        if let Some(b) = bodies {
+            r.stage("body_index", |pass| b.encode_index(pass, q));
+        }
+        r.stage("ghost", |pass| self.ghost.encode(pass, q));
+        if let Some(o) = &self.open_boundaries {
+            r.stage("inlet_pressure", |pass| o.encode_pressure(pass, q));
+        }
+        r.stage("interaction", |pass| self.interaction.encode(pass, q));
+        if let Some(e) = &self.elastic {
+            r.stage("elastic_rates", |pass| e.encode_rates(pass, q));
+            r.stage("elastic_correct", |pass| e.encode_correct(pass, q));
+        }
+        if let Some(t) = &self.total_lagrangian {
+            r.stage("total_lagrangian_rates", |pass| t.encode_rates(pass, q));
+        }
+        if let Some(b) = bodies {
+            r.stage("body_force", |pass| b.encode_force(pass, q));
+        }
+        r.stage("correct", |pass| self.integrate.encode_correct(pass, q));
+        if let Some(f) = &self.density_filter {
+            r.stage("density_filter", |pass| f.encode(pass, q));
+        }
+        drop(r);
+        self.parity = q;
     }
 
     /// Re-bases the GPU's f32 clock on the host's f64 one, so that it only ever counts a short
@@ -715,6 +743,34 @@ impl Solver {
         self.state = self.read_state()?;
         self.steps += (self.state.steps - st.steps) as u64;
         self.check_stability()
+    }
+
+    /// Takes `count` steps as [`Solver::run_steps`] does, one submission each, with every stage
+    /// in a timed pass of its own, and returns each stage's GPU time summed over the steps (in
+    /// the step's order). The particles evolve exactly as without profiling.
+    pub fn profile_steps(&mut self, count: u64) -> Result<Vec<StageTime>> {
+        if self.profiler.is_none() {
+            self.profiler = Some(Profiler::new(&self.device, &self.queue)?);
+        }
+        let mut st = self.rebased_state();
+        st.t_target_rel = f32::MAX;
+        st.dt = st.dt_cfl;
+        self.queue
+            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
+        self.state = st;
+        let result = (0..count).try_for_each(|_| {
+            let before = self.state.steps;
+            self.take_steps(1)?;
+            self.steps += (self.state.steps - before) as u64;
+            self.profiler
+                .as_mut()
+                .expect("profiling")
+                .collect(&self.device)
+        });
+        let profiler = self.profiler.take().expect("profiling");
+        result?;
+        self.check_stability()?;
+        Ok(profiler.totals().to_vec())
     }
 
     /// Benchmark hook: records `reps` repetitions of `stage`, submits them and waits. After
