@@ -190,6 +190,7 @@ fn solid_loads(i: u32) -> vec3<f32> {
     let v_i = vr_i.xyz;
     let b_i = s_i.interface_p / (vr_i.w * vr_i.w);
     let body_i = s_i.body;
+    let group_i = params.friction_first_solid + body_i;
     let support2 = 4.0 * params.h * params.h;
     var r = vec3<f32>(0.0);
     var ranges: array<vec2<u32>, 27>;
@@ -214,11 +215,13 @@ fn solid_loads(i: u32) -> vec3<f32> {
                 if (is_body_particle(code[j] & ID_MASK)) {
                     k = contact_weight(m_i, params.mass);
                 }
-                r += k * contact(x_ij, r2, v_i - contact_velocity(j));
+                let mu = friction_between(group_i, boundary_group(code[j] & ID_MASK));
+                r += k * contact(x_ij, r2, v_i - contact_velocity(j), mu);
             } else {
                 let s_j = solid[solid_slot(code[j])];
                 if (s_j.body != body_i) {
-                    r += contact_weight(m_i, material_of(s_j).mass) * contact(x_ij, r2, v_i - velrho[j].xyz);
+                    let mu = friction_between(group_i, params.friction_first_solid + s_j.body);
+                    r += contact_weight(m_i, material_of(s_j).mass) * contact(x_ij, r2, v_i - velrho[j].xyz, mu);
                 }
             }
         }
@@ -232,16 +235,36 @@ fn solid_loads(i: u32) -> vec3<f32> {
 //   F = F_n − μ |F_n| v_t / sqrt(|v_t|² + ε²),
 // v_t the part of the relative velocity v_ij = v_i − v_j across x_ij (the velocities of
 // `contact_velocity`), ε = params.friction_slip. Equal and opposite for a pair (x_ji = −x_ij,
-// v_ji = −v_ij); friction acts only where the normal force does (r < r0 for Lennard-Jones).
-fn contact(x_ij: vec3<f32>, r2: f32, v_ij: vec3<f32>) -> vec3<f32> {
+// v_ji = −v_ij); friction acts only where the normal force does (r < r0 for Lennard-Jones). μ is
+// the pair's (`friction_between`).
+fn contact(x_ij: vec3<f32>, r2: f32, v_ij: vec3<f32>, mu: f32) -> vec3<f32> {
     let f_n = repulsion(x_ij, r2);
-    if (params.friction == 0.0 || r2 <= 0.0) {
+    if (mu == 0.0 || r2 <= 0.0) {
         return f_n;
     }
     let n = x_ij * inverseSqrt(r2);
     let v_t = v_ij - dot(v_ij, n) * n;
     let e = params.friction_slip;
-    return f_n - (params.friction * length(f_n) * inverseSqrt(dot(v_t, v_t) + e * e)) * v_t;
+    return f_n - (mu * length(f_n) * inverseSqrt(dot(v_t, v_t) + e * e)) * v_t;
+}
+
+// The Coulomb μ between contact groups a and b (0 the fixed walls, 1 + body for a body's
+// particles, friction_first_solid + body for a solid's): the `[[friction]]` table's entry, or
+// the walls' μ when the case has no pairs.
+fn friction_between(a: u32, b: u32) -> f32 {
+    if (params.friction_groups == 0u) {
+        return params.friction;
+    }
+    let k = a * params.friction_groups + b;
+    return params.friction_table[k / 4u][k % 4u];
+}
+
+// The contact group of the boundary particle with id `id`: its body's, or the fixed walls'.
+fn boundary_group(id: u32) -> u32 {
+    if (is_body_particle(id)) {
+        return 1u + body_particles[id - params.body_id_base].body;
+    }
+    return 0u;
 }
 
 // The velocity particle j presents in contact: a solid particle's own, a body particle's rigid
@@ -431,7 +454,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let support2 = 4.0 * params.h * params.h;
     // The rigid velocity a body particle presents in contact (friction only).
     var v_contact_i = vec3<f32>(0.0);
-    if (on_body && params.friction != 0.0) {
+    if (on_body && (params.friction != 0.0 || params.friction_groups != 0u)) {
         v_contact_i = contact_velocity(i);
     }
 
@@ -464,11 +487,13 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                     }
                 } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
                     // Contact with an elastic solid.
-                    let m_j = material_of(solid[solid_slot(code[j])]).mass;
-                    r += vec4<f32>(contact_weight(params.mass, m_j) * contact(x_ij, r2, v_contact_i - velrho[j].xyz), 0.0);
+                    let s_j = solid[solid_slot(code[j])];
+                    let mu = friction_between(1u + body_i, params.friction_first_solid + s_j.body);
+                    r += vec4<f32>(contact_weight(params.mass, material_of(s_j).mass) * contact(x_ij, r2, v_contact_i - velrho[j].xyz, mu), 0.0);
                 } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, code[j] & ID_MASK)) {
                     // Contact with a fixed wall or another body.
-                    r += vec4<f32>(contact(x_ij, r2, v_contact_i - contact_velocity(j)), 0.0);
+                    let mu = friction_between(1u + body_i, boundary_group(code[j] & ID_MASK));
+                    r += vec4<f32>(contact(x_ij, r2, v_contact_i - contact_velocity(j), mu), 0.0);
                 }
                 continue;
             }

@@ -121,9 +121,12 @@ impl Fnv {
 pub fn fingerprint(sc: &Scenario) -> u64 {
     let mut h = Fnv::default();
     // Friction only when on, so checkpoints written before it existed still match (without
-    // it, its regularisation speed changes nothing).
+    // it, its regularisation speed changes nothing); pairs with their own μ only when given.
     let mut walls = format!("{:?}", sc.walls);
-    if sc.walls.friction == 0.0 {
+    if sc.walls.friction_pairs.is_empty() {
+        walls = walls.replace(", friction_pairs: []", "");
+    }
+    if sc.walls.friction == 0.0 && sc.walls.friction_pairs.is_empty() {
         walls = walls.replace(
             &format!(
                 ", friction: {:?}, friction_slip: {:?}",
@@ -467,9 +470,15 @@ mod tests {
         assert_eq!(fingerprint(&a), fingerprint(&b));
         let walls = format!("{:?}", a.walls);
         assert!(
-            walls.contains(", friction: 0.0, friction_slip: 0.001,"),
+            walls.contains(", friction: 0.0, friction_slip: 0.001, friction_pairs: [],"),
             "{walls}"
         );
+        // A pair with a coefficient of its own is seen, even one of 0 (the default's value).
+        let paired =
+            format!("{text}\n[[friction]]\nbetween = [\"box\", \"walls\"]\ncoefficient = 0.0\n");
+        let c = crate::case::load_str(&paired, "x.toml", &[]).unwrap();
+        assert_eq!(c.walls.friction_pairs.len(), 1);
+        assert_ne!(fingerprint(&a), fingerprint(&c));
     }
 
     #[test]

@@ -5,7 +5,7 @@ use bytemuck::{Pod, Zeroable};
 
 /// Mirrors `Params` in shaders/lib/common.wgsl.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct Params {
     pub grid_cells: [u32; 3],
     pub hash_mask: u32,
@@ -54,11 +54,20 @@ pub struct Params {
     /// Coulomb μ of contact and its regularisation speed ε [m/s] (`WallParams::friction`).
     pub friction: f32,
     pub friction_slip: f32,
-    pub pad: [u32; 2],
+    /// With `[[friction]]` pairs: the number G of contact groups (the walls, then the bodies,
+    /// then the solids; 0 without pairs: every pair has `friction`), and the first solid's.
+    pub friction_groups: u32,
+    pub friction_first_solid: u32,
     /// The distinct materials of the elastic solids; a solid particle's is
     /// `SolidState::material`.
     pub solid_materials: [SolidMaterial; MAX_SOLID_MATERIALS],
+    /// μ between contact groups a and b at a·G + b (4 to a vector), when friction_groups > 0.
+    pub friction_table: [[f32; 4]; MAX_FRICTION_GROUPS * MAX_FRICTION_GROUPS / 4],
 }
+
+/// How many contact groups (walls, bodies, solids) a case with `[[friction]]` pairs may hold
+/// (`MAX_FRICTION_GROUPS` in shaders/lib/common.wgsl).
+pub const MAX_FRICTION_GROUPS: usize = 16;
 
 /// How many different solid materials a case may hold (the length of
 /// `Params::solid_materials`; `MAX_SOLID_MATERIALS` in shaders/lib/common.wgsl).
@@ -362,8 +371,10 @@ mod tests {
                 dense_grid,
                 friction,
                 friction_slip,
-                pad,
-                solid_materials
+                friction_groups,
+                friction_first_solid,
+                solid_materials,
+                friction_table
             ]
         );
         check_layout!(
@@ -375,6 +386,10 @@ mod tests {
         assert_eq!(
             wgsl_u32(Pass::Interaction, "MAX_SOLID_MATERIALS") as usize,
             MAX_SOLID_MATERIALS
+        );
+        assert_eq!(
+            4 * wgsl_u32(Pass::Interaction, "FRICTION_TABLE_VECTORS") as usize,
+            MAX_FRICTION_GROUPS * MAX_FRICTION_GROUPS
         );
     }
 

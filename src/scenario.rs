@@ -238,12 +238,41 @@ pub struct WallParams {
     /// Regularisation speed ε [m/s] of the friction: the tangential force is
     /// μ|F_n| v_t/sqrt(|v_t|² + ε²).
     pub friction_slip: f64,
+    /// Pairs in contact with a μ of their own (`[[friction]]`); every other pair has `friction`.
+    pub friction_pairs: Vec<FrictionPair>,
     pub mirror_planes: Vec<MirrorPlane>,
     /// Whether the boundary particles of fixed walls also get the fluid's force on them (as
     /// moving bodies' always do): wall-pressure probes read it. Off otherwise: fixed ghosts and
     /// repulsive particles would pay a neighbour sum they otherwise skip (dynamic walls sum
     /// over their neighbours for dρ/dt anyway).
     pub reactions: bool,
+}
+
+/// What takes part in contact, for friction by pair: the fixed walls (tank, obstacles), a rigid
+/// body or an elastic solid (by their index in `Scenario::bodies` and in the solids' bodies).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactGroup {
+    Walls,
+    Body(usize),
+    Solid(usize),
+}
+
+/// A pair of contact groups with a Coulomb friction coefficient of its own.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrictionPair {
+    pub between: [ContactGroup; 2],
+    pub coefficient: f64,
+}
+
+impl WallParams {
+    /// The Coulomb μ between two contact groups: their pair's, in either order, else the
+    /// walls' `friction`.
+    pub fn friction_between(&self, a: ContactGroup, b: ContactGroup) -> f64 {
+        self.friction_pairs
+            .iter()
+            .find(|p| p.between == [a, b] || p.between == [b, a])
+            .map_or(self.friction, |p| p.coefficient)
+    }
 }
 
 /// The default regularisation speed of contact friction [m/s].
@@ -372,6 +401,7 @@ impl WallParams {
             repulsive_beta: 1.0,
             friction: 0.0,
             friction_slip: DEFAULT_FRICTION_SLIP,
+            friction_pairs: Vec::new(),
             mirror_planes: Vec::new(),
             reactions: false,
         }

@@ -277,15 +277,24 @@ const BODY_KINDS: [Kind; 4] = [
 fn body_rates_and_loads_match_reference() {
     for (dim, seed) in [(2, 11), (3, 12)] {
         for kind in BODY_KINDS {
-            body_rates_and_loads(dim, seed, kind);
+            body_rates_and_loads(dim, seed, kind, false);
         }
+        // The pressed box's own μ against the walls, from the `[[friction]]` table.
+        body_rates_and_loads(dim, seed, Kind::Wall, true);
     }
 }
 
-fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind) {
+fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind, pair: bool) {
+    use wgsph::scenario::{ContactGroup, FrictionPair};
     let mut sc = scene(dim, seed, kind);
     // Contact with friction: the pressed box slides on the floor (up to 0.14 m/s, ε = 1 mm/s).
     sc.walls.friction = 0.5;
+    if pair {
+        sc.walls.friction_pairs = vec![FrictionPair {
+            between: [ContactGroup::Walls, ContactGroup::Body(1)],
+            coefficient: 0.9,
+        }];
+    }
     let mut solver = Solver::new(gpu(), &sc).unwrap();
     solver.single_step(1e-3).unwrap();
     let gpu_rates = solver.rerun_interaction(true).unwrap();
@@ -338,6 +347,7 @@ fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind) {
         // The friction's part of these rows (against the same rates without it).
         let frictionless = WallParams {
             friction: 0.0,
+            friction_pairs: Vec::new(),
             ..sc.walls.clone()
         };
         let cpu0 = reference::interaction::rates(&sc.physics, &frictionless, &space, &parts);
@@ -353,8 +363,8 @@ fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind) {
         };
         let friction = rms(&|i, a| cpu[i][a] - cpu0[i][a]) / rms(&|i, a| cpu[i][a]);
         println!(
-            "dim {dim} {kind:?}, contact {contact}: {} rows, error {worst:.2e} of RMS (friction \
-             {friction:.2} of it)",
+            "dim {dim} {kind:?}, pair {pair}, contact {contact}: {} rows, error {worst:.2e} of \
+             RMS (friction {friction:.2} of it)",
             rows.len()
         );
         assert!(worst < 2e-4, "body-particle acceleration error {worst}");

@@ -351,12 +351,32 @@ fn solids_in_contact(dim: u32, seed: u64) -> Scenario {
 /// solid particles and `interaction::rates` (with the solids' reaction) for the rigid body's.
 /// Rows in contact and rows without are compared each against their own RMS (the repulsive law
 /// is much stronger than the elastic forces here).
+/// Run with one μ for all contact, then with `[[friction]]` pairs of their own μ (the table the
+/// GPU looks the pair's μ up in).
 #[test]
 fn solid_contact_matches_reference() {
-    for dim in [2, 3] {
+    use wgsph::scenario::{ContactGroup, FrictionPair};
+    let pair = |a, b, coefficient| FrictionPair {
+        between: [a, b],
+        coefficient,
+    };
+    let tables = [
+        vec![],
+        vec![
+            pair(ContactGroup::Solid(0), ContactGroup::Walls, 0.9),
+            pair(ContactGroup::Solid(1), ContactGroup::Solid(0), 0.0),
+            pair(ContactGroup::Body(0), ContactGroup::Solid(1), 0.2),
+        ],
+    ];
+    for (dim, pairs) in [2, 3]
+        .into_iter()
+        .flat_map(|d| tables.iter().map(move |t| (d, t)))
+    {
         let mut sc = solids_in_contact(dim, 40 + dim as u64);
         // With friction (random velocities of ±0.5 m/s slide the solids against everything).
         sc.walls.friction = 0.5;
+        sc.walls.friction_pairs = pairs.clone();
+        let dim_label = format!("{dim}D, {} pairs", pairs.len());
         let ph = &sc.physics;
         let mats = &sc.solids.as_ref().unwrap().materials;
         let (_solver, parts, solid, gpu_rate) = rerun(&sc);
@@ -365,6 +385,7 @@ fn solid_contact_matches_reference() {
         let contact = elastic::contact_rates(ph, mats, &sc.walls, &space, &parts, &solid);
         let frictionless = WallParams {
             friction: 0.0,
+            friction_pairs: Vec::new(),
             ..sc.walls.clone()
         };
         let contact0 = elastic::contact_rates(ph, mats, &frictionless, &space, &parts, &solid);
@@ -394,7 +415,11 @@ fn solid_contact_matches_reference() {
                 assert!(rows.iter().all(|(_, w)| *w == [0.0; 3]));
                 continue;
             }
-            assert!(rows.len() >= 5, "{dim}D: only {} {name} rows", rows.len());
+            assert!(
+                rows.len() >= 5,
+                "{dim_label}: only {} {name} rows",
+                rows.len()
+            );
             let scale = rms(rows.iter().flat_map(|(_, w)| w.to_vec()));
             // The friction's part of the compared rates.
             let (with, without) = (&contact, &contact0);
@@ -403,7 +428,10 @@ fn solid_contact_matches_reference() {
                 .flat_map(|&(i, _)| (0..3).map(move |a| with[i][a] - without[i][a])))
                 / scale;
             if name.ends_with("in contact") {
-                assert!(friction > 0.05, "{dim}D {name}: friction only {friction}");
+                assert!(
+                    friction > 0.05,
+                    "{dim_label} {name}: friction only {friction}"
+                );
             }
             let mut err = 0.0f64;
             for (i, w) in rows {
@@ -414,11 +442,11 @@ fn solid_contact_matches_reference() {
                 }
             }
             println!(
-                "{dim}D {name}: {} rows, acceleration error {err:.1e} of RMS {scale:.3e} \
+                "{dim_label} {name}: {} rows, acceleration error {err:.1e} of RMS {scale:.3e} \
                  (friction {friction:.2} of it)",
                 rows.len()
             );
-            assert!(err < 2e-4, "{dim}D {name}: error {err}");
+            assert!(err < 2e-4, "{dim_label} {name}: error {err}");
         }
     }
 }

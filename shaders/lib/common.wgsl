@@ -54,10 +54,18 @@ struct Params {
     dense_grid: u32,
     friction: f32,              // Coulomb μ of contact (interaction.wgsl `contact`); 0: none
     friction_slip: f32,         // its regularisation speed ε [m/s]
-    pad: vec2<u32>,
+    // With [[friction]] pairs: the number G of contact groups (0 without: every pair has
+    // `friction`) and the first solid's (interaction.wgsl `friction_between`).
+    friction_groups: u32,
+    friction_first_solid: u32,
     // The distinct materials of the solids; a solid particle's is SolidState.material.
     solid_materials: array<SolidMaterial, MAX_SOLID_MATERIALS>,
+    // μ between contact groups a and b at a·G + b, four to a vector.
+    friction_table: array<vec4<f32>, FRICTION_TABLE_VECTORS>,
 }
+
+// Mirrored by `layout::MAX_FRICTION_GROUPS` (16 groups: 16 × 16 / 4 vectors).
+const FRICTION_TABLE_VECTORS: u32 = 64u;
 
 // Mirrored by `layout::MAX_SOLID_MATERIALS`.
 const MAX_SOLID_MATERIALS: u32 = 8u;

@@ -954,6 +954,7 @@ pub(super) fn wall_params(
     walls.repulsive_beta = set.repulsive_beta;
     walls.friction = set.friction;
     walls.friction_slip = set.friction_slip;
+    walls.friction_pairs = set.friction_pairs.clone();
     let (field, strength) = match walls.repulsive_form {
         RepulsiveForm::LennardJones => ("walls.repulsive_d_m2_s2", walls.repulsive_d),
         RepulsiveForm::MonaghanKajtar => ("walls.repulsive_k_m2_s2", walls.repulsive_k),

@@ -10,6 +10,7 @@ mod bodies;
 mod build;
 mod diagnose;
 mod error;
+mod friction;
 mod lattice;
 mod limits;
 mod locate;

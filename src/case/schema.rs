@@ -30,6 +30,16 @@ pub(super) struct RawCase {
     pub inlet: Vec<RawInlet>,
     #[serde(default)]
     pub outlet: Vec<RawOutlet>,
+    #[serde(default)]
+    pub friction: Vec<RawFriction>,
+}
+
+/// A pair's own friction coefficient: `[[friction]]` (`docs/cases.md`, "Friction").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawFriction {
+    pub between: Vec<String>,
+    pub coefficient: f64,
 }
 
 /// An outlet: `[[outlet]]` (`docs/cases.md`, "Outlets").
@@ -676,6 +686,26 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "friction_coefficient = 0.3",
     ),
     f(
+        "friction",
+        "the pairs with a friction coefficient of their own",
+        "[[friction]] with between and coefficient",
+    ),
+    f(
+        "friction[]",
+        "a pair with a friction coefficient of its own",
+        "[[friction]] with between and coefficient",
+    ),
+    f(
+        "friction[].between",
+        "the two names of the pair: bodies, solids or \"walls\"",
+        "between = [\"box\", \"walls\"]",
+    ),
+    f(
+        "friction[].coefficient",
+        "the pair's Coulomb friction coefficient",
+        "coefficient = 0.5",
+    ),
+    f(
         "walls.friction_slip_m_s",
         "the regularisation speed of contact friction in m/s",
         "friction_slip_m_s = 0.001",
@@ -969,9 +999,8 @@ impl FieldHelp {
         let value = self.example.split_once('=').map_or("", |(_, v)| v.trim());
         match self.path {
             "dimension" | "tank.layers" | "physics.density_filter_every" => "an integer",
-            "fluid_block" | "obstacle" | "probe" | "body" | "solid" | "inlet" | "outlet" => {
-                "an array of tables"
-            }
+            "fluid_block" | "obstacle" | "probe" | "body" | "solid" | "inlet" | "outlet"
+            | "friction" => "an array of tables",
             "body[].layers" => "an integer",
             _ if self.example.starts_with('[') => "a table",
             _ if value.starts_with('"') => "a string",

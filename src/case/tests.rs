@@ -1357,3 +1357,67 @@ fn point_probes_choose_the_nearest_body_particle() {
     let attached = format!("{BASE}{body}{point}body = \"b\"\n");
     assert_err(&attached, &[], None, &["probe[1].body", "remove body"]);
 }
+
+#[test]
+fn friction_pairs_resolve_names_and_refuse_bad_ones() {
+    use crate::scenario::ContactGroup;
+    let with = |pairs: &str| format!("{FLOATING}\n{pairs}");
+    let sc = load_str(
+        &with("[[friction]]\nbetween = [\"walls\", \"box\"]\ncoefficient = 0.7\n"),
+        "f.toml",
+        &[],
+    )
+    .unwrap();
+    let w = &sc.walls;
+    assert_eq!(w.friction_pairs.len(), 1);
+    assert_eq!(
+        w.friction_between(ContactGroup::Body(0), ContactGroup::Walls),
+        0.7
+    );
+    assert_eq!(
+        w.friction_between(ContactGroup::Body(0), ContactGroup::Body(1)),
+        0.0
+    );
+    // A moving tank is a body (index 0) and, for friction, one of the walls.
+    let sloshing = format!(
+        "{}\n[[body]]\nname = \"float\"\nshape = \"box\"\nmin_m = [0.4, 0.3]\nmax_m = [0.5, 0.4]\n\
+         density_kg_m3 = 500.0\n[[friction]]\nbetween = [\"float\", \"walls\"]\ncoefficient = 0.4\n",
+        include_str!("../../cases/sloshing_2d.toml")
+    );
+    let sc = load_str(&sloshing, "f.toml", &[]).unwrap();
+    for g in [ContactGroup::Walls, ContactGroup::Body(0)] {
+        assert_eq!(sc.walls.friction_between(ContactGroup::Body(1), g), 0.4);
+    }
+
+    let bad: &[(&str, &[&str])] = &[
+        (
+            "between = [\"box\", \"lid\"]\ncoefficient = 0.3",
+            &["friction[0].between[1] = \"lid\"", "\"walls\", \"box\""],
+        ),
+        (
+            "between = [\"box\", \"box\"]\ncoefficient = 0.3",
+            &["friction[0].between", "same thing twice"],
+        ),
+        (
+            "between = [\"box\"]\ncoefficient = 0.3",
+            &["friction[0].between", "a pair is two"],
+        ),
+        (
+            "between = [\"box\", \"walls\"]\ncoefficient = -0.1",
+            &["friction[0].coefficient = -0.1"],
+        ),
+        (
+            "between = [\"box\", \"walls\"]\ncoefficient = 0.3\n[[friction]]\n\
+             between = [\"walls\", \"box\"]\ncoefficient = 0.5",
+            &["friction[1].between", "friction[0] already"],
+        ),
+    ];
+    for (pair, words) in bad {
+        let text = with(&format!("[[friction]]\n{pair}\n"));
+        let e = load_str(&text, "f.toml", &[]).unwrap_err().to_string();
+        for w in *words {
+            assert!(e.contains(w), "`{w}` expected in: {e}");
+        }
+        assert!(e.contains("fix:"), "{e}");
+    }
+}

@@ -3,8 +3,8 @@
 //! Geometric checks that need several fields at once live in `build.rs`.
 
 use crate::scenario::{
-    DeltaSphForm, DensityFilter, GhostCorrection, KernelKind, Probe, RepulsiveForm, TimeControl,
-    Viscosity, DEFAULT_FRICTION_SLIP,
+    DeltaSphForm, DensityFilter, FrictionPair, GhostCorrection, KernelKind, Probe, RepulsiveForm,
+    TimeControl, Viscosity, DEFAULT_FRICTION_SLIP,
 };
 
 use super::error::{num, CaseError};
@@ -51,8 +51,9 @@ pub(super) enum Treatment {
     FixedGhost { no_slip: bool },
 }
 
-/// `[walls]`, with the defaults that need the built particles left as `None`.
-#[derive(Debug, Clone, Copy)]
+/// `[walls]`, with the defaults that need the built particles left as `None`, and the
+/// `[[friction]]` pairs.
+#[derive(Debug, Clone)]
 pub(super) struct WallSettings {
     pub ghost_correction: GhostCorrection,
     /// Lennard-Jones strength D [m²/s²]; default 5 |g| H.
@@ -66,6 +67,7 @@ pub(super) struct WallSettings {
     /// Coulomb μ of contact (0: frictionless) and its regularisation speed ε [m/s].
     pub friction: f64,
     pub friction_slip: f64,
+    pub friction_pairs: Vec<FrictionPair>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -575,6 +577,7 @@ pub(super) fn validate(
             repulsive_beta: 1.0,
             friction: 0.0,
             friction_slip: DEFAULT_FRICTION_SLIP,
+            friction_pairs: Vec::new(),
         },
         Some(w) => WallSettings {
             ghost_correction: match w.ghost_correction.unwrap_or(GhostCorrectionName::Mls) {
@@ -648,6 +651,7 @@ pub(super) fn validate(
                 "the regularisation speed of contact friction in m/s",
                 "use a speed well below the sliding speeds of interest, e.g. 0.001",
             )?,
+            friction_pairs: Vec::new(),
         },
     };
     let domain = match &raw.domain {
@@ -669,6 +673,9 @@ pub(super) fn validate(
     let inlets = super::open_boundaries::validate(ctx, &raw.inlet, dim, time.end_s)?;
     let outlets = super::open_boundaries::validate_outlets(ctx, &raw.outlet, dim)?;
     let tank_moves = tank.as_ref().is_some_and(|t| t.motion.is_some());
+    let mut walls = walls;
+    walls.friction_pairs =
+        super::friction::pairs(ctx, &raw.friction, &bodies, &solids, tank_moves)?;
     let mut probes: Vec<Probe> = Vec::with_capacity(raw.probe.len());
     let mut points = Vec::new();
     for (i, p) in raw.probe.iter().enumerate() {

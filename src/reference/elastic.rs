@@ -2,7 +2,7 @@
 //! brute force over all pairs, f64. See the shader's header for the equations.
 
 use super::{dot, kernel, RefParticle, Space};
-use crate::scenario::{ElasticMaterial, Physics};
+use crate::scenario::{ContactGroup, ElasticMaterial, Physics};
 
 pub const SOLID: u32 = crate::scenario::Kind::Solid as u32;
 pub const SOLID_CLAMPED: u32 = crate::scenario::Kind::SolidClamped as u32;
@@ -342,18 +342,28 @@ pub fn contact_rates(
             let mut a = [0.0; 3];
             let pi = &parts[i];
             for (j, pj) in parts.iter().enumerate() {
-                let k = if is_solid(pi.kind) {
+                let solid_group = |k: usize| ContactGroup::Solid(solid[k].body as usize);
+                let (k, groups) = if is_solid(pi.kind) {
                     if fixed_wall(pj) {
-                        1.0
+                        (1.0, [solid_group(i), ContactGroup::Walls])
                     } else if is_solid(pj.kind) && solid[j].body != solid[i].body {
-                        contact_weight(m_s(i), m_s(j))
+                        (
+                            contact_weight(m_s(i), m_s(j)),
+                            [solid_group(i), solid_group(j)],
+                        )
                     } else if on_a_body(pj) {
-                        contact_weight(m_s(i), m_f)
+                        (
+                            contact_weight(m_s(i), m_f),
+                            [solid_group(i), super::interaction::contact_group(pj)],
+                        )
                     } else {
                         continue;
                     }
                 } else if on_a_body(pi) && is_solid(pj.kind) {
-                    contact_weight(m_f, m_s(j))
+                    (
+                        contact_weight(m_f, m_s(j)),
+                        [super::interaction::contact_group(pi), solid_group(j)],
+                    )
                 } else {
                     continue;
                 };
@@ -365,7 +375,8 @@ pub fn contact_rates(
                     super::interaction::contact_velocity(pi)[a]
                         - super::interaction::contact_velocity(pj)[a]
                 });
-                let f = super::interaction::contact(ph, walls, x_ij, v_ij);
+                let mu = walls.friction_between(groups[0], groups[1]);
+                let f = super::interaction::contact(ph, walls, mu, x_ij, v_ij);
                 for c in 0..3 {
                     a[c] += k * f[c];
                 }

@@ -4,7 +4,9 @@ use super::{
     dot, kernel, laminar_nu, pressure, sub, RefParticle, Space, EXCLUDED, FLUID, GHOST_FREE_SLIP,
     GHOST_NO_SLIP, INLET, REPULSIVE, WALL,
 };
-use crate::scenario::{DeltaSphForm, MirrorPlane, Physics, RepulsiveForm, Viscosity, WallParams};
+use crate::scenario::{
+    ContactGroup, DeltaSphForm, MirrorPlane, Physics, RepulsiveForm, Viscosity, WallParams,
+};
 
 struct Pair<'a> {
     ph: &'a Physics,
@@ -120,18 +122,31 @@ pub fn repulsion(ph: &Physics, walls: &WallParams, x_ij: [f64; 3]) -> [f64; 3] {
 
 /// The contact force per unit mass between particles of which one is a body's or a solid's
 /// (as `contact` in interaction.wgsl): the repulsive law F_n at x_ij with regularised Coulomb
-/// friction, F_n − μ|F_n| v_t/sqrt(|v_t|² + ε²), v_t the part of v_ij across x_ij.
-pub fn contact(ph: &Physics, walls: &WallParams, x_ij: [f64; 3], v_ij: [f64; 3]) -> [f64; 3] {
+/// friction, F_n − μ|F_n| v_t/sqrt(|v_t|² + ε²), v_t the part of v_ij across x_ij, μ the pair's
+/// (`WallParams::friction_between`).
+pub fn contact(
+    ph: &Physics,
+    walls: &WallParams,
+    mu: f64,
+    x_ij: [f64; 3],
+    v_ij: [f64; 3],
+) -> [f64; 3] {
     let f_n = repulsion(ph, walls, x_ij);
     let r2 = dot(x_ij, x_ij);
-    if walls.friction == 0.0 || r2 <= 0.0 {
+    if mu == 0.0 || r2 <= 0.0 {
         return f_n;
     }
     let vn = dot(v_ij, x_ij) / r2;
     let v_t = [0, 1, 2].map(|a| v_ij[a] - vn * x_ij[a]);
-    let k = walls.friction * dot(f_n, f_n).sqrt()
+    let k = mu * dot(f_n, f_n).sqrt()
         / (dot(v_t, v_t) + walls.friction_slip * walls.friction_slip).sqrt();
     [0, 1, 2].map(|a| f_n[a] - k * v_t[a])
+}
+
+/// The contact group of a boundary particle: its body's, or the fixed walls'.
+pub fn contact_group(p: &RefParticle) -> ContactGroup {
+    p.body
+        .map_or(ContactGroup::Walls, |b| ContactGroup::Body(b as usize))
 }
 
 /// The velocity a particle presents in contact: a solid particle's own, a boundary particle's
@@ -252,7 +267,8 @@ pub fn rates_and_energy(
                         // Contact with a fixed wall or another body (with elastic solids:
                         // `elastic::contact_rates`).
                         let v_ij = sub(contact_velocity(pi), contact_velocity(pj));
-                        let f = contact(ph, walls, x_ij, v_ij);
+                        let mu = walls.friction_between(contact_group(pi), contact_group(pj));
+                        let f = contact(ph, walls, mu, x_ij, v_ij);
                         add(&mut r, [f[0], f[1], f[2], 0.0]);
                     }
                 }

@@ -18,6 +18,7 @@ pub mod state;
 pub mod total_lagrangian;
 
 use anyhow::{bail, Context, Result};
+use bytemuck::Zeroable;
 
 use crate::body::BodySet;
 use crate::gpu::buffers::{map_read, read, readback_buffer};
@@ -29,7 +30,8 @@ use crate::layout::{
     pack_block, unpack_block, Params, Pos, SimState, ID_MASK, KIND_EXCLUDED, KIND_SHIFT,
 };
 use crate::scenario::{
-    DeltaSphForm, GhostCorrection, KernelKind, Kind, ProbeKind, RepulsiveForm, Scenario, Viscosity,
+    ContactGroup, DeltaSphForm, GhostCorrection, KernelKind, Kind, ProbeKind, RepulsiveForm,
+    Scenario, Viscosity,
 };
 use bodies::Bodies;
 use buffers::{InitialParticles, ParticleBuffers};
@@ -270,8 +272,19 @@ impl Solver {
             friction_slip: sc.walls.friction_slip as f32,
             body_id_base,
             n_body_particles: n as u32 - body_id_base,
-            ..Default::default()
+            ..Zeroable::zeroed()
         };
+        if !sc.walls.friction_pairs.is_empty() {
+            let groups = friction_groups(sc)?;
+            params.friction_groups = groups.len() as u32;
+            params.friction_first_solid = 1 + sc.bodies.len() as u32;
+            let table: &mut [f32] = bytemuck::cast_slice_mut(&mut params.friction_table);
+            for (a, ga) in groups.iter().enumerate() {
+                for (b, gb) in groups.iter().enumerate() {
+                    table[a * groups.len() + b] = sc.walls.friction_between(*ga, *gb) as f32;
+                }
+            }
+        }
         if let Some(solids) = &sc.solids {
             let (distinct, _) = solids.distinct_materials();
             if distinct.len() > crate::layout::MAX_SOLID_MATERIALS {
@@ -1224,6 +1237,24 @@ fn body_id_base(sc: &Scenario) -> Result<u32> {
         bail!("the bodies' particles must be the last ones of the scenario");
     }
     Ok(base as u32)
+}
+
+/// The contact groups of a case in the GPU's order (`Params::friction_groups`): the walls, the
+/// bodies, the solids.
+fn friction_groups(sc: &Scenario) -> Result<Vec<ContactGroup>> {
+    let solids = sc.solids.as_ref().map_or(0, |s| s.materials.len());
+    let groups: Vec<ContactGroup> = std::iter::once(ContactGroup::Walls)
+        .chain((0..sc.bodies.len()).map(ContactGroup::Body))
+        .chain((0..solids).map(ContactGroup::Solid))
+        .collect();
+    if groups.len() > crate::layout::MAX_FRICTION_GROUPS {
+        bail!(
+            "friction by pair needs at most {} walls, bodies and solids together; the case has {}",
+            crate::layout::MAX_FRICTION_GROUPS,
+            groups.len()
+        );
+    }
+    Ok(groups)
 }
 
 /// The solid particles' ids; they must be consecutive (the case loader builds them so), which

@@ -386,6 +386,39 @@ max_m = [0.7, 0.04]
     });
 }
 
+/// The rigid box with a coefficient of its own against the walls (`[[friction]]`, μ = 0.2) in
+/// a case whose other contact has μ = 0.5 (which would hold it): it slides as Coulomb says for
+/// 0.2, within the 3 % of `slides_as_coulomb_says`.
+#[test]
+fn a_pair_with_its_own_friction_coefficient_slides_by_it() {
+    let body = r#"[[body]]
+name = "box"
+shape = "box"
+min_m = [0.2, 0.0]
+max_m = [0.4, 0.06]
+density_kg_m3 = 800.0
+wall = "dynamic"
+[[fluid_block]]
+min_m = [0.62, 0.0]
+max_m = [0.7, 0.04]
+[[friction]]
+between = ["box", "walls"]
+coefficient = 0.2
+"#;
+    let runs = slope_runs(body, &[0.5], &|s: &Solver| {
+        s.bodies().unwrap().pose(0).velocity.x
+    });
+    let theta = SLOPE.to_radians();
+    let coulomb = 9.81 * (theta.sin() - 0.2 * theta.cos());
+    let error = runs[0].0 / coulomb - 1.0;
+    println!(
+        "rigid box, walls μ = 0.5, pair μ = 0.2: {:.4} m/s² (Coulomb {coulomb:.4}, {:+.2} %)",
+        runs[0].0,
+        100.0 * error
+    );
+    assert!(error.abs() < 0.03, "pair μ = 0.2: {error:+.3}");
+}
+
 /// An elastic block (0.2 × 0.06 m, ρ = 1000, E = 0.25 MPa) on the slope (measured: +0.01 %,
 /// −0.9 %, held at 7e-3 m/s² and 1.7 mm/s).
 #[test]
