@@ -369,7 +369,13 @@ fn slides_as_coulomb_says(label: &str, body: &str, velocity: &dyn Fn(&Solver) ->
 /// +2.0 %, held at 1.4e-3 m/s²).
 #[test]
 fn a_rigid_box_slides_down_a_slope_as_coulomb_friction_says() {
-    let body = r#"[[body]]
+    slides_as_coulomb_says("rigid box", RIGID_BOX, &|s: &Solver| {
+        s.bodies().unwrap().pose(0).velocity.x
+    });
+}
+
+/// The rigid box of the slope tests.
+const RIGID_BOX: &str = r#"[[body]]
 name = "box"
 shape = "box"
 min_m = [0.2, 0.0]
@@ -381,31 +387,15 @@ wall = "dynamic"
 min_m = [0.62, 0.0]
 max_m = [0.7, 0.04]
 "#;
-    slides_as_coulomb_says("rigid box", body, &|s: &Solver| {
-        s.bodies().unwrap().pose(0).velocity.x
-    });
-}
 
 /// The rigid box with a coefficient of its own against the walls (`[[friction]]`, μ = 0.2) in
 /// a case whose other contact has μ = 0.5 (which would hold it): it slides as Coulomb says for
 /// 0.2, within the 3 % of `slides_as_coulomb_says`.
 #[test]
 fn a_pair_with_its_own_friction_coefficient_slides_by_it() {
-    let body = r#"[[body]]
-name = "box"
-shape = "box"
-min_m = [0.2, 0.0]
-max_m = [0.4, 0.06]
-density_kg_m3 = 800.0
-wall = "dynamic"
-[[fluid_block]]
-min_m = [0.62, 0.0]
-max_m = [0.7, 0.04]
-[[friction]]
-between = ["box", "walls"]
-coefficient = 0.2
-"#;
-    let runs = slope_runs(body, &[0.5], &|s: &Solver| {
+    let body =
+        format!("{RIGID_BOX}[[friction]]\nbetween = [\"box\", \"walls\"]\ncoefficient = 0.2\n");
+    let runs = slope_runs(&body, &[0.5], &|s: &Solver| {
         s.bodies().unwrap().pose(0).velocity.x
     });
     let theta = SLOPE.to_radians();
