@@ -277,3 +277,76 @@ fn a_body_mass_or_inertia_out_of_range_is_refused() {
     );
     assert!(load_str(&body("density_kg_m3 = 500.0"), "cases/t.toml", &[]).is_ok());
 }
+
+/// serde fills a struct from an array by position: `time = [0.5, 9.0, 1, 5e-324]` was accepted
+/// as end_s, output_every_s, probe_every_s and cfl (`CASE_FUZZ_SEED=6823451076234179599`,
+/// 20 000 cases, on the seed tests/data/case_fuzz/mirror_2d.toml). A case file names its fields.
+#[test]
+fn tables_written_as_arrays_are_refused() {
+    assert_err(
+        &format!(
+            "time = [1.0, 0.1]\n{}",
+            base_with("[time]\nend_s = 1.0\noutput_every_s = 0.1\n", "")
+        ),
+        &[],
+        Some(1),
+        &[
+            "time = [1.0, 0.1]",
+            "expected a table",
+            "found an array",
+            "[time] with end_s",
+        ],
+    );
+    assert_err(
+        &format!(
+            "probe = [[\"P1\", \"pressure\", [0.5, 0.05]]]\n{}",
+            base_with(
+                "[[probe]]\nname = \"P1\"\nkind = \"pressure\"\npoint_m = [0.5, 0.05]\n",
+                ""
+            )
+        ),
+        &[],
+        Some(1),
+        &[
+            "probe[0]",
+            "expected a table",
+            "found an array",
+            "[[probe]]",
+        ],
+    );
+    // The same through an override, and for tables nested in tables and in `[[...]]` elements.
+    assert_err(
+        BASE,
+        &["particles=[0.1, 2.0]"],
+        None,
+        &[
+            "particles",
+            "--set particles=[0.1, 2.0]",
+            "expected a table",
+        ],
+    );
+    assert_err(
+        FLOATING,
+        &["body[0].motion=[\"free\"]"],
+        None,
+        &[
+            "body[0].motion",
+            "expected a table",
+            "[body.motion] with kind",
+        ],
+    );
+    assert_err(
+        &format!(
+            "{BASE}[[solid]]\nname = \"s\"\nmin_m = [0.6, 0.0]\nmax_m = [0.7, 0.3]\n\
+                  density_kg_m3 = 1100.0\nyoungs_modulus_pa = 1e6\npoisson_ratio = 0.4\n\
+                  initial_velocity = [\"cantilever_mode\"]\n"
+        ),
+        &[],
+        Some(32),
+        &[
+            "solid[0].initial_velocity",
+            "expected a table",
+            "found an array",
+        ],
+    );
+}
