@@ -379,7 +379,7 @@ fn bench_reports_throughput_and_the_stages() {
     let share = |r: &Vec<&str>| -> f64 { r[r.len() - 3].parse().unwrap() };
     let (all, stages) = rows.split_last().expect("a stage table");
     assert_eq!(all[..2], ["all", "stages"], "{stdout}");
-    for name in ["predict", "cell_list", "interaction", "correct"] {
+    for name in ["predict", "sort_key", "interaction", "correct"] {
         assert!(stages.iter().any(|r| r[0] == name), "{name}: {stdout}");
     }
     let sum: f64 = stages.iter().map(share).sum();

@@ -42,7 +42,10 @@ fn profiling_the_stages_changes_nothing_but_the_timing() {
             &[
                 "predict",
                 "body_move",
-                "cell_list",
+                "sort_key",
+                "sort_scan",
+                "sort_scatter",
+                "sort_reorder",
                 "body_index",
                 "ghost",
                 "interaction",
@@ -56,7 +59,10 @@ fn profiling_the_stages_changes_nothing_but_the_timing() {
             &[
                 "predict",
                 "elastic_predict",
-                "cell_list",
+                "sort_key",
+                "sort_scan",
+                "sort_scatter",
+                "sort_reorder",
                 "ghost",
                 "interaction",
                 "elastic_rates",

@@ -128,18 +128,36 @@ impl CellList {
     }
 
     /// Sorts the arrays of parity `p` into parity `1 - p` (and `rate` into `rate_sorted`).
+    /// The whole sort of parity `p`'s particles: [`CellList::encode_key`], `encode_scan`,
+    /// `encode_scatter`, `encode_reorder`, which `Solver::record_step` times one by one.
     pub fn encode(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.cell_key.dispatch(pass, &self.bind_key[p], self.n);
+        self.encode_key(pass, p);
         self.encode_scan(pass);
+        self.encode_scatter(pass);
+        self.encode_reorder(pass, p);
+    }
+
+    /// Each particle's cell key, counted into its slot.
+    pub fn encode_key(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.cell_key.dispatch(pass, &self.bind_key[p], self.n);
+    }
+
+    /// Each particle's place in the sorted order: after the slots, then within its cell.
+    pub fn encode_scatter(&self, pass: &mut wgpu::ComputePass<'_>) {
         self.scatter.dispatch(pass, &self.bind_scatter, self.n);
         self.rank_in_cell.dispatch(pass, &self.bind_rank, self.n);
+    }
+
+    /// The particle arrays of parity `p` copied into the other parity in sorted order.
+    pub fn encode_reorder(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.reorder.dispatch(pass, &self.bind_reorder[p], self.n);
         if let Some((k, bind)) = &self.reorder_energy {
             k.dispatch(pass, &bind[p], self.n);
         }
     }
 
-    fn encode_scan(&self, pass: &mut wgpu::ComputePass<'_>) {
+    /// The prefix sum of the slot counts (the slots' starts).
+    pub fn encode_scan(&self, pass: &mut wgpu::ComputePass<'_>) {
         let per_group = 2 * crate::gpu::shader::WORKGROUP_SIZE;
         for (l, (blocks, _)) in self.bind_scan.iter().enumerate() {
             self.scan_blocks
