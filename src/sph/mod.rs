@@ -739,12 +739,7 @@ impl Solver {
     /// Takes exactly `count` steps of CFL size (no target time), for benchmarks; waits for the
     /// GPU at the end and checks stability.
     pub fn run_steps(&mut self, count: u64) -> Result<()> {
-        let mut st = self.rebased_state();
-        st.t_target_rel = f32::MAX;
-        st.dt = st.dt_cfl;
-        self.queue
-            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
-        self.state = st;
+        let st = self.start_untargeted();
         let mut left = count;
         while left > 0 {
             let batch = left.min(MAX_BATCH as u64) as u32;
@@ -762,6 +757,17 @@ impl Solver {
         self.check_stability()
     }
 
+    /// Sets the GPU state for steps of CFL size with no target time (benchmarks) and returns it.
+    fn start_untargeted(&mut self) -> SimState {
+        let mut st = self.rebased_state();
+        st.t_target_rel = f32::MAX;
+        st.dt = st.dt_cfl;
+        self.queue
+            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
+        self.state = st;
+        st
+    }
+
     /// Takes `count` steps as [`Solver::run_steps`] does, one submission each, with every stage
     /// in a timed pass of its own, and returns each stage's GPU time summed over the steps (in
     /// the step's order). The particles evolve exactly as without profiling.
@@ -769,12 +775,7 @@ impl Solver {
         if self.profiler.is_none() {
             self.profiler = Some(Profiler::new(&self.device, &self.queue)?);
         }
-        let mut st = self.rebased_state();
-        st.t_target_rel = f32::MAX;
-        st.dt = st.dt_cfl;
-        self.queue
-            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
-        self.state = st;
+        self.start_untargeted();
         let result = (0..count).try_for_each(|_| {
             let before = self.state.steps;
             self.take_steps(1)?;
