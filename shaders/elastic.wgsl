@@ -143,11 +143,20 @@ struct SolidParticle {
     rho: f32,
 }
 
+// Whether particle i is a solid particle of this pass: of an updated-Lagrangian material (a
+// total-Lagrangian solid's forces are total_lagrangian.wgsl's, and it has no τ to integrate).
+fn is_updated_lagrangian(i: u32) -> bool {
+    let c = code[i];
+    return is_solid(code_kind(c)) && material_of(solid[solid_slot(c)]).total_lagrangian == 0u;
+}
+
 // σ/ρ², R and the body of every solid particle, for elastic_rates (one invocation per
 // particle, before it).
 @compute @workgroup_size(WG)
 fn solid_stress_terms(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
+    // Every solid particle, total-Lagrangian ones too: elastic_rates reads its neighbours'
+    // bodies here (a total-Lagrangian body's terms are not used).
     if (i >= params.n_particles || !is_solid(code_kind(code[i]))) {
         return;
     }
@@ -178,7 +187,7 @@ fn solid_particle(k: u32, t: SolidTerms) -> SolidParticle {
 @compute @workgroup_size(WG)
 fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
-    if (i >= params.n_particles || !is_solid(code_kind(code[i]))) {
+    if (i >= params.n_particles || !is_updated_lagrangian(i)) {
         return;
     }
     let slot_i = solid_slot(code[i]);
@@ -248,7 +257,7 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
 @compute @workgroup_size(WG)
 fn stress_predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
-    if (i >= params.n_particles || !is_solid(code_kind(code[i]))) {
+    if (i >= params.n_particles || !is_updated_lagrangian(i)) {
         return;
     }
     let dt = state.dt;
@@ -262,7 +271,7 @@ fn stress_predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
 @compute @workgroup_size(WG)
 fn stress_correct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
-    if (i >= params.n_particles || !is_solid(code_kind(code[i]))) {
+    if (i >= params.n_particles || !is_updated_lagrangian(i)) {
         return;
     }
     let half_dt = 0.5 * state.dt;

@@ -25,9 +25,11 @@
 // a depends on the positions only, the scheme is symplectic.
 //
 // Particles are re-sorted every step: tl_index (after the sort) records the slot of every TL
-// particle (the solid particles have consecutive ids from tlp.first_id), as body_index does for
-// body particles. Everything else is indexed by TL index. Clamped particles get F and stress
-// (they are neighbours) and a rate that integrate.wgsl ignores.
+// particle (the total-Lagrangian solids' particles have consecutive ids from tlp.first_id), as
+// body_index does for body particles. Everything else is indexed by TL index. A case may also
+// hold updated-Lagrangian solids (elastic.wgsl), whose particles are not in the TL lists.
+// Clamped particles get F and stress (they are neighbours) and a rate that integrate.wgsl
+// ignores.
 
 struct TlParams {
     n: u32,
@@ -58,9 +60,15 @@ struct TlPair {
 @group(0) @binding(8) var<storage, read_write> tl_h: array<mat3x3<f32>>;
 @group(0) @binding(9) var<storage, read_write> tl_t: array<mat3x3<f32>>;
 @group(0) @binding(10) var<storage, read_write> tl_p: array<mat3x3<f32>>;
-// The solid state, for the material of TL particle k (solid[k]: TL and solid indices agree;
+// The solid state, for the material of TL particle k (tl_material; the TL particles are a run
+// of the solid slots, from tlp.first_id − params.solid_id_base;
 // λ, G and ρ0 of params.solid_materials, per body).
 @group(0) @binding(11) var<storage, read> solid: array<SolidState>;
+
+// The material of TL particle k.
+fn tl_material(k: u32) -> SolidMaterial {
+    return material_of(solid[tlp.first_id - params.solid_id_base + k]);
+}
 
 fn zero3() -> mat3x3<f32> {
     return mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
@@ -131,7 +139,7 @@ fn tl_gradient(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         d1 += de * p.w_ij.y;
         d2 += de * p.w_ij.z;
     }
-    let mat = material_of(solid[k]);
+    let mat = tl_material(k);
     tl_t[3u * k] = tlp.k2 * svk(mat, d0);
     tl_t[3u * k + 1u] = tlp.k2 * svk(mat, d1);
     tl_t[3u * k + 2u] = tlp.k2 * svk(mat, d2);
@@ -154,7 +162,7 @@ fn tl_stress(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     }
     s2 -= tl_t[3u * k] * w_sum.x + tl_t[3u * k + 1u] * w_sum.y + tl_t[3u * k + 2u] * w_sum.z;
     let h = tl_h[k];
-    tl_p[k] = (identity3() + h) * (svk(material_of(solid[k]), green(h)) + s2);
+    tl_p[k] = (identity3() + h) * (svk(tl_material(k), green(h)) + s2);
 }
 
 @compute @workgroup_size(WG)
@@ -170,5 +178,5 @@ fn tl_accel(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
         f += p_i * p.w_ij - tl_p[p.j] * p.w_ji;
     }
     let i = tl_slot[k];
-    rate[i] += vec4<f32>(f / material_of(solid[k]).rho0 + params.gravity, 0.0);
+    rate[i] += vec4<f32>(f / tl_material(k).rho0 + params.gravity, 0.0);
 }

@@ -92,7 +92,9 @@ pub struct SolidMaterial {
     pub eps: f32,
     /// Lamé's λ = K − 2μ/3 [Pa].
     pub lambda: f32,
-    pub pad: f32,
+    /// 1 for a total-Lagrangian solid's material, 0 for an updated-Lagrangian one's: which
+    /// pass computes the solid's own forces.
+    pub total_lagrangian: u32,
 }
 
 /// Mirrors `SolidState` in shaders/lib/common.wgsl: the deviatoric stress τ of a solid particle
@@ -381,7 +383,7 @@ mod tests {
             Pass::Interaction,
             "SolidMaterial",
             SolidMaterial,
-            [rho0, c2, mu, mass, alpha, eps, lambda, pad]
+            [rho0, c2, mu, mass, alpha, eps, lambda, total_lagrangian]
         );
         assert_eq!(
             wgsl_u32(Pass::Interaction, "MAX_SOLID_MATERIALS") as usize,

@@ -584,11 +584,11 @@ impl ElasticMaterial {
 }
 
 /// The solid particles of a case: several bodies (solid particles interact only within their
-/// body), each of its own material, all of one formulation.
+/// body), each of its own material and formulation (the total-Lagrangian solids' particles in
+/// one run of ids: the case loader builds those solids first).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Solids {
-    /// The material of every elastic body, indexed by body (`[[solid]]` order); their
-    /// `formulation`s are equal.
+    /// The material of every elastic body, indexed by body (`[[solid]]` order).
     pub materials: Vec<ElasticMaterial>,
     /// Elastic body of every particle, indexed like `Scenario::particles` (read for solid
     /// kinds only).
@@ -616,9 +616,9 @@ pub fn distinct_materials(materials: &[ElasticMaterial]) -> (Vec<ElasticMaterial
 }
 
 impl Solids {
-    /// The formulation of every solid of the case.
-    pub fn formulation(&self) -> SolidFormulation {
-        self.materials[0].formulation
+    /// Whether any solid of the case is of formulation `f`.
+    pub fn has(&self, f: SolidFormulation) -> bool {
+        self.materials.iter().any(|m| m.formulation == f)
     }
 
     /// The material of particle `i` (a solid particle).

@@ -706,6 +706,180 @@ fn total_lagrangian_rates_match_reference() {
     }
 }
 
+/// Layer 1 for a case of both formulations: the lower body updated-Lagrangian (random τ and
+/// ρ), the upper total-Lagrangian, 2D and 3D; the updated-Lagrangian body's ids come first, so
+/// the TL particles are a run of solid slots that does not start at the first. After one step
+/// of random velocities, each body's rates against its own reference: dv/dt, dρ/dt and dτ/dt of
+/// the updated-Lagrangian particles (src/reference/elastic.rs), dv/dt of the total-Lagrangian
+/// ones (src/reference/total_lagrangian.rs) with dρ/dt = 0, and the TL particles' τ, which
+/// elastic.wgsl's predictor and corrector must leave alone, still zero. Rates poisoned first.
+#[test]
+fn solids_of_both_formulations_match_their_references() {
+    use wgsph::reference::total_lagrangian;
+    for dim in [2, 3] {
+        let mut sc = random_solid(dim, KernelKind::WendlandC2, 53 + dim as u64, material());
+        let solids = sc.solids.as_mut().unwrap();
+        let tl = ElasticMaterial {
+            alpha: 0.0,
+            artificial_stress: 0.0,
+            formulation: SolidFormulation::TotalLagrangian,
+            ..solids.materials[1]
+        };
+        solids.materials[1] = tl;
+        // Another half dx up, so that the step does not bring the bodies within the contact
+        // law's reach (these references leave contact out): at least 1.6 dx apart, less the
+        // step's 0.1 dx a side, and still within the kernel's 2h.
+        for i in 0..sc.particles.len() {
+            if solids.body[i] == 1 {
+                solids.tau0[i] = [0.0; 6];
+                sc.particles[i].rho = tl.density;
+                sc.particles[i].pos[1] += 0.5 * sc.physics.dx;
+            }
+        }
+        // The solver takes the TL particles as one run of ids (the case loader builds them so):
+        // in 3D the lattice alternates the bodies layer by layer, so order them by body.
+        let mut order: Vec<usize> = (0..sc.particles.len()).collect();
+        order.sort_by_key(|&i| solids.body[i]);
+        sc.particles = order.iter().map(|&i| sc.particles[i]).collect();
+        solids.body = order.iter().map(|&i| solids.body[i]).collect();
+        solids.tau0 = order.iter().map(|&i| solids.tau0[i]).collect();
+        let mut solver = Solver::new(gpu(), &sc).unwrap();
+        solver.single_step(0.002).unwrap();
+        let (parts, codes) = gpu_particles_and_codes(&solver);
+        let solid = solid_refs(&solver);
+        let gpu_rate = solver.rerun_interaction(true).unwrap();
+        let gpu_dtau = in_gpu_order(
+            &solver,
+            &solver.read_stress_rates().unwrap(),
+            SymRate::default(),
+        );
+        let mats = &sc.solids.as_ref().unwrap().materials;
+
+        // The updated-Lagrangian body.
+        let cpu = elastic::rates(&sc.physics, mats, &Space::of(&sc), &parts, &solid);
+        let ul: Vec<usize> = (0..parts.len()).filter(|&i| cpu[i].is_some()).collect();
+        let n_tl = parts
+            .iter()
+            .zip(&solid)
+            .filter(|(p, s)| elastic::is_solid(p.kind) && s.body == 1)
+            .count();
+        assert_eq!(
+            ul.len() + n_tl,
+            parts.len(),
+            "{dim}D: every particle is solid"
+        );
+        assert!(!ul.is_empty() && n_tl > 0);
+        let cpu_ul = |i: usize| cpu[i].as_ref().expect("updated-Lagrangian");
+        let acc_rms = rms(ul.iter().flat_map(|&i| cpu_ul(i).rate[..3].to_vec()));
+        let rho_rms = rms(ul.iter().map(|&i| cpu_ul(i).rate[3]));
+        let tau_rms = rms(ul.iter().flat_map(|&i| cpu_ul(i).dtau.to_vec()));
+        let (mut e_acc, mut e_rho, mut e_tau) = (0.0f64, 0.0f64, 0.0f64);
+        for &i in &ul {
+            let (g, c, t) = (gpu_rate[i], cpu_ul(i), gpu_dtau[i]);
+            let g6 = [t.a[0], t.a[1], t.a[2], t.a[3], t.b[0], t.b[1]];
+            assert!(
+                g.iter().chain(&g6).all(|x| x.is_finite()),
+                "particle {i}: non-finite GPU rate {g:?} {g6:?}"
+            );
+            for a in 0..3 {
+                e_acc = e_acc.max((g[a] as f64 - c.rate[a]).abs() / acc_rms);
+            }
+            e_rho = e_rho.max((g[3] as f64 - c.rate[3]).abs() / rho_rms);
+            for k in 0..6 {
+                e_tau = e_tau.max((g6[k] as f64 - c.dtau[k]).abs() / tau_rms);
+            }
+        }
+
+        // The total-Lagrangian body: current positions by TL index, and the GPU slot of each.
+        let (range, setup) = wgsph::sph::total_lagrangian::setup(&sc).unwrap();
+        assert_eq!(setup.len(), n_tl);
+        assert!(range.start > solver.solid_id_base() as usize);
+        let mut x = vec![[0.0; 3]; setup.len()];
+        let mut slot = vec![usize::MAX; setup.len()];
+        for (i, c) in codes.iter().enumerate() {
+            let id = (c & ID_MASK) as usize;
+            if range.contains(&id) {
+                x[id - range.start] = parts[i].pos;
+                slot[id - range.start] = i;
+            }
+        }
+        let cpu_tl = total_lagrangian::accelerations(&setup, &sc.physics, mats, &x);
+        let d = dim as usize;
+        let tl_rms = rms(cpu_tl.iter().flat_map(|a| a[..d].to_vec()));
+        let mut e_tl = 0.0f64;
+        for k in 0..setup.len() {
+            let g = gpu_rate[slot[k]];
+            assert!(
+                g.iter().all(|v| v.is_finite()) && g[3] == 0.0,
+                "TL particle {k}: GPU rate {g:?}"
+            );
+            for a in 0..3 {
+                e_tl = e_tl.max((g[a] as f64 - cpu_tl[k][a]).abs() / tl_rms);
+            }
+        }
+        let state = solver.read_solid().unwrap();
+        let base = solver.solid_id_base() as usize;
+        for id in range.clone() {
+            let s = state[id - base];
+            assert!(
+                s.tau_a == [0.0; 4] && s.tau_b == [0.0; 3],
+                "TL particle {id}: τ {:?} {:?}",
+                s.tau_a,
+                s.tau_b
+            );
+        }
+        // The particle outputs: τ as stored for the updated-Lagrangian particles, the Cauchy
+        // stress σ = P Fᵀ/J (as τ and p) for the total-Lagrangian ones.
+        let want = total_lagrangian::cauchy(&setup, &sc.physics, mats, &x);
+        let out = solver.read_particles().unwrap();
+        let stress = out
+            .stress
+            .as_ref()
+            .expect("solid particles output their stress");
+        let sigma_rms = rms(want.iter().flat_map(|(s, _)| s.iter().flatten().copied()));
+        let mut e_sigma = 0.0f64;
+        for (i, &id) in out.id.iter().enumerate() {
+            let id = id as usize;
+            let t = stress[i];
+            if !range.contains(&id) {
+                let s = state[id - base];
+                let tau = [
+                    s.tau_a[0], s.tau_a[1], s.tau_a[2], s.tau_a[3], s.tau_b[0], s.tau_b[1],
+                ];
+                assert_eq!(t, tau, "updated-Lagrangian particle {id}: output τ");
+                continue;
+            }
+            // Relative to the particle's own largest component, at least the RMS (as in
+            // total_lagrangian_rates_match_reference).
+            let (s, _) = &want[id - range.start];
+            let scale = s.iter().flatten().fold(sigma_rms, |m, v| m.max(v.abs()));
+            let p = out.pressure[i] as f64;
+            let got = [
+                [t[0] as f64 - p, t[3] as f64, t[4] as f64],
+                [t[3] as f64, t[1] as f64 - p, t[5] as f64],
+                [t[4] as f64, t[5] as f64, t[2] as f64 - p],
+            ];
+            for a in 0..3 {
+                for b in 0..3 {
+                    e_sigma = e_sigma.max((got[a][b] - s[a][b]).abs() / scale);
+                }
+            }
+        }
+        println!(
+            "mixed {dim}D: {} updated-Lagrangian particles, dv/dt error {e_acc:.1e} of RMS \
+             {acc_rms:.3e}, dρ/dt {e_rho:.1e} of {rho_rms:.3e}, dτ/dt {e_tau:.1e} of \
+             {tau_rms:.3e}; {n_tl} total-Lagrangian, dv/dt error {e_tl:.1e} of RMS {tl_rms:.3e}, \
+             output σ {e_sigma:.1e}",
+            ul.len()
+        );
+        assert!(e_acc < 2e-4, "acceleration error {e_acc}");
+        assert!(e_rho < 2e-4, "density-rate error {e_rho}");
+        assert!(e_tau < 2e-4, "stress-rate error {e_tau}");
+        assert!(e_tl < 5e-5, "TL acceleration error {e_tl}");
+        assert!(e_sigma < 1e-4, "TL output stress error {e_sigma}");
+    }
+}
+
 /// Layer 2: the total-Lagrangian solid with integrate.wgsl's predictor–corrector (velocity
 /// Verlet for forces of the positions alone) conserves kinetic + elastic energy (the f64
 /// reference's discrete energy at the GPU positions), 2D and 3D, random initial velocities on

@@ -79,7 +79,7 @@ struct SolidMaterial {
     alpha: f32,                 // Monaghan artificial viscosity α between solid particles
     eps: f32,                   // artificial stress ε (Monaghan 2000)
     lambda: f32,                // Lamé's λ = K − 2μ/3 [Pa] (total-Lagrangian solid)
-    pad: f32,
+    total_lagrangian: u32,      // 1: a total-Lagrangian solid's (total_lagrangian.wgsl), 0: elastic.wgsl's
 }
 
 // Time-stepping state that lives on the GPU; read back once per batch of steps.

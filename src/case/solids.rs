@@ -345,7 +345,6 @@ pub(super) fn solid_particles(
     max_particles: f64,
 ) -> Result<SolidParticles, CaseError> {
     let first = &solids[0];
-    let material = first.material;
     for (i, s) in solids.iter().enumerate().skip(1) {
         if let Some(j) = solids[..i].iter().position(|o| o.name == s.name) {
             return Err(ctx.err(
@@ -353,18 +352,6 @@ pub(super) fn solid_particles(
                 Some(format!("{:?}", s.name)),
                 format!("is also the name of solid[{j}]"),
                 "give every solid its own name",
-            ));
-        }
-        if s.material.formulation != material.formulation {
-            return Err(ctx.err(
-                &format!("solid[{i}].formulation"),
-                None,
-                format!(
-                    "differs from solid[0].formulation ({:?}): all solids of a case use one \
-                     formulation",
-                    material.formulation
-                ),
-                "give every solid the same formulation",
             ));
         }
     }
@@ -395,7 +382,10 @@ pub(super) fn solid_particles(
     let mut body = Vec::new();
     // Counted over all solids, before any is built (the budget of the other cases).
     let mut total = 0.0;
-    for (i, s) in solids.iter().enumerate() {
+    // The total-Lagrangian solids first: the solver indexes their particles as one run of ids.
+    let mut order: Vec<usize> = (0..solids.len()).collect();
+    order.sort_by_key(|&i| solids[i].material.formulation != SolidFormulation::TotalLagrangian);
+    for (i, s) in order.into_iter().map(|i| (i, &solids[i])) {
         let Some((lo, hi)) = lat.range_in(&s.bx) else {
             return Err(ctx.err(
                 &format!("solid[{i}].max_m"),
@@ -411,7 +401,7 @@ pub(super) fn solid_particles(
                 "particles.dx_m",
                 Some(format!("{dx}")),
                 format!(
-                    "the solids up to solid[{i}] would have {total:.3e} particles, more than the \
+                    "with solid[{i}] the solids would have {total:.3e} particles, more than the \
                      limit of {max_particles:.3e}"
                 ),
                 "increase particles.dx_m",

@@ -2,7 +2,7 @@
 //! brute force over all pairs, f64. See the shader's header for the equations.
 
 use super::{dot, kernel, RefParticle, Space};
-use crate::scenario::{ContactGroup, ElasticMaterial, Physics};
+use crate::scenario::{ContactGroup, ElasticMaterial, Physics, SolidFormulation};
 
 pub const SOLID: u32 = crate::scenario::Kind::Solid as u32;
 pub const SOLID_CLAMPED: u32 = crate::scenario::Kind::SolidClamped as u32;
@@ -124,9 +124,10 @@ fn stress_terms(mat: &ElasticMaterial, p: &RefParticle, s: &SolidRef) -> (M3, M3
     (sigma.map(|row| row.map(|x| x / (p.rho * p.rho))), r)
 }
 
-/// Rates of every solid particle (None for the others): continuity, momentum with σ = −pI + τ,
-/// artificial viscosity and artificial stress, and the Jaumann rate of τ, over the solid
-/// particles of the same body, of the body's material (`mats` indexed by body).
+/// Rates of every updated-Lagrangian solid particle (None for the others, total-Lagrangian
+/// solids' included): continuity, momentum with σ = −pI + τ, artificial viscosity and
+/// artificial stress, and the Jaumann rate of τ, over the solid particles of the same body, of
+/// the body's material (`mats` indexed by body).
 pub fn rates(
     ph: &Physics,
     mats: &[ElasticMaterial],
@@ -140,7 +141,11 @@ pub fn rates(
     let terms: Vec<Option<(M3, M3)>> = parts
         .iter()
         .zip(solid)
-        .map(|(p, s)| is_solid(p.kind).then(|| stress_terms(&mats[s.body as usize], p, s)))
+        .map(|(p, s)| {
+            let mat = &mats[s.body as usize];
+            (is_solid(p.kind) && mat.formulation == SolidFormulation::UpdatedLagrangian)
+                .then(|| stress_terms(mat, p, s))
+        })
         .collect();
     (0..parts.len())
         .map(|i| {

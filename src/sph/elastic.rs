@@ -1,6 +1,7 @@
 //! Hypoelastic solid particles (shaders/elastic.wgsl): continuity, momentum with the total
 //! stress and the artificial stress, and the Jaumann stress rate, plus the predictor and
-//! corrector of the stress. Only built when the case has solid particles.
+//! corrector of the stress. Only built when the case has updated-Lagrangian solids (the
+//! total-Lagrangian ones are src/sph/total_lagrangian.rs's).
 
 use anyhow::Result;
 

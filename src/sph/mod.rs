@@ -31,7 +31,7 @@ use crate::layout::{
 };
 use crate::scenario::{
     ContactGroup, DeltaSphForm, GhostCorrection, KernelKind, Kind, ProbeKind, RepulsiveForm,
-    Scenario, Viscosity,
+    Scenario, SolidFormulation, Viscosity,
 };
 use bodies::Bodies;
 use buffers::{InitialParticles, ParticleBuffers};
@@ -404,15 +404,13 @@ impl Solver {
             mode => DensityFilter::new(&device, &module(Pass::DensityFilter)?, &buffers, mode)?,
         };
         let integrate = Integrate::new(&device, &module(Pass::Integrate)?, &buffers)?;
-        let tl = sc
-            .solids
-            .as_ref()
-            .is_some_and(|s| s.formulation() == crate::scenario::SolidFormulation::TotalLagrangian);
-        let elastic = match sc.solids {
-            Some(_) if !tl => Some(Elastic::new(&device, &module(Pass::Elastic)?, &buffers)?),
-            _ => None,
+        let has_formulation = |f| sc.solids.as_ref().is_some_and(|s| s.has(f));
+        let elastic = if has_formulation(SolidFormulation::UpdatedLagrangian) {
+            Some(Elastic::new(&device, &module(Pass::Elastic)?, &buffers)?)
+        } else {
+            None
         };
-        let total_lagrangian = if tl {
+        let total_lagrangian = if has_formulation(SolidFormulation::TotalLagrangian) {
             Some(TotalLagrangian::new(
                 &device,
                 &module(Pass::TotalLagrangian)?,
@@ -1175,9 +1173,13 @@ impl Solver {
             let mat = state.map_or_else(Default::default, |s| {
                 self.params.solid_materials[s.material as usize]
             });
-            if let (true, Some((first, stress))) = (solid_kind, &tl) {
+            let tl_stress = tl.as_ref().and_then(|(first, stress)| {
+                stress
+                    .get(id.checked_sub(*first)? as usize)
+                    .filter(|_| solid_kind)
+            });
+            if let Some(c) = tl_stress {
                 // Total-Lagrangian: ρ = ρs/J, p = −tr σ/3 and τ = σ + p I.
-                let c = stress[(id - first) as usize];
                 let p = -(c.sigma[0] + c.sigma[1] + c.sigma[2]) / 3.0;
                 *out.rho.last_mut().expect("pushed above") = (mat.rho0 as f64 / c.j) as f32;
                 out.pressure.push(p as f32);
@@ -1291,7 +1293,8 @@ fn solid_material(
         alpha: m.alpha as f32,
         eps: m.artificial_stress as f32,
         lambda: crate::reference::total_lagrangian::lame(m).0 as f32,
-        pad: 0.0,
+        total_lagrangian: (m.formulation == crate::scenario::SolidFormulation::TotalLagrangian)
+            as u32,
     }
 }
 

@@ -1,20 +1,21 @@
 //! Total-Lagrangian elastic solid (shaders/total_lagrangian.wgsl): the reference neighbour
 //! lists and gradient weights, computed once in f64 (src/reference/total_lagrangian.rs) and
 //! uploaded; per step the slot of every solid particle after the sort, then F, the strain
-//! gradient's stress T, the first Piola–Kirchhoff stress P and the accelerations. Replaces the
-//! hypoelastic pass (src/sph/elastic.rs) when `formulation = "total_lagrangian"`; there is no
-//! stress or density to integrate, integrate.wgsl moves the particles (velocity Verlet).
+//! gradient's stress T, the first Piola–Kirchhoff stress P and the accelerations. Takes the
+//! place of the hypoelastic pass (src/sph/elastic.rs) for the solids of `formulation =
+//! "total_lagrangian"`; there is no stress or density to integrate, integrate.wgsl moves the
+//! particles (velocity Verlet).
 //! GPU memory only for the solid particles: the lists (48 bytes a pair) and 5 matrices a
 //! particle.
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 
 use super::buffers::ParticleBuffers;
 use crate::gpu::buffers::{read, storage, storage_init, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::layout::{TlPair, TlParams};
 use crate::reference::total_lagrangian::{cauchy_of, TlSetup};
-use crate::scenario::Scenario;
+use crate::scenario::{Scenario, SolidFormulation};
 
 pub struct TotalLagrangian {
     index: ParityKernel,
@@ -34,14 +35,33 @@ pub struct TotalLagrangian {
     bytes: u64,
 }
 
-/// The f64 setup of the scenario's solid particles (TL index = id − first solid id).
+/// The ids of the total-Lagrangian solids' particles and their f64 setup (TL index = id − the
+/// range's start).
 pub fn setup(sc: &Scenario) -> Result<(std::ops::Range<usize>, TlSetup)> {
-    let range = super::solid_range(sc)?;
+    let range = tl_range(sc)?;
     let solids = sc.solids.as_ref().expect("a case with solids");
     let x0: Vec<[f64; 3]> = sc.particles[range.clone()].iter().map(|p| p.pos).collect();
     let setup =
         TlSetup::new(&sc.physics, &x0, &solids.body[range.clone()]).map_err(anyhow::Error::msg)?;
     Ok((range, setup))
+}
+
+/// The ids of the particles of the total-Lagrangian solids: one run of consecutive ids (the case
+/// loader builds these solids before the updated-Lagrangian ones), which the kernels index as
+/// TL index + first id.
+pub fn tl_range(sc: &Scenario) -> Result<std::ops::Range<usize>> {
+    let solids = sc.solids.as_ref().expect("a case with solids");
+    let solid = super::solid_range(sc)?;
+    let ids: Vec<usize> = solid
+        .filter(|&i| solids.material_of(i).formulation == SolidFormulation::TotalLagrangian)
+        .collect();
+    let (Some(&first), Some(&last)) = (ids.first(), ids.last()) else {
+        bail!("the case has no total-Lagrangian solid");
+    };
+    if last - first + 1 != ids.len() {
+        bail!("the total-Lagrangian solids' particles must have consecutive ids");
+    }
+    Ok(first..last + 1)
 }
 
 impl TotalLagrangian {

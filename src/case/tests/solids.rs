@@ -96,12 +96,6 @@ fn solid_errors_name_the_field() {
         &["solid[0].clamped_max_m", "empty"],
     );
     assert_err(
-        &format!("{SOLID}\n[[solid]]\nname = \"b\"\nmin_m = [0.3, 0.0]\nmax_m = [0.4, 0.04]\ndensity_kg_m3 = 1000.0\nyoungs_modulus_pa = 3.0e6\npoisson_ratio = 0.3975\nformulation = \"total_lagrangian\"\nalpha = 0.0\nartificial_stress = 0.0\n"),
-        &[],
-        None,
-        &["solid[1].formulation", "one formulation"],
-    );
-    assert_err(
         &format!("{SOLID}\n[solid.initial_velocity]\nkind = \"cantilever_mode\"\nroot_m = [0.05, 0.02]\naxis = [1.0, 0.0]\ndirection = [0.0, 1.0]\ntip_velocity_m_s = 0.5\n"),
         &[],
         None,
@@ -271,10 +265,12 @@ youngs_modulus_pa = 2.0e6
 poisson_ratio = 0.3975
 formulation = "total_lagrangian"
 "#;
-    let s3 = load_str(three_d, "cases/t.toml", &[]).unwrap();
-    assert_eq!(
-        s3.solids.unwrap().formulation(),
-        SolidFormulation::TotalLagrangian
+    let s3 = load_str(three_d, "cases/t.toml", &[])
+        .unwrap()
+        .solids
+        .unwrap();
+    assert!(
+        s3.has(SolidFormulation::TotalLagrangian) && !s3.has(SolidFormulation::UpdatedLagrangian)
     );
     let fluid = GATE_IN_WATER.replace(
         "poisson_ratio = 0.4\n",
@@ -282,10 +278,51 @@ formulation = "total_lagrangian"
     );
     let sc = load_str(&fluid, "c.toml", &[]).unwrap();
     assert!(sc.count(Kind::Fluid) > 0 && sc.count(Kind::Solid) > 0);
-    assert_eq!(
-        sc.solids.unwrap().formulation(),
-        SolidFormulation::TotalLagrangian
+    let solids = sc.solids.unwrap();
+    assert!(
+        solids.has(SolidFormulation::TotalLagrangian)
+            && !solids.has(SolidFormulation::UpdatedLagrangian)
     );
+}
+
+/// Solids of both formulations share a case: each keeps its own (by `[[solid]]` index), and the
+/// total-Lagrangian solid's particles are built first, in one run of ids (the solver's TL
+/// lists index them so), whatever the order of the `[[solid]]` tables.
+#[test]
+fn solids_of_both_formulations_share_a_case() {
+    let text = format!(
+        "{SOLID}\n[[solid]]\nname = \"b\"\nmin_m = [0.3, 0.0]\nmax_m = [0.4, 0.04]\n\
+         density_kg_m3 = 1000.0\nyoungs_modulus_pa = 3.0e6\npoisson_ratio = 0.3975\n\
+         formulation = \"total_lagrangian\"\n[walls]\nrepulsive_d_m2_s2 = 1.0\n"
+    );
+    let sc = load_str(&text, "cases/t.toml", &[]).unwrap();
+    let solids = sc.solids.as_ref().unwrap();
+    assert_eq!(
+        solids
+            .materials
+            .iter()
+            .map(|m| m.formulation)
+            .collect::<Vec<_>>(),
+        [
+            SolidFormulation::UpdatedLagrangian,
+            SolidFormulation::TotalLagrangian
+        ]
+    );
+    let ids: Vec<usize> = (0..sc.particles.len())
+        .filter(|&i| sc.particles[i].kind.is_solid())
+        .collect();
+    let bodies: Vec<u32> = ids.iter().map(|&i| solids.body[i]).collect();
+    let n_tl = bodies.iter().filter(|&&b| b == 1).count();
+    assert!(n_tl > 0 && n_tl < bodies.len());
+    assert!(
+        bodies[..n_tl].iter().all(|&b| b == 1) && bodies[n_tl..].iter().all(|&b| b == 0),
+        "the total-Lagrangian solid's particles come first"
+    );
+    // Each particle is where its own solid is: "b" spans x ∈ [0.3, 0.4].
+    for &i in &ids {
+        let in_b = sc.particles[i].pos[0] > 0.25;
+        assert_eq!(in_b, solids.body[i] == 1, "particle {i}");
+    }
 }
 
 /// A solid in a tank without fluid: the tank's walls on the lattice from its inner corner, the
