@@ -1,6 +1,6 @@
 //! Restart and crash safety: a run split by a checkpoint and resumed is bit-identical to an
 //! uninterrupted one (fluid with density filter and energy equation; a floating body; elastic
-//! plates; an injection through a velocity inlet); a real
+//! plates of both formulations in one case; an injection through a velocity inlet); a real
 //! run killed with SIGKILL leaves only complete files behind and resumes from its last
 //! checkpoint to the same result; Ctrl-C (SIGINT) checkpoints and stops; a lost GPU device and
 //! a case too large for the adapter give clear errors instead of panics.
@@ -130,32 +130,21 @@ fn resume_is_bit_identical_for_a_floating_body() {
     split_run_matches("floating-box", &sc, 0.07);
 }
 
+/// Elastic plates of both formulations in one case (tests/common `both_plates_case`): the
+/// updated-Lagrangian plate's τ and ρ come from the checkpoint; the total-Lagrangian plate's
+/// reference lattice and lists come from the case, not the checkpoint, and F, T, P are
+/// recomputed each step, so a resumed run continues exactly.
 #[test]
-fn resume_is_bit_identical_for_an_elastic_plate() {
-    let sc = load(
-        "cases/oscillating_plate_2d.toml",
-        &[
-            "time.end_s=0.04",
-            "time.output_every_s=0.01",
-            "time.probe_every_s=0.005",
-        ],
-    );
-    split_run_matches("plate", &sc, 0.02);
-}
-
-/// The total-Lagrangian plate: the reference lattice and lists come from the case, not the
-/// checkpoint, and F, T, P are recomputed each step, so a resumed run continues exactly.
-#[test]
-fn resume_is_bit_identical_for_a_total_lagrangian_plate() {
-    let sc = load(
-        "cases/oscillating_plate_tl_2d.toml",
-        &[
-            "time.end_s=0.04",
-            "time.output_every_s=0.01",
-            "time.probe_every_s=0.005",
-        ],
-    );
-    split_run_matches("plate-tl", &sc, 0.02);
+fn resume_is_bit_identical_for_elastic_plates_of_both_formulations() {
+    let set: Vec<String> = [
+        "time.end_s=0.04",
+        "time.output_every_s=0.01",
+        "time.probe_every_s=0.005",
+    ]
+    .map(String::from)
+    .to_vec();
+    let sc = wgsph::case::load_str(&common::both_plates_case(), "plates.toml", &set).unwrap();
+    split_run_matches("plates", &sc, 0.02);
 }
 
 /// Velocity inlets place their particles from the time alone (and count the joined ones in

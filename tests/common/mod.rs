@@ -263,3 +263,30 @@ pub fn mls_borderline(sc: &Scenario, parts: &[RefParticle], x: [f64; 3]) -> bool
     sc.walls.ghost_correction == GhostCorrection::Mls
         && (min_pivot_ratio(sc.physics.dim as usize, a) / MLS_MIN_PIVOT - 1.0).abs() < 0.1
 }
+
+/// A case of solids of both formulations: the shipped total-Lagrangian plate
+/// (cases/oscillating_plate_tl_2d.toml, probe "tip") and, 0.1 m above it, the shipped
+/// updated-Lagrangian one (cases/oscillating_plate_2d.toml; "plate_ul", probe "tip_ul"), each
+/// started in its first mode. TOML text.
+pub fn both_plates_case() -> String {
+    let ul = "cases/oscillating_plate_2d.toml";
+    let ul_text = std::fs::read_to_string(ul).unwrap();
+    let mut upper = ul_text[ul_text.find("[[solid]]").unwrap()..].to_string();
+    for (from, to) in [
+        ("name = \"plate\"", "name = \"plate_ul\""),
+        ("name = \"tip\"", "name = \"tip_ul\""),
+        ("min_m = [0.0, 0.0]", "min_m = [0.0, 0.1]"),
+        ("max_m = [0.26, 0.02]", "max_m = [0.26, 0.12]"),
+        ("max_m = [0.06, 0.02]", "max_m = [0.06, 0.12]"),
+        ("root_m = [0.06, 0.01]", "root_m = [0.06, 0.11]"),
+        ("point_m = [0.26, 0.01]", "point_m = [0.26, 0.11]"),
+    ] {
+        assert!(upper.contains(from), "{ul} no longer has {from}");
+        upper = upper.replace(from, to);
+    }
+    // Without gravity the contact law needs a strength of its own (the plates stay apart).
+    format!(
+        "{}\n{upper}\n[walls]\nrepulsive_d_m2_s2 = 1.0\n",
+        std::fs::read_to_string("cases/oscillating_plate_tl_2d.toml").unwrap()
+    )
+}

@@ -372,26 +372,7 @@ repulsive_d_m2_s2 = 1.0
 /// plates' velocities).
 #[test]
 fn plates_of_both_formulations_in_one_case_move_as_alone() {
-    let ul_text = std::fs::read_to_string(UL).unwrap();
-    let tail = &ul_text[ul_text.find("[[solid]]").unwrap()..];
-    let mut upper = tail.to_string();
-    for (from, to) in [
-        ("name = \"plate\"", "name = \"plate_ul\""),
-        ("name = \"tip\"", "name = \"tip_ul\""),
-        ("min_m = [0.0, 0.0]", "min_m = [0.0, 0.1]"),
-        ("max_m = [0.26, 0.02]", "max_m = [0.26, 0.12]"),
-        ("max_m = [0.06, 0.02]", "max_m = [0.06, 0.12]"),
-        ("root_m = [0.06, 0.01]", "root_m = [0.06, 0.11]"),
-        ("point_m = [0.26, 0.01]", "point_m = [0.26, 0.11]"),
-    ] {
-        assert!(upper.contains(from), "{UL} no longer has {from}");
-        upper = upper.replace(from, to);
-    }
-    // Without gravity the contact law needs a strength of its own (the plates stay apart).
-    let both = format!(
-        "{}\n{upper}\n[walls]\nrepulsive_d_m2_s2 = 1.0\n",
-        std::fs::read_to_string(TL).unwrap()
-    );
+    let both = both_plates_case();
     let sc = wgsph::case::load_str(&both, "plates.toml", &[]).unwrap();
     let tips = |sc: &Scenario| -> Vec<Vec<f64>> {
         let mut solver = Solver::new(gpu(), sc).unwrap();
