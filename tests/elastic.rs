@@ -140,6 +140,15 @@ fn in_gpu_order<T: Copy>(solver: &Solver, by_id: &[T], other: T) -> Vec<T> {
         .collect()
 }
 
+/// dτ/dt of the last evaluation in the GPU order of the particle arrays (zero for the others).
+fn stress_rates(solver: &Solver) -> Vec<SymRate> {
+    in_gpu_order(
+        solver,
+        &solver.read_stress_rates().unwrap(),
+        SymRate::default(),
+    )
+}
+
 /// The solid state of the GPU arrays (GPU order) as reference input.
 fn solid_refs(solver: &Solver) -> Vec<SolidRef> {
     let by_id: Vec<SolidRef> = solver
@@ -308,11 +317,7 @@ fn elastic_rates_match_reference() {
     ] {
         let sc = random_solid(dim, kernel, 11 + dim as u64, material());
         let (solver, parts, solid, gpu_rate) = rerun(&sc);
-        let gpu_dtau = in_gpu_order(
-            &solver,
-            &solver.read_stress_rates().unwrap(),
-            SymRate::default(),
-        );
+        let gpu_dtau = stress_rates(&solver);
         let mats = &sc.solids.as_ref().unwrap().materials;
         let cpu = elastic::rates(&sc.physics, mats, &Space::of(&sc), &parts, &solid);
         let all: Vec<_> = cpu.iter().map(|c| c.as_ref().expect("all solid")).collect();
@@ -813,11 +818,7 @@ fn solids_of_both_formulations_match_their_references() {
         let (parts, codes) = gpu_particles_and_codes(&solver);
         let solid = solid_refs(&solver);
         let gpu_rate = solver.rerun_interaction(true).unwrap();
-        let gpu_dtau = in_gpu_order(
-            &solver,
-            &solver.read_stress_rates().unwrap(),
-            SymRate::default(),
-        );
+        let gpu_dtau = stress_rates(&solver);
         let mats = &sc.solids.as_ref().unwrap().materials;
 
         // The updated-Lagrangian body.

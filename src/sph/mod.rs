@@ -1270,11 +1270,16 @@ pub(crate) fn solid_range(sc: &Scenario) -> Result<std::ops::Range<usize>> {
     let ids: Vec<usize> = (0..sc.particles.len())
         .filter(|&i| sc.particles[i].kind.is_solid())
         .collect();
+    consecutive(&ids, "the elastic solids")
+}
+
+/// The range that sorted `ids` fill, when they are consecutive (the particles of `what`).
+pub(crate) fn consecutive(ids: &[usize], what: &str) -> Result<std::ops::Range<usize>> {
     let (Some(&first), Some(&last)) = (ids.first(), ids.last()) else {
-        bail!("the elastic solids have no particles");
+        bail!("{what} have no particles");
     };
     if last - first + 1 != ids.len() {
-        bail!("the elastic solids' particles must have consecutive ids");
+        bail!("{what}' particles must have consecutive ids");
     }
     Ok(first..last + 1)
 }

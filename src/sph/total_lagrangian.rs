@@ -8,7 +8,7 @@
 //! GPU memory only for the solid particles: the lists (48 bytes a pair) and 5 matrices a
 //! particle.
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
 use crate::gpu::buffers::{read, storage, storage_init, uniform_init};
@@ -55,13 +55,7 @@ pub fn tl_range(sc: &Scenario) -> Result<std::ops::Range<usize>> {
     let ids: Vec<usize> = solid
         .filter(|&i| solids.material_of(i).formulation == SolidFormulation::TotalLagrangian)
         .collect();
-    let (Some(&first), Some(&last)) = (ids.first(), ids.last()) else {
-        bail!("the case has no total-Lagrangian solid");
-    };
-    if last - first + 1 != ids.len() {
-        bail!("the total-Lagrangian solids' particles must have consecutive ids");
-    }
-    Ok(first..last + 1)
+    super::consecutive(&ids, "the total-Lagrangian solids")
 }
 
 impl TotalLagrangian {
