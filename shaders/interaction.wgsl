@@ -427,7 +427,12 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         set_hydrostatic_coefficients();
     }
     if (is_solid(kind_i)) {
-        rate[i] = vec4<f32>(solid_loads(i), 0.0);
+        // A lone elastic body (shader::Present) has nothing outside it to load it.
+        var loads = vec3<f32>(0.0);
+        if (!LONE_SOLID) {
+            loads = solid_loads(i);
+        }
+        rate[i] = vec4<f32>(loads, 0.0);
         return;
     }
     let fluid_i = kind_i == KIND_FLUID;

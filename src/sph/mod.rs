@@ -1220,6 +1220,8 @@ fn present(sc: &Scenario, body_id_base: u32) -> Present {
         repulsive: has(&[Kind::Repulsive]),
         bodies: (body_id_base as usize) < sc.particles.len(),
         mirrors: !sc.walls.mirror_planes.is_empty(),
+        lone_solid: sc.solids.as_ref().is_some_and(|s| s.materials.len() == 1)
+            && sc.particles.iter().all(|p| p.kind.is_solid()),
     }
 }
 
@@ -1340,3 +1342,30 @@ fn solid_states(sc: &Scenario) -> Result<Vec<crate::layout::SolidState>> {
 
 /// Kind word of an excluded particle, for callers filtering outputs.
 pub const EXCLUDED: u32 = KIND_EXCLUDED;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn present_in(case: &str) -> Present {
+        let sc = crate::case::load(std::path::Path::new(case), &[]).unwrap();
+        present(&sc, body_id_base(&sc).unwrap())
+    }
+
+    /// Only a case of one elastic body and nothing else skips its solids' neighbour search:
+    /// with water, walls or a second solid, the solid must be loaded.
+    #[test]
+    fn a_lone_solid_is_a_case_of_one_elastic_body_alone() {
+        assert!(present_in("cases/oscillating_plate_2d.toml").lone_solid);
+        assert!(present_in("cases/oscillating_plate_tl_2d.toml").lone_solid);
+        assert!(!present_in("cases/elastic_gate_2d.toml").lone_solid);
+        assert!(!present_in("cases/dam_break_2d.toml").lone_solid);
+        let text = std::fs::read_to_string("cases/oscillating_plate_2d.toml")
+            .unwrap()
+            .replace("[[solid]]", "[walls]\nrepulsive_d_m2_s2 = 1.0\n[[solid]]")
+            + "\n[[solid]]\nname = \"second\"\nmin_m = [0.0, 0.1]\nmax_m = [0.2, 0.12]\n\
+               density_kg_m3 = 1000.0\nyoungs_modulus_pa = 2.0e6\npoisson_ratio = 0.3975\n";
+        let two = crate::case::load_str(&text, "two.toml", &[]).unwrap();
+        assert!(!present(&two, body_id_base(&two).unwrap()).lone_solid);
+    }
+}

@@ -49,7 +49,7 @@ pub fn setup(sc: &Scenario) -> Result<(std::ops::Range<usize>, TlSetup)> {
 /// The ids of the particles of the total-Lagrangian solids: one run of consecutive ids (the case
 /// loader builds these solids before the updated-Lagrangian ones), which the kernels index as
 /// TL index + first id.
-pub fn tl_range(sc: &Scenario) -> Result<std::ops::Range<usize>> {
+fn tl_range(sc: &Scenario) -> Result<std::ops::Range<usize>> {
     let solids = sc.solids.as_ref().expect("a case with solids");
     let solid = super::solid_range(sc)?;
     let ids: Vec<usize> = solid
