@@ -60,9 +60,9 @@ struct TlPair {
 @group(0) @binding(8) var<storage, read_write> tl_h: array<mat3x3<f32>>;
 @group(0) @binding(9) var<storage, read_write> tl_t: array<mat3x3<f32>>;
 @group(0) @binding(10) var<storage, read_write> tl_p: array<mat3x3<f32>>;
-// The solid state, for the material of TL particle k (tl_material; the TL particles are a run
-// of the solid slots, from tlp.first_id − params.solid_id_base;
-// λ, G and ρ0 of params.solid_materials, per body).
+// The solid state, for the material of TL particle k (λ, G and ρ0 of params.solid_materials,
+// per body; `tl_material`): the TL particles are the run of solid slots from
+// tlp.first_id − params.solid_id_base.
 @group(0) @binding(11) var<storage, read> solid: array<SolidState>;
 
 // The material of TL particle k.

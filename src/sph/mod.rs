@@ -1300,8 +1300,7 @@ fn solid_material(
         alpha: m.alpha as f32,
         eps: m.artificial_stress as f32,
         lambda: crate::reference::total_lagrangian::lame(m).0 as f32,
-        total_lagrangian: (m.formulation == crate::scenario::SolidFormulation::TotalLagrangian)
-            as u32,
+        total_lagrangian: (m.formulation == SolidFormulation::TotalLagrangian) as u32,
     }
 }
 
