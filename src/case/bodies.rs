@@ -5,16 +5,18 @@
 
 use std::f64::consts::PI;
 use std::path::Path;
+use std::sync::Arc;
 
 use crate::scenario::{Motion, MotionLaw, Prescribed};
 
 use super::error::{num, CaseError};
 use super::locate::Ctx;
+use super::mesh::Mesh;
 use super::schema::{MotionName, RawBody, RawMotion, ShapeName};
 use super::validate::Treatment;
 use super::validate::{aabb, number, vector, Aabb, Bound};
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(super) enum Shape {
     Box(Aabb),
     /// A circle (2D) or a sphere (3D).
@@ -22,6 +24,8 @@ pub(super) enum Shape {
         center: [f64; 3],
         radius: f64,
     },
+    /// A closed triangle surface read from an STL file (3D).
+    Mesh(Arc<Mesh>),
 }
 
 #[derive(Debug, Clone)]
@@ -79,7 +83,7 @@ pub(super) fn validate(
                 "use wall = \"fixed_ghost\" (or \"dynamic\", \"repulsive\")",
             ));
         }
-        let shape = shape(ctx, &path, b, dim)?;
+        let shape = shape(ctx, &path, b, dim, case_dir)?;
         let mass = match (b.density_kg_m3, b.mass_kg) {
             (Some(_), Some(_)) => {
                 return Err(ctx.err(
@@ -174,17 +178,25 @@ pub(super) fn validate(
     Ok(out)
 }
 
-fn shape(ctx: &Ctx<'_>, path: &str, b: &RawBody, dim: usize) -> Result<Shape, CaseError> {
+fn shape(
+    ctx: &Ctx<'_>,
+    path: &str,
+    b: &RawBody,
+    dim: usize,
+    case_dir: &Path,
+) -> Result<Shape, CaseError> {
     let (name, needs): (&str, &[&str]) = match b.shape {
         ShapeName::Box => ("box", &["min_m", "max_m"]),
         ShapeName::Circle => ("circle", &["center_m", "radius_m"]),
         ShapeName::Sphere => ("sphere", &["center_m", "radius_m"]),
+        ShapeName::Mesh => ("mesh", &["file"]),
     };
     let given = [
         ("min_m", b.min_m.is_some()),
         ("max_m", b.max_m.is_some()),
         ("center_m", b.center_m.is_some()),
         ("radius_m", b.radius_m.is_some()),
+        ("file", b.file.is_some()),
     ];
     for (field, present) in given {
         if present != needs.contains(&field) {
@@ -201,7 +213,7 @@ fn shape(ctx: &Ctx<'_>, path: &str, b: &RawBody, dim: usize) -> Result<Shape, Ca
         }
     }
     match (b.shape, dim) {
-        (ShapeName::Circle, 3) | (ShapeName::Sphere, 2) => {
+        (ShapeName::Circle, 3) | (ShapeName::Sphere | ShapeName::Mesh, 2) => {
             return Err(ctx.err(
                 &format!("{path}.shape"),
                 Some(format!("\"{name}\"")),
@@ -209,11 +221,22 @@ fn shape(ctx: &Ctx<'_>, path: &str, b: &RawBody, dim: usize) -> Result<Shape, Ca
                 if dim == 2 {
                     "use shape = \"circle\" (or \"box\") in 2D"
                 } else {
-                    "use shape = \"sphere\" (or \"box\") in 3D"
+                    "use shape = \"sphere\" (or \"box\", \"mesh\") in 3D"
                 },
             ))
         }
         _ => {}
+    }
+    if let Some(file) = &b.file {
+        let mesh = Mesh::read(&case_dir.join(file)).map_err(|e| {
+            ctx.err(
+                &format!("{path}.file"),
+                Some(format!("{file:?}")),
+                e.to_string(),
+                e.fix(),
+            )
+        })?;
+        return Ok(Shape::Mesh(Arc::new(mesh)));
     }
     Ok(match (&b.min_m, &b.max_m, &b.center_m, b.radius_m) {
         (Some(lo), Some(hi), _, _) => Shape::Box(aabb(ctx, path, lo, hi, dim, "the body")?),
@@ -531,36 +554,52 @@ fn series(
 impl Shape {
     /// Area (2D) or volume (3D).
     pub(super) fn measure(&self, dim: usize) -> f64 {
-        match *self {
+        match self {
             Shape::Box(b) => (0..dim).map(|a| b.max[a] - b.min[a]).product(),
             Shape::Ball { radius, .. } if dim == 2 => PI * radius * radius,
             Shape::Ball { radius, .. } => 4.0 / 3.0 * PI * radius.powi(3),
+            Shape::Mesh(m) => m.volume(),
         }
     }
 
     /// How many lattice points [`Shape::points`] considers at spacing `dx` (at least as many
     /// as it returns), for the particle budget.
     pub(super) fn lattice_size(&self, dx: f64, dim: usize) -> f64 {
-        match *self {
+        match self {
             Shape::Box(b) => (0..dim)
                 .map(|a| ((b.max[a] - b.min[a]) / dx).round().max(1.0))
                 .product(),
             // Rings a spacing apart, each with about 2 pi r / dx points.
             Shape::Ball { radius, .. } if dim == 2 => PI * (radius / dx + 1.0).powi(2),
             Shape::Ball { radius, .. } => (2.0 * (radius / dx).ceil() + 1.0).powi(3),
+            Shape::Mesh(m) => m.lattice(dx).0.iter().map(|&n| n as f64).product(),
         }
     }
 
+    /// The centre of mass at uniform density.
     pub(super) fn center(&self) -> [f64; 3] {
-        match *self {
+        match self {
             Shape::Box(b) => [0, 1, 2].map(|a| 0.5 * (b.min[a] + b.max[a])),
-            Shape::Ball { center, .. } => center,
+            Shape::Ball { center, .. } => *center,
+            Shape::Mesh(m) => m.centroid(),
+        }
+    }
+
+    /// The smallest box around the shape (third axis 0 in 2D).
+    pub(super) fn bounds(&self, dim: usize) -> Aabb {
+        match self {
+            Shape::Box(b) => *b,
+            Shape::Ball { center, radius } => Aabb {
+                min: [0, 1, 2].map(|a| if a < dim { center[a] - radius } else { 0.0 }),
+                max: [0, 1, 2].map(|a| if a < dim { center[a] + radius } else { 0.0 }),
+            },
+            Shape::Mesh(m) => m.bounds(),
         }
     }
 
     /// Inertia tensor about the centre of a uniform body of `mass`.
     pub(super) fn inertia(&self, dim: usize, mass: f64) -> [[f64; 3]; 3] {
-        let diag = match *self {
+        let diag = match self {
             Shape::Box(b) => {
                 let s = [0, 1, 2].map(|a| if a < dim { b.max[a] - b.min[a] } else { 0.0 });
                 let sq = s.map(|x| x * x);
@@ -575,6 +614,7 @@ impl Shape {
                 [mass * r2 / 4.0, mass * r2 / 4.0, mass * r2 / 2.0]
             }
             Shape::Ball { radius, .. } => [0.4 * mass * radius * radius; 3],
+            Shape::Mesh(m) => return m.inertia(mass),
         };
         [
             [diag[0], 0.0, 0.0],
@@ -583,34 +623,23 @@ impl Shape {
         ]
     }
 
-    /// Distance from `p` to the shape's surface, negative inside.
-    pub(super) fn signed_distance(&self, p: [f64; 3], dim: usize) -> f64 {
-        match *self {
-            Shape::Box(b) => {
-                let d: Vec<f64> = (0..dim)
-                    .map(|a| (b.min[a] - p[a]).max(p[a] - b.max[a]))
-                    .collect();
-                let outside = d.iter().map(|x| x.max(0.0).powi(2)).sum::<f64>().sqrt();
-                let inside = d.iter().cloned().fold(f64::MIN, f64::max).min(0.0);
-                outside + inside
-            }
-            Shape::Ball { center, radius } => {
-                (0..dim)
-                    .map(|a| (p[a] - center[a]).powi(2))
-                    .sum::<f64>()
-                    .sqrt()
-                    - radius
-            }
+    /// Whether `p` is inside the shape or less than `margin` from its surface.
+    pub(super) fn near(&self, p: [f64; 3], margin: f64, dim: usize) -> bool {
+        match self {
+            Shape::Box(b) => box_distance(b, p, dim) < margin,
+            Shape::Ball { center, radius } => ball_distance(*center, *radius, p, dim) < margin,
+            Shape::Mesh(m) => m.contains(p) || m.distance_within(p, margin).is_some(),
         }
     }
 
     /// The body's particles at spacing `dx`: a box on its own cell-centred lattice, a circle
-    /// as concentric rings (a smooth surface), a sphere on a lattice through its centre; only
-    /// the outer `layers` when given.
+    /// as concentric rings (a smooth surface), a sphere on a lattice through its centre, a mesh
+    /// on a cell-centred lattice over its bounding box; only the outer `layers` when given.
     pub(super) fn points(&self, dx: f64, dim: usize, layers: Option<u32>) -> Vec<[f64; 3]> {
         let depth = layers.map_or(f64::MAX, |l| l as f64 * dx);
         let mut out = Vec::new();
         match *self {
+            Shape::Mesh(ref m) => return m.points(dx, layers.map(|_| depth)),
             Shape::Box(b) => {
                 let n = [0, 1, 2].map(|a| {
                     if a < dim {
@@ -637,7 +666,7 @@ impl Shape {
                                     0.0
                                 }
                             });
-                            if -self.signed_distance(p, dim) < depth {
+                            if -box_distance(&b, p, dim) < depth {
                                 out.push(p);
                             }
                         }
@@ -676,7 +705,7 @@ impl Shape {
                                 center[1] + j as f64 * dx,
                                 center[2] + k as f64 * dx,
                             ];
-                            let d = -self.signed_distance(p, dim);
+                            let d = -ball_distance(center, radius, p, dim);
                             if d >= 0.5 * dx - 1e-9 * dx && d < depth + 0.5 * dx {
                                 out.push(p);
                             }
@@ -687,6 +716,25 @@ impl Shape {
         }
         out
     }
+}
+
+/// Distance from `p` to the surface of the box `b`, negative inside.
+fn box_distance(b: &Aabb, p: [f64; 3], dim: usize) -> f64 {
+    let d: Vec<f64> = (0..dim)
+        .map(|a| (b.min[a] - p[a]).max(p[a] - b.max[a]))
+        .collect();
+    let outside = d.iter().map(|x| x.max(0.0).powi(2)).sum::<f64>().sqrt();
+    let inside = d.iter().cloned().fold(f64::MIN, f64::max).min(0.0);
+    outside + inside
+}
+
+/// Distance from `p` to the surface of the ball, negative inside.
+fn ball_distance(center: [f64; 3], radius: f64, p: [f64; 3], dim: usize) -> f64 {
+    (0..dim)
+        .map(|a| (p[a] - center[a]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+        - radius
 }
 
 #[cfg(test)]
@@ -721,8 +769,9 @@ mod tests {
         // Two layers: everything but the inner 6 x 2.
         assert_eq!(b.points(0.01, 2, Some(2)).len(), 60 - 12);
         assert!((b.measure(2) - 0.006).abs() < 1e-15);
-        assert!((b.signed_distance([0.05, 0.03, 0.0], 2) + 0.03).abs() < 1e-15);
-        assert!((b.signed_distance([0.13, 0.1, 0.0], 2) - 0.05).abs() < 1e-15);
+        let Shape::Box(bx) = b else { unreachable!() };
+        assert!((box_distance(&bx, [0.05, 0.03, 0.0], 2) + 0.03).abs() < 1e-15);
+        assert!((box_distance(&bx, [0.13, 0.1, 0.0], 2) - 0.05).abs() < 1e-15);
     }
 
     #[test]
@@ -742,7 +791,7 @@ mod tests {
         // Outer ring half a spacing inside the surface.
         let outer = pts
             .iter()
-            .map(|p| c.signed_distance(*p, 2))
+            .map(|p| ball_distance([0.3, 0.4, 0.0], 0.055, *p, 2))
             .fold(f64::MIN, f64::max);
         assert!((outer + 0.5 * dx).abs() < 1e-12);
         // Mean is the centre.

@@ -361,7 +361,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         let body = || {
             case.bodies
                 .iter()
-                .position(|b| b.shape.signed_distance(p, dim) < 0.5 * dx * (1.0 - 1e-6))
+                .position(|b| b.shape.near(p, 0.5 * dx * (1.0 - 1e-6), dim))
         };
         match (obstacle, elastic_solid()) {
             (Some(i), _) => Some(("obstacle", i)),
@@ -549,19 +549,31 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             _ => spec.layers,
         };
         let points = spec.shape.points(dx, dim, layers);
-        if let (true, Shape::Ball { radius, .. }) = (points.is_empty(), spec.shape) {
-            // Particles sit half a spacing inside the surface: a smaller ball has none, and
-            // a body without particles would feel no fluid.
-            return Err(ctx.err(
-                &format!("body[{i}].radius_m"),
-                Some(num(radius)),
-                format!(
-                    "is less than half a particle spacing (dx / 2 = {} m): the body would have \
-                     no particles",
-                    num(0.5 * dx)
+        if points.is_empty() {
+            // Particles sit half a spacing inside the surface: a smaller ball has none, nor a
+            // mesh thinner than a spacing, and a body without particles would feel no fluid.
+            return Err(match &spec.shape {
+                Shape::Ball { radius, .. } => ctx.err(
+                    &format!("body[{i}].radius_m"),
+                    Some(num(*radius)),
+                    format!(
+                        "is less than half a particle spacing (dx / 2 = {} m): the body would \
+                         have no particles",
+                        num(0.5 * dx)
+                    ),
+                    "make the radius a few particle spacings, or decrease particles.dx_m",
                 ),
-                "make the radius a few particle spacings, or decrease particles.dx_m",
-            ));
+                _ => ctx.err(
+                    &format!("body[{i}].file"),
+                    None,
+                    format!(
+                        "the mesh holds no point of the particle lattice (spacing dx = {} m): \
+                         the body would have no particles",
+                        num(dx)
+                    ),
+                    "make the body a few particle spacings thick, or decrease particles.dx_m",
+                ),
+            });
         }
         for pos in points {
             let vel = match &spec.motion {
@@ -701,15 +713,7 @@ fn domain(
     }
     // Bodies, each at its start position (a free body's later path is the user's business).
     for (i, body) in case.bodies.iter().enumerate() {
-        let c = body.shape.center();
-        let reach = match body.shape {
-            Shape::Box(b) => [0, 1, 2].map(|a| 0.5 * (b.max[a] - b.min[a])),
-            Shape::Ball { radius, .. } => [radius; 3],
-        };
-        let mut b = Aabb {
-            min: [0, 1, 2].map(|a| if a < dim { c[a] - reach[a] } else { 0.0 }),
-            max: [0, 1, 2].map(|a| if a < dim { c[a] + reach[a] } else { 0.0 }),
-        };
+        let mut b = body.shape.bounds(dim);
         let mut path = format!("body[{i}]");
         if let Motion::Prescribed(_) = body.motion {
             b = swept(&b, &body.motion, case.time.end_s, dim);

@@ -14,6 +14,7 @@ mod friction;
 mod lattice;
 mod limits;
 mod locate;
+mod mesh;
 mod open_boundaries;
 mod overrides;
 mod probes;

@@ -202,6 +202,7 @@ pub(super) struct RawBody {
     pub max_m: Option<Vec<f64>>,
     pub center_m: Option<Vec<f64>>,
     pub radius_m: Option<f64>,
+    pub file: Option<String>,
     pub density_kg_m3: Option<f64>,
     pub mass_kg: Option<f64>,
     pub layers: Option<i64>,
@@ -216,6 +217,7 @@ pub(super) enum ShapeName {
     Box,
     Circle,
     Sphere,
+    Mesh,
 }
 
 /// How a body or the tank moves: `[body.motion]`, `[tank.motion]`.
@@ -753,7 +755,7 @@ pub(super) const FIELDS: &[FieldHelp] = &[
     ),
     f(
         "body[].shape",
-        "the body shape: box, circle (2D) or sphere (3D)",
+        "the body shape: box, circle (2D), sphere (3D) or mesh (3D, an STL file)",
         "shape = \"box\"",
     ),
     f(
@@ -775,6 +777,11 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "body[].radius_m",
         "the radius of a circle or sphere body in metres",
         "radius_m = 0.055",
+    ),
+    f(
+        "body[].file",
+        "the STL file of a mesh body, relative to the case file",
+        "file = \"hull.stl\"",
     ),
     f(
         "body[].density_kg_m3",

@@ -1086,6 +1086,7 @@ fn nothing_panics_on_hostile_values() {
     assert!(n > 100);
 }
 
+mod meshes;
 mod open_boundaries;
 mod solids;
 mod walls;

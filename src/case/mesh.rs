@@ -1,0 +1,946 @@
+//! Closed triangle meshes (STL files) as the shape of a 3D body: reading and checking the file,
+//! the solid's mass properties at uniform density, which points lie inside it and how far a
+//! point is from its surface.
+//!
+//! Inside means an odd number of surface crossings on the vertical line above the point (the
+//! even–odd rule, exact for a closed surface). The lines are cast through points shifted by a
+//! fixed tiny offset, so a line through a lattice point does not run exactly along an edge of a
+//! mesh drawn on round numbers. Triangles are bucketed by the columns of a grid in x–y, so a
+//! line or a small ball meets only the triangles of the columns it touches.
+
+use std::collections::HashMap;
+use std::io::Read;
+use std::path::Path;
+
+use super::validate::Aabb;
+
+/// The largest STL file read (about five million triangles in binary).
+const MAX_BYTES: u64 = 256 << 20;
+
+/// What is wrong with a mesh file; the messages name the file and say where.
+#[derive(Debug, thiserror::Error)]
+pub(super) enum MeshError {
+    #[error("cannot read {file}: {reason}")]
+    Read { file: String, reason: String },
+    #[error("{file} is not an STL file stl_io can read: {reason}")]
+    Format { file: String, reason: String },
+    #[error("{file} has no triangles")]
+    Empty { file: String },
+    #[error("{file} has a vertex with a coordinate that is not a finite number")]
+    NotFinite { file: String },
+    #[error(
+        "{file} is not closed: {count} edges belong to one triangle only, one from {from:?} to \
+         {to:?}; inside and outside are then undefined"
+    )]
+    Open {
+        file: String,
+        count: usize,
+        from: [f64; 3],
+        to: [f64; 3],
+    },
+    #[error(
+        "{file} is not a surface: {count} edges are shared by more than two triangles, one from \
+         {from:?} to {to:?}"
+    )]
+    NonManifold {
+        file: String,
+        count: usize,
+        from: [f64; 3],
+        to: [f64; 3],
+    },
+    #[error(
+        "{file}'s triangles are not oriented alike: the two triangles on the edge from {from:?} \
+         to {to:?} run along it in the same direction"
+    )]
+    Inconsistent {
+        file: String,
+        from: [f64; 3],
+        to: [f64; 3],
+    },
+    #[error("{file} encloses no volume ({volume:e} m³)")]
+    NoVolume { file: String, volume: f64 },
+}
+
+impl MeshError {
+    /// What the user can do about it.
+    pub(super) fn fix(&self) -> &'static str {
+        match self {
+            MeshError::Read { .. } => "give the path of an STL file relative to the case file",
+            MeshError::Format { .. } | MeshError::Empty { .. } | MeshError::NotFinite { .. } => {
+                "export the body as an ASCII or binary STL of its closed surface, in metres"
+            }
+            MeshError::Open { .. } | MeshError::NonManifold { .. } => {
+                "export one closed, watertight surface (repair it in the CAD tool or with a mesh \
+                 fixer such as MeshLab's 'close holes')"
+            }
+            MeshError::Inconsistent { .. } => {
+                "re-orient the faces consistently (MeshLab: 'Re-Orient all faces coherently')"
+            }
+            MeshError::NoVolume { .. } => "export the solid's surface, in metres",
+        }
+    }
+}
+
+/// A closed, consistently oriented triangle surface and the solid it bounds.
+#[derive(Clone, PartialEq)]
+pub(super) struct Mesh {
+    /// The triangles, counter-clockwise seen from outside.
+    tris: Vec<[[f64; 3]; 3]>,
+    bounds: Aabb,
+    volume: f64,
+    centroid: [f64; 3],
+    /// ∫ (r − c)(r − c)ᵀ dV over the solid, about its centroid c [m⁵].
+    second_moment: [[f64; 3]; 3],
+    columns: Columns,
+}
+
+impl std::fmt::Debug for Mesh {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "Mesh {{ {} triangles, {:?} .. {:?} }}",
+            self.tris.len(),
+            self.bounds.min,
+            self.bounds.max
+        )
+    }
+}
+
+/// Triangles by the grid columns (in x–y) their bounding boxes overlap.
+#[derive(Clone, PartialEq)]
+struct Columns {
+    origin: [f64; 2],
+    cell: f64,
+    n: [usize; 2],
+    /// Column k holds `tris[start[k]..start[k + 1]]`.
+    start: Vec<u32>,
+    tris: Vec<u32>,
+}
+
+impl Mesh {
+    /// Reads an ASCII or binary STL file and checks that it bounds a solid.
+    pub(super) fn read(path: &Path) -> Result<Mesh, MeshError> {
+        let file = path.display().to_string();
+        let read_err = |reason: String| MeshError::Read {
+            file: file.clone(),
+            reason,
+        };
+        let meta = std::fs::metadata(path).map_err(|e| read_err(e.to_string()))?;
+        if !meta.is_file() {
+            return Err(read_err("it is not a regular file".into()));
+        }
+        if meta.len() > MAX_BYTES {
+            return Err(read_err(format!(
+                "it has {} bytes, more than the {} MiB a mesh may have",
+                meta.len(),
+                MAX_BYTES >> 20
+            )));
+        }
+        let mut bytes = Vec::new();
+        std::fs::File::open(path)
+            .and_then(|f| f.take(MAX_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(|e| read_err(e.to_string()))?;
+        let stl =
+            stl_io::read_stl(&mut std::io::Cursor::new(bytes)).map_err(|e| MeshError::Format {
+                file: file.clone(),
+                reason: e.to_string(),
+            })?;
+        let vertices: Vec<[f64; 3]> = stl.vertices.iter().map(|v| v.0.map(f64::from)).collect();
+        let faces: Vec<[usize; 3]> = stl.faces.iter().map(|f| f.vertices).collect();
+        Mesh::new(&file, &vertices, &faces)
+    }
+
+    /// The mesh of indexed triangles; `file` names it in errors.
+    pub(super) fn new(
+        file: &str,
+        vertices: &[[f64; 3]],
+        faces: &[[usize; 3]],
+    ) -> Result<Mesh, MeshError> {
+        if faces.is_empty() {
+            return Err(MeshError::Empty { file: file.into() });
+        }
+        if vertices.iter().flatten().any(|c| !c.is_finite()) {
+            return Err(MeshError::NotFinite { file: file.into() });
+        }
+        check_closed(file, vertices, faces)?;
+        // Zero-area triangles bound nothing (their edges are their neighbours' too).
+        let mut tris: Vec<[[f64; 3]; 3]> = faces
+            .iter()
+            .map(|f| f.map(|v| vertices[v]))
+            .filter(|[a, b, c]| cross(sub(*b, *a), sub(*c, *a)) != [0.0; 3])
+            .collect();
+        let mut bounds = Aabb {
+            min: [f64::MAX; 3],
+            max: [f64::MIN; 3],
+        };
+        for p in vertices {
+            for (a, &x) in p.iter().enumerate() {
+                bounds.min[a] = bounds.min[a].min(x);
+                bounds.max[a] = bounds.max[a].max(x);
+            }
+        }
+        let (mut volume, centroid, mut second_moment) = mass_properties(&tris, &bounds);
+        if !(volume.abs() > 0.0 && volume.is_finite()) {
+            return Err(MeshError::NoVolume {
+                file: file.into(),
+                volume,
+            });
+        }
+        if volume < 0.0 {
+            // Inward normals: the same solid, read the other way round.
+            for t in &mut tris {
+                t.swap(1, 2);
+            }
+            volume = -volume;
+            for row in &mut second_moment {
+                for x in row {
+                    *x = -*x;
+                }
+            }
+        }
+        let columns = Columns::new(&tris, &bounds);
+        Ok(Mesh {
+            tris,
+            bounds,
+            volume,
+            centroid,
+            second_moment,
+            columns,
+        })
+    }
+
+    pub(super) fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    pub(super) fn volume(&self) -> f64 {
+        self.volume
+    }
+
+    pub(super) fn centroid(&self) -> [f64; 3] {
+        self.centroid
+    }
+
+    /// Inertia tensor about the centroid of the solid of uniform density and `mass`:
+    /// I = (mass / V) (tr S 1 − S) with S the second moment.
+    pub(super) fn inertia(&self, mass: f64) -> [[f64; 3]; 3] {
+        let s = &self.second_moment;
+        let trace = s[0][0] + s[1][1] + s[2][2];
+        let k = mass / self.volume;
+        let mut i = [[0.0; 3]; 3];
+        for (a, row) in i.iter_mut().enumerate() {
+            for (b, x) in row.iter_mut().enumerate() {
+                *x = k * (if a == b { trace } else { 0.0 } - s[a][b]);
+            }
+        }
+        i
+    }
+
+    /// The heights at which the vertical line through (x, y) crosses the surface, ascending.
+    fn crossings(&self, x: f64, y: f64) -> Vec<f64> {
+        let (x, y) = self.shifted(x, y);
+        let mut z = Vec::new();
+        let Some(k) = self.columns.column(x, y) else {
+            return z;
+        };
+        for &t in self.columns.of(k) {
+            let [a, b, c] = self.tris[t as usize];
+            // Twice the signed areas of the sub-triangles opposite each vertex, in x–y.
+            let w = [orient(b, c, x, y), orient(c, a, x, y), orient(a, b, x, y)];
+            let area = w[0] + w[1] + w[2];
+            let inside = if area > 0.0 {
+                w.iter().all(|&v| v > 0.0)
+            } else if area < 0.0 {
+                w.iter().all(|&v| v < 0.0)
+            } else {
+                // Seen edge-on from above: the line does not cross it.
+                false
+            };
+            if inside {
+                z.push((w[0] * a[2] + w[1] * b[2] + w[2] * c[2]) / area);
+            }
+        }
+        z.sort_by(f64::total_cmp);
+        z
+    }
+
+    /// Whether `p` is inside the solid.
+    pub(super) fn contains(&self, p: [f64; 3]) -> bool {
+        odd_above(p[2], &self.crossings(p[0], p[1]))
+    }
+
+    /// The line casts go through (x, y) moved by a fixed offset far below a lattice spacing
+    /// (a few 1e-9 of the mesh's size), off the mesh's own round numbers.
+    fn shifted(&self, x: f64, y: f64) -> (f64, f64) {
+        let size = (0..3)
+            .map(|a| self.bounds.max[a] - self.bounds.min[a])
+            .fold(0.0, f64::max);
+        (x + 2.718_281_8e-9 * size, y + 1.414_213_5e-9 * size)
+    }
+
+    /// The distance from `p` to the surface if it is less than `reach`.
+    pub(super) fn distance_within(&self, p: [f64; 3], reach: f64) -> Option<f64> {
+        let mut best = reach;
+        let mut found = false;
+        for k in self.columns.around(p[0], p[1], reach) {
+            for &t in self.columns.of(k) {
+                let tri = &self.tris[t as usize];
+                // A column holds its triangles at every height: those farther than the best
+                // so far along any axis are passed over without the full test.
+                let apart = (0..3).any(|a| {
+                    let (lo, hi) = (
+                        tri.iter().map(|q| q[a]).fold(f64::MAX, f64::min),
+                        tri.iter().map(|q| q[a]).fold(f64::MIN, f64::max),
+                    );
+                    p[a] < lo - best || p[a] > hi + best
+                });
+                if apart {
+                    continue;
+                }
+                let d = distance_to_triangle(p, tri);
+                if d < best {
+                    best = d;
+                    found = true;
+                }
+            }
+        }
+        found.then_some(best)
+    }
+
+    /// The lattice points of the solid: a cell-centred lattice of spacing `dx` centred on the
+    /// bounding box (whose cells cover it), keeping the points inside the surface and, with
+    /// `depth`, less than `depth` from it. A cuboid whose sides are whole multiples of `dx`
+    /// gets a box body's lattice.
+    pub(super) fn points(&self, dx: f64, depth: Option<f64>) -> Vec<[f64; 3]> {
+        let (n, origin) = self.lattice(dx);
+        let at = |a: usize, i: usize| origin[a] + (i as f64 + 0.5) * dx;
+        let near = depth.map(|d| self.near_lattice(n, origin, dx, d));
+        let mut out = Vec::new();
+        for i in 0..n[0] {
+            for j in 0..n[1] {
+                let (x, y) = (at(0, i), at(1, j));
+                let crossings = self.crossings(x, y);
+                if crossings.is_empty() {
+                    continue;
+                }
+                for k in 0..n[2] {
+                    let p = [x, y, at(2, k)];
+                    let close = near
+                        .as_ref()
+                        .is_none_or(|near| near[i + n[0] * (j + n[1] * k)]);
+                    if close && odd_above(p[2], &crossings) {
+                        out.push(p);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Which points of the lattice (`n` cells from `origin`, spacing `dx`) are less than
+    /// `reach` from the surface: each triangle marks the points of its bounding box grown by
+    /// `reach`, so the work goes with the surface, not with the solid's volume.
+    fn near_lattice(&self, n: [usize; 3], origin: [f64; 3], dx: f64, reach: f64) -> Vec<bool> {
+        let mut near = vec![false; n[0] * n[1] * n[2]];
+        let at = |a: usize, i: usize| origin[a] + (i as f64 + 0.5) * dx;
+        for tri in &self.tris {
+            let range = [0, 1, 2].map(|a| {
+                let lo = tri.iter().map(|q| q[a]).fold(f64::MAX, f64::min) - reach;
+                let hi = tri.iter().map(|q| q[a]).fold(f64::MIN, f64::max) + reach;
+                let first = ((lo - origin[a]) / dx - 0.5).ceil().max(0.0) as usize;
+                let last = ((hi - origin[a]) / dx - 0.5).floor().min(n[a] as f64 - 1.0);
+                (first, last)
+            });
+            if range.iter().any(|&(first, last)| last < first as f64) {
+                continue;
+            }
+            for k in range[2].0..=range[2].1 as usize {
+                for j in range[1].0..=range[1].1 as usize {
+                    for i in range[0].0..=range[0].1 as usize {
+                        let idx = i + n[0] * (j + n[1] * k);
+                        if !near[idx]
+                            && distance_to_triangle([at(0, i), at(1, j), at(2, k)], tri) < reach
+                        {
+                            near[idx] = true;
+                        }
+                    }
+                }
+            }
+        }
+        near
+    }
+
+    /// Cells of size `dx` along each axis that cover the bounding box (a whole multiple of
+    /// `dx` to rounding is covered exactly), and the corner of the first.
+    pub(super) fn lattice(&self, dx: f64) -> ([usize; 3], [f64; 3]) {
+        let b = &self.bounds;
+        let n = [0, 1, 2].map(|a| ((b.max[a] - b.min[a]) / dx - 1e-9).ceil().max(1.0) as usize);
+        let origin = [0, 1, 2].map(|a| 0.5 * (b.min[a] + b.max[a]) - 0.5 * n[a] as f64 * dx);
+        (n, origin)
+    }
+}
+
+/// Whether an odd number of the ascending `crossings` lie above `z`: inside, by the even–odd
+/// rule.
+fn odd_above(z: f64, crossings: &[f64]) -> bool {
+    (crossings.len() - crossings.partition_point(|&c| c <= z)) % 2 == 1
+}
+
+/// Every edge must be shared by exactly two triangles that run along it in opposite
+/// directions: then the surface is closed and its orientation is consistent.
+fn check_closed(file: &str, v: &[[f64; 3]], faces: &[[usize; 3]]) -> Result<(), MeshError> {
+    // Directed edges (from, to) and how often each occurs, in the order first seen.
+    let mut count: HashMap<(usize, usize), u32> = HashMap::new();
+    let mut order = Vec::new();
+    for f in faces {
+        for e in 0..3 {
+            let (a, b) = (f[e], f[(e + 1) % 3]);
+            if a == b {
+                // A collapsed edge of a degenerate triangle bounds nothing.
+                continue;
+            }
+            let c = count.entry((a, b)).or_insert(0);
+            if *c == 0 {
+                order.push((a, b));
+            }
+            *c += 1;
+        }
+    }
+    let uses = |a: usize, b: usize| count.get(&(a, b)).copied().unwrap_or(0);
+    let (mut open, mut crowded, mut same_way) = (Vec::new(), Vec::new(), None);
+    for &(a, b) in &order {
+        let (along, back) = (uses(a, b), uses(b, a));
+        match along + back {
+            1 => open.push((a, b)),
+            2 if back == 0 => same_way = same_way.or(Some((a, b))),
+            2 => {}
+            // Each undirected edge once, from its first-seen direction.
+            _ if back == 0 || (a, b) < (b, a) => crowded.push((a, b)),
+            _ => {}
+        }
+    }
+    if let Some(&(a, b)) = open.first() {
+        return Err(MeshError::Open {
+            file: file.into(),
+            count: open.len(),
+            from: v[a],
+            to: v[b],
+        });
+    }
+    if let Some(&(a, b)) = crowded.first() {
+        return Err(MeshError::NonManifold {
+            file: file.into(),
+            count: crowded.len(),
+            from: v[a],
+            to: v[b],
+        });
+    }
+    if let Some((a, b)) = same_way {
+        return Err(MeshError::Inconsistent {
+            file: file.into(),
+            from: v[a],
+            to: v[b],
+        });
+    }
+    Ok(())
+}
+
+/// Signed volume, centroid and second moment about the centroid of the solid bounded by
+/// `tris`, summed over the tetrahedra each triangle spans with a reference point (the centre of
+/// the bounds, which keeps the terms small). For the tetrahedron (0, a, b, c) with
+/// D = a·(b × c): V = D/6, ∫r dV = D/24 (a + b + c), and
+/// ∫r rᵀ dV = D/120 (a aᵀ + b bᵀ + c cᵀ + s sᵀ), s = a + b + c.
+fn mass_properties(tris: &[[[f64; 3]; 3]], bounds: &Aabb) -> (f64, [f64; 3], [[f64; 3]; 3]) {
+    let o = [0, 1, 2].map(|a| 0.5 * (bounds.min[a] + bounds.max[a]));
+    let (mut vol, mut first, mut second) = (0.0, [0.0; 3], [[0.0; 3]; 3]);
+    for t in tris {
+        let [a, b, c] = t.map(|p| [0, 1, 2].map(|k| p[k] - o[k]));
+        let d = dot(a, cross(b, c));
+        let s = [0, 1, 2].map(|k| a[k] + b[k] + c[k]);
+        vol += d / 6.0;
+        for k in 0..3 {
+            first[k] += d / 24.0 * s[k];
+        }
+        for (i, row) in second.iter_mut().enumerate() {
+            for (j, x) in row.iter_mut().enumerate() {
+                *x += d / 120.0 * (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + s[i] * s[j]);
+            }
+        }
+    }
+    // Centroid relative to o, then the parallel-axis shift of the second moment to it.
+    let rel = first.map(|x| x / vol);
+    let centroid = [0, 1, 2].map(|k| o[k] + rel[k]);
+    for (i, row) in second.iter_mut().enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            *x -= vol * rel[i] * rel[j];
+        }
+    }
+    (vol, centroid, second)
+}
+
+impl Columns {
+    /// A grid of about as many columns as triangles (at most 512 a side) over the bounds.
+    fn new(tris: &[[[f64; 3]; 3]], bounds: &Aabb) -> Columns {
+        let extent = [0, 1].map(|a| (bounds.max[a] - bounds.min[a]).max(f64::MIN_POSITIVE));
+        let side = (tris.len() as f64).sqrt().ceil().clamp(1.0, 512.0);
+        let cell = extent[0].max(extent[1]) / side;
+        let n = extent.map(|e| ((e / cell).ceil() as usize).clamp(1, 512));
+        let mut columns = Columns {
+            origin: [bounds.min[0], bounds.min[1]],
+            cell,
+            n,
+            start: Vec::new(),
+            tris: Vec::new(),
+        };
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); n[0] * n[1]];
+        for (t, tri) in tris.iter().enumerate() {
+            let lo = [0, 1].map(|a| tri.iter().map(|p| p[a]).fold(f64::MAX, f64::min));
+            let hi = [0, 1].map(|a| tri.iter().map(|p| p[a]).fold(f64::MIN, f64::max));
+            let (i0, j0) = columns.index(lo[0], lo[1]);
+            let (i1, j1) = columns.index(hi[0], hi[1]);
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    lists[i + n[0] * j].push(t as u32);
+                }
+            }
+        }
+        columns.start.push(0);
+        for l in lists {
+            columns.tris.extend(l);
+            columns.start.push(columns.tris.len() as u32);
+        }
+        columns
+    }
+
+    /// The column holding (x, y), clamped to the grid.
+    fn index(&self, x: f64, y: f64) -> (usize, usize) {
+        let at = |v: f64, a: usize| {
+            (((v - self.origin[a]) / self.cell).floor().max(0.0) as usize).min(self.n[a] - 1)
+        };
+        (at(x, 0), at(y, 1))
+    }
+
+    /// The column of (x, y) if it lies over the grid (a line elsewhere meets no triangle).
+    fn column(&self, x: f64, y: f64) -> Option<usize> {
+        let (fx, fy) = (
+            (x - self.origin[0]) / self.cell,
+            (y - self.origin[1]) / self.cell,
+        );
+        let over = |f: f64, a: usize| (0.0..=self.n[a] as f64).contains(&f);
+        if !(over(fx, 0) && over(fy, 1)) {
+            return None;
+        }
+        let (i, j) = self.index(x, y);
+        Some(i + self.n[0] * j)
+    }
+
+    /// The columns that the disc of radius `r` about (x, y) touches.
+    fn around(&self, x: f64, y: f64, r: f64) -> impl Iterator<Item = usize> + '_ {
+        let (i0, j0) = self.index(x - r, y - r);
+        let (i1, j1) = self.index(x + r, y + r);
+        (j0..=j1).flat_map(move |j| (i0..=i1).map(move |i| i + self.n[0] * j))
+    }
+
+    fn of(&self, k: usize) -> &[u32] {
+        &self.tris[self.start[k] as usize..self.start[k + 1] as usize]
+    }
+}
+
+/// Twice the signed area of the triangle (a, b, (x, y)) in x–y: positive when counter-clockwise.
+fn orient(a: [f64; 3], b: [f64; 3], x: f64, y: f64) -> f64 {
+    (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// Distance from `p` to the closest point of the triangle (Ericson, Real-Time Collision
+/// Detection, 2005, §5.1.5: the Voronoi region of `p` among the vertices, edges and face).
+fn distance_to_triangle(p: [f64; 3], [a, b, c]: &[[f64; 3]; 3]) -> f64 {
+    let (ab, ac, ap) = (sub(*b, *a), sub(*c, *a), sub(p, *a));
+    let at = |s: f64, t: f64| {
+        let q = [0, 1, 2].map(|k| a[k] + s * ab[k] + t * ac[k]);
+        let d = sub(p, q);
+        dot(d, d).sqrt()
+    };
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return at(0.0, 0.0);
+    }
+    let bp = sub(p, *b);
+    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return at(1.0, 0.0);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return at(d1 / (d1 - d3), 0.0);
+    }
+    let cp = sub(p, *c);
+    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return at(0.0, 1.0);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return at(0.0, d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return at(1.0 - w, w);
+    }
+    let denom = va + vb + vc;
+    at(vb / denom, vc / denom)
+}
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+
+    /// The box [lo, hi] as 8 vertices and 12 outward triangles.
+    pub(in crate::case) fn cuboid(lo: [f64; 3], hi: [f64; 3]) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+        let v = (0..8)
+            .map(|i| [0, 1, 2].map(|a| if i >> a & 1 == 1 { hi[a] } else { lo[a] }))
+            .collect();
+        let f = vec![
+            [0, 2, 3],
+            [0, 3, 1],
+            [4, 5, 7],
+            [4, 7, 6],
+            [0, 1, 5],
+            [0, 5, 4],
+            [2, 6, 7],
+            [2, 7, 3],
+            [0, 4, 6],
+            [0, 6, 2],
+            [1, 3, 7],
+            [1, 7, 5],
+        ];
+        (v, f)
+    }
+
+    /// A latitude–longitude sphere of `rings` bands and `sectors` sectors.
+    fn globe(
+        c: [f64; 3],
+        r: f64,
+        rings: usize,
+        sectors: usize,
+    ) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+        use std::f64::consts::PI;
+        let mut v = vec![[c[0], c[1], c[2] + r]];
+        for k in 1..rings {
+            let th = PI * k as f64 / rings as f64;
+            for j in 0..sectors {
+                let ph = 2.0 * PI * j as f64 / sectors as f64;
+                v.push([
+                    c[0] + r * th.sin() * ph.cos(),
+                    c[1] + r * th.sin() * ph.sin(),
+                    c[2] + r * th.cos(),
+                ]);
+            }
+        }
+        v.push([c[0], c[1], c[2] - r]);
+        let south = v.len() - 1;
+        let at = |k: usize, j: usize| 1 + (k - 1) * sectors + j % sectors;
+        let mut f = Vec::new();
+        for j in 0..sectors {
+            f.push([0, at(1, j), at(1, j + 1)]);
+            for k in 1..rings - 1 {
+                let (a, b, c, d) = (at(k, j), at(k, j + 1), at(k + 1, j), at(k + 1, j + 1));
+                f.push([a, c, d]);
+                f.push([a, d, b]);
+            }
+            f.push([south, at(rings - 1, j + 1), at(rings - 1, j)]);
+        }
+        (v, f)
+    }
+
+    fn mesh(vf: (Vec<[f64; 3]>, Vec<[usize; 3]>)) -> Mesh {
+        Mesh::new("test.stl", &vf.0, &vf.1).unwrap()
+    }
+
+    fn close(a: f64, b: f64, tol: f64) -> bool {
+        (a - b).abs() <= tol * b.abs().max(1e-300)
+    }
+
+    #[test]
+    fn a_cuboid_has_the_mass_properties_of_a_box() {
+        let (lo, hi) = ([0.1, -0.2, 0.3], [0.5, 0.1, 0.45]);
+        let m = mesh(cuboid(lo, hi));
+        let s = [0, 1, 2].map(|a| hi[a] - lo[a]);
+        assert!(close(m.volume(), s[0] * s[1] * s[2], 1e-12));
+        for a in 0..3 {
+            assert!(close(m.centroid()[a], 0.5 * (lo[a] + hi[a]), 1e-12));
+        }
+        let i = m.inertia(3.0);
+        let sq = s.map(|x| x * x);
+        let expect = [sq[1] + sq[2], sq[0] + sq[2], sq[0] + sq[1]].map(|x| 3.0 * x / 12.0);
+        for a in 0..3 {
+            assert!(close(i[a][a], expect[a], 1e-12), "{i:?}");
+            for b in 0..3 {
+                assert!(a == b || i[a][b].abs() < 1e-14, "{i:?}");
+            }
+        }
+    }
+
+    /// The corner tetrahedron of the unit cube, scaled by L and moved: V = L³/6, centroid at
+    /// L/4 from the corner, and by direct integration ∫x'² dV = L⁵/160, ∫x'y' dV = −L⁵/480
+    /// about the centroid, so I_xx = (m/V)(2 L⁵/160) and I_xy = (m/V) L⁵/480. Its centroid is not the centre of its bounds, which the mass
+    /// properties are summed about.
+    #[test]
+    fn a_tetrahedron_has_its_textbook_mass_properties() {
+        let (l, o) = (0.3, [1.0, -2.0, 0.5]);
+        let v: Vec<[f64; 3]> = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+            .iter()
+            .map(|p| [0, 1, 2].map(|a| o[a] + l * p[a]))
+            .collect();
+        let m = mesh((v, vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]));
+        let vol = l * l * l / 6.0;
+        assert!(close(m.volume(), vol, 1e-13));
+        for (got, o) in m.centroid().iter().zip(o) {
+            assert!(close(*got, o + 0.25 * l, 1e-13));
+        }
+        let (mass, l5) = (2.0, l.powi(5));
+        for (a, row) in m.inertia(mass).iter().enumerate() {
+            for (b, got) in row.iter().enumerate() {
+                let want = mass / vol * if a == b { 2.0 * l5 / 160.0 } else { l5 / 480.0 };
+                assert!(close(*got, want, 1e-12), "{a}{b}: {got} vs {want}");
+            }
+        }
+    }
+
+    /// Turned by R, the inertia tensor is R I Rᵀ, off-diagonal terms included.
+    #[test]
+    fn a_turned_cuboid_has_the_turned_inertia() {
+        let (v, f) = cuboid([-0.2, -0.1, -0.05], [0.2, 0.1, 0.05]);
+        let (a, b) = (0.4f64, -0.7f64);
+        // R = Rz(a) Rx(b).
+        let r = [
+            [a.cos(), -a.sin() * b.cos(), a.sin() * b.sin()],
+            [a.sin(), a.cos() * b.cos(), -a.cos() * b.sin()],
+            [0.0, b.sin(), b.cos()],
+        ];
+        let turn =
+            |p: [f64; 3]| [0, 1, 2].map(|i| (0..3).map(|k| r[i][k] * p[k]).sum::<f64>() + 1.0);
+        let m = mesh((v.iter().map(|&p| turn(p)).collect(), f));
+        let i0 = [0.04 + 0.01, 0.16 + 0.01, 0.16 + 0.04].map(|x| 2.0 * x / 12.0);
+        for p in 0..3 {
+            assert!(close(m.centroid()[p], 1.0, 1e-12));
+            for q in 0..3 {
+                let want: f64 = (0..3).map(|k| r[p][k] * i0[k] * r[q][k]).sum();
+                assert!((m.inertia(2.0)[p][q] - want).abs() < 1e-14, "{p}{q}");
+            }
+        }
+        assert!(
+            m.inertia(2.0)[0][1].abs() > 1e-4,
+            "the test turns the box off the axes"
+        );
+    }
+
+    /// Faces listed inward give the same solid.
+    #[test]
+    fn inward_faces_give_the_same_solid() {
+        let (v, f) = cuboid([0.0; 3], [0.3, 0.2, 0.1]);
+        let flipped: Vec<[usize; 3]> = f.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        let (out, inw) = (mesh((v.clone(), f)), mesh((v, flipped)));
+        assert!(close(inw.volume(), out.volume(), 1e-14));
+        assert_eq!(inw.inertia(1.0), out.inertia(1.0));
+        assert_eq!(inw.points(0.05, Some(0.05)), out.points(0.05, Some(0.05)));
+    }
+
+    /// The cuboid's lattice is a box body's: cell-centred, as many cells as fit.
+    #[test]
+    fn a_cuboid_is_filled_like_a_box() {
+        let m = mesh(cuboid([0.0, 0.0, 0.0], [0.1, 0.06, 0.04]));
+        let all = m.points(0.01, None);
+        assert_eq!(all.len(), 10 * 6 * 4);
+        assert_eq!(all[0], [0.005, 0.005, 0.005]);
+        // Two layers: everything but the inner 6 x 2 x 0.
+        assert_eq!(m.points(0.01, Some(0.02)).len(), 240);
+        // One layer: everything but the inner 8 x 4 x 2.
+        assert_eq!(m.points(0.01, Some(0.01)).len(), 240 - 64);
+    }
+
+    /// A faceted sphere: its volume is the polyhedron's (computed here from its facets
+    /// independently: the sum of the pyramids from the centre), points well inside and well
+    /// outside are classified as the sphere's, and its lattice fills the volume.
+    #[test]
+    fn a_faceted_sphere() {
+        let (c, r) = ([0.3, -0.1, 0.2], 0.1);
+        let (v, f) = globe(c, r, 24, 48);
+        let m = mesh((v.clone(), f.clone()));
+        let pyramids: f64 = f
+            .iter()
+            .map(|t| {
+                let [a, b, d] = t.map(|k| sub(v[k], c));
+                dot(a, cross(b, d)) / 6.0
+            })
+            .sum();
+        assert!(close(m.volume(), pyramids.abs(), 1e-12));
+        assert!(close(
+            m.volume(),
+            4.0 / 3.0 * std::f64::consts::PI * r * r * r,
+            0.01
+        ));
+        for (got, c) in m.centroid().iter().zip(c) {
+            assert!((got - c).abs() < 1e-12);
+        }
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..2000 {
+            let p = [0, 1, 2].map(|a| c[a] + 0.25 * (2.0 * next() - 1.0));
+            let d = (0..3).map(|a| (p[a] - c[a]).powi(2)).sum::<f64>().sqrt();
+            // The facets lie within r (1 − cos(π/24)) < 0.01 r of the sphere.
+            if (d - r).abs() > 0.01 * r {
+                assert_eq!(m.contains(p), d < r, "{p:?} at {d} from the centre");
+            }
+        }
+        let dx = 0.01;
+        let n = m.points(dx, None).len() as f64;
+        assert!(close(n * dx * dx * dx, m.volume(), 0.05), "{n}");
+        let shell = m.points(dx, Some(2.0 * dx));
+        assert!(shell.len() < n as usize && !shell.is_empty());
+        for p in shell {
+            let d = (0..3).map(|a| (p[a] - c[a]).powi(2)).sum::<f64>().sqrt();
+            assert!(d > r - 2.0 * dx - 0.01 * r && d < r, "{p:?}");
+        }
+    }
+
+    /// The distance to a triangle against an independent form: the distance to the plane
+    /// where the foot of the perpendicular lies inside, else to the nearest edge.
+    #[test]
+    fn distance_to_triangles() {
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            2.0 * ((rng >> 11) as f64 / (1u64 << 53) as f64) - 1.0
+        };
+        for _ in 0..20000 {
+            let t = [
+                [next(), next(), next()],
+                [next(), next(), next()],
+                [next(), next(), next()],
+            ];
+            let p = [next(), next(), next()].map(|x| 2.0 * x);
+            let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+            let nn = dot(n, n);
+            let h = dot(sub(p, t[0]), n) / nn;
+            let foot = [0, 1, 2].map(|k| p[k] - h * n[k]);
+            let inside = (0..3).all(|e| {
+                let (u, v) = (t[e], t[(e + 1) % 3]);
+                dot(cross(sub(v, u), sub(foot, u)), n) >= 0.0
+            });
+            let want = if inside {
+                h.abs() * nn.sqrt()
+            } else {
+                (0..3)
+                    .map(|e| {
+                        let (u, v) = (t[e], t[(e + 1) % 3]);
+                        let (uv, up) = (sub(v, u), sub(p, u));
+                        let s = (dot(up, uv) / dot(uv, uv)).clamp(0.0, 1.0);
+                        let d = sub(up, uv.map(|x| s * x));
+                        dot(d, d).sqrt()
+                    })
+                    .fold(f64::MAX, f64::min)
+            };
+            let got = distance_to_triangle(p, &t);
+            assert!((got - want).abs() < 1e-9 * (1.0 + want), "{got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn broken_meshes_are_refused_with_the_reason() {
+        let (v, f) = cuboid([0.0; 3], [1.0; 3]);
+        let err = |v: &[[f64; 3]], f: &[[usize; 3]]| Mesh::new("hull.stl", v, f).unwrap_err();
+        let e = err(&v, &f[1..]);
+        assert!(matches!(e, MeshError::Open { count: 3, .. }), "{e}");
+        assert!(
+            e.to_string().contains("hull.stl is not closed: 3 edges"),
+            "{e}"
+        );
+        let mut flipped = f.clone();
+        flipped[4] = [f[4][0], f[4][2], f[4][1]];
+        assert!(matches!(err(&v, &flipped), MeshError::Inconsistent { .. }));
+        let mut doubled = f.clone();
+        doubled.push(f[0]);
+        doubled.push([f[0][0], f[0][2], f[0][1]]);
+        assert!(matches!(
+            err(&v, &doubled),
+            MeshError::NonManifold { count: 3, .. }
+        ));
+        assert!(matches!(err(&v, &[]), MeshError::Empty { .. }));
+        let mut nan = v.clone();
+        nan[3][1] = f64::NAN;
+        assert!(matches!(err(&nan, &f), MeshError::NotFinite { .. }));
+        // Two faces back to back: closed, oriented, and flat.
+        let flat = [[0, 1, 3], [0, 3, 1]];
+        assert!(matches!(err(&v, &flat), MeshError::NoVolume { .. }));
+        for e in [err(&v, &f[1..]), err(&v, &flat)] {
+            assert!(!e.fix().is_empty());
+        }
+    }
+
+    /// Binary and ASCII STL files read back as the mesh written.
+    #[test]
+    fn stl_files_of_both_encodings_read_back() {
+        let (v, f) = globe([0.0; 3], 0.5, 6, 8);
+        let tris: Vec<stl_io::Triangle> = f
+            .iter()
+            .map(|t| {
+                let p = t.map(|k| v[k]);
+                let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+                stl_io::Triangle {
+                    normal: stl_io::Vector::new(n.map(|x| x as f32)),
+                    vertices: p.map(|q| stl_io::Vector::new(q.map(|x| x as f32))),
+                }
+            })
+            .collect();
+        let dir = std::env::temp_dir().join(format!("wgsph_mesh_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let binary = dir.join("globe.stl");
+        let mut out = std::fs::File::create(&binary).unwrap();
+        stl_io::write_stl(&mut out, tris.iter()).unwrap();
+        drop(out);
+        let mut ascii = String::from("solid globe\n");
+        for t in &tris {
+            ascii += "facet normal 0 0 0\nouter loop\n";
+            for q in &t.vertices {
+                ascii += &format!("vertex {:e} {:e} {:e}\n", q[0], q[1], q[2]);
+            }
+            ascii += "endloop\nendfacet\n";
+        }
+        ascii += "endsolid globe\n";
+        let text = dir.join("globe_ascii.stl");
+        std::fs::write(&text, ascii).unwrap();
+        let a = Mesh::read(&binary).unwrap();
+        let b = Mesh::read(&text).unwrap();
+        std::fs::remove_dir_all(&dir).ok();
+        // The f32 coordinates of the file against the f64 mesh.
+        let exact = mesh((v, f));
+        assert!(close(a.volume(), exact.volume(), 1e-6));
+        assert_eq!(a, b);
+        let missing = Mesh::read(&dir.join("none.stl")).unwrap_err();
+        assert!(matches!(missing, MeshError::Read { .. }), "{missing}");
+    }
+}

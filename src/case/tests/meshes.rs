@@ -1,0 +1,236 @@
+//! `shape = "mesh"` bodies: an STL file read relative to the case file, its lattice and mass
+//! properties, and the loader's errors.
+
+use super::*;
+use crate::case::mesh::tests::cuboid;
+use std::path::{Path, PathBuf};
+
+/// A 3D tank half full, with one body described by `body` (a `[[body]]` table's lines).
+fn case(body: &str) -> String {
+    format!(
+        r#"dimension = 3
+[particles]
+dx_m = 0.0625
+[physics]
+gravity_m_s2 = [0.0, 0.0, -9.81]
+sound_speed_coef = 10.0
+[time]
+end_s = 0.1
+output_every_s = 0.05
+[tank]
+min_m = [0.0, 0.0, 0.0]
+max_m = [1.0, 1.0, 1.0]
+[[fluid_block]]
+min_m = [0.0, 0.0, 0.0]
+max_m = [1.0, 1.0, 0.5]
+[[body]]
+name = "hull"
+density_kg_m3 = 500.0
+{body}
+"#
+    )
+}
+
+/// A fresh folder for one test's files.
+fn folder(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("wgsph_mesh_{test}_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Writes the triangles as a binary STL (f32 coordinates).
+fn write_stl(path: &Path, (v, f): &(Vec<[f64; 3]>, Vec<[usize; 3]>)) {
+    let tris: Vec<stl_io::Triangle> = f
+        .iter()
+        .map(|t| stl_io::Triangle {
+            normal: stl_io::Vector::new([0.0; 3]),
+            vertices: t.map(|k| stl_io::Vector::new(v[k].map(|x| x as f32))),
+        })
+        .collect();
+    let mut out = std::fs::File::create(path).unwrap();
+    stl_io::write_stl(&mut out, tris.iter()).unwrap();
+}
+
+/// The case text `text` loaded as `dir/c.toml`, so that files are found beside it.
+fn load_in(dir: &Path, text: &str) -> Result<Scenario, CaseError> {
+    load_str(text, dir.join("c.toml").to_str().unwrap(), &[])
+}
+
+/// A cuboid drawn as an STL (on coordinates that f32 holds exactly) is the same body as the
+/// box of those corners: the same particles, fluid and domain, the same mass and centre, and
+/// the inertia to rounding. Filled and as a shell of fixed ghosts.
+#[test]
+fn a_cuboid_mesh_is_the_box_body() {
+    let dir = folder("cuboid");
+    let (lo, hi) = ([0.375, 0.3125, 0.375], [0.625, 0.6875, 0.75]);
+    write_stl(&dir.join("hull.stl"), &cuboid(lo, hi));
+    for extra in ["", "layers = 2\nwall = \"fixed_ghost\""] {
+        let mesh = load_in(
+            &dir,
+            &case(&format!("shape = \"mesh\"\nfile = \"hull.stl\"\n{extra}")),
+        )
+        .unwrap();
+        let bx = load_in(
+            &dir,
+            &case(&format!(
+                "shape = \"box\"\nmin_m = {lo:?}\nmax_m = {hi:?}\n{extra}"
+            )),
+        )
+        .unwrap();
+        check_invariants(&mesh);
+        assert_eq!(mesh.particles.len(), bx.particles.len(), "{extra}");
+        for (p, q) in mesh.particles.iter().zip(&bx.particles) {
+            assert_eq!((p.pos, p.vel, p.rho, p.kind), (q.pos, q.vel, q.rho, q.kind));
+        }
+        assert_eq!(mesh.domain, bx.domain);
+        let (m, b) = (&mesh.bodies[0], &bx.bodies[0]);
+        assert_eq!(m.particles, b.particles);
+        assert!((m.mass - b.mass).abs() < 1e-12 * b.mass);
+        assert_eq!(m.center, b.center);
+        for a in 0..3 {
+            for c in 0..3 {
+                assert!(
+                    (m.inertia[a][c] - b.inertia[a][c]).abs() < 1e-12 * b.inertia[0][0],
+                    "{:?} vs {:?}",
+                    m.inertia,
+                    b.inertia
+                );
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A turned cuboid: mass from the mesh's volume, a full inertia tensor, every body particle
+/// inside the surface, and no fluid left within dx/2 of it.
+#[test]
+fn a_turned_mesh_body_takes_its_mass_properties_from_its_surface() {
+    let dir = folder("turned");
+    let (v, f) = cuboid([-0.15, -0.1, -0.1], [0.15, 0.1, 0.1]);
+    let a = 0.5f64;
+    let turn = |p: [f64; 3]| {
+        [
+            0.5 + a.cos() * p[0] - a.sin() * p[1],
+            0.5 + a.sin() * p[0] + a.cos() * p[1],
+            0.55 + p[2],
+        ]
+    };
+    let turned = (v.iter().map(|&p| turn(p)).collect::<Vec<_>>(), f);
+    write_stl(&dir.join("turned.stl"), &turned);
+    let s = load_in(&dir, &case("shape = \"mesh\"\nfile = \"turned.stl\"")).unwrap();
+    check_invariants(&s);
+    let b = &s.bodies[0];
+    assert!(
+        (b.mass - 500.0 * 0.3 * 0.2 * 0.2).abs() < 1e-5 * b.mass,
+        "{}",
+        b.mass
+    );
+    assert!(
+        b.inertia[0][1].abs() > 1e-3 * b.inertia[2][2],
+        "{:?}",
+        b.inertia
+    );
+    // The box's own frame: inside when every coordinate is within its half-size.
+    let local = |p: [f64; 3]| {
+        let (x, y) = (p[0] - 0.5, p[1] - 0.5);
+        [
+            a.cos() * x + a.sin() * y,
+            -a.sin() * x + a.cos() * y,
+            p[2] - 0.55,
+        ]
+    };
+    let half = [0.15, 0.1, 0.1];
+    let margin = |p: [f64; 3]| {
+        let q = local(p);
+        (0..3)
+            .map(|k| half[k] - q[k].abs())
+            .fold(f64::MAX, f64::min)
+    };
+    let dx = s.physics.dx;
+    let body = &s.particles[b.particles.clone()];
+    assert!(body.len() > 10);
+    assert!(body.iter().all(|p| margin(p.pos) > 0.0));
+    for p in s.particles.iter().filter(|p| p.kind == Kind::Fluid) {
+        let q = local(p.pos);
+        // Distance from the fluid particle to the box (zero inside).
+        let out: f64 = (0..3)
+            .map(|k| (q[k].abs() - half[k]).max(0.0).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!(out >= 0.5 * dx * (1.0 - 1e-5), "fluid at {:?}", p.pos);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bad_mesh_bodies_are_refused_naming_the_file() {
+    let dir = folder("bad");
+    let e = |text: &str| match load_in(&dir, text) {
+        Ok(_) => panic!("accepted: {text}"),
+        Err(e) => e.to_string(),
+    };
+    let has = |e: &str, words: &[&str]| {
+        for w in words {
+            assert!(e.contains(w), "`{w}` expected in: {e}");
+        }
+        assert!(e.contains("fix:"), "no fix in: {e}");
+    };
+    has(
+        &e(&case("shape = \"mesh\"\nfile = \"none.stl\"")),
+        &[
+            "body[0].file",
+            "none.stl",
+            "cannot read",
+            "relative to the case file",
+        ],
+    );
+    let (v, f) = cuboid([0.4; 3], [0.6; 3]);
+    write_stl(&dir.join("open.stl"), &(v.clone(), f[2..].to_vec()));
+    has(
+        &e(&case("shape = \"mesh\"\nfile = \"open.stl\"")),
+        &["body[0].file", "open.stl is not closed", "watertight"],
+    );
+    std::fs::write(
+        dir.join("junk.stl"),
+        "solid x\nfacet normal 0 0 0\nouter loop\n",
+    )
+    .unwrap();
+    has(
+        &e(&case("shape = \"mesh\"\nfile = \"junk.stl\"")),
+        &["body[0].file", "junk.stl"],
+    );
+    has(
+        &e(&case("shape = \"mesh\"")),
+        &["body[0].file", "is required for a mesh body"],
+    );
+    write_stl(&dir.join("ok.stl"), &(v, f));
+    has(
+        &e(&case(
+            "shape = \"mesh\"\nfile = \"ok.stl\"\nmin_m = [0.1, 0.1, 0.1]",
+        )),
+        &["body[0].min_m", "is not used by a mesh body"],
+    );
+    // A plate thinner than a spacing, turned off the lattice's lines: no lattice point inside.
+    let (v, f) = cuboid([-0.2, -0.001, -0.2], [0.2, 0.001, 0.2]);
+    let a = 30f64.to_radians();
+    let turn = |p: [f64; 3]| {
+        [
+            0.5 + a.cos() * p[0] - a.sin() * p[1],
+            0.5 + a.sin() * p[0] + a.cos() * p[1],
+            0.5 + p[2],
+        ]
+    };
+    write_stl(
+        &dir.join("thin.stl"),
+        &(v.iter().map(|&p| turn(p)).collect(), f),
+    );
+    has(
+        &e(&case("shape = \"mesh\"\nfile = \"thin.stl\"")),
+        &["body[0].file", "no point of the particle lattice"],
+    );
+    // STL is a 3D shape.
+    let flat = BASE.to_string()
+        + "\n[[body]]\nname = \"b\"\nshape = \"mesh\"\nfile = \"ok.stl\"\nmass_kg = 1.0\n";
+    has(&e(&flat), &["body[0].shape", "2D"]);
+    std::fs::remove_dir_all(&dir).ok();
+}
