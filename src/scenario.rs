@@ -679,6 +679,9 @@ pub struct Prescribed {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum MotionLaw {
+    /// d = 0, θ = 0: a body held where it is (a building in a flood), whose particles are
+    /// walls and whose load is still summed and written.
+    Fixed,
     /// d(t) = a_d sin(ωt + φ), θ(t) = a_θ sin(ωt + φ).
     Sine {
         translation: [f64; 3],

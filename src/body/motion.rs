@@ -19,6 +19,12 @@ pub struct Sample {
 impl MotionLaw {
     pub fn sample(&self, t: f64) -> Sample {
         match self {
+            MotionLaw::Fixed => Sample {
+                translation: DVec3::ZERO,
+                velocity: DVec3::ZERO,
+                angle: 0.0,
+                angle_rate: 0.0,
+            },
             MotionLaw::Sine {
                 translation,
                 angle,

@@ -261,17 +261,19 @@ fn shape(
     })
 }
 
-/// A `[... .motion]` table; `allow_free` for bodies (the tank can only be prescribed).
+/// A `[... .motion]` table; `for_body`: a body's, which may also be free or fixed (the tank is
+/// only prescribed).
 pub(super) fn motion(
     ctx: &Ctx<'_>,
     path: &str,
     m: &RawMotion,
     dim: usize,
-    allow_free: bool,
+    for_body: bool,
     case_dir: &Path,
 ) -> Result<Motion, CaseError> {
     let needs: &[&str] = match m.kind {
         MotionName::Free => &["velocity_m_s", "angular_velocity_rad_s"],
+        MotionName::Fixed => &[],
         MotionName::Sine => &[
             "pivot_m",
             "axis",
@@ -284,6 +286,7 @@ pub(super) fn motion(
     };
     let kind = match m.kind {
         MotionName::Free => "free",
+        MotionName::Fixed => "fixed",
         MotionName::Sine => "sine",
         MotionName::Series => "series",
     };
@@ -304,19 +307,34 @@ pub(super) fn motion(
                 &format!("{path}.{field}"),
                 None,
                 format!("is not used by a {kind} motion"),
-                format!("a {kind} motion takes {}", needs.join(", ")),
+                if needs.is_empty() {
+                    format!("a {kind} motion takes no other field: remove it")
+                } else {
+                    format!("a {kind} motion takes {}", needs.join(", "))
+                },
             ));
         }
     }
+    if !for_body && matches!(m.kind, MotionName::Free | MotionName::Fixed) {
+        return Err(ctx.err(
+            &format!("{path}.kind"),
+            Some(format!("\"{kind}\"")),
+            if m.kind == MotionName::Free {
+                "the tank cannot move freely"
+            } else {
+                "a tank without [tank.motion] is fixed"
+            },
+            "use kind = \"sine\" or \"series\" (or remove [tank.motion])",
+        ));
+    }
+    if m.kind == MotionName::Fixed {
+        return Ok(Motion::Prescribed(Prescribed {
+            pivot: [0.0; 3],
+            axis: [0.0, 0.0, 1.0],
+            law: MotionLaw::Fixed,
+        }));
+    }
     if m.kind == MotionName::Free {
-        if !allow_free {
-            return Err(ctx.err(
-                &format!("{path}.kind"),
-                Some("\"free\"".into()),
-                "the tank cannot move freely",
-                "use kind = \"sine\" or \"series\"",
-            ));
-        }
         let velocity = match &m.velocity_m_s {
             Some(v) => vector(
                 ctx,

@@ -240,6 +240,7 @@ pub(super) struct RawMotion {
 #[serde(rename_all = "snake_case")]
 pub(super) enum MotionName {
     Free,
+    Fixed,
     Sine,
     Series,
 }
@@ -815,7 +816,7 @@ pub(super) const FIELDS: &[FieldHelp] = &[
     ),
     f(
         "motion.kind",
-        "the motion: free (bodies only), sine or series",
+        "the motion: free or fixed (bodies only), sine or series",
         "kind = \"sine\"",
     ),
     f(

@@ -1241,6 +1241,42 @@ fn bad_bodies_and_motions_are_refused() {
         None,
         &["tank.motion.kind", "sine"],
     );
+    assert_err(
+        &format!("{BASE}\n[tank.motion]\nkind = \"fixed\"\n"),
+        &[],
+        None,
+        &["tank.motion.kind", "without [tank.motion] is fixed"],
+    );
+    assert_err(
+        &with_body("shape = \"box\"\nmin_m = [0.4, 0.4]\nmax_m = [0.5, 0.5]\n[body.motion]\nkind = \"fixed\"\nperiod_s = 1.0"),
+        &[],
+        None,
+        &["body[0].motion.period_s", "not used by a fixed motion", "no other field"],
+    );
+}
+
+/// `kind = "fixed"`: a body held where it is, needing no mass; its particles are placed as a
+/// box body's and stay at rest.
+#[test]
+fn a_fixed_body_needs_no_mass_and_stays_at_rest() {
+    let text = format!(
+        "{BASE}\n[[body]]\nname = \"pier\"\nshape = \"box\"\nmin_m = [0.4, 0.4]\n\
+         max_m = [0.5, 0.5]\n[body.motion]\nkind = \"fixed\"\n"
+    );
+    let s = load_str(&text, "c.toml", &[]).unwrap();
+    let b = &s.bodies[0];
+    let Motion::Prescribed(p) = &b.motion else {
+        panic!("{:?}", b.motion)
+    };
+    assert_eq!(p.law, crate::scenario::MotionLaw::Fixed);
+    for t in [0.0, 0.37, 1e3] {
+        let pose = p.pose(glam::DVec3::from_array(b.center), t);
+        assert_eq!(pose.center.to_array(), b.center);
+        assert_eq!((pose.velocity, pose.omega), (glam::DVec3::ZERO, glam::DVec3::ZERO));
+    }
+    assert!(s.particles[b.particles.clone()]
+        .iter()
+        .all(|q| q.vel == [0.0; 3] && q.kind == Kind::Wall));
 }
 
 // ---------------------------------------------------------------- found by tests/case_fuzz/

@@ -78,6 +78,70 @@ fn a_neutrally_buoyant_box_stays_put() {
     assert!(drift < 0.25 * 0.02, "drift {drift} m");
 }
 
+/// A box held fixed (`kind = "fixed"`) under the water: it does not move, and the water's
+/// force on it is its buoyancy, ρ g A per metre (Archimedes), on average over the second half
+/// second (the tank rings from the start), within the issue's 2 % for Archimedes. Dynamic
+/// particles (the default; measured +1.37 %; fixed ghosts +0.92 %, not run here to save CI
+/// time: the law under test is the fixed motion and the load's sum).
+#[test]
+fn a_fixed_submerged_box_feels_its_buoyancy() {
+    let wall = "dynamic";
+    let text = format!(
+        r#"
+        dimension = 2
+        [particles]
+        dx_m = 0.02
+        [physics]
+        sound_speed_coef = 15.0
+        alpha = 0.05
+        [time]
+        end_s = 1.0
+        output_every_s = 0.25
+        [tank]
+        min_m = [0.0, 0.0]
+        max_m = [0.6, 0.5]
+        [[fluid_block]]
+        min_m = [0.0, 0.0]
+        max_m = [0.6, 0.4]
+        [[body]]
+        name = "box"
+        shape = "box"
+        min_m = [0.24, 0.14]
+        max_m = [0.36, 0.26]
+        wall = "{wall}"
+        [body.motion]
+        kind = "fixed"
+    "#
+    );
+    let sc = wgsph::case::load_str(&text, "fixed.toml", &[]).unwrap();
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    let (mut lift, mut n) = (0.0, 0);
+    for k in 1..=20 {
+        solver.advance_to(0.05 * k as f64).unwrap();
+        if k > 10 {
+            lift += solver.bodies().unwrap().load(0).force.y;
+            n += 1;
+        }
+    }
+    let lift = lift / n as f64;
+    let archimedes = 1000.0 * 9.81 * 0.12 * 0.12;
+    let pose = solver.bodies().unwrap().pose(0);
+    println!(
+        "fixed box ({wall}): mean lift over 0.5-1 s {lift:.2} N/m, Archimedes \
+         {archimedes:.2} N/m ({:+.2} %)",
+        100.0 * (lift / archimedes - 1.0)
+    );
+    assert_eq!(pose.center.to_array(), sc.bodies[0].center);
+    assert!(pose.velocity == glam::DVec3::ZERO && pose.omega == glam::DVec3::ZERO);
+    assert!(
+        (lift / archimedes - 1.0).abs() < BUOYANCY_BOUND,
+        "{wall}: {lift} N/m"
+    );
+}
+
+/// How far the fixed box's mean lift may be from ρ g A.
+const BUOYANCY_BOUND: f64 = 0.02;
+
 #[test]
 fn water_entry_penetration_within_30_percent_coarse() {
     // dx = D/11, fixed-ghost cylinder. Measured: +12.6 % at t* = 0.10, within 8.3 % after
