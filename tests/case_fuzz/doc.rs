@@ -239,6 +239,7 @@ pub(crate) fn required(path: &str) -> bool {
             | "body[].max_m"
             | "body[].center_m"
             | "body[].radius_m"
+            | "body[].file"
             | "motion.kind"
             | "motion.period_s"
             | "motion.file"
