@@ -11,7 +11,8 @@ use crate::scenario::{Motion, MotionLaw, Prescribed};
 
 use super::error::{num, CaseError};
 use super::locate::Ctx;
-use super::mesh::Mesh;
+use super::mesh::{lattice, Mesh};
+use super::polygon::Polygon;
 use super::schema::{MotionName, RawBody, RawMotion, ShapeName};
 use super::validate::Treatment;
 use super::validate::{aabb, number, vector, Aabb, Bound};
@@ -24,6 +25,8 @@ pub(super) enum Shape {
         center: [f64; 3],
         radius: f64,
     },
+    /// A simple polygon (2D).
+    Polygon(Arc<Polygon>),
     /// A closed triangle surface read from an STL file (3D).
     Mesh(Arc<Mesh>),
 }
@@ -189,6 +192,7 @@ fn shape(
         ShapeName::Box => ("box", &["min_m", "max_m"]),
         ShapeName::Circle => ("circle", &["center_m", "radius_m"]),
         ShapeName::Sphere => ("sphere", &["center_m", "radius_m"]),
+        ShapeName::Polygon => ("polygon", &["vertices_m"]),
         ShapeName::Mesh => ("mesh", &["file"]),
     };
     let given = [
@@ -196,6 +200,7 @@ fn shape(
         ("max_m", b.max_m.is_some()),
         ("center_m", b.center_m.is_some()),
         ("radius_m", b.radius_m.is_some()),
+        ("vertices_m", b.vertices_m.is_some()),
         ("file", b.file.is_some()),
     ];
     for (field, present) in given {
@@ -213,13 +218,13 @@ fn shape(
         }
     }
     match (b.shape, dim) {
-        (ShapeName::Circle, 3) | (ShapeName::Sphere | ShapeName::Mesh, 2) => {
+        (ShapeName::Circle | ShapeName::Polygon, 3) | (ShapeName::Sphere | ShapeName::Mesh, 2) => {
             return Err(ctx.err(
                 &format!("{path}.shape"),
                 Some(format!("\"{name}\"")),
                 format!("is not a {dim}D shape"),
                 if dim == 2 {
-                    "use shape = \"circle\" (or \"box\") in 2D"
+                    "use shape = \"circle\" (or \"box\", \"polygon\") in 2D"
                 } else {
                     "use shape = \"sphere\" (or \"box\", \"mesh\") in 3D"
                 },
@@ -237,6 +242,24 @@ fn shape(
             )
         })?;
         return Ok(Shape::Mesh(Arc::new(mesh)));
+    }
+    if let Some(corners) = &b.vertices_m {
+        let field = format!("{path}.vertices_m");
+        let mut v = Vec::with_capacity(corners.len());
+        for (k, c) in corners.iter().enumerate() {
+            let p = vector(ctx, &format!("{field}[{k}]"), c, 2, "a corner in metres")?;
+            v.push([p[0], p[1]]);
+        }
+        let polygon = Polygon::new(&v).map_err(|e| {
+            ctx.err(
+                &field,
+                None,
+                e.to_string(),
+                "list the corners in order around the outline (either sense), each once, \
+                 with no two edges crossing",
+            )
+        })?;
+        return Ok(Shape::Polygon(Arc::new(polygon)));
     }
     Ok(match (&b.min_m, &b.max_m, &b.center_m, b.radius_m) {
         (Some(lo), Some(hi), _, _) => Shape::Box(aabb(ctx, path, lo, hi, dim, "the body")?),
@@ -576,12 +599,13 @@ impl Shape {
             Shape::Box(b) => (0..dim).map(|a| b.max[a] - b.min[a]).product(),
             Shape::Ball { radius, .. } if dim == 2 => PI * radius * radius,
             Shape::Ball { radius, .. } => 4.0 / 3.0 * PI * radius.powi(3),
+            Shape::Polygon(p) => p.area(),
             Shape::Mesh(m) => m.volume(),
         }
     }
 
-    /// How many lattice points [`Shape::points`] considers at spacing `dx` (at least as many
-    /// as it returns), for the particle budget.
+    /// How many points [`Shape::points`] considers at spacing `dx` (at least as many as it
+    /// returns), for the particle budget.
     pub(super) fn lattice_size(&self, dx: f64, dim: usize) -> f64 {
         match self {
             Shape::Box(b) => (0..dim)
@@ -590,7 +614,12 @@ impl Shape {
             // Rings a spacing apart, each with about 2 pi r / dx points.
             Shape::Ball { radius, .. } if dim == 2 => PI * (radius / dx + 1.0).powi(2),
             Shape::Ball { radius, .. } => (2.0 * (radius / dx).ceil() + 1.0).powi(3),
-            Shape::Mesh(m) => m.lattice(dx).0.iter().map(|&n| n as f64).product(),
+            Shape::Polygon(p) => p.particle_bound(dx, None, super::limits::MAX_PARTICLES),
+            Shape::Mesh(m) => lattice(&m.bounds(), dx, 3)
+                .0
+                .iter()
+                .map(|&n| n as f64)
+                .product(),
         }
     }
 
@@ -599,6 +628,7 @@ impl Shape {
         match self {
             Shape::Box(b) => [0, 1, 2].map(|a| 0.5 * (b.min[a] + b.max[a])),
             Shape::Ball { center, .. } => *center,
+            Shape::Polygon(p) => p.centroid(),
             Shape::Mesh(m) => m.centroid(),
         }
     }
@@ -611,6 +641,7 @@ impl Shape {
                 min: [0, 1, 2].map(|a| if a < dim { center[a] - radius } else { 0.0 }),
                 max: [0, 1, 2].map(|a| if a < dim { center[a] + radius } else { 0.0 }),
             },
+            Shape::Polygon(p) => p.bounds(),
             Shape::Mesh(m) => m.bounds(),
         }
     }
@@ -632,6 +663,7 @@ impl Shape {
                 [mass * r2 / 4.0, mass * r2 / 4.0, mass * r2 / 2.0]
             }
             Shape::Ball { radius, .. } => [0.4 * mass * radius * radius; 3],
+            Shape::Polygon(p) => return p.inertia(mass),
             Shape::Mesh(m) => return m.inertia(mass),
         };
         [
@@ -646,17 +678,20 @@ impl Shape {
         match self {
             Shape::Box(b) => box_distance(b, p, dim) < margin,
             Shape::Ball { center, radius } => ball_distance(*center, *radius, p, dim) < margin,
+            Shape::Polygon(q) => q.contains(p) || q.distance(p) < margin,
             Shape::Mesh(m) => m.contains(p) || m.distance_within(p, margin).is_some(),
         }
     }
 
     /// The body's particles at spacing `dx`: a box on its own cell-centred lattice, a circle
-    /// as concentric rings (a smooth surface), a sphere on a lattice through its centre, a mesh
-    /// on a cell-centred lattice over its bounding box; only the outer `layers` when given.
+    /// as concentric rings (a smooth surface), a sphere on a lattice through its centre, a
+    /// polygon or mesh on a cell-centred lattice over its bounding box; only the outer `layers`
+    /// when given.
     pub(super) fn points(&self, dx: f64, dim: usize, layers: Option<u32>) -> Vec<[f64; 3]> {
         let depth = layers.map_or(f64::MAX, |l| l as f64 * dx);
         let mut out = Vec::new();
         match *self {
+            Shape::Polygon(ref p) => return p.points(dx, layers.map(|_| depth)),
             Shape::Mesh(ref m) => return m.points(dx, layers.map(|_| depth)),
             Shape::Box(b) => {
                 let n = [0, 1, 2].map(|a| {

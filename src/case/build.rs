@@ -563,12 +563,19 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
                     ),
                     "make the radius a few particle spacings, or decrease particles.dx_m",
                 ),
-                _ => ctx.err(
-                    &format!("body[{i}].file"),
+                shape => ctx.err(
+                    &format!(
+                        "body[{i}].{}",
+                        if let Shape::Polygon(_) = shape {
+                            "vertices_m"
+                        } else {
+                            "file"
+                        }
+                    ),
                     None,
                     format!(
-                        "the mesh holds no point of the particle lattice (spacing dx = {} m): \
-                         the body would have no particles",
+                        "no particle fits in the shape (particles sit at least dx/2 inside \
+                         its surface, dx = {} m): the body would have no particles",
                         num(dx)
                     ),
                     "make the body a few particle spacings thick, or decrease particles.dx_m",

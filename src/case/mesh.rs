@@ -312,7 +312,7 @@ impl Mesh {
     /// `depth`, less than `depth` from it. A cuboid whose sides are whole multiples of `dx`
     /// gets a box body's lattice.
     pub(super) fn points(&self, dx: f64, depth: Option<f64>) -> Vec<[f64; 3]> {
-        let (n, origin) = self.lattice(dx);
+        let (n, origin) = lattice(&self.bounds, dx, 3);
         let at = |a: usize, i: usize| origin[a] + (i as f64 + 0.5) * dx;
         let near = depth.map(|d| self.near_lattice(n, origin, dx, d));
         let mut out = Vec::new();
@@ -369,15 +369,27 @@ impl Mesh {
         }
         near
     }
+}
 
-    /// Cells of size `dx` along each axis that cover the bounding box (a whole multiple of
-    /// `dx` to rounding is covered exactly), and the corner of the first.
-    pub(super) fn lattice(&self, dx: f64) -> ([usize; 3], [f64; 3]) {
-        let b = &self.bounds;
-        let n = [0, 1, 2].map(|a| ((b.max[a] - b.min[a]) / dx - 1e-9).ceil().max(1.0) as usize);
-        let origin = [0, 1, 2].map(|a| 0.5 * (b.min[a] + b.max[a]) - 0.5 * n[a] as f64 * dx);
-        (n, origin)
-    }
+/// Cells of size `dx` along each of the first `dim` axes that cover the box `b` (a whole
+/// multiple of `dx`, to rounding, is covered exactly), centred on it, and the corner of the
+/// first: the lattice of a mesh or polygon body.
+pub(super) fn lattice(b: &Aabb, dx: f64, dim: usize) -> ([usize; 3], [f64; 3]) {
+    let n = [0, 1, 2].map(|a| {
+        if a < dim {
+            ((b.max[a] - b.min[a]) / dx - 1e-9).ceil().max(1.0) as usize
+        } else {
+            1
+        }
+    });
+    let origin = [0, 1, 2].map(|a| {
+        if a < dim {
+            0.5 * (b.min[a] + b.max[a]) - 0.5 * n[a] as f64 * dx
+        } else {
+            0.0
+        }
+    });
+    (n, origin)
 }
 
 /// Whether an odd number of the ascending `crossings` lie above `z`: inside, by the even–odd

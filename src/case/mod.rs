@@ -17,6 +17,7 @@ mod locate;
 mod mesh;
 mod open_boundaries;
 mod overrides;
+mod polygon;
 mod probes;
 mod schema;
 mod solids;

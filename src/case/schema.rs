@@ -202,6 +202,7 @@ pub(super) struct RawBody {
     pub max_m: Option<Vec<f64>>,
     pub center_m: Option<Vec<f64>>,
     pub radius_m: Option<f64>,
+    pub vertices_m: Option<Vec<Vec<f64>>>,
     pub file: Option<String>,
     pub density_kg_m3: Option<f64>,
     pub mass_kg: Option<f64>,
@@ -217,6 +218,7 @@ pub(super) enum ShapeName {
     Box,
     Circle,
     Sphere,
+    Polygon,
     Mesh,
 }
 
@@ -756,7 +758,7 @@ pub(super) const FIELDS: &[FieldHelp] = &[
     ),
     f(
         "body[].shape",
-        "the body shape: box, circle (2D), sphere (3D) or mesh (3D, an STL file)",
+        "the body shape: box, circle or polygon (2D), sphere or mesh (3D, an STL file)",
         "shape = \"box\"",
     ),
     f(
@@ -778,6 +780,11 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "body[].radius_m",
         "the radius of a circle or sphere body in metres",
         "radius_m = 0.055",
+    ),
+    f(
+        "body[].vertices_m",
+        "the corners of a polygon body in order, in metres",
+        "vertices_m = [[0.4, 0.3], [0.5, 0.2], [0.6, 0.3]]",
     ),
     f(
         "body[].file",

@@ -1086,8 +1086,8 @@ fn nothing_panics_on_hostile_values() {
     assert!(n > 100);
 }
 
-mod meshes;
 mod open_boundaries;
+mod shapes;
 mod solids;
 mod walls;
 
@@ -1272,7 +1272,10 @@ fn a_fixed_body_needs_no_mass_and_stays_at_rest() {
     for t in [0.0, 0.37, 1e3] {
         let pose = p.pose(glam::DVec3::from_array(b.center), t);
         assert_eq!(pose.center.to_array(), b.center);
-        assert_eq!((pose.velocity, pose.omega), (glam::DVec3::ZERO, glam::DVec3::ZERO));
+        assert_eq!(
+            (pose.velocity, pose.omega),
+            (glam::DVec3::ZERO, glam::DVec3::ZERO)
+        );
     }
     assert!(s.particles[b.particles.clone()]
         .iter()

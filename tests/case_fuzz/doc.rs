@@ -240,6 +240,7 @@ pub(crate) fn required(path: &str) -> bool {
             | "body[].center_m"
             | "body[].radius_m"
             | "body[].file"
+            | "body[].vertices_m"
             | "motion.kind"
             | "motion.period_s"
             | "motion.file"

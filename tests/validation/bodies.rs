@@ -78,19 +78,16 @@ fn a_neutrally_buoyant_box_stays_put() {
     assert!(drift < 0.25 * 0.02, "drift {drift} m");
 }
 
-/// A box held fixed (`kind = "fixed"`) under the water: it does not move, and the water's
-/// force on it is its buoyancy, ρ g A per metre (Archimedes), on average over the second half
-/// second (the tank rings from the start), within the issue's 2 % for Archimedes. Dynamic
-/// particles (the default; measured +1.37 %; fixed ghosts +0.92 %, not run here to save CI
-/// time: the law under test is the fixed motion and the load's sum).
-#[test]
-fn a_fixed_submerged_box_feels_its_buoyancy() {
-    let wall = "dynamic";
+/// A body held fixed (`kind = "fixed"`) under 0.14 m of water or more, of the given shape
+/// lines and area A, with `wall` particles at spacing `dx`: it must not move, and the water's
+/// force on it must be its buoyancy ρ g A per metre (Archimedes). Returns the relative error of
+/// the mean lift over the second half second (the tank rings from the start).
+fn fixed_lift(shape: &str, area: f64, wall: &str, dx: f64) -> f64 {
     let text = format!(
         r#"
         dimension = 2
         [particles]
-        dx_m = 0.02
+        dx_m = {dx}
         [physics]
         sound_speed_coef = 15.0
         alpha = 0.05
@@ -104,10 +101,8 @@ fn a_fixed_submerged_box_feels_its_buoyancy() {
         min_m = [0.0, 0.0]
         max_m = [0.6, 0.4]
         [[body]]
-        name = "box"
-        shape = "box"
-        min_m = [0.24, 0.14]
-        max_m = [0.36, 0.26]
+        name = "held"
+        {shape}
         wall = "{wall}"
         [body.motion]
         kind = "fixed"
@@ -124,22 +119,42 @@ fn a_fixed_submerged_box_feels_its_buoyancy() {
         }
     }
     let lift = lift / n as f64;
-    let archimedes = 1000.0 * 9.81 * 0.12 * 0.12;
+    let archimedes = 1000.0 * 9.81 * area;
     let pose = solver.bodies().unwrap().pose(0);
-    println!(
-        "fixed box ({wall}): mean lift over 0.5-1 s {lift:.2} N/m, Archimedes \
-         {archimedes:.2} N/m ({:+.2} %)",
-        100.0 * (lift / archimedes - 1.0)
-    );
     assert_eq!(pose.center.to_array(), sc.bodies[0].center);
     assert!(pose.velocity == glam::DVec3::ZERO && pose.omega == glam::DVec3::ZERO);
-    assert!(
-        (lift / archimedes - 1.0).abs() < BUOYANCY_BOUND,
-        "{wall}: {lift} N/m"
+    let error = lift / archimedes - 1.0;
+    println!(
+        "fixed {} ({wall}, dx = {dx}): mean lift over 0.5-1 s {lift:.2} N/m, \
+         Archimedes {archimedes:.2} N/m ({:+.2} %)",
+        shape.replace('\n', ", "),
+        100.0 * error
     );
+    error
 }
 
-/// How far the fixed box's mean lift may be from ρ g A.
+/// A box 0.12 m square held under the water feels its buoyancy within the issue's 2 % for
+/// Archimedes (dynamic particles, the default; docs/validation.md has fixed ghosts, circles
+/// and polygons at two resolutions).
+#[test]
+fn a_fixed_submerged_box_feels_its_buoyancy() {
+    let box_lines = "shape = \"box\"\nmin_m = [0.24, 0.14]\nmax_m = [0.36, 0.26]";
+    let error = fixed_lift(box_lines, 0.12 * 0.12, "dynamic", 0.02);
+    assert!(error.abs() < BUOYANCY_BOUND, "{:+.2} %", 100.0 * error);
+}
+
+/// A diamond (a polygon of slanted faces, 0.2 × 0.16 m) held under the water, with the seed's
+/// fixed ghosts.
+#[test]
+#[ignore = "fails: +8.1 % at dx = 0.02 (+10.1 % at 0.01) with fixed ghosts, +22.7 % (+11.9 %) with dynamic particles, where a box gets +0.9 % (+3.9 %): slanted faces hold the water off; docs/validation.md 'Fixed bodies'"]
+fn a_fixed_submerged_diamond_feels_its_buoyancy() {
+    let diamond =
+        "shape = \"polygon\"\nvertices_m = [[0.2, 0.2], [0.3, 0.12], [0.4, 0.2], [0.3, 0.28]]";
+    let error = fixed_lift(diamond, 0.016, "fixed_ghost", 0.02);
+    assert!(error.abs() < BUOYANCY_BOUND, "{:+.2} %", 100.0 * error);
+}
+
+/// How far a fixed body's mean lift may be from ρ g A: the issue's bound for Archimedes.
 const BUOYANCY_BOUND: f64 = 0.02;
 
 #[test]

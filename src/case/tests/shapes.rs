@@ -1,5 +1,5 @@
-//! `shape = "mesh"` bodies: an STL file read relative to the case file, its lattice and mass
-//! properties, and the loader's errors.
+//! `shape = "mesh"` bodies (an STL file read relative to the case file) and `shape =
+//! "polygon"` bodies: their particles and mass properties, and the loader's errors.
 
 use super::*;
 use crate::case::mesh::tests::cuboid;
@@ -226,11 +226,110 @@ fn bad_mesh_bodies_are_refused_naming_the_file() {
     );
     has(
         &e(&case("shape = \"mesh\"\nfile = \"thin.stl\"")),
-        &["body[0].file", "no point of the particle lattice"],
+        &["body[0].file", "no particle fits in the shape"],
     );
     // STL is a 3D shape.
     let flat = BASE.to_string()
         + "\n[[body]]\nname = \"b\"\nshape = \"mesh\"\nfile = \"ok.stl\"\nmass_kg = 1.0\n";
     has(&e(&flat), &["body[0].shape", "2D"]);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A 2D case (BASE at dx = 0.0625, water to 0.5 m) with one body of the given lines.
+fn case_2d(body: &str) -> String {
+    format!(
+        "{}\n[[body]]\nname = \"b\"\ndensity_kg_m3 = 500.0\n{body}\n",
+        BASE.replace("dx_m = 0.1", "dx_m = 0.0625")
+    )
+}
+
+/// A rectangle drawn as a polygon is the box body of its corners: the same particles (to
+/// rounding: the polygon's are placed ring by ring), fluid, mass, centre and inertia.
+#[test]
+fn a_rectangle_polygon_is_the_box_body() {
+    let poly = load_str(
+        &case_2d("shape = \"polygon\"\nvertices_m = [[0.5, 0.625], [0.75, 0.625], [0.75, 0.8125], [0.5, 0.8125]]"),
+        "c.toml",
+        &[],
+    )
+    .unwrap();
+    let bx = load_str(
+        &case_2d("shape = \"box\"\nmin_m = [0.5, 0.625]\nmax_m = [0.75, 0.8125]"),
+        "c.toml",
+        &[],
+    )
+    .unwrap();
+    check_invariants(&poly);
+    let (p, b) = (&poly.bodies[0], &bx.bodies[0]);
+    assert_eq!(p.particles, b.particles);
+    assert_eq!(poly.particles.len(), bx.particles.len());
+    assert_eq!(
+        poly.particles[..p.particles.start],
+        bx.particles[..b.particles.start]
+    );
+    for q in &poly.particles[p.particles.clone()] {
+        assert!(
+            bx.particles[b.particles.clone()]
+                .iter()
+                .any(|r| (0..2).all(|a| (q.pos[a] - r.pos[a]).abs() < 1e-12) && q.kind == r.kind),
+            "{:?} is not a box particle",
+            q.pos
+        );
+    }
+    assert!((p.mass - b.mass).abs() < 1e-12 * b.mass);
+    assert!((0..2).all(|a| (p.center[a] - b.center[a]).abs() < 1e-12));
+    assert!((p.inertia[2][2] - b.inertia[2][2]).abs() < 1e-12 * b.inertia[2][2]);
+}
+
+#[test]
+fn bad_polygon_bodies_are_refused_naming_the_field() {
+    let e = |text: &str| match load_str(text, "cases/t.toml", &[]) {
+        Ok(_) => panic!("accepted: {text}"),
+        Err(e) => e.to_string(),
+    };
+    let has = |e: &str, words: &[&str]| {
+        for w in words {
+            assert!(e.contains(w), "`{w}` expected in: {e}");
+        }
+        assert!(e.contains("fix:"), "no fix in: {e}");
+    };
+    has(
+        &e(&case_2d(
+            "shape = \"polygon\"\nvertices_m = [[0.2, 0.6], [0.4, 0.8], [0.4, 0.6], [0.2, 0.8]]",
+        )),
+        &[
+            "body[0].vertices_m",
+            "not a simple outline",
+            "in order around the outline",
+        ],
+    );
+    has(
+        &e(&case_2d(
+            "shape = \"polygon\"\nvertices_m = [[0.2, 0.6], [0.4, 0.6, 0.1], [0.3, 0.8]]",
+        )),
+        &["body[0].vertices_m[1]", "2 numbers"],
+    );
+    has(
+        &e(&case_2d(
+            "shape = \"polygon\"\nvertices_m = [[0.2, 0.6], [0.4, 0.6]]",
+        )),
+        &["body[0].vertices_m", "at least 3"],
+    );
+    has(
+        &e(&case_2d("shape = \"polygon\"")),
+        &["body[0].vertices_m", "is required for a polygon body"],
+    );
+    // A sliver: no particle fits half a spacing inside it.
+    has(
+        &e(&case_2d(
+            "shape = \"polygon\"\nvertices_m = [[0.2, 0.6], [0.6, 0.6], [0.4, 0.62]]",
+        )),
+        &["body[0].vertices_m", "no particle fits in the shape"],
+    );
+    has(
+        &e(&case(
+            "shape = \"polygon\"\nvertices_m = [[0.2, 0.6], [0.4, 0.6], [0.3, 0.8]]",
+        )),
+        &["body[0].shape", "3D"],
+    );
 }
