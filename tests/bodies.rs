@@ -679,21 +679,22 @@ fn a_mesh_body_tumbles_in_free_flight_keeping_its_angular_momentum() {
             DVec3::from_array([0, 1, 2].map(|a| if i >> a & 1 == 1 { half[a] } else { -half[a] }));
         center + turn * local
     };
-    // The 12 outward triangles of the corners (bit a of a corner's index: +half along axis a).
-    let faces = [
-        [0, 2, 3],
-        [0, 3, 1],
-        [4, 5, 7],
-        [4, 7, 6],
-        [0, 1, 5],
-        [0, 5, 4],
-        [2, 6, 7],
-        [2, 7, 3],
-        [0, 4, 6],
-        [0, 6, 2],
-        [1, 3, 7],
-        [1, 7, 5],
-    ];
+    // Two triangles a face: the face of axis a on side `side` goes round its corners (bit a
+    // of a corner's index: +half along axis a) counter-clockwise about +a, so reversed on the
+    // low side to face outward.
+    let mut faces = Vec::new();
+    for a in 0..3 {
+        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+        for side in 0..2 {
+            let mut quad =
+                [(0, 0), (1, 0), (1, 1), (0, 1)].map(|(u, v)| side << a | u << b | v << c);
+            if side == 0 {
+                quad.reverse();
+            }
+            faces.push([quad[0], quad[1], quad[2]]);
+            faces.push([quad[0], quad[2], quad[3]]);
+        }
+    }
     let mut stl = String::from("solid brick\n");
     for f in faces {
         stl += "facet normal 0 0 0\nouter loop\n";

@@ -42,48 +42,10 @@ fn floating_box_draft_within_2_percent_fine() {
     assert!(o.passed(), "{}", crate::common::rows(&o));
 }
 
-#[test]
-fn a_neutrally_buoyant_box_stays_put() {
-    // A 0.12 m square of water density held under 0.14 m of water, released at rest.
-    let text = r#"
-        dimension = 2
-        [particles]
-        dx_m = 0.02
-        [physics]
-        sound_speed_coef = 15.0
-        alpha = 0.05
-        [time]
-        end_s = 1.0
-        output_every_s = 0.25
-        [tank]
-        min_m = [0.0, 0.0]
-        max_m = [0.6, 0.5]
-        [[fluid_block]]
-        min_m = [0.0, 0.0]
-        max_m = [0.6, 0.4]
-        [[body]]
-        name = "box"
-        shape = "box"
-        min_m = [0.24, 0.14]
-        max_m = [0.36, 0.26]
-        density_kg_m3 = 1000.0
-    "#;
-    let sc = wgsph::case::load_str(text, "neutral.toml", &[]).unwrap();
-    let s = sample(&sc, 0.05, 1.0);
-    let drift = s
-        .iter()
-        .map(|(_, p)| ((p.center.x - 0.3).powi(2) + (p.center.y - 0.2).powi(2)).sqrt())
-        .fold(0.0, f64::max);
-    println!("neutral box: largest drift {drift:.5} m in 1 s (dx = 0.02 m)");
-    assert!(drift < 0.25 * 0.02, "drift {drift} m");
-}
-
-/// A body held fixed (`kind = "fixed"`) under 0.14 m of water or more, of the given shape
-/// lines and area A, with `wall` particles at spacing `dx`: it must not move, and the water's
-/// force on it must be its buoyancy ρ g A per metre (Archimedes). Returns the relative error of
-/// the mean lift over the second half second (the tank rings from the start).
-fn fixed_lift(shape: &str, area: f64, wall: &str, dx: f64) -> f64 {
-    let text = format!(
+/// A tank 0.6 m wide with water 0.4 m deep, 1 s at spacing `dx`, and one `[[body]]` of the
+/// given lines (under water where the tests put it).
+fn under_water(dx: f64, body: &str) -> String {
+    format!(
         r#"
         dimension = 2
         [particles]
@@ -101,12 +63,37 @@ fn fixed_lift(shape: &str, area: f64, wall: &str, dx: f64) -> f64 {
         min_m = [0.0, 0.0]
         max_m = [0.6, 0.4]
         [[body]]
-        name = "held"
-        {shape}
-        wall = "{wall}"
-        [body.motion]
-        kind = "fixed"
+        {body}
     "#
+    )
+}
+
+#[test]
+fn a_neutrally_buoyant_box_stays_put() {
+    // A 0.12 m square of water density held under 0.14 m of water, released at rest.
+    let text = under_water(
+        0.02,
+        "name = \"box\"\nshape = \"box\"\nmin_m = [0.24, 0.14]\nmax_m = [0.36, 0.26]\n\
+         density_kg_m3 = 1000.0",
+    );
+    let sc = wgsph::case::load_str(&text, "neutral.toml", &[]).unwrap();
+    let s = sample(&sc, 0.05, 1.0);
+    let drift = s
+        .iter()
+        .map(|(_, p)| ((p.center.x - 0.3).powi(2) + (p.center.y - 0.2).powi(2)).sqrt())
+        .fold(0.0, f64::max);
+    println!("neutral box: largest drift {drift:.5} m in 1 s (dx = 0.02 m)");
+    assert!(drift < 0.25 * 0.02, "drift {drift} m");
+}
+
+/// A body held fixed (`kind = "fixed"`) under 0.14 m of water or more, of the given shape
+/// lines and area A, with `wall` particles at spacing `dx`: it must not move, and the water's
+/// force on it must be its buoyancy ρ g A per metre (Archimedes). Returns the relative error of
+/// the mean lift over the second half second (the tank rings from the start).
+fn fixed_lift(shape: &str, area: f64, wall: &str, dx: f64) -> f64 {
+    let text = under_water(
+        dx,
+        &format!("name = \"held\"\n{shape}\nwall = \"{wall}\"\n[body.motion]\nkind = \"fixed\""),
     );
     let sc = wgsph::case::load_str(&text, "fixed.toml", &[]).unwrap();
     let mut solver = Solver::new(gpu(), &sc).unwrap();

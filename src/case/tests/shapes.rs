@@ -162,19 +162,26 @@ fn a_turned_mesh_body_takes_its_mass_properties_from_its_surface() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The error of a case that must be refused.
+fn refusal(loaded: Result<Scenario, CaseError>, text: &str) -> String {
+    match loaded {
+        Ok(_) => panic!("accepted: {text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// `e` names every one of `words` and gives a fix.
+fn has(e: &str, words: &[&str]) {
+    for w in words {
+        assert!(e.contains(w), "`{w}` expected in: {e}");
+    }
+    assert!(e.contains("fix:"), "no fix in: {e}");
+}
+
 #[test]
 fn bad_mesh_bodies_are_refused_naming_the_file() {
     let dir = folder("bad");
-    let e = |text: &str| match load_in(&dir, text) {
-        Ok(_) => panic!("accepted: {text}"),
-        Err(e) => e.to_string(),
-    };
-    let has = |e: &str, words: &[&str]| {
-        for w in words {
-            assert!(e.contains(w), "`{w}` expected in: {e}");
-        }
-        assert!(e.contains("fix:"), "no fix in: {e}");
-    };
+    let e = |text: &str| refusal(load_in(&dir, text), text);
     has(
         &e(&case("shape = \"mesh\"\nfile = \"none.stl\"")),
         &[
@@ -283,16 +290,7 @@ fn a_rectangle_polygon_is_the_box_body() {
 
 #[test]
 fn bad_polygon_bodies_are_refused_naming_the_field() {
-    let e = |text: &str| match load_str(text, "cases/t.toml", &[]) {
-        Ok(_) => panic!("accepted: {text}"),
-        Err(e) => e.to_string(),
-    };
-    let has = |e: &str, words: &[&str]| {
-        for w in words {
-            assert!(e.contains(w), "`{w}` expected in: {e}");
-        }
-        assert!(e.contains("fix:"), "no fix in: {e}");
-    };
+    let e = |text: &str| refusal(load_str(text, "cases/t.toml", &[]), text);
     has(
         &e(&case_2d(
             "shape = \"polygon\"\nvertices_m = [[0.2, 0.6], [0.4, 0.8], [0.4, 0.6], [0.2, 0.8]]",
