@@ -550,8 +550,9 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         };
         let points = spec.shape.points(dx, dim, layers);
         if points.is_empty() {
-            // Particles sit half a spacing inside the surface: a smaller ball has none, nor a
-            // mesh thinner than a spacing, and a body without particles would feel no fluid.
+            // Particles sit inside the surface (a ball's and a polygon's at least dx/2): a ball
+            // smaller than that, a polygon too thin or a mesh around no lattice point has none,
+            // and a body without particles would feel no fluid.
             return Err(match &spec.shape {
                 Shape::Ball { radius, .. } => ctx.err(
                     &format!("body[{i}].radius_m"),
