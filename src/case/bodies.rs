@@ -11,7 +11,7 @@ use crate::scenario::{Motion, MotionLaw, Prescribed};
 
 use super::error::{num, CaseError};
 use super::locate::Ctx;
-use super::mesh::{lattice, Mesh};
+use super::mesh::Mesh;
 use super::polygon::Polygon;
 use super::schema::{MotionName, RawBody, RawMotion, ShapeName};
 use super::validate::Treatment;
@@ -615,11 +615,7 @@ impl Shape {
             Shape::Ball { radius, .. } if dim == 2 => PI * (radius / dx + 1.0).powi(2),
             Shape::Ball { radius, .. } => (2.0 * (radius / dx).ceil() + 1.0).powi(3),
             Shape::Polygon(p) => p.particle_bound(dx, None, super::limits::MAX_PARTICLES),
-            Shape::Mesh(m) => lattice(&m.bounds(), dx, 3)
-                .0
-                .iter()
-                .map(|&n| n as f64)
-                .product(),
+            Shape::Mesh(m) => m.lattice(dx).0.iter().map(|&n| n as f64).product(),
         }
     }
 
@@ -684,9 +680,9 @@ impl Shape {
     }
 
     /// The body's particles at spacing `dx`: a box on its own cell-centred lattice, a circle
-    /// as concentric rings (a smooth surface), a sphere on a lattice through its centre, a
-    /// polygon or mesh on a cell-centred lattice over its bounding box; only the outer `layers`
-    /// when given.
+    /// as concentric rings (a smooth surface), a polygon in layers along its outline, a sphere
+    /// on a lattice through its centre, a mesh on a cell-centred lattice over its bounding box;
+    /// only the outer `layers` when given.
     pub(super) fn points(&self, dx: f64, dim: usize, layers: Option<u32>) -> Vec<[f64; 3]> {
         let depth = layers.map_or(f64::MAX, |l| l as f64 * dx);
         let mut out = Vec::new();

@@ -14,6 +14,11 @@ use std::path::Path;
 
 use super::validate::Aabb;
 
+/// How far, relative to the shape's size, the lines that count crossings are moved off the
+/// points they go through (x, y): far below a spacing, off any round number (also a
+/// polygon's).
+pub(super) const LINE_SHIFT: [f64; 2] = [2.718_281_8e-9, 1.414_213_5e-9];
+
 /// The largest STL file read (about five million triangles in binary).
 const MAX_BYTES: u64 = 256 << 20;
 
@@ -275,7 +280,7 @@ impl Mesh {
         let size = (0..3)
             .map(|a| self.bounds.max[a] - self.bounds.min[a])
             .fold(0.0, f64::max);
-        (x + 2.718_281_8e-9 * size, y + 1.414_213_5e-9 * size)
+        (x + LINE_SHIFT[0] * size, y + LINE_SHIFT[1] * size)
     }
 
     /// The distance from `p` to the surface if it is less than `reach`.
@@ -312,7 +317,7 @@ impl Mesh {
     /// `depth`, less than `depth` from it. A cuboid whose sides are whole multiples of `dx`
     /// gets a box body's lattice.
     pub(super) fn points(&self, dx: f64, depth: Option<f64>) -> Vec<[f64; 3]> {
-        let (n, origin) = lattice(&self.bounds, dx, 3);
+        let (n, origin) = self.lattice(dx);
         let at = |a: usize, i: usize| origin[a] + (i as f64 + 0.5) * dx;
         let near = depth.map(|d| self.near_lattice(n, origin, dx, d));
         let mut out = Vec::new();
@@ -335,6 +340,15 @@ impl Mesh {
             }
         }
         out
+    }
+
+    /// Cells of size `dx` along each axis that cover the bounding box (a whole multiple of
+    /// `dx`, to rounding, is covered exactly), centred on it, and the corner of the first.
+    pub(super) fn lattice(&self, dx: f64) -> ([usize; 3], [f64; 3]) {
+        let b = &self.bounds;
+        let n = [0, 1, 2].map(|a| ((b.max[a] - b.min[a]) / dx - 1e-9).ceil().max(1.0) as usize);
+        let origin = [0, 1, 2].map(|a| 0.5 * (b.min[a] + b.max[a]) - 0.5 * n[a] as f64 * dx);
+        (n, origin)
     }
 
     /// Which points of the lattice (`n` cells from `origin`, spacing `dx`) are less than
@@ -371,30 +385,9 @@ impl Mesh {
     }
 }
 
-/// Cells of size `dx` along each of the first `dim` axes that cover the box `b` (a whole
-/// multiple of `dx`, to rounding, is covered exactly), centred on it, and the corner of the
-/// first: the lattice of a mesh or polygon body.
-pub(super) fn lattice(b: &Aabb, dx: f64, dim: usize) -> ([usize; 3], [f64; 3]) {
-    let n = [0, 1, 2].map(|a| {
-        if a < dim {
-            ((b.max[a] - b.min[a]) / dx - 1e-9).ceil().max(1.0) as usize
-        } else {
-            1
-        }
-    });
-    let origin = [0, 1, 2].map(|a| {
-        if a < dim {
-            0.5 * (b.min[a] + b.max[a]) - 0.5 * n[a] as f64 * dx
-        } else {
-            0.0
-        }
-    });
-    (n, origin)
-}
-
 /// Whether an odd number of the ascending `crossings` lie above `z`: inside, by the even–odd
-/// rule.
-fn odd_above(z: f64, crossings: &[f64]) -> bool {
+/// rule (also a polygon's, src/case/polygon.rs).
+pub(super) fn odd_above(z: f64, crossings: &[f64]) -> bool {
     (crossings.len() - crossings.partition_point(|&c| c <= z)) % 2 == 1
 }
 

@@ -12,8 +12,8 @@ use super::validate::Aabb;
 pub(super) enum PolygonError {
     /// Fewer than three vertices.
     TooFew(usize),
-    /// Vertex k repeats the one before it.
-    Repeated(usize),
+    /// Vertex `at` repeats vertex `of`, the one before it.
+    Repeated { at: usize, of: usize },
     /// Edges j and k (from vertex j to j + 1, k to k + 1) cross or overlap.
     Crossing(usize, usize),
     /// The outline encloses no area.
@@ -24,11 +24,10 @@ impl std::fmt::Display for PolygonError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             PolygonError::TooFew(n) => write!(f, "has {n} vertices; an outline needs at least 3"),
-            PolygonError::Repeated(k) => {
+            PolygonError::Repeated { at, of } => {
                 write!(
                     f,
-                    "repeats vertex {} at vertex {k} (an edge of length 0)",
-                    k - 1
+                    "repeats vertex {of} at vertex {at} (an edge of length 0)"
                 )
             }
             PolygonError::Crossing(j, k) => write!(
@@ -60,7 +59,10 @@ impl Polygon {
             return Err(PolygonError::TooFew(n));
         }
         if let Some(k) = (0..n).find(|&k| vertices[k] == vertices[(k + n - 1) % n]) {
-            return Err(PolygonError::Repeated(if k == 0 { n } else { k }));
+            return Err(PolygonError::Repeated {
+                at: k,
+                of: (k + n - 1) % n,
+            });
         }
         for j in 0..n {
             // Edges that share a vertex meet there; they must not fold back along each other.
@@ -158,7 +160,7 @@ impl Polygon {
     fn crossings(&self, x: f64) -> Vec<f64> {
         let size =
             (self.bounds.max[0] - self.bounds.min[0]).max(self.bounds.max[1] - self.bounds.min[1]);
-        let x = x + 2.718_281_8e-9 * size;
+        let x = x + super::mesh::LINE_SHIFT[0] * size;
         let mut y: Vec<f64> = self
             .edges()
             .filter(|(a, b)| (a[0] < x) != (b[0] < x))
@@ -170,8 +172,7 @@ impl Polygon {
 
     /// Whether `p` is inside the area.
     pub(super) fn contains(&self, p: [f64; 3]) -> bool {
-        let c = self.crossings(p[0]);
-        (c.len() - c.partition_point(|&y| y <= p[1])) % 2 == 1
+        super::mesh::odd_above(p[1], &self.crossings(p[0]))
     }
 
     /// The distance from `p` to the outline.
@@ -530,7 +531,12 @@ mod tests {
         );
         assert_eq!(
             Polygon::new(&[[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
-            Err(PolygonError::Repeated(2))
+            Err(PolygonError::Repeated { at: 2, of: 1 })
+        );
+        // The last corner back on the first.
+        assert_eq!(
+            Polygon::new(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]),
+            Err(PolygonError::Repeated { at: 0, of: 3 })
         );
         // A bow tie: the edges from vertex 0 and from vertex 2 cross.
         assert_eq!(
