@@ -661,8 +661,14 @@ pub struct Body {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Motion {
     /// Moves under the fluid's force and torque, gravity and contact, from this initial
-    /// velocity of its centre of mass and angular velocity (world axes; 2D: only z).
-    Free { velocity: [f64; 3], omega: [f64; 3] },
+    /// velocity of its centre of mass and angular velocity (world axes; 2D: only z); held at
+    /// rest where it is until t = `release_s` (0: from the start; a held body has no initial
+    /// velocity), while the water settles around it (DualSPHysics' FtPause).
+    Free {
+        velocity: [f64; 3],
+        omega: [f64; 3],
+        release_s: f64,
+    },
     /// Follows a given law whatever the forces: x(t) = pivot + d(t) + R(θ(t) about `axis`)(x0 − pivot).
     Prescribed(Prescribed),
 }

@@ -161,6 +161,7 @@ fn scene(dim: u32, seed: u64, kind: Kind) -> Scenario {
         Motion::Free {
             velocity: [0.3, -0.2, 0.0],
             omega,
+            release_s: 0.0,
         },
         kind,
         &mut parts,
@@ -436,6 +437,7 @@ fn a_body_in_free_flight_follows_the_exact_trajectory() {
         Motion::Free {
             velocity: v0,
             omega: [0.0, 0.0, w0],
+            release_s: 0.0,
         },
         Kind::Wall,
         &mut parts,
@@ -794,4 +796,49 @@ angular_velocity_rad_s = {:?}
         let e = (DVec3::from_array(gpu_parts[id].pos) - DVec3::from_array(x)).length();
         assert!(e < 2e-6, "particle {id} is {e} m off its rigid position");
     }
+}
+
+/// `release_s`: a light box (200 kg/m³) in the water, held until t = 0.1 s, stays exactly where
+/// it was and at rest while the water's lift on it is summed, then rises from the first step
+/// that ends after its release.
+#[test]
+fn a_held_body_stays_put_until_its_release() {
+    let case = std::fs::read_to_string("cases/floating_box_2d.toml").unwrap();
+    let body_wall = "wall = \"fixed_ghost\"\n";
+    assert!(case.contains(body_wall));
+    let text = case.replacen(
+        body_wall,
+        "wall = \"fixed_ghost\"\n[body.motion]\nkind = \"free\"\nrelease_s = 0.1\n",
+        1,
+    );
+    let set = [
+        "particles.dx_m=0.02".into(),
+        "body[0].density_kg_m3=200.0".into(),
+    ];
+    let sc = wgsph::case::load_str(&text, "held.toml", &set).unwrap();
+    assert!(matches!(sc.bodies[0].motion, Motion::Free { release_s, .. } if release_s == 0.1));
+    let start = DVec3::from_array(sc.bodies[0].center);
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    for t in [0.05, 0.1] {
+        solver.advance_to(t).unwrap();
+        let (pose, load) = (
+            solver.bodies().unwrap().pose(0),
+            solver.bodies().unwrap().load(0),
+        );
+        assert_eq!(pose.center, start, "t = {t}");
+        assert_eq!(
+            (pose.velocity, pose.omega),
+            (DVec3::ZERO, DVec3::ZERO),
+            "t = {t}"
+        );
+        assert!(load.force.y > 0.0, "t = {t}: lift {:?}", load.force);
+    }
+    solver.advance_to(0.15).unwrap();
+    let pose = solver.bodies().unwrap().pose(0);
+    let rise = pose.center.y - start.y;
+    println!(
+        "held box: rose {rise:.2e} m at {:.3} m/s in the 0.05 s after its release",
+        pose.velocity.y
+    );
+    assert!(rise > 1e-4 && pose.velocity.y > 0.0, "{pose:?}");
 }

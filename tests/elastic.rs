@@ -451,6 +451,7 @@ fn solids_in_contact(dim: u32, seed: u64) -> Scenario {
         motion: Motion::Free {
             velocity: [0.0; 3],
             omega: [0.0; 3],
+            release_s: 0.0,
         },
     }];
     sc

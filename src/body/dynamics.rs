@@ -93,6 +93,7 @@ mod tests {
             motion: Motion::Free {
                 velocity: [0.0; 3],
                 omega: [0.0; 3],
+                release_s: 0.0,
             },
         }
     }

@@ -123,7 +123,13 @@ pub fn csv_row(pose: &Pose, load: &Load, dim: u32) -> Vec<f64> {
 }
 
 enum State {
-    Free(RigidBody),
+    /// A free body, held at rest until t = `release_s`; `held`: in the step being taken (set
+    /// by the predictor).
+    Free {
+        body: RigidBody,
+        release_s: f64,
+        held: bool,
+    },
     Prescribed {
         law: Prescribed,
         center0: DVec3,
@@ -148,9 +154,15 @@ impl BodySet {
             .map(|b| {
                 let center0 = DVec3::from_array(b.center);
                 match &b.motion {
-                    Motion::Free { velocity, omega } => {
-                        State::Free(RigidBody::new(b, *velocity, *omega, dim == 2))
-                    }
+                    Motion::Free {
+                        velocity,
+                        omega,
+                        release_s,
+                    } => State::Free {
+                        body: RigidBody::new(b, *velocity, *omega, dim == 2),
+                        release_s: *release_s,
+                        held: *release_s > 0.0,
+                    },
                     Motion::Prescribed(law) => State::Prescribed {
                         pose: law.pose(center0, 0.0),
                         law: law.clone(),
@@ -176,16 +188,25 @@ impl BodySet {
     }
 
     /// Predictor: every body moved to `t_next = t + dt` (free bodies with their last
-    /// acceleration, prescribed ones by their law). Returns the poses the step evaluates at.
+    /// acceleration, prescribed ones by their law; a free body not yet released stays at rest
+    /// until the first step that ends after its `release_s`, by more than the 1e-4 dt of
+    /// rounding the GPU's clock counts as arrival). Returns the poses the step evaluates at.
     pub fn predict(&mut self, t_next: f64, dt: f64) -> Vec<Pose> {
         let planar = self.planar;
         self.states
             .iter_mut()
             .map(|s| {
                 let pose = match s {
-                    State::Free(b) => {
-                        b.predict(dt);
-                        &mut b.pose
+                    State::Free {
+                        body,
+                        release_s,
+                        held,
+                    } => {
+                        *held = t_next <= *release_s + 1e-4 * dt;
+                        if !*held {
+                            body.predict(dt);
+                        }
+                        &mut body.pose
                     }
                     State::Prescribed { law, center0, pose } => {
                         *pose = law.pose(*center0, t_next);
@@ -207,11 +228,14 @@ impl BodySet {
     /// central differences of its law's velocities (ε = 1e-5 s). What a body's fixed ghosts
     /// carry the fluid pressure along (g − a, Adami, Hu & Adams 2012, eq. 27).
     pub fn accelerations(&self, t: f64) -> Vec<[DVec3; 2]> {
+        // (After `predict`, which marks the bodies held in this step.)
         const EPS: f64 = 1e-5;
         self.states
             .iter()
             .map(|s| match s {
-                State::Free(b) => [b.accel, b.alpha],
+                // A held body is at rest, whatever its load would do to it.
+                State::Free { held: true, .. } => [DVec3::ZERO; 2],
+                State::Free { body, .. } => [body.accel, body.alpha],
                 State::Prescribed { law, center0, .. } => {
                     let (a, b) = (law.pose(*center0, t - EPS), law.pose(*center0, t + EPS));
                     [
@@ -230,11 +254,14 @@ impl BodySet {
             .collect()
     }
 
-    /// Corrector with the loads evaluated at the predicted poses.
+    /// Corrector with the loads evaluated at the predicted poses. A body held in this step
+    /// stays at rest but takes the accelerations its load gives, so that the step that
+    /// releases it starts as any other does.
     pub fn correct(&mut self, dt: f64, loads: &[Load]) {
         for ((s, load), last) in self.states.iter_mut().zip(loads).zip(&mut self.loads) {
-            if let State::Free(b) = s {
-                b.correct(dt, *load, self.gravity);
+            if let State::Free { body, held, .. } = s {
+                // Held: a corrector of no time (velocities unchanged, accelerations taken).
+                body.correct(if *held { 0.0 } else { dt }, *load, self.gravity);
             }
             *last = *load;
         }
@@ -243,7 +270,7 @@ impl BodySet {
     /// The current pose of body `k`.
     pub fn pose(&self, k: usize) -> Pose {
         match &self.states[k] {
-            State::Free(b) => b.pose,
+            State::Free { body, .. } => body.pose,
             State::Prescribed { pose, .. } => *pose,
         }
     }
@@ -259,7 +286,7 @@ impl BodySet {
         let mut out = Vec::with_capacity(SAVED_PER_BODY * self.len());
         for (s, load) in self.states.iter().zip(&self.loads) {
             let (pose, accel, alpha) = match s {
-                State::Free(b) => (b.pose, b.accel, b.alpha),
+                State::Free { body, .. } => (body.pose, body.accel, body.alpha),
                 State::Prescribed { pose, .. } => (*pose, DVec3::ZERO, DVec3::ZERO),
             };
             out.extend(pose.center.to_array());
@@ -302,10 +329,10 @@ impl BodySet {
                 omega: vec3(10),
             };
             match s {
-                State::Free(b) => {
-                    b.pose = pose;
-                    b.accel = vec3(13);
-                    b.alpha = vec3(16);
+                State::Free { body, .. } => {
+                    body.pose = pose;
+                    body.accel = vec3(13);
+                    body.alpha = vec3(16);
                 }
                 State::Prescribed { pose: p, .. } => *p = pose,
             }
@@ -321,3 +348,52 @@ impl BodySet {
 /// Numbers per body in [`BodySet::save`]: centre 3, quaternion 4, velocity 3, ω 3,
 /// accelerations 3 + 3, force 3, torque 3.
 pub const SAVED_PER_BODY: usize = 25;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A body held until t = 0.5005 s under gravity alone stays where it is, at rest, and its
+    /// ghosts see no acceleration; the step from 0.5 s is the first that ends after the release,
+    /// and from it the body falls as one dropped at 0.5 s (the predictor–corrector is exact for
+    /// a constant acceleration, so only if the held body took its accelerations).
+    #[test]
+    fn a_held_body_rests_until_its_release_then_falls_from_rest() {
+        const RELEASE: f64 = 0.5005;
+        let body = Body {
+            name: "held".into(),
+            particles: 0..1,
+            mass: 2.0,
+            center: [0.0, 1.0, 0.0],
+            inertia: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            motion: Motion::Free {
+                velocity: [0.0; 3],
+                omega: [0.0; 3],
+                release_s: RELEASE,
+            },
+        };
+        let g = 9.81;
+        let mut set = BodySet::new(&[body], [0.0, -g, 0.0], 2);
+        let dt = 1e-3;
+        for k in 1..=1000 {
+            let t_next = k as f64 * dt;
+            let pose = set.predict(t_next, dt)[0];
+            let [accel, alpha] = set.accelerations(t_next)[0];
+            if t_next <= RELEASE {
+                assert_eq!(pose.center, DVec3::new(0.0, 1.0, 0.0), "t = {t_next}");
+                assert_eq!((pose.velocity, pose.omega), (DVec3::ZERO, DVec3::ZERO));
+                assert_eq!((accel, alpha), (DVec3::ZERO, DVec3::ZERO));
+            } else {
+                assert_eq!(accel, DVec3::new(0.0, -g, 0.0), "t = {t_next}");
+            }
+            set.correct(dt, &[Load::default()]);
+        }
+        let (pose, fall) = (set.pose(0), 0.5);
+        assert!(
+            (pose.center.y - (1.0 - 0.5 * g * fall * fall)).abs() < 1e-9,
+            "{pose:?}"
+        );
+        assert!((pose.velocity.y + g * fall).abs() < 1e-9, "{pose:?}");
+        assert_eq!(pose.center.x, 0.0);
+    }
+}

@@ -157,6 +157,7 @@ pub(super) fn validate(
             None => Motion::Free {
                 velocity: [0.0; 3],
                 omega: [0.0; 3],
+                release_s: 0.0,
             },
             Some(m) => motion(ctx, &motion_path, m, dim, true, case_dir)?,
         };
@@ -295,7 +296,7 @@ pub(super) fn motion(
     case_dir: &Path,
 ) -> Result<Motion, CaseError> {
     let needs: &[&str] = match m.kind {
-        MotionName::Free => &["velocity_m_s", "angular_velocity_rad_s"],
+        MotionName::Free => &["velocity_m_s", "angular_velocity_rad_s", "release_s"],
         MotionName::Fixed => &[],
         MotionName::Sine => &[
             "pivot_m",
@@ -316,6 +317,7 @@ pub(super) fn motion(
     let given = [
         ("velocity_m_s", m.velocity_m_s.is_some()),
         ("angular_velocity_rad_s", m.angular_velocity_rad_s.is_some()),
+        ("release_s", m.release_s.is_some()),
         ("pivot_m", m.pivot_m.is_some()),
         ("axis", m.axis.is_some()),
         ("translation_m", m.translation_m.is_some()),
@@ -398,7 +400,34 @@ pub(super) fn motion(
                 ))
             }
         };
-        return Ok(Motion::Free { velocity, omega });
+        let release_s = match m.release_s {
+            None => 0.0,
+            Some(r) if r.is_finite() && r >= 0.0 => r,
+            Some(r) => {
+                return Err(ctx.err(
+                    &format!("{path}.release_s"),
+                    Some(r.to_string()),
+                    "must be a time of at least 0 s (how long the body is held at rest before \
+                     it is released)",
+                    "write e.g. release_s = 1.0, or remove it to release the body at once",
+                ))
+            }
+        };
+        if release_s > 0.0 && (velocity != [0.0; 3] || omega != [0.0; 3]) {
+            return Err(ctx.err(
+                &format!("{path}.release_s"),
+                Some(release_s.to_string()),
+                "holds the body at rest until it is released, so it cannot also have an \
+                 initial velocity_m_s or angular_velocity_rad_s",
+                "remove velocity_m_s and angular_velocity_rad_s (a held body is released from \
+                 rest), or remove release_s",
+            ));
+        }
+        return Ok(Motion::Free {
+            velocity,
+            omega,
+            release_s,
+        });
     }
     let pivot = match &m.pivot_m {
         Some(p) => vector(

@@ -585,7 +585,9 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         }
         for pos in points {
             let vel = match &spec.motion {
-                Motion::Free { velocity, omega } => {
+                Motion::Free {
+                    velocity, omega, ..
+                } => {
                     let r = [0, 1, 2].map(|a| pos[a] - center[a]);
                     [
                         velocity[0] + omega[1] * r[2] - omega[2] * r[1],

@@ -229,6 +229,7 @@ pub(super) struct RawMotion {
     pub kind: MotionName,
     pub velocity_m_s: Option<Vec<f64>>,
     pub angular_velocity_rad_s: Option<Vec<f64>>,
+    pub release_s: Option<f64>,
     pub pivot_m: Option<Vec<f64>>,
     pub axis: Option<Vec<f64>>,
     pub translation_m: Option<Vec<f64>>,
@@ -835,6 +836,12 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "motion.angular_velocity_rad_s",
         "the initial angular velocity of a free body in rad/s: [w_z] in 2D, [w_x, w_y, w_z] in 3D",
         "angular_velocity_rad_s = [0.0]",
+    ),
+    f(
+        "motion.release_s",
+        "how long a free body is held at rest before it is released, in s (the water settles \
+         around it meanwhile)",
+        "release_s = 2.0",
     ),
     f(
         "motion.pivot_m",

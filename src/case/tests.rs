@@ -1253,6 +1253,49 @@ fn bad_bodies_and_motions_are_refused() {
         None,
         &["body[0].motion.period_s", "not used by a fixed motion", "no other field"],
     );
+    let held = |more: &str| {
+        with_body(&format!(
+            "shape = \"box\"\nmin_m = [0.4, 0.4]\nmax_m = [0.5, 0.5]\nmass_kg = 1.0\n\
+             [body.motion]\nkind = \"free\"\n{more}"
+        ))
+    };
+    assert_err(
+        &held("release_s = -1.0"),
+        &[],
+        None,
+        &[
+            "body[0].motion.release_s",
+            "at least 0 s",
+            "release_s = 1.0",
+        ],
+    );
+    assert_err(
+        &held("release_s = 1.0\nvelocity_m_s = [0.0, -1.0]"),
+        &[],
+        None,
+        &["body[0].motion.release_s", "initial velocity_m_s", "remove"],
+    );
+    assert_err(
+        &held("release_s = 1.0\nangular_velocity_rad_s = [2.0]"),
+        &[],
+        None,
+        &["body[0].motion.release_s", "angular_velocity_rad_s"],
+    );
+    assert_err(
+        &format!("{BASE}\n[tank.motion]\nkind = \"sine\"\nrelease_s = 1.0\n"),
+        &[],
+        None,
+        &["tank.motion.release_s", "not used by a sine motion"],
+    );
+    let s = load_str(&held("release_s = 1.5"), "c.toml", &[]).unwrap();
+    assert_eq!(
+        s.bodies[0].motion,
+        Motion::Free {
+            velocity: [0.0; 3],
+            omega: [0.0; 3],
+            release_s: 1.5
+        }
+    );
 }
 
 /// `kind = "fixed"`: a body held where it is, needing no mass; its particles are placed as a

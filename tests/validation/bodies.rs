@@ -138,7 +138,7 @@ fn a_fixed_submerged_diamond_feels_its_buoyancy() {
 
 /// A box 0.12 m square held under the water, of dynamic particles (the default wall).
 #[test]
-#[ignore = "fails: +2.8 % at dx = 0.02 once settled (+1.9 % with fixed ghosts): the dynamic boundary holds the water off its faces; docs/validation.md 'Fixed bodies'"]
+#[ignore = "fails: +2.8 % at dx = 0.02 once settled (+2.1 % over 4-6 s; +1.9 % with fixed ghosts): the dynamic boundary holds the water off its faces; docs/validation.md 'Fixed bodies'"]
 fn a_fixed_submerged_box_feels_its_buoyancy() {
     let box_lines = "shape = \"box\"\nmin_m = [0.24, 0.14]\nmax_m = [0.36, 0.26]";
     let error = fixed_lift(box_lines, 0.12 * 0.12, "dynamic", 0.02);
