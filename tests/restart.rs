@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use common::gpu;
 use wgsph::progress::LogLines;
 use wgsph::run::RunOptions;
-use wgsph::scenario::Scenario;
+use wgsph::scenario::{Motion, Scenario};
 
 fn temp_dir(name: &str) -> common::Scratch {
     common::Scratch::new(&format!("restart-{name}"))
@@ -128,6 +128,25 @@ fn resume_is_bit_identical_for_a_floating_body() {
         ],
     );
     split_run_matches("floating-box", &sc, 0.07);
+}
+
+/// The same box held until t = 0.1 s (`release_s`), halted while held: the resumed run
+/// releases it at the same step.
+#[test]
+fn resume_is_bit_identical_for_a_body_held_across_the_halt() {
+    let sc = load(
+        "cases/floating_box_2d.toml",
+        &[
+            "particles.dx_m=0.02",
+            "body[0].motion.kind=\"free\"",
+            "body[0].motion.release_s=0.1",
+            "time.end_s=0.16",
+            "time.output_every_s=0.04",
+            "time.probe_every_s=0.01",
+        ],
+    );
+    assert!(matches!(sc.bodies[0].motion, Motion::Free { release_s, .. } if release_s == 0.1));
+    split_run_matches("held-box", &sc, 0.07);
 }
 
 /// Elastic plates of both formulations in one case (tests/common `both_plates_case`): the
