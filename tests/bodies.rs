@@ -803,19 +803,14 @@ angular_velocity_rad_s = {:?}
 /// that ends after its release.
 #[test]
 fn a_held_body_stays_put_until_its_release() {
-    let case = std::fs::read_to_string("cases/floating_box_2d.toml").unwrap();
-    let body_wall = "wall = \"fixed_ghost\"\n";
-    assert!(case.contains(body_wall));
-    let text = case.replacen(
-        body_wall,
-        "wall = \"fixed_ghost\"\n[body.motion]\nkind = \"free\"\nrelease_s = 0.1\n",
-        1,
-    );
     let set = [
-        "particles.dx_m=0.02".into(),
-        "body[0].density_kg_m3=200.0".into(),
-    ];
-    let sc = wgsph::case::load_str(&text, "held.toml", &set).unwrap();
+        "particles.dx_m=0.02",
+        "body[0].density_kg_m3=200.0",
+        "body[0].motion.kind=\"free\"",
+        "body[0].motion.release_s=0.1",
+    ]
+    .map(String::from);
+    let sc = wgsph::case::load(std::path::Path::new("cases/floating_box_2d.toml"), &set).unwrap();
     assert!(matches!(sc.bodies[0].motion, Motion::Free { release_s, .. } if release_s == 0.1));
     let start = DVec3::from_array(sc.bodies[0].center);
     let mut solver = Solver::new(gpu(), &sc).unwrap();

@@ -101,10 +101,12 @@ fn fixed_lift(shape: &str, area: f64, wall: &str, dx: f64) -> f64 {
     );
     let sc = wgsph::case::load_str(&text, "fixed.toml", &[]).unwrap();
     let mut solver = Solver::new(gpu(), &sc).unwrap();
+    // Samples every 0.05 s to the case's end (3.5 s); the mean over the last second.
+    let samples = (sc.time.end_s / 0.05).round() as usize;
     let (mut lift, mut n) = (0.0, 0);
-    for k in 1..=70 {
+    for k in 1..=samples {
         solver.advance_to(0.05 * k as f64).unwrap();
-        if k > 50 {
+        if k > samples - 20 {
             lift += solver.bodies().unwrap().load(0).force.y;
             n += 1;
         }
