@@ -400,6 +400,9 @@ impl<'a> Runner<'a> {
             solver.gpu_bytes() as f64 / sc.particles.len() as f64,
             solver.dt()
         );
+        for w in &sc.warnings {
+            log::warn!("{}: {w}", sc.name);
+        }
         Ok(Self {
             ctx,
             sc,
@@ -496,6 +499,7 @@ impl<'a> Runner<'a> {
                 (None, Some(_)) => format!("interrupted{resume_hint}"),
                 (None, None) => "completed".into(),
             },
+            warnings: sc.warnings.clone(),
         };
         self.outputs.out.write_run_summary(&summary)?;
         Ok(RunReport {

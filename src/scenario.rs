@@ -431,6 +431,9 @@ pub struct Scenario {
     pub inlets: Vec<Inlet>,
     /// Outlets: boxes that remove the fluid entering them.
     pub outlets: Vec<Outlet>,
+    /// Doubts about the case found while building it, each naming the part, the concern and a
+    /// fix. The run goes on: `wgsph run` logs them and `DIR/run.json` lists them.
+    pub warnings: Vec<String>,
 }
 
 /// An outlet (`[[outlet]]`, docs/cases.md "Outlets"): a box that removes every fluid particle

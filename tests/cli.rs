@@ -148,6 +148,50 @@ fn quiet_prints_nothing_but_errors() {
     assert!(!out.join("snapshots").exists());
 }
 
+/// A case's warnings (here a fixed-ghost baffle 0.04 m thick, under 4h − dx = 0.084 m) go to
+/// the log as WARN lines and into run.json; the run goes on.
+#[test]
+fn case_warnings_go_to_the_log_and_run_json() {
+    let dir = temp_dir("warnings");
+    std::fs::create_dir_all(&*dir).unwrap();
+    let case = dir.join("baffle.toml");
+    let text = std::fs::read_to_string("cases/hydrostatic_2d.toml").unwrap()
+        + "\n[[obstacle]]\nmin_m = [0.6, 0.1]\nmax_m = [0.64, 0.4]\nwall = \"fixed_ghost\"\n";
+    std::fs::write(&case, text).unwrap();
+    let out = dir.join("out");
+    let o = wgsph()
+        .arg("run")
+        .arg(&case)
+        .args([
+            "--set",
+            "time.end_s=0.01",
+            "--set",
+            "time.output_every_s=0.01",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    let expected = "obstacle[0] ([0.6, 0.1] to [0.64, 0.4]) has fixed ghosts and is 0.04 m thick";
+    assert!(
+        stderr
+            .lines()
+            .any(|l| l.contains("WARN") && l.contains(expected)),
+        "{stderr}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(summary["status"], "completed");
+    let warnings = summary["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].as_str().unwrap().starts_with(expected),
+        "{warnings:?}"
+    );
+}
+
 #[test]
 fn snapshot_field_needs_snapshots_and_a_known_field() {
     for (args, word) in [

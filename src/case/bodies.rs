@@ -698,6 +698,32 @@ impl Shape {
         ]
     }
 
+    /// The shape's thickness, twice the depth of its deepest point, when that is less than
+    /// `limit` (`None`: at least `limit` thick). Exact for a box (its smallest side) and a
+    /// ball; for a polygon or mesh estimated from its particles at spacing `dx` (their layers
+    /// are dx apart and the deepest lies less than dx under the middle): twice the deepest
+    /// particle's depth plus dx, to within dx.
+    pub(super) fn thinner_than(&self, limit: f64, dx: f64, dim: usize) -> Option<f64> {
+        // A particle (limit − dx)/2 deep makes the estimate reach the limit: stop there.
+        let reach = 0.5 * (limit - dx);
+        let deepest = |depth: &dyn Fn([f64; 3]) -> Option<f64>| {
+            self.points(dx, dim, None)
+                .into_iter()
+                .try_fold(0.0f64, |deepest, p| Some(deepest.max(depth(p)?)))
+        };
+        let thickness = match self {
+            Shape::Box(b) => (0..dim)
+                .map(|a| b.max[a] - b.min[a])
+                .fold(f64::MAX, f64::min),
+            Shape::Ball { radius, .. } => 2.0 * radius,
+            Shape::Polygon(q) => {
+                2.0 * deepest(&|p| Some(q.distance(p)).filter(|&d| d < reach))? + dx
+            }
+            Shape::Mesh(m) => 2.0 * deepest(&|p| m.distance_within(p, reach))? + dx,
+        };
+        (thickness < limit).then_some(thickness)
+    }
+
     /// Whether `p` is inside the shape or less than `margin` from its surface.
     pub(super) fn near(&self, p: [f64; 3], margin: f64, dim: usize) -> bool {
         match self {

@@ -550,6 +550,7 @@ pub(super) fn build_solid_case(
         }),
         inlets: Vec::new(),
         outlets: Vec::new(),
+        warnings: Vec::new(),
     })
 }
 

@@ -30,6 +30,9 @@ pub struct RunSummary {
     pub outputs: u64,
     /// "completed" | "stopped: <reason>"
     pub status: String,
+    /// The case's warnings (`Scenario::warnings`).
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 pub(crate) fn write_run_summary(path: &Path, summary: &RunSummary) -> Result<(), OutputError> {
@@ -65,6 +68,7 @@ mod tests {
             gpu_bytes_per_particle: 212.0,
             outputs: 51,
             status: "completed".into(),
+            warnings: vec!["body[0] ('plate') has fixed ghosts and is 0.01 m thick".into()],
         }
     }
 

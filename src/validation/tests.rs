@@ -32,6 +32,7 @@ fn summary(case: &str, excluded: u64) -> RunSummary {
         gpu_bytes_per_particle: 1.0,
         outputs: 1,
         status: "completed".into(),
+        warnings: Vec::new(),
     }
 }
 

@@ -147,6 +147,7 @@ pub fn scenario(
         solids: None,
         inlets: Vec::new(),
         outlets: Vec::new(),
+        warnings: Vec::new(),
         domain,
         particles,
         probes,

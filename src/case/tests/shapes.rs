@@ -331,3 +331,75 @@ fn bad_polygon_bodies_are_refused_naming_the_field() {
         &["body[0].shape", "3D"],
     );
 }
+
+/// Fixed-ghost bodies and obstacles thinner than 4h − dx (0.2625 m here: dx = 0.0625,
+/// h = 1.3 dx) load with a warning naming the part, its thickness, the limit and a fix; thicker
+/// ones, and thin ones of other wall treatments, load without.
+#[test]
+fn thin_fixed_ghost_parts_load_with_a_warning() {
+    let warnings = |text: &str| load_str(text, "c.toml", &[]).unwrap().warnings;
+    let ghost = "wall = \"fixed_ghost\"";
+    let thin_box = "shape = \"box\"\nmin_m = [0.6, 0.6]\nmax_m = [0.9, 0.725]";
+    let w = warnings(&case_2d(&format!("{thin_box}\n{ghost}")));
+    assert_eq!(w.len(), 1, "{w:?}");
+    for words in [
+        "body[0] ('b') has fixed ghosts and is 0.125 m thick",
+        "4h - dx = 0.2625 m",
+        "fix: make it at least 0.2625 m thick",
+    ] {
+        assert!(w[0].contains(words), "{words:?} not in {:?}", w[0]);
+    }
+    assert!(warnings(&case_2d(thin_box)).is_empty(), "dynamic");
+    let thick_box = "shape = \"box\"\nmin_m = [0.55, 0.55]\nmax_m = [0.85, 0.85]";
+    assert!(warnings(&case_2d(&format!("{thick_box}\n{ghost}"))).is_empty());
+
+    let circle =
+        |r: f64| format!("shape = \"circle\"\ncenter_m = [0.75, 0.75]\nradius_m = {r}\n{ghost}");
+    let w = warnings(&case_2d(&circle(0.125)));
+    assert!(w.len() == 1 && w[0].contains("is 0.25 m thick"), "{w:?}");
+    assert!(warnings(&case_2d(&circle(0.14))).is_empty());
+
+    // A slanted plate 0.115 m thick: measured at its particles, so "about".
+    let plate =
+        "shape = \"polygon\"\nvertices_m = [[0.55, 0.6], [0.9, 0.75], [0.9, 0.875], [0.55, 0.725]]";
+    let w = warnings(&case_2d(&format!("{plate}\n{ghost}")));
+    assert!(
+        w.len() == 1 && w[0].contains("body[0] ('b') has fixed ghosts and is about 0.1"),
+        "{w:?}"
+    );
+    // A diamond 0.38 m thick (its particles say 0.375).
+    let diamond =
+        "shape = \"polygon\"\nvertices_m = [[0.72, 0.43], [0.99, 0.7], [0.72, 0.97], [0.45, 0.7]]";
+    assert!(warnings(&case_2d(&format!("{diamond}\n{ghost}"))).is_empty());
+
+    let obstacle = |max_x: f64| {
+        BASE.replace("dx_m = 0.1", "dx_m = 0.0625")
+            + &format!("\n[[obstacle]]\nmin_m = [0.6, 0.0]\nmax_m = [{max_x}, 0.3]\n{ghost}\n")
+    };
+    let w = warnings(&obstacle(0.8));
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("obstacle[0] ([0.6, 0.0] to [0.8, 0.3]) has fixed ghosts and is 0.2"),
+        "{w:?}"
+    );
+    assert!(warnings(&obstacle(0.9)).is_empty());
+
+    // A mesh, in 3D: a plate 0.125 m thick, and a block 0.4 m thick.
+    let dir = folder("thin");
+    let mesh_case = |lo, hi| {
+        write_stl(&dir.join("hull.stl"), &cuboid(lo, hi));
+        load_in(
+            &dir,
+            &case(&format!("shape = \"mesh\"\nfile = \"hull.stl\"\n{ghost}")),
+        )
+        .unwrap()
+        .warnings
+    };
+    let w = mesh_case([0.3, 0.3, 0.6], [0.7, 0.7, 0.725]);
+    assert!(
+        w.len() == 1 && w[0].contains("body[0] ('hull') has fixed ghosts and is about"),
+        "{w:?}"
+    );
+    assert!(mesh_case([0.3, 0.3, 0.4], [0.7, 0.7, 0.8]).is_empty());
+    std::fs::remove_dir_all(&dir).ok();
+}
