@@ -28,7 +28,7 @@ fn point_inside(p: [f64; 3], b: &Aabb, dim: usize) -> bool {
     (0..dim).all(|a| b.min[a] - TOL <= p[a] && p[a] <= b.max[a] + TOL)
 }
 
-fn fmt_box(b: &Aabb, dim: usize) -> String {
+pub(super) fn fmt_box(b: &Aabb, dim: usize) -> String {
     format!("{:?} to {:?}", &b.min[..dim], &b.max[..dim])
 }
 
@@ -634,7 +634,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     }
 
     let points = super::probes::resolve_points(ctx, &case.points, &particles, &bodies, dim, dx)?;
-    let warnings = thin_ghost_warnings(&case, dx, h);
+    let warnings = super::warnings::of(&case, dx, h);
     let mut probes = case.probes;
     super::probes::resolve_wall_patches(ctx, &mut probes, &particles, dim, dx, h)?;
     let physics = Physics {
@@ -689,68 +689,6 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         outlets: case.outlets,
         warnings,
     })
-}
-
-/// Fixed-ghost obstacles and bodies thinner than 4h − dx (docs/cases.md, "fixed_ghost"): the
-/// water stays about dx/2 off a face, so a ghost within 2h of the water on one side is then
-/// also within 2h of the water beyond the opposite face, and where water is on both sides the
-/// ghost's interpolated pressure and velocity mix the two sides'. A warning, not a refusal: a
-/// thin wall with water on one side only is fine.
-fn thin_ghost_warnings(case: &Case, dx: f64, h: f64) -> Vec<String> {
-    let limit = 4.0 * h - dx;
-    let dim = case.dim;
-    let ghosts = |t: Treatment| matches!(t, Treatment::FixedGhost { .. });
-    // `measured`: on the lattice (polygons and meshes), to within dx.
-    let warning = |part: String, thickness: f64, measured: bool| {
-        format!(
-            "{part} has fixed ghosts and is {}{} m thick, less than 4h - dx = {} m: where water \
-             is on both sides, a ghost near one face also interpolates the water beyond the \
-             other, mixing the two sides' pressures; fix: make it at least {} m thick, or \
-             decrease particles.dx_m (the limit is (4 h_over_dx - 1) dx)",
-            if measured { "about " } else { "" },
-            // Three digits of a measured thickness are all it has.
-            num(if measured {
-                format!("{thickness:.2e}").parse().unwrap_or(thickness)
-            } else {
-                thickness
-            }),
-            num(limit),
-            num(limit)
-        )
-    };
-    let obstacles = case
-        .obstacles
-        .iter()
-        .zip(&case.obstacle_walls)
-        .enumerate()
-        .filter(|(_, (_, &t))| ghosts(t))
-        .filter_map(|(i, (b, _))| {
-            let thickness = (0..dim)
-                .map(|a| b.max[a] - b.min[a])
-                .fold(f64::MAX, f64::min);
-            (thickness < limit).then(|| {
-                warning(
-                    format!("obstacle[{i}] ({})", fmt_box(b, dim)),
-                    thickness,
-                    false,
-                )
-            })
-        });
-    let bodies = case
-        .bodies
-        .iter()
-        .enumerate()
-        .filter(|(_, b)| ghosts(b.wall))
-        .filter_map(|(i, b)| {
-            let thickness = b.shape.thinner_than(limit, dx, dim)?;
-            let measured = matches!(b.shape, Shape::Polygon(_) | Shape::Mesh(_));
-            Some(warning(
-                format!("body[{i}] ('{}')", b.name),
-                thickness,
-                measured,
-            ))
-        });
-    obstacles.chain(bodies).collect()
 }
 
 /// The given domain, or the default one; checks that fluid, walls and probes lie inside it.

@@ -22,6 +22,7 @@ mod probes;
 mod schema;
 mod solids;
 mod validate;
+mod warnings;
 
 #[cfg(test)]
 mod tests;

@@ -403,3 +403,39 @@ fn thin_fixed_ghost_parts_load_with_a_warning() {
     assert!(mesh_case([0.3, 0.3, 0.4], [0.7, 0.7, 0.8]).is_empty());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Tank walls and shell bodies of dynamic particles or fixed ghosts whose layers are thinner
+/// than the kernel support 2h load with a warning that names the field and the layers needed;
+/// enough layers, a filled body and repulsive walls (one layer by design) load without.
+#[test]
+fn wall_layers_short_of_the_kernel_support_load_with_a_warning() {
+    let warnings =
+        |text: &str, over: &[&str]| load_str(text, "c.toml", &sets(over)).unwrap().warnings;
+    let body = "shape = \"box\"\nmin_m = [0.55, 0.55]\nmax_m = [0.85, 0.85]";
+    // dx = 0.0625, h = 1.3 dx: 2h = 0.1625 m needs 3 layers; the tank has 3.
+    assert!(warnings(&case_2d(body), &[]).is_empty());
+    let w = warnings(&case_2d(body), &["particles.h_over_dx=2"]);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("tank.layers = 3: 3 particle layers (0.1875 m) are less than the kernel support 2h = 0.25 m deep, so fluid beside the tank wall")
+            && w[0].ends_with("fix: set tank.layers to 4 or more"),
+        "{w:?}"
+    );
+    assert!(warnings(
+        &case_2d(body),
+        &["particles.h_over_dx=2", "tank.wall=\"repulsive\""]
+    )
+    .is_empty());
+    let w = warnings(
+        &case_2d(&format!("{body}\nlayers = 2\nwall = \"fixed_ghost\"")),
+        &[],
+    );
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].starts_with("body[0].layers = 2: 2 particle layers (0.125 m) are less than the kernel support 2h = 0.1625 m deep, so fluid beside the body 'b' misses"), "{w:?}");
+    assert!(warnings(&case_2d(&format!("{body}\nlayers = 3")), &[]).is_empty());
+    assert!(warnings(
+        &case_2d(&format!("{body}\nlayers = 1\nwall = \"repulsive\"")),
+        &[]
+    )
+    .is_empty());
+}
