@@ -634,7 +634,15 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     }
 
     let points = super::probes::resolve_points(ctx, &case.points, &particles, &bodies, dim, dx)?;
-    let warnings = super::warnings::of(&case, dx, h);
+    let warnings = super::warnings::of(
+        &case,
+        dx,
+        h,
+        super::warnings::Sound {
+            c0,
+            field: sound_path,
+        },
+    );
     let mut probes = case.probes;
     super::probes::resolve_wall_patches(ctx, &mut probes, &particles, dim, dx, h)?;
     let physics = Physics {

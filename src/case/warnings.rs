@@ -6,12 +6,87 @@ use super::bodies::Shape;
 use super::build::fmt_box;
 use super::error::num;
 use super::validate::{Case, Treatment};
+use crate::scenario::{Motion, MotionLaw};
+
+/// The speed of sound `c0` and the field it came from (`physics.sound_speed_m_s` or
+/// `physics.sound_speed_coef`).
+pub(super) struct Sound<'a> {
+    pub c0: f64,
+    pub field: &'a str,
+}
 
 /// Every warning about `case` at spacing `dx` and smoothing length `h`.
-pub(super) fn of(case: &Case, dx: f64, h: f64) -> Vec<String> {
+pub(super) fn of(case: &Case, dx: f64, h: f64, sound: Sound<'_>) -> Vec<String> {
     let mut out = shallow_walls(case, dx, h);
     out.extend(thin_ghosts(case, dx, h));
+    out.extend(fast_flow(case, sound));
     out
+}
+
+/// The fastest speed the case sets (a fluid block's or a free body's initial velocity, an
+/// inlet's, a prescribed translation's largest) when it is more than c0/10: weakly
+/// compressible SPH then compresses the water by more than about (u/c0)² = 1 %. The speeds
+/// the flow reaches on its own (a dam break's fall) and those of rotations are not known here.
+fn fast_flow(case: &Case, sound: Sound<'_>) -> Option<String> {
+    if case.blocks.is_empty() && case.inlets.is_empty() {
+        return None;
+    }
+    let norm = |v: &[f64; 3]| v.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let moving = |path: String, m: &Motion| -> (String, f64) {
+        let speed = match m {
+            Motion::Free { velocity, .. } => norm(velocity),
+            Motion::Prescribed(p) => match &p.law {
+                MotionLaw::Fixed => 0.0,
+                MotionLaw::Sine {
+                    translation, omega, ..
+                } => norm(translation) * omega.abs(),
+                MotionLaw::Series { t, translation, .. } => t
+                    .windows(2)
+                    .zip(translation.windows(2))
+                    .map(|(t, d)| {
+                        let step = [0, 1, 2].map(|a| d[1][a] - d[0][a]);
+                        norm(&step) / (t[1] - t[0])
+                    })
+                    .fold(0.0, f64::max),
+            },
+        };
+        (path, speed)
+    };
+    let blocks = case
+        .blocks
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (format!("fluid_block[{i}].velocity_m_s"), norm(&b.vel)));
+    let inlets = (case.inlets.iter().enumerate())
+        .map(|(i, s)| (format!("inlet[{i}].velocity_m_s"), s.speed));
+    let bodies = (case.bodies.iter().enumerate())
+        .map(|(i, b)| moving(format!("body[{i}].motion"), &b.motion));
+    let tank =
+        (case.tank.iter()).filter_map(|t| Some(moving("tank.motion".into(), t.motion.as_ref()?)));
+    let (field, u) = blocks
+        .chain(inlets)
+        .chain(bodies)
+        .chain(tank)
+        .filter(|(_, u)| u.is_finite())
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    (u > 0.1 * sound.c0).then(|| {
+        format!(
+            "{field} sets a speed of {} m/s, more than c0/10 = {} m/s (c0 from {}): the water \
+             is compressed by about (u/c0)² = {} %, more than weakly compressible SPH allows; \
+             fix: raise {} so that c0 is at least {} m/s (the time step shrinks with it)",
+            num(round3(u)),
+            num(round3(0.1 * sound.c0)),
+            sound.field,
+            num(round3(100.0 * (u / sound.c0).powi(2))),
+            sound.field,
+            num(round3(10.0 * u))
+        )
+    })
+}
+
+/// `x` to three significant digits, for messages.
+fn round3(x: f64) -> f64 {
+    format!("{x:.2e}").parse().unwrap_or(x)
 }
 
 /// Tank walls and shell bodies (`layers`) of dynamic particles or fixed ghosts whose layers
@@ -60,23 +135,20 @@ fn thin_ghosts(case: &Case, dx: f64, h: f64) -> Vec<String> {
     let dim = case.dim;
     let ghosts = |t: Treatment| matches!(t, Treatment::FixedGhost { .. });
     // `measured`: on the lattice (polygons and meshes), to within dx.
-    let warning = |part: String, thickness: f64, measured: bool| {
-        format!(
+    let warning =
+        |part: String, thickness: f64, measured: bool| {
+            format!(
             "{part} has fixed ghosts and is {}{} m thick, less than 4h - dx = {} m: where water \
              is on both sides, a ghost near one face also interpolates the water beyond the \
              other, mixing the two sides' pressures; fix: make it at least {} m thick, or \
              decrease particles.dx_m (the limit is (4 h_over_dx - 1) dx)",
             if measured { "about " } else { "" },
             // Three digits of a measured thickness are all it has.
-            num(if measured {
-                format!("{thickness:.2e}").parse().unwrap_or(thickness)
-            } else {
-                thickness
-            }),
+            num(if measured { round3(thickness) } else { thickness }),
             num(limit),
             num(limit)
         )
-    };
+        };
     let obstacles = case
         .obstacles
         .iter()

@@ -439,3 +439,42 @@ fn wall_layers_short_of_the_kernel_support_load_with_a_warning() {
     )
     .is_empty());
 }
+
+/// A speed the case sets above c0/10 (c0 = 10 sqrt(g 0.5 m) = 22.1 m/s here) loads with a
+/// warning naming the fastest field; slower ones load without.
+#[test]
+fn speeds_above_a_tenth_of_the_sound_speed_load_with_a_warning() {
+    let warnings =
+        |text: &str, over: &[&str]| load_str(text, "c.toml", &sets(over)).unwrap().warnings;
+    let body = |motion: &str| {
+        case_2d(&format!(
+            "shape = \"box\"\nmin_m = [0.55, 0.55]\nmax_m = [0.85, 0.85]\n[body.motion]\n{motion}"
+        ))
+    };
+    let w = warnings(&body("kind = \"free\"\nvelocity_m_s = [0.0, -3.0]"), &[]);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with(
+            "body[0].motion sets a speed of 3 m/s, more than c0/10 = 2.21 m/s (c0 from \
+             physics.sound_speed_coef): the water is compressed by about (u/c0)² = 1.83 %"
+        ) && w[0].ends_with("fix: raise physics.sound_speed_coef so that c0 is at least 30 m/s (the time step shrinks with it)"),
+        "{w:?}"
+    );
+    assert!(warnings(&body("kind = \"free\"\nvelocity_m_s = [0.0, -2.0]"), &[]).is_empty());
+    // A sine of 0.1 m every 0.2 s: 3.14 m/s at its fastest.
+    let sine = "kind = \"sine\"\npivot_m = [0.7, 0.7]\ntranslation_m = [0.1, 0.0]\nperiod_s = 0.2";
+    let w = warnings(&body(sine), &[]);
+    assert!(
+        w.len() == 1 && w[0].starts_with("body[0].motion sets a speed of 3.14 m/s"),
+        "{w:?}"
+    );
+    assert!(warnings(&body(sine), &["physics.sound_speed_coef=20"]).is_empty());
+    let w = warnings(
+        &body("kind = \"free\""),
+        &["fluid_block[0].velocity_m_s=[2.5, 0.0]"],
+    );
+    assert!(
+        w.len() == 1 && w[0].starts_with("fluid_block[0].velocity_m_s sets a speed of 2.5 m/s"),
+        "{w:?}"
+    );
+}
