@@ -4,7 +4,8 @@
 //! directory), the `--set` overrides of the quick and the full mode, the reference with its
 //! citation, and the function that turns the run's outputs (probe CSVs, body CSVs, run.json)
 //! into metrics and figures. The metrics live in one file per case family ([`hydrostatic`],
-//! [`dam_break`], [`lobovsky`], [`bodies`]); the integration tests (`tests/validation_*.rs`) call
+//! [`dam_break`], [`lobovsky`], [`bodies`], [`sloshing`], [`gate`]); the integration tests
+//! (`tests/validation/`) call
 //! the same functions, so a bound asserted in CI and a row of the report are the same code.
 //!
 //! A metric's bound depends on the [`Mode`]: quick mode judges with the coarse bounds the CI
@@ -17,6 +18,7 @@ pub mod gate;
 pub mod hydrostatic;
 pub mod lobovsky;
 mod report;
+pub mod sloshing;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -229,6 +231,15 @@ pub static CASES: &[Case] = &[
         citation: bodies::ENTRY_CITATION,
         overrides: bodies::water_entry_1000_overrides,
         evaluate: bodies::evaluate_water_entry_1000,
+    },
+    Case {
+        name: "sloshing_2d",
+        file: "cases/sloshing_2d.toml",
+        text: include_str!("../../cases/sloshing_2d.toml"),
+        reference: "tests/data/sloshing_akyildiz_unal_2006_pitch_probe{2,8}.csv",
+        citation: sloshing::CITATION,
+        overrides: sloshing::overrides,
+        evaluate: sloshing::evaluate,
     },
     Case {
         name: "elastic_gate_2d",

@@ -225,7 +225,8 @@ fn cases_are_selected_by_mode_and_name() {
             "dam_break_2d",
             "dam_break_lobovsky_2d",
             "floating_box_2d",
-            "water_entry_cylinder_2d"
+            "water_entry_cylinder_2d",
+            "sloshing_2d"
         ]
     );
     assert_eq!(select(Mode::Full, &[]).unwrap().len(), CASES.len());
