@@ -386,16 +386,21 @@ impl<'a> Runner<'a> {
         let probes = out.probe_writer(&names)?;
         let solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
         let bodies = BodyOutputs::new(&out, sc)?;
-        let inlet = match sc.count(Kind::Inlet) {
+        let some = |n: usize, what: &str| match n {
             0 => String::new(),
-            n => format!(", {n} inlet"),
+            n => format!(", {n} {what}"),
         };
+        let solid = some(
+            sc.particles.iter().filter(|p| p.kind.is_solid()).count(),
+            "solid",
+        );
+        let inlet = some(sc.count(Kind::Inlet), "inlet");
         log::info!(
-            "{}: {} particles ({} fluid, {} wall{inlet}) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
+            "{}: {} particles ({} fluid, {} boundary{solid}{inlet}) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
             sc.name,
             sc.particles.len(),
             sc.count(Kind::Fluid),
-            sc.count(Kind::Wall),
+            sc.boundary_count(),
             ctx.describe(),
             solver.gpu_bytes() as f64 / sc.particles.len() as f64,
             solver.dt()
@@ -484,7 +489,8 @@ impl<'a> Runner<'a> {
             backend: format!("{:?}", self.ctx.info.backend),
             dimension: sc.physics.dim,
             particles_fluid: sc.count(Kind::Fluid) as u64,
-            particles_wall: sc.count(Kind::Wall) as u64,
+            particles_wall: sc.boundary_count() as u64,
+            particles_solid: sc.particles.iter().filter(|p| p.kind.is_solid()).count() as u64,
             particles_inlet: sc.count(Kind::Inlet) as u64,
             particles_excluded: end.excluded,
             particles_drained: end.drained,

@@ -13,7 +13,11 @@ pub struct RunSummary {
     pub backend: String,
     pub dimension: u32,
     pub particles_fluid: u64,
+    /// Boundary particles of every wall treatment (walls, obstacles, bodies).
     pub particles_wall: u64,
+    /// Elastic solid particles, clamped ones included.
+    #[serde(default)]
+    pub particles_solid: u64,
     /// Inlet particles (the buffers and the layers waiting behind them).
     #[serde(default)]
     pub particles_inlet: u64,
@@ -58,6 +62,7 @@ mod tests {
             dimension: 2,
             particles_fluid: 123_456,
             particles_wall: 7_890,
+            particles_solid: 0,
             particles_inlet: 0,
             particles_excluded: 0,
             particles_drained: 0,

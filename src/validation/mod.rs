@@ -4,7 +4,7 @@
 //! directory), the `--set` overrides of the quick and the full mode, the reference with its
 //! citation, and the function that turns the run's outputs (probe CSVs, body CSVs, run.json)
 //! into metrics and figures. The metrics live in one file per case family ([`hydrostatic`],
-//! [`dam_break`], [`lobovsky`], [`bodies`], [`sloshing`], [`gate`]); the integration tests
+//! [`dam_break`], [`lobovsky`], [`bodies`], [`sloshing`], [`plate`], [`gate`]); the integration tests
 //! (`tests/validation/`) call
 //! the same functions, so a bound asserted in CI and a row of the report are the same code.
 //!
@@ -17,6 +17,7 @@ pub mod dam_break;
 pub mod gate;
 pub mod hydrostatic;
 pub mod lobovsky;
+pub mod plate;
 mod report;
 pub mod sloshing;
 
@@ -240,6 +241,24 @@ pub static CASES: &[Case] = &[
         citation: sloshing::CITATION,
         overrides: sloshing::overrides,
         evaluate: sloshing::evaluate,
+    },
+    Case {
+        name: "oscillating_plate_2d",
+        file: "cases/oscillating_plate_2d.toml",
+        text: include_str!("../../cases/oscillating_plate_2d.toml"),
+        reference: "analytic: Euler–Bernoulli first-mode period (shared/validation/analytic_oscillating_plate_frequency.csv)",
+        citation: "",
+        overrides: plate::overrides,
+        evaluate: plate::evaluate,
+    },
+    Case {
+        name: "oscillating_plate_tl_2d",
+        file: "cases/oscillating_plate_tl_2d.toml",
+        text: include_str!("../../cases/oscillating_plate_tl_2d.toml"),
+        reference: "analytic: Euler–Bernoulli first-mode period (shared/validation/analytic_oscillating_plate_frequency.csv)",
+        citation: "",
+        overrides: plate::overrides,
+        evaluate: plate::evaluate_tl,
     },
     Case {
         name: "elastic_gate_2d",

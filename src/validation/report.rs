@@ -138,7 +138,8 @@ impl Report {
         for c in &self.cases {
             let (particles, steps) = match &c.summary {
                 Some(r) => (
-                    (r.particles_fluid + r.particles_wall).to_string(),
+                    (r.particles_fluid + r.particles_wall + r.particles_solid + r.particles_inlet)
+                        .to_string(),
                     r.steps.to_string(),
                 ),
                 None => ("–".into(), "–".into()),
@@ -173,8 +174,8 @@ impl Report {
             if let Some(r) = &c.summary {
                 let _ = writeln!(
                     s,
-                    "- run: {}; t = {:.4} s, {} steps, {} fluid + {} boundary particles, {:.1} s in the time loop",
-                    r.status, r.simulated_time_s, r.steps, r.particles_fluid, r.particles_wall, r.wall_time_s
+                    "- run: {}; t = {:.4} s, {} steps, {} fluid + {} boundary + {} solid particles, {:.1} s in the time loop",
+                    r.status, r.simulated_time_s, r.steps, r.particles_fluid, r.particles_wall, r.particles_solid, r.wall_time_s
                 );
             }
             if let Some(f) = &c.failure {

@@ -22,6 +22,7 @@ fn summary(case: &str, excluded: u64) -> RunSummary {
         dimension: 2,
         particles_fluid: 1250,
         particles_wall: 348,
+        particles_solid: 0,
         particles_inlet: 0,
         particles_excluded: excluded,
         particles_drained: 0,
@@ -226,7 +227,9 @@ fn cases_are_selected_by_mode_and_name() {
             "dam_break_lobovsky_2d",
             "floating_box_2d",
             "water_entry_cylinder_2d",
-            "sloshing_2d"
+            "sloshing_2d",
+            "oscillating_plate_2d",
+            "oscillating_plate_tl_2d"
         ]
     );
     assert_eq!(select(Mode::Full, &[]).unwrap().len(), CASES.len());
