@@ -11,7 +11,7 @@ use super::{
     Evaluation, Figure, Metric, Mode, Reference, Unit, CASE_G,
 };
 use crate::plot::interpolate;
-use crate::scenario::{ProbeKind, Scenario};
+use crate::scenario::{Motion, ProbeKind, Scenario};
 
 // ---- floating box ------------------------------------------------------------------------
 
@@ -261,6 +261,25 @@ fn evaluate_water_entry(
         .map(|(t, s, w, e)| format!("t* {t:.3}: {s:.3} vs {w:.3} ({:+.1} %)", 100.0 * e))
         .collect::<Vec<_>>()
         .join("; ");
+    // Free fall from the entry speed, the deepest any cylinder can be (the water only ever
+    // pushes it up): drawn so that a reference point beyond it shows for what it is.
+    let vertical = sc.physics.dim as usize - 1;
+    let v0 = match sc.bodies.first().map(|b| &b.motion) {
+        Some(Motion::Free { velocity, .. }) => -velocity[vertical],
+        _ => f64::NAN,
+    };
+    let (g, ts) = (gravity(sc), t_scale(gravity(sc)));
+    // Only as far as the comparison's own range, so as not to squash it.
+    let t_end = p.sim.last().map_or(0.0, |q| q.0);
+    let top = 1.1 * (p.sim.iter().chain(&p.experiment)).fold(0.0, |m, q| q.1.max(m));
+    let free_fall: Vec<(f64, f64)> = (0..=60)
+        .map(|k| t_end * k as f64 / 60.0)
+        .map(|t_star| {
+            let t = t_star / ts;
+            (t_star, (v0 * t + 0.5 * g * t * t) / DIAMETER_M)
+        })
+        .take_while(|q| q.1 <= top)
+        .collect();
     Ok(Evaluation {
         metrics: vec![
             Metric {
@@ -279,6 +298,7 @@ fn evaluate_water_entry(
             y_label: "(y0 − y)/D".into(),
             curves: vec![
                 sim_curve("wgsph", p.sim),
+                sim_curve("free fall from the entry speed (no water)", free_fall),
                 reference_curve("Greenhow & Lin (1983)", p.experiment),
             ],
         }],
