@@ -201,8 +201,14 @@ pub struct BodyMotion {
     pub first_group: u32,
     /// Angular acceleration.
     pub alpha: [f32; 3],
-    pub pad: u32,
+    /// [`BODY_FIXED`] or 0.
+    pub flags: u32,
 }
+
+/// `BodyMotion::flags`: the body never moves (`[body.motion] kind = "fixed"`), so its contact
+/// with the fixed walls and with other fixed bodies, which it rests against by design (a
+/// building on a street), is left out of its load.
+pub const BODY_FIXED: u32 = 1;
 
 pub const KIND_SHIFT: u32 = 28;
 pub const ID_MASK: u32 = 0x0FFF_FFFF;
@@ -465,6 +471,11 @@ mod tests {
     }
 
     #[test]
+    fn body_flags_match_wgsl() {
+        assert_eq!(wgsl_u32(Pass::Interaction, "BODY_FIXED"), BODY_FIXED);
+    }
+
+    #[test]
     fn inlet_pressure_modes_match_wgsl() {
         for (name, v) in [
             ("INLET_ZERO", INLET_ZERO),
@@ -534,7 +545,8 @@ mod tests {
                 count,
                 accel,
                 first_group,
-                alpha
+                alpha,
+                flags
             ]
         );
     }

@@ -661,6 +661,13 @@ pub struct Body {
     pub motion: Motion,
 }
 
+impl Body {
+    /// Whether it never moves (`[body.motion] kind = "fixed"`).
+    pub fn is_fixed(&self) -> bool {
+        matches!(&self.motion, Motion::Prescribed(p) if p.law == MotionLaw::Fixed)
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub enum Motion {
     /// Moves under the fluid's force and torque, gravity and contact, from this initial

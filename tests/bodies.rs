@@ -837,3 +837,64 @@ fn a_held_body_stays_put_until_its_release() {
     );
     assert!(rise > 1e-4 && pose.velocity.y > 0.0, "{pose:?}");
 }
+
+/// A fixed body (`kind = "fixed"`) resting on the floor: its contact with the fixed walls is
+/// left out (it never moves, and its load is the water's), as the reference leaves it out; the
+/// same rows with the contact counted would differ by most of their size.
+#[test]
+fn a_fixed_body_takes_no_contact_from_the_walls_it_rests_on() {
+    for (dim, seed) in [(2, 21), (3, 22)] {
+        let mut sc = scene(dim, seed, Kind::Wall);
+        let Motion::Prescribed(rocking) = sc.bodies[1].motion.clone() else {
+            unreachable!("the pressed box rocks")
+        };
+        sc.bodies[1].motion = Motion::Prescribed(Prescribed {
+            law: MotionLaw::Fixed,
+            ..rocking
+        });
+        let mut solver = Solver::new(gpu(), &sc).unwrap();
+        assert!(solver.body_is_fixed(1) && !solver.body_is_fixed(0));
+        solver.single_step(1e-3).unwrap();
+        let gpu_rates = solver.rerun_interaction(true).unwrap();
+        let parts = gpu_particles(&solver);
+        assert!(parts.iter().any(|p| p.body == Some(1) && p.body_fixed));
+        let space = reference::Space::of(&sc);
+        let cpu = reference::interaction::rates(&sc.physics, &sc.walls, &space, &parts);
+        let counted: Vec<RefParticle> = parts
+            .iter()
+            .map(|p| RefParticle {
+                body_fixed: false,
+                ..*p
+            })
+            .collect();
+        let cpu_counted = reference::interaction::rates(&sc.physics, &sc.walls, &space, &counted);
+        let up = dim as usize - 1;
+        let rows: Vec<usize> = (0..parts.len())
+            .filter(|&i| parts[i].body == Some(1) && parts[i].pos[up] < 0.03 + sc.physics.dx)
+            .collect();
+        assert!(!rows.is_empty());
+        let (worst, _) = rate_errors(&rows, &cpu, &gpu_rates);
+        let size = |r: &[[f64; 4]]| -> f64 {
+            rows.iter()
+                .map(|&i| (0..3).map(|a| r[i][a] * r[i][a]).sum::<f64>())
+                .sum::<f64>()
+                .sqrt()
+        };
+        let diff: Vec<[f64; 4]> = cpu
+            .iter()
+            .zip(&cpu_counted)
+            .map(|(a, b)| [0, 1, 2, 3].map(|k| a[k] - b[k]))
+            .collect();
+        let contact_share = size(&diff) / size(&cpu_counted);
+        println!(
+            "dim {dim}: {} floor rows of the fixed box, GPU error {worst:.1e} of RMS; the \
+             contact would be {contact_share:.3} of them",
+            rows.len()
+        );
+        assert!(
+            worst < 2e-4,
+            "fixed-body rows against the reference: {worst}"
+        );
+        assert!(contact_share > 0.5, "contact share {contact_share}");
+    }
+}

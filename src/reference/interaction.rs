@@ -263,9 +263,11 @@ pub fn rates_and_energy(
                         && pj.kind != INLET
                         && !super::elastic::is_solid(pj.kind)
                         && pj.body != pi.body
+                        && !(pi.body_fixed && (pj.body.is_none() || pj.body_fixed))
                     {
                         // Contact with a fixed wall or another body (with elastic solids:
-                        // `elastic::contact_rates`).
+                        // `elastic::contact_rates`), but not between two solids that never
+                        // move.
                         let v_ij = sub(contact_velocity(pi), contact_velocity(pj));
                         let mu = walls.friction_between(contact_group(pi), contact_group(pj));
                         let f = contact(ph, walls, mu, x_ij, v_ij);

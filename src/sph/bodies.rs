@@ -12,7 +12,7 @@ use crate::gpu::buffers::{storage, storage_init};
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::shader::WORKGROUP_SIZE;
 use crate::gpu::Kernel;
-use crate::layout::{pack_block, BodyMotion, BodyParticle};
+use crate::layout::{pack_block, BodyMotion, BodyParticle, BODY_FIXED};
 use crate::scenario::Scenario;
 
 /// Body-frame offsets of the bodies' particles (index = id − first body id).
@@ -41,6 +41,7 @@ pub fn initial_motions(sc: &Scenario, first_id: u32) -> Vec<BodyMotion> {
                 first: body.particles.start as u32 - first_id,
                 count,
                 first_group: groups,
+                flags: if body.is_fixed() { BODY_FIXED } else { 0 },
                 ..Default::default()
             };
             groups += count.div_ceil(WORKGROUP_SIZE).max(1);
@@ -190,6 +191,11 @@ impl Bodies {
     pub fn encode_force(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.body_force
             .dispatch_groups(pass, &self.bind_force[p], self.groups);
+    }
+
+    /// Whether body `b` never moves (its `BODY_FIXED` flag).
+    pub fn is_fixed(&self, b: u32) -> bool {
+        self.motions[b as usize].flags & BODY_FIXED != 0
     }
 
     /// The body of body particle `k` (id − first body id).

@@ -991,6 +991,13 @@ impl Solver {
         )
     }
 
+    /// Whether body `b` never moves (`kind = "fixed"`; its GPU flag).
+    pub fn body_is_fixed(&self, b: u32) -> bool {
+        self.bodies
+            .as_ref()
+            .is_some_and(|(gpu, _, _)| gpu.is_fixed(b))
+    }
+
     /// The body particle `id` belongs to, if any.
     pub fn body_of_id(&self, id: u32) -> Option<u32> {
         let (gpu, _, _) = self.bodies.as_ref()?;
