@@ -390,10 +390,7 @@ impl<'a> Runner<'a> {
             0 => String::new(),
             n => format!(", {n} {what}"),
         };
-        let solid = some(
-            sc.particles.iter().filter(|p| p.kind.is_solid()).count(),
-            "solid",
-        );
+        let solid = some(sc.solid_count(), "solid");
         let inlet = some(sc.count(Kind::Inlet), "inlet");
         log::info!(
             "{}: {} particles ({} fluid, {} boundary{solid}{inlet}) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
@@ -490,7 +487,7 @@ impl<'a> Runner<'a> {
             dimension: sc.physics.dim,
             particles_fluid: sc.count(Kind::Fluid) as u64,
             particles_wall: sc.boundary_count() as u64,
-            particles_solid: sc.particles.iter().filter(|p| p.kind.is_solid()).count() as u64,
+            particles_solid: sc.solid_count() as u64,
             particles_inlet: sc.count(Kind::Inlet) as u64,
             particles_excluded: end.excluded,
             particles_drained: end.drained,

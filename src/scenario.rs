@@ -727,6 +727,11 @@ impl Scenario {
             .count()
     }
 
+    /// Elastic solid particles, clamped ones included.
+    pub fn solid_count(&self) -> usize {
+        self.particles.iter().filter(|p| p.kind.is_solid()).count()
+    }
+
     /// Inlet particles that wait behind their buffers at t = 0.
     pub fn dormant_count(&self) -> usize {
         self.inlets
