@@ -535,31 +535,32 @@ fn probe_moves_with_the_tank(case: &str, dx: &str, t1: f64, up: usize) {
             body: None,
         });
     }
-    // The force sensor w2 (2D case only): a fixed twin with the patch turned to the tank's
-    // pose at t1 must sum the same particles over the same area.
-    let w2 = sc.probes.iter().find(|p| p.name == "w2").cloned();
-    if let Some(Probe {
-        kind: ProbeKind::WallPressure(patch),
-        ..
-    }) = &w2
-    {
-        let turn = |v: [f64; 3], pivot: f64| {
-            let r = [v[0] - pivot, v[up]];
-            let mut out = v;
-            out[0] = pivot + c * r[0] - s * r[1];
-            out[up] = s * r[0] + c * r[1];
-            out
-        };
-        sc.probes.push(Probe {
-            name: "w2_fixed_at_x1".into(),
-            kind: ProbeKind::WallPressure(WallPatch {
-                point: turn(patch.point, 0.46),
-                normal: turn(patch.normal, 0.0),
-                ..*patch
-            }),
-            body: None,
-        });
-    }
+    // The force sensor w2 (both cases carry it): a fixed twin with the patch turned to the
+    // tank's pose at t1 must sum the same particles over the same area.
+    let Some(ProbeKind::WallPressure(patch)) = sc
+        .probes
+        .iter()
+        .find(|p| p.name == "w2")
+        .map(|p| p.kind.clone())
+    else {
+        panic!("{case}: no force sensor w2")
+    };
+    let turn = |v: [f64; 3], pivot: f64| {
+        let r = [v[0] - pivot, v[up]];
+        let mut out = v;
+        out[0] = pivot + c * r[0] - s * r[1];
+        out[up] = s * r[0] + c * r[1];
+        out
+    };
+    sc.probes.push(Probe {
+        name: "w2_fixed_at_x1".into(),
+        kind: ProbeKind::WallPressure(WallPatch {
+            point: turn(patch.point, 0.46),
+            normal: turn(patch.normal, 0.0),
+            ..patch
+        }),
+        body: None,
+    });
     let mut solver = Solver::new(gpu(), &sc).unwrap();
     solver.advance_to(t1).unwrap();
     let v = solver.sample_probes().unwrap();
@@ -573,12 +574,10 @@ fn probe_moves_with_the_tank(case: &str, dx: &str, t1: f64, up: usize) {
         "{case}: attached {attached} vs fixed at the moved point {at_x1}"
     );
     assert!((attached - at_x0).abs() > 0.03 * at_x0.abs(), "{case}");
-    if w2.is_some() {
-        let (w, twin) = (value("w2"), value("w2_fixed_at_x1"));
-        println!("{case}: force sensor attached {w:.3} Pa, fixed twin {twin:.3} Pa");
-        assert!(w > 0.5 * attached, "{case}: the force sensor reads {w} Pa");
-        assert_eq!(w, twin, "{case}: attached force sensor vs its fixed twin");
-    }
+    let (w, twin) = (value("w2"), value("w2_fixed_at_x1"));
+    println!("{case}: force sensor attached {w:.3} Pa, fixed twin {twin:.3} Pa");
+    assert!(w > 0.5 * attached, "{case}: the force sensor reads {w} Pa");
+    assert_eq!(w, twin, "{case}: attached force sensor vs its fixed twin");
 }
 
 /// `probe[].body` must name a moving body; the error names the field and the choices.
