@@ -30,6 +30,12 @@
 //! 10, energy conserved, cfl 0.2). tl=2: decomposed (Laplacian shear) form, does not work here
 //! (see tl.rs). RQ=1 with tl prints the Rayleigh quotient of the smooth plane-strain bending
 //! field instead of running (the discrete energy of a smooth mode, no dynamics).
+//! STATIC=F (experiment): a static cantilever instead of the free vibration. The plate starts
+//! at rest, a load F [N per metre of width] pulls its free end's column down and a damping
+//! −ζ v (STATIC_ZETA=ζ, default 40 /s, about 0.8 of critical for the first mode) acts on every
+//! free particle; after `periods` theory periods the tip's deflection is compared with
+//! Euler–Bernoulli, F a³/(3D), D = E H³/(12(1 − ν²)), a the load's arm (the column's centre),
+//! and with Timoshenko's, which adds F a/(κ G H), κ = 5/6.
 #![allow(clippy::needless_range_loop)]
 
 mod tl;
@@ -67,6 +73,8 @@ struct P {
     rho: f64,
     tau: [f64; 4],
     clamped: bool,
+    /// In the free end's column (STATIC).
+    loaded: bool,
 }
 #[derive(Clone, Copy, Default)]
 struct R {
@@ -139,6 +147,10 @@ struct Sim {
     y0: f64,
     tl: Option<tl::Tl>,
     e_tl: f64,
+    /// STATIC: the end load [N/m], the damping rate [1/s] and the loaded particles' number.
+    static_load: Option<f64>,
+    zeta: f64,
+    n_loaded: usize,
 }
 
 impl Sim {
@@ -171,6 +183,7 @@ impl Sim {
                     rho: RHO0,
                     tau: [0.0; 4],
                     clamped,
+                    loaded: false,
                 });
             }
         }
@@ -189,6 +202,7 @@ impl Sim {
                         rho: RHO0,
                         tau: [0.0; 4],
                         clamped: true,
+                        loaded: false,
                     });
                 }
             }
@@ -199,6 +213,11 @@ impl Sim {
                 key(&p[a]).partial_cmp(&key(&p[b])).unwrap()
             })
             .unwrap();
+        for q in p.iter_mut() {
+            q.loaded = !q.clamped && q.x[0] > 0.26 - dx;
+        }
+        let n_loaded = p.iter().filter(|q| q.loaded).count();
+        let env = |k: &str| std::env::var(k).ok().map(|v| v.parse::<f64>().expect(k));
         let h = c.hdx * dx;
         let kb = E / (3.0 * (1.0 - 2.0 * NU));
         let y0 = p[tip].x[1];
@@ -219,6 +238,9 @@ impl Sim {
             c,
             tl: None,
             e_tl: 0.0,
+            static_load: env("STATIC"),
+            zeta: env("STATIC_ZETA").unwrap_or(40.0),
+            n_loaded,
         };
         if let Some(tc) = s.c.tl.clone() {
             let nb = s.neighbours();
@@ -236,6 +258,28 @@ impl Sim {
         self.e_tl = e;
         for (r, a) in self.r.iter_mut().zip(acc) {
             *r = R { a, ..R::default() };
+        }
+        let mut r = std::mem::take(&mut self.r);
+        self.external(&mut r);
+        self.r = r;
+    }
+
+    /// STATIC: the end load and the damping (see the header), added to the rates.
+    fn external(&self, r: &mut [R]) {
+        let Some(f) = self.static_load else {
+            return;
+        };
+        let a_load = f / (self.n_loaded as f64 * self.m);
+        for (q, ri) in self.p.iter().zip(r) {
+            if q.clamped {
+                continue;
+            }
+            if q.loaded {
+                ri.a[1] -= a_load;
+            }
+            for a in 0..2 {
+                ri.a[a] -= self.zeta * q.v[a];
+            }
         }
     }
 
@@ -438,7 +482,7 @@ impl Sim {
                 g
             })
             .collect();
-        (0..n)
+        let mut out = (0..n)
             .map(|i| {
                 let pi = &self.p[i];
                 let mut acc = [0.0; 2];
@@ -556,7 +600,9 @@ impl Sim {
                     a_vis,
                 }
             })
-            .collect()
+            .collect::<Vec<R>>();
+        self.external(&mut out);
+        out
     }
 
     fn energy(&self) -> (f64, f64) {
@@ -725,6 +771,9 @@ fn main() {
     if tc.mode > 0 {
         c.tl = Some(tc);
     }
+    if std::env::var("STATIC").is_ok() {
+        c.tipv = 0.0;
+    }
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut s = Sim::new(c.clone());
     let k = KL / L;
@@ -855,6 +904,26 @@ fn main() {
             }
             println!("tip w {tipw:.5}");
         }
+    }
+    if let Some(f) = s.static_load {
+        // The tip's deflection, settled, against beam theory at the load's arm a.
+        let y = hist.last().unwrap().1;
+        let drift = y - hist[hist.len() - 11].1;
+        let a = L - 0.5 * s.c.dx;
+        let d = E * H.powi(3) / (12.0 * (1.0 - NU * NU));
+        let eb = -f * a.powi(3) / (3.0 * d);
+        let g = E / (2.0 * (1.0 + NU));
+        let timo = eb - f * a / (5.0 / 6.0 * g * H);
+        println!(
+            "{} | N {} steps {} | static tip {y:+.6} m (last 10 samples {drift:+.1e}) | E-B \
+             {eb:+.6} ({:+.1} %) | Timoshenko {timo:+.6} ({:+.1} %)",
+            args.join(" "),
+            s.p.len(),
+            steps,
+            100.0 * (y / eb - 1.0),
+            100.0 * (y / timo - 1.0)
+        );
+        return;
     }
     let cr: Vec<f64> = hist
         .windows(2)
