@@ -272,10 +272,10 @@ pub(super) fn resolve_wall_patches(
                          (mirror walls have none)",
                         patch.radius
                     ),
-                    "put point_m on the face of a particle wall (of the [tank] or an \
-                     [[obstacle]], dynamic, fixed_ghost or repulsive) with normal pointing into \
-                     the fluid; a wall that particles.dx_m leaves without particles there needs \
-                     a smaller particles.dx_m",
+                    "put point_m on the face of a particle wall (of the [tank], an \
+                     [[obstacle]] or a [[body]], dynamic, fixed_ghost or repulsive) with normal \
+                     pointing into the fluid; a wall that particles.dx_m leaves without \
+                     particles there needs a smaller particles.dx_m",
                 ));
             }
         }

@@ -350,3 +350,23 @@ fn tables_written_as_arrays_are_refused() {
         ],
     );
 }
+
+/// Deleting the building of `cases/street_flood_mesh_3d.toml` (`body = []`) left its
+/// wall-pressure probe on nothing, and the refusal's fix named the tank and obstacles as the
+/// walls a probe may sit on but not the bodies it was on.
+#[test]
+fn a_wall_pressure_probe_on_a_removed_body_names_bodies_in_its_fix() {
+    let body = "[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.2, 0.2]\nmax_m = [0.4, 0.4]\n\
+                [body.motion]\nkind = \"fixed\"\n";
+    let probe = "[[probe]]\nname = \"w\"\nkind = \"wall_pressure\"\npoint_m = [0.2, 0.3]\n\
+                 normal = [-1.0, 0.0]\nradius_m = 0.05\n";
+    let with_body = format!("{BASE}\n{probe}\n{body}");
+    let sc = load_str(&with_body, "cases/t.toml", &[]).unwrap();
+    assert!(sc.bodies[0].is_fixed());
+    assert_err(
+        &format!("{BASE}\n{probe}"),
+        &[],
+        None,
+        &["probe[1].point_m", "has no wall particle", "[[body]]"],
+    );
+}
