@@ -268,7 +268,8 @@ fn evaluate_water_entry(
         Some(Motion::Free { velocity, .. }) => -velocity[vertical],
         _ => f64::NAN,
     };
-    let (g, ts) = (gravity(sc), t_scale(gravity(sc)));
+    let g = gravity(sc);
+    let ts = t_scale(g);
     // Only as far as the comparison's own range, so as not to squash it.
     let t_end = p.sim.last().map_or(0.0, |q| q.0);
     let top = 1.1 * (p.sim.iter().chain(&p.experiment)).fold(0.0, |m, q| q.1.max(m));

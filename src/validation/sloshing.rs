@@ -65,13 +65,13 @@ pub fn window(mode: Mode) -> Window {
 pub const MEAN_BOUND: f64 = 0.05;
 
 pub fn overrides(mode: Mode) -> Option<Vec<String>> {
-    let (dx, end) = match mode {
-        Mode::Quick => ("0.02", window(mode).to_s),
-        Mode::Full => ("0.01", window(mode).to_s),
+    let dx = match mode {
+        Mode::Quick => "0.02",
+        Mode::Full => "0.01",
     };
     Some(vec![
         format!("particles.dx_m={dx}"),
-        format!("time.end_s={end}"),
+        format!("time.end_s={}", window(mode).to_s),
         "time.output_every_s=1".into(),
     ])
 }
