@@ -332,17 +332,18 @@ fn other_solid(body_i: u32, id_j: u32) -> bool {
     return !is_body_particle(id_j) || body_particles[id_j - params.body_id_base].body != body_i;
 }
 
-// Whether body `b` never moves (`kind = "fixed"`).
-fn body_fixed(b: u32) -> bool {
-    return (bodies[b].flags & BODY_FIXED) != 0u;
+// Whether body `b` moves as the case prescribes whatever its load (`kind = "fixed"`, `"sine"`
+// or `"series"`, the moving tank too).
+fn body_kinematic(b: u32) -> bool {
+    return (bodies[b].flags & BODY_KINEMATIC) != 0u;
 }
 
-// Whether the contact of a body particle (of a fixed body: `fixed_i`) with the wall or other
-// body's particle `id_j` counts: not when neither side ever moves (a fixed body against the
-// fixed walls it rests on or another fixed body), where it would only add their standing
-// contact to the load written for the body.
-fn contact_counts(fixed_i: bool, id_j: u32) -> bool {
-    return !fixed_i || (is_body_particle(id_j) && !body_fixed(body_particles[id_j - params.body_id_base].body));
+// Whether the contact of a body particle (of a kinematic body: `kinematic_i`) with the wall or
+// other body's particle `id_j` counts: not when neither side's motion answers the force (a
+// fixed building on the street, a paddle sliding on the floor, another prescribed body), where
+// it would only add their standing contact to the load written for the body.
+fn contact_counts(kinematic_i: bool, id_j: u32) -> bool {
+    return !kinematic_i || (is_body_particle(id_j) && !body_kinematic(body_particles[id_j - params.body_id_base].body));
 }
 
 // Velocity of a ghost across `plane`: normal part reversed (free-slip) or all (no-slip).
@@ -458,10 +459,10 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         return;
     }
     var body_i = NO_BODY;
-    var fixed_i = false;
+    var kinematic_i = false;
     if (on_body) {
         body_i = body_particles[id_i - params.body_id_base].body;
-        fixed_i = body_fixed(body_i);
+        kinematic_i = body_kinematic(body_i);
     }
     let p_i = pos[i];
     let vr_i = velrho[i];
@@ -510,7 +511,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                     let s_j = solid[solid_slot(code[j])];
                     let mu = friction_between(1u + body_i, params.friction_first_solid + s_j.body);
                     r += vec4<f32>(contact_weight(params.mass, material_of(s_j).mass) * contact(x_ij, r2, v_contact_i - velrho[j].xyz, mu), 0.0);
-                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, code[j] & ID_MASK) && contact_counts(fixed_i, code[j] & ID_MASK)) {
+                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, code[j] & ID_MASK) && contact_counts(kinematic_i, code[j] & ID_MASK)) {
                     // Contact with a fixed wall or another body.
                     let mu = friction_between(1u + body_i, boundary_group(code[j] & ID_MASK));
                     r += vec4<f32>(contact(x_ij, r2, v_contact_i - contact_velocity(j), mu), 0.0);

@@ -201,14 +201,15 @@ pub struct BodyMotion {
     pub first_group: u32,
     /// Angular acceleration.
     pub alpha: [f32; 3],
-    /// [`BODY_FIXED`] or 0.
+    /// [`BODY_KINEMATIC`] or 0.
     pub flags: u32,
 }
 
-/// `BodyMotion::flags`: the body never moves (`[body.motion] kind = "fixed"`), so its contact
-/// with the fixed walls and with other fixed bodies, which it rests against by design (a
-/// building on a street), is left out of its load.
-pub const BODY_FIXED: u32 = 1;
+/// `BodyMotion::flags`: the body moves as the case prescribes (`[body.motion] kind = "fixed"`,
+/// `"sine"` or `"series"`, or the moving tank), whatever its load. Its contact with the fixed
+/// walls and with other such bodies, which it may rest against or slide along by design (a
+/// building on a street, a paddle on the floor), answers nothing and is left out of its load.
+pub const BODY_KINEMATIC: u32 = 1;
 
 pub const KIND_SHIFT: u32 = 28;
 pub const ID_MASK: u32 = 0x0FFF_FFFF;
@@ -472,7 +473,10 @@ mod tests {
 
     #[test]
     fn body_flags_match_wgsl() {
-        assert_eq!(wgsl_u32(Pass::Interaction, "BODY_FIXED"), BODY_FIXED);
+        assert_eq!(
+            wgsl_u32(Pass::Interaction, "BODY_KINEMATIC"),
+            BODY_KINEMATIC
+        );
     }
 
     #[test]

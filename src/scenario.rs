@@ -666,6 +666,12 @@ impl Body {
     pub fn is_fixed(&self) -> bool {
         matches!(&self.motion, Motion::Prescribed(p) if p.law == MotionLaw::Fixed)
     }
+
+    /// Whether it moves as the case prescribes whatever its load (fixed, sine or series; the
+    /// moving tank too), so that contact with the walls cannot move it.
+    pub fn is_kinematic(&self) -> bool {
+        matches!(&self.motion, Motion::Prescribed(_))
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]

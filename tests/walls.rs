@@ -300,7 +300,7 @@ fn mirror_planes_cannot_be_crossed() {
         rho: 1000.0,
         kind: 0,
         body: None,
-        body_fixed: false,
+        body_kinematic: false,
         wall_vel: [0.0; 3],
         wall_acc: [0.0; 3],
     };

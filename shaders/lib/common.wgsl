@@ -138,12 +138,12 @@ struct BodyMotion {
     accel: vec3<f32>,           // of the centre of mass
     first_group: u32,           // its first workgroup in body_force
     alpha: vec3<f32>,           // angular acceleration
-    flags: u32,                 // BODY_FIXED or 0
+    flags: u32,                 // BODY_KINEMATIC or 0
 }
 
-// BodyMotion.flags: the body never moves (`kind = "fixed"`); see interaction.wgsl's
-// `contact_counts`.
-const BODY_FIXED: u32 = 1u;
+// BodyMotion.flags: the body moves as prescribed whatever its load (`kind = "fixed"`, `"sine"`,
+// `"series"`, the moving tank); see interaction.wgsl's `contact_counts`.
+const BODY_KINEMATIC: u32 = 1u;
 
 // The rigid velocity and acceleration of the body particle `id` (id ≥ body_id_base) at its
 // place x_c + R r this step: u = u_c + ω × R r, a = a_c + α × R r + ω × (ω × R r).

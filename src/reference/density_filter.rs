@@ -191,7 +191,7 @@ mod tests {
                         rho: 1000.0 * (1.0 + rng.range(-0.02, 0.02)),
                         kind: FLUID,
                         body: None,
-                        body_fixed: false,
+                        body_kinematic: false,
                         wall_vel: [0.0; 3],
                         wall_acc: [0.0; 3],
                     });
@@ -302,7 +302,7 @@ mod tests {
                 rho: 1010.0,
                 kind: FLUID,
                 body: None,
-                body_fixed: false,
+                body_kinematic: false,
                 wall_vel: [0.0; 3],
                 wall_acc: [0.0; 3],
             };

@@ -263,11 +263,11 @@ pub fn rates_and_energy(
                         && pj.kind != INLET
                         && !super::elastic::is_solid(pj.kind)
                         && pj.body != pi.body
-                        && !(pi.body_fixed && (pj.body.is_none() || pj.body_fixed))
+                        && !(pi.body_kinematic && (pj.body.is_none() || pj.body_kinematic))
                     {
                         // Contact with a fixed wall or another body (with elastic solids:
-                        // `elastic::contact_rates`), but not between two solids that never
-                        // move.
+                        // `elastic::contact_rates`), but not between two solids whose motion
+                        // is prescribed.
                         let v_ij = sub(contact_velocity(pi), contact_velocity(pj));
                         let mu = walls.friction_between(contact_group(pi), contact_group(pj));
                         let f = contact(ph, walls, mu, x_ij, v_ij);

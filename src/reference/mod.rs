@@ -28,9 +28,10 @@ pub struct RefParticle {
     pub kind: u32,
     /// The moving body the particle belongs to, if any.
     pub body: Option<u32>,
-    /// Whether that body never moves (`kind = "fixed"`): its contact with fixed walls and other
-    /// fixed bodies is left out (interaction.wgsl, `contact_counts`).
-    pub body_fixed: bool,
+    /// Whether that body moves as prescribed whatever its load (fixed, sine, series, the moving
+    /// tank): its contact with fixed walls and other such bodies is left out (interaction.wgsl,
+    /// `contact_counts`).
+    pub body_kinematic: bool,
     /// The velocity of the solid a boundary particle belongs to, at the particle: a body's
     /// rigid velocity, zero for fixed walls (and unused for fluid). A fixed ghost's `vel` is
     /// the fluid velocity interpolated at it; this is the wall it stands for.

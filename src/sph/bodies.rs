@@ -12,7 +12,7 @@ use crate::gpu::buffers::{storage, storage_init};
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::shader::WORKGROUP_SIZE;
 use crate::gpu::Kernel;
-use crate::layout::{pack_block, BodyMotion, BodyParticle, BODY_FIXED};
+use crate::layout::{pack_block, BodyMotion, BodyParticle, BODY_KINEMATIC};
 use crate::scenario::Scenario;
 
 /// Body-frame offsets of the bodies' particles (index = id − first body id).
@@ -41,7 +41,11 @@ pub fn initial_motions(sc: &Scenario, first_id: u32) -> Vec<BodyMotion> {
                 first: body.particles.start as u32 - first_id,
                 count,
                 first_group: groups,
-                flags: if body.is_fixed() { BODY_FIXED } else { 0 },
+                flags: if body.is_kinematic() {
+                    BODY_KINEMATIC
+                } else {
+                    0
+                },
                 ..Default::default()
             };
             groups += count.div_ceil(WORKGROUP_SIZE).max(1);
@@ -193,9 +197,9 @@ impl Bodies {
             .dispatch_groups(pass, &self.bind_force[p], self.groups);
     }
 
-    /// Whether body `b` never moves (its `BODY_FIXED` flag).
-    pub fn is_fixed(&self, b: u32) -> bool {
-        self.motions[b as usize].flags & BODY_FIXED != 0
+    /// Whether body `b` moves as prescribed, whatever its load (its `BODY_KINEMATIC` flag).
+    pub fn is_kinematic(&self, b: u32) -> bool {
+        self.motions[b as usize].flags & BODY_KINEMATIC != 0
     }
 
     /// The body of body particle `k` (id − first body id).

@@ -991,11 +991,12 @@ impl Solver {
         )
     }
 
-    /// Whether body `b` never moves (`kind = "fixed"`; its GPU flag).
-    pub fn body_is_fixed(&self, b: u32) -> bool {
+    /// Whether body `b` moves as prescribed, whatever its load (`kind = "fixed"`, `"sine"`,
+    /// `"series"` or the moving tank; its GPU flag).
+    pub fn body_is_kinematic(&self, b: u32) -> bool {
         self.bodies
             .as_ref()
-            .is_some_and(|(gpu, _, _)| gpu.is_fixed(b))
+            .is_some_and(|(gpu, _, _)| gpu.is_kinematic(b))
     }
 
     /// The body particle `id` belongs to, if any.

@@ -204,9 +204,9 @@ pub fn gpu_particles_and_codes(s: &Solver) -> (Vec<RefParticle>, Vec<u32>) {
                 rho: v[3] as f64,
                 kind: c >> KIND_SHIFT,
                 body: s.body_of_id(c & ID_MASK),
-                body_fixed: s
+                body_kinematic: s
                     .body_of_id(c & ID_MASK)
-                    .is_some_and(|b| s.body_is_fixed(b)),
+                    .is_some_and(|b| s.body_is_kinematic(b)),
                 wall_vel,
                 wall_acc,
             }
