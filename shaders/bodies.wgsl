@@ -1,7 +1,9 @@
 // Moving bodies (rigid, free or prescribed). The host integrates each body in f64
 // (src/body/) and uploads its motion for the step; here the GPU
 //   body_move:  places every body particle a at x_a = x_c + R r_a with u_a = u_c + ω × (R r_a)
-//               (the seed's rigid-body kinematics), after the predictor and before the sort;
+//               (the seed's rigid-body kinematics), after the predictor and before the sort,
+//               and puts c_a + |u_a| into the time step's max-reduction (integrate.wgsl): a
+//               ghost's stored velocity is the fluid's, not the body's it moves with;
 //   body_index: after the sort, records where each body particle now is (body_slot);
 //   body_force: after the interaction, sums per workgroup the force m a_a that the fluid (and
 //               contact) exerts on each body particle and its moment (R r_a) × m a_a about the
@@ -22,28 +24,49 @@
 @group(0) @binding(7) var<storage, read_write> body_slot: array<u32>;
 // Per workgroup of body_force: (force, 0) then (torque, 0).
 @group(0) @binding(8) var<storage, read_write> body_partials: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read_write> state: SimState;
 
 var<workgroup> wg_force: array<vec3<f32>, WG>;
 var<workgroup> wg_torque: array<vec3<f32>, WG>;
+var<workgroup> wg_speed: array<f32, WG>;
 
 @compute @workgroup_size(WG)
-fn body_move(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+fn body_move(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
     let k = linear_index(gid, nwg);
-    if (k >= params.n_body_particles) {
-        return;
+    var speed = 0.0;
+    if (k < params.n_body_particles) {
+        let i = body_slot[k];
+        if (code_kind(code[i]) != KIND_EXCLUDED) {
+            let bp = body_particles[k];
+            let m = bodies[bp.body];
+            let arm = m.rotation * bp.r;
+            let moved = move_by(Pos(m.center_off, m.center_block), arm);
+            let vr = vec4<f32>(body_wall_motion(m, bp.r).velocity, velrho[i].w);
+            pos[i] = moved.pos;
+            velrho[i] = vr;
+            if (moved.inside) {
+                speed = sound_speed_of(vr.w) + length(vr.xyz);
+            } else {
+                code[i] = with_kind(code[i], KIND_EXCLUDED);
+            }
+        }
     }
-    let i = body_slot[k];
-    if (code_kind(code[i]) == KIND_EXCLUDED) {
-        return;
+    // Workgroup max, then one atomic per workgroup, as in integrate.wgsl's `correct` (which
+    // runs later in the step, before the time step is chosen from the maximum).
+    wg_speed[li] = speed;
+    workgroupBarrier();
+    for (var s = WG / 2u; s > 0u; s >>= 1u) {
+        if (li < s) {
+            wg_speed[li] = max(wg_speed[li], wg_speed[li + s]);
+        }
+        workgroupBarrier();
     }
-    let bp = body_particles[k];
-    let m = bodies[bp.body];
-    let arm = m.rotation * bp.r;
-    let moved = move_by(Pos(m.center_off, m.center_block), arm);
-    pos[i] = moved.pos;
-    velrho[i] = vec4<f32>(body_wall_motion(m, bp.r).velocity, velrho[i].w);
-    if (!moved.inside) {
-        code[i] = with_kind(code[i], KIND_EXCLUDED);
+    if (li == 0u) {
+        atomicMax(&state.max_speed_bits, bitcast<u32>(wg_speed[0]));
     }
 }
 

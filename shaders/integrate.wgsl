@@ -134,10 +134,10 @@ fn correct(
             velrho[i].w = rho;
             // Moving walls (bodies) count with their speed.
             speed = sound_speed_of(rho) + length(vr.xyz);
-        } else if (kind == KIND_INLET || (kind != KIND_EXCLUDED && is_body_particle(code[i] & ID_MASK))) {
-            // An inlet particle counts with its inflow velocity (open_boundaries.wgsl), a body's ghost or
-            // repulsive particle with its own (a ghost's is the fluid's interpolated at it,
-            // which follows the body it touches).
+        } else if (kind == KIND_INLET) {
+            // An inlet particle counts with its inflow velocity (open_boundaries.wgsl). A
+            // body's ghost and repulsive particles count with their rigid velocity in
+            // bodies.wgsl's `body_move` (a ghost's stored one is the fluid's at it).
             speed = sound_speed_of(vr.w) + length(vr.xyz);
         }
     }

@@ -107,6 +107,7 @@ impl Bodies {
                 (6, &b.body_motions),
                 (7, &body_slot),
                 (8, &partials),
+                (9, &b.state),
             ]
         };
         let bind = |k: &Kernel| -> Result<[wgpu::BindGroup; 2]> {
