@@ -429,14 +429,14 @@ fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind, pair: bool) {
     }
 }
 
-#[test]
-fn a_body_in_free_flight_follows_the_exact_trajectory() {
+/// A box of `kind` particles thrown through air (2D, dx = 0.02 m) at `v0` [m/s] spinning at
+/// `w0` [rad/s], with a little still water on a floor far away, so the run has fluid.
+fn thrown_box(kind: Kind, v0: [f64; 3], w0: f64) -> Scenario {
     let dim = 2;
     let dx = 0.02;
     let ph = physics(dim, dx, 15.0);
     let mut parts = Vec::new();
-    // A little fluid far away on a floor, so the run has fluid.
-    for (kind, min, max) in [
+    for (k, min, max) in [
         (Kind::Wall, [1.0, 0.0, 0.0], [2.5, 0.04, 0.0]),
         (Kind::Fluid, [1.7, 0.04, 0.0], [1.8, 0.1, 0.0]),
     ] {
@@ -445,11 +445,10 @@ fn a_body_in_free_flight_follows_the_exact_trajectory() {
                 pos: p,
                 vel: [0.0; 3],
                 rho: 1000.0,
-                kind,
+                kind: k,
             });
         }
     }
-    let (v0, w0) = ([0.5, 1.0, 0.0], 2.0);
     let body = box_body(
         "thrown",
         dim,
@@ -461,7 +460,7 @@ fn a_body_in_free_flight_follows_the_exact_trajectory() {
             omega: [0.0, 0.0, w0],
             release_s: 0.0,
         },
-        Kind::Wall,
+        kind,
         &mut parts,
     );
     let mut sc = scenario(
@@ -473,8 +472,15 @@ fn a_body_in_free_flight_follows_the_exact_trajectory() {
         },
         vec![],
     );
-    let c0 = DVec3::from_array(body.center);
     sc.bodies = vec![body];
+    sc
+}
+
+#[test]
+fn a_body_in_free_flight_follows_the_exact_trajectory() {
+    let (v0, w0) = ([0.5, 1.0, 0.0], 2.0);
+    let sc = thrown_box(Kind::Wall, v0, w0);
+    let c0 = DVec3::from_array(sc.bodies[0].center);
     let run = |sc: &Scenario| {
         let mut solver = Solver::new(gpu(), sc).unwrap();
         solver.advance_to(0.2).unwrap();
@@ -516,49 +522,8 @@ fn a_body_in_free_flight_follows_the_exact_trajectory() {
 /// too long.
 #[test]
 fn a_flying_body_sets_the_time_step_with_its_rigid_speed() {
-    let dim = 2;
-    let dx = 0.02;
     for kind in BODY_KINDS {
-        let ph = physics(dim, dx, 15.0);
-        let mut parts = Vec::new();
-        // Still water on a floor, far from the body.
-        for (k, min, max) in [
-            (Kind::Wall, [1.0, 0.0, 0.0], [2.5, 0.04, 0.0]),
-            (Kind::Fluid, [1.7, 0.04, 0.0], [1.8, 0.1, 0.0]),
-        ] {
-            for p in lattice(dim, dx, min, max) {
-                parts.push(Particle {
-                    pos: p,
-                    vel: [0.0; 3],
-                    rho: 1000.0,
-                    kind: k,
-                });
-            }
-        }
-        let body = box_body(
-            "thrown",
-            dim,
-            dx,
-            ([0.2, 0.5, 0.0], [0.36, 0.6, 0.0]),
-            500.0,
-            Motion::Free {
-                velocity: [0.5, 1.0, 0.0],
-                omega: [0.0, 0.0, 4.0],
-                release_s: 0.0,
-            },
-            kind,
-            &mut parts,
-        );
-        let mut sc = scenario(
-            ph,
-            parts,
-            Domain {
-                min: [0.0, 0.0, 0.0],
-                max: [2.6, 1.5, 0.0],
-            },
-            vec![],
-        );
-        sc.bodies = vec![body];
+        let sc = thrown_box(kind, [0.5, 1.0, 0.0], 4.0);
         let mut solver = Solver::new(gpu(), &sc).unwrap();
         for _ in 0..3 {
             // The densities the particles have when the body is moved (the last step's), and
