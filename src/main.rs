@@ -114,7 +114,7 @@ enum Command {
     /// Exit status: 0 when every judged row passes; 1 when a metric is over its bound or a case
     /// goes unstable or cannot run (the report is written either way), or on an error.
     Validate {
-        /// The resolutions and bounds of the CI tests (the default): about 4 minutes on a
+        /// The resolutions and bounds of the CI tests (the default): about 8.5 minutes on a
         /// software adapter with 2 cores.
         #[arg(long, conflicts_with = "full")]
         quick: bool,

@@ -82,11 +82,26 @@ pub const BAND_STEP: f64 = 0.005;
 pub const POINT: &str = "free_end";
 /// Bound of the largest error over the peak measured displacement (full mode).
 pub const BOUND: f64 = 0.2;
+/// Quick mode's end: the gate's opening, through the experiment's samples at 40 and 80 ms
+/// (its next is at 119 ms).
+pub const OPENING_END_S: f64 = 0.085;
+/// Bound of the largest error over the peak measured displacement in the opening (quick
+/// mode): there the published solutions lie within about 5 % of the experiment, and it is
+/// after the opening that they all leave it (the full bound allows for that).
+pub const OPENING_BOUND: f64 = 0.1;
 
-/// Full mode only, the shipped case (dx = 1 mm, 5 particles through the gate, 0.4 s): about
-/// 250 000 steps of 17 000 particles, hours on a software adapter. Quick mode does not run it.
+/// Full mode: the shipped case (dx = 1 mm, 5 particles through the gate, 0.4 s), about
+/// 215 000 steps of 17 000 particles, hours on a software adapter. Quick mode: the opening,
+/// to [`OPENING_END_S`], at dx = 5/3 mm (3 particles through the gate; 6 400 particles,
+/// 27 500 steps, 4 minutes on a software adapter).
 pub fn overrides(mode: Mode) -> Option<Vec<String>> {
-    (mode == Mode::Full).then(Vec::new)
+    Some(match mode {
+        Mode::Full => Vec::new(),
+        Mode::Quick => vec![
+            "particles.dx_m=0.0016666667".into(),
+            format!("time.end_s={OPENING_END_S}"),
+        ],
+    })
 }
 
 /// One displacement component of the free end against the experiment.
@@ -138,15 +153,20 @@ impl BandError {
 }
 
 /// Where `sim` leaves the band [min, max] of `solutions` by most, over every `BAND_STEP` from
-/// 0 at which all solutions are defined. `None` when the run does not cover those times.
-pub fn band_error(sim: &[(f64, f64)], solutions: &[Vec<(f64, f64)>]) -> Option<BandError> {
+/// 0 to `until` at which all solutions are defined. `None` when the run does not cover those
+/// times.
+pub fn band_error(
+    sim: &[(f64, f64)],
+    solutions: &[Vec<(f64, f64)>],
+    until: f64,
+) -> Option<BandError> {
     let start = solutions
         .iter()
         .map(|s| s.first().map_or(f64::INFINITY, |p| p.0));
     let end = solutions
         .iter()
         .map(|s| s.last().map_or(f64::NEG_INFINITY, |p| p.0));
-    let (start, end) = (start.fold(f64::MIN, f64::max), end.fold(f64::MAX, f64::min));
+    let (start, end) = (start.fold(f64::MIN, f64::max), end.fold(until, f64::min));
     let mut worst: Option<BandError> = None;
     let mut k = (start / BAND_STEP).ceil() as i64;
     while k as f64 * BAND_STEP <= end {
@@ -167,15 +187,21 @@ pub fn band_error(sim: &[(f64, f64)], solutions: &[Vec<(f64, f64)>]) -> Option<B
     worst
 }
 
-/// `column` (`ux_m` or `uy_m`) of the free end in the run in `dir` against `reference`.
-/// Reference samples before t = 0 (the digitised y series starts at −0.8 ms, the gate at rest)
-/// are not compared; every later one must be inside the run.
-pub fn displacement(dir: &Path, column: &str, reference: &Reference) -> Result<Displacement> {
+/// `column` (`ux_m` or `uy_m`) of the free end in the run in `dir` against `reference` up to
+/// `until` (the run's end time). Reference samples before t = 0 (the digitised y series starts
+/// at −0.8 ms, the gate at rest) or after `until` are not compared; every other one must be
+/// inside the run.
+pub fn displacement(
+    dir: &Path,
+    column: &str,
+    reference: &Reference,
+    until: f64,
+) -> Result<Displacement> {
     let sim = table_series(dir, &format!("point_{POINT}"), column)?;
     let experiment = reference.points()?;
     let points = experiment
         .iter()
-        .filter(|&&(t, _)| t >= 0.0)
+        .filter(|&&(t, _)| (0.0..=until).contains(&t))
         .map(|&(t, want)| {
             let got = interpolate(&sim, t)
                 .ok_or_else(|| anyhow!("no finite free-end displacement at t = {t} s"))?;
@@ -192,12 +218,18 @@ pub fn displacement(dir: &Path, column: &str, reference: &Reference) -> Result<D
 pub fn evaluate(sc: &Scenario, dir: &Path, bounds: Mode) -> Result<Evaluation> {
     let mut metrics = Vec::new();
     let mut figures = Vec::new();
-    let judged = |bound| (bounds == Mode::Full).then_some(Bound::Within(bound));
+    // Quick mode runs the opening only, where the published solutions still agree with the
+    // experiment.
+    let bound = match bounds {
+        Mode::Full => BOUND,
+        Mode::Quick => OPENING_BOUND,
+    };
+    let until = sc.time.end_s;
     for (axis, column, reference) in [
         ("x", "ux_m", &X_DISPLACEMENT),
         ("y", "uy_m", &Y_DISPLACEMENT),
     ] {
-        let d = displacement(dir, column, reference)?;
+        let d = displacement(dir, column, reference, until)?;
         let detail = d
             .points
             .iter()
@@ -208,7 +240,7 @@ pub fn evaluate(sc: &Scenario, dir: &Path, bounds: Mode) -> Result<Evaluation> {
             name: format!("free-end {axis} displacement, largest error / peak measured"),
             value: d.worst_error(),
             unit: Unit::Percent,
-            bound: judged(BOUND),
+            bound: Some(Bound::Within(bound)),
             detail,
         });
         let mut curves = vec![
@@ -222,7 +254,7 @@ pub fn evaluate(sc: &Scenario, dir: &Path, bounds: Mode) -> Result<Evaluation> {
             curves.push(sim_curve(p.label, points.clone()));
             solutions.push(points);
         }
-        let band = band_error(&d.sim, &solutions).ok_or_else(|| {
+        let band = band_error(&d.sim, &solutions, until).ok_or_else(|| {
             anyhow!("the free-end table does not cover the published solutions' times")
         })?;
         let peak = d.experiment.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
@@ -233,7 +265,7 @@ pub fn evaluate(sc: &Scenario, dir: &Path, bounds: Mode) -> Result<Evaluation> {
             ),
             value: band.distance() / peak,
             unit: Unit::Percent,
-            bound: judged(BAND_BOUND),
+            bound: Some(Bound::Within(BAND_BOUND)),
             detail: format!(
                 "t {:.3} s: {:.1} mm, published {:.1}…{:.1} mm",
                 band.t,
