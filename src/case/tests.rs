@@ -1401,6 +1401,31 @@ fn friction_pairs_resolve_names_and_refuse_bad_ones() {
         assert_eq!(sc.walls.friction_between(ContactGroup::Body(1), g), 0.4);
     }
 
+    assert!(sc.warnings.is_empty(), "{:?}", sc.warnings);
+    // A fixed pier in the moving tank: the pair never acts (one warning, though "walls"
+    // stands for both the fixed walls and the tank).
+    let pier = sloshing
+        .replace("name = \"float\"", "name = \"pier\"")
+        .replace("between = [\"float\"", "between = [\"pier\"")
+        .replace(
+            "density_kg_m3 = 500.0\n",
+            "density_kg_m3 = 500.0\n[body.motion]\nkind = \"fixed\"\n",
+        );
+    let sc = load_str(&pier, "f.toml", &[]).unwrap();
+    assert!(sc.bodies[1].is_fixed());
+    assert_eq!(sc.warnings.len(), 1, "{:?}", sc.warnings);
+    for words in [
+        "[[friction]] between \"pier\" and \"walls\"",
+        "never acts",
+        "fix: remove the table, or make \"pier\" a free body",
+    ] {
+        assert!(
+            sc.warnings[0].contains(words),
+            "{words:?} in {:?}",
+            sc.warnings[0]
+        );
+    }
+
     let bad: &[(&str, &[&str])] = &[
         (
             "between = [\"box\", \"lid\"]\ncoefficient = 0.3",

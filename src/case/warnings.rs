@@ -6,7 +6,7 @@ use super::bodies::Shape;
 use super::build::fmt_box;
 use super::error::num;
 use super::validate::{Case, Treatment};
-use crate::scenario::{Motion, MotionLaw};
+use crate::scenario::{ContactGroup, Motion, MotionLaw};
 
 /// The speed of sound `c0` and the field it came from (`physics.sound_speed_m_s` or
 /// `physics.sound_speed_coef`).
@@ -20,6 +20,43 @@ pub(super) fn of(case: &Case, dx: f64, h: f64, sound: Sound<'_>) -> Vec<String> 
     let mut out = shallow_walls(case, dx, h);
     out.extend(thin_ghosts(case, dx, h));
     out.extend(fast_flow(case, sound));
+    out.extend(idle_friction(case));
+    out
+}
+
+/// `[[friction]]` pairs between two things that both move as the case prescribes (the walls, a
+/// moving tank, fixed and prescribed bodies): their contact is left out of the step
+/// (interaction.wgsl, `contact_counts`), so the coefficient never acts.
+fn idle_friction(case: &Case) -> Vec<String> {
+    let tank_moves = case.tank.as_ref().is_some_and(|t| t.motion.is_some());
+    // The name `between` gives a kinematic group, or None for one that moves under its load.
+    let kinematic = |g: ContactGroup| -> Option<String> {
+        match g {
+            ContactGroup::Walls => Some("walls".into()),
+            ContactGroup::Body(0) if tank_moves => Some("walls".into()),
+            ContactGroup::Body(k) => {
+                let b = &case.bodies[k - tank_moves as usize];
+                matches!(b.motion, Motion::Prescribed(_)).then(|| b.name.clone())
+            }
+            ContactGroup::Solid(_) => None,
+        }
+    };
+    let mut out: Vec<String> = Vec::new();
+    for pair in &case.walls.friction_pairs {
+        let [Some(a), Some(b)] = pair.between.map(kinematic) else {
+            continue;
+        };
+        let body = if a == "walls" { &b } else { &a };
+        let w = format!(
+            "[[friction]] between \"{a}\" and \"{b}\": neither moves under its load (fixed \
+             walls, a moving tank, fixed or prescribed bodies), so their contact is left out of \
+             the step and this coefficient never acts; fix: remove the table, or make \"{body}\" \
+             a free body"
+        );
+        if !out.contains(&w) {
+            out.push(w);
+        }
+    }
     out
 }
 
