@@ -1413,7 +1413,13 @@ fn friction_pairs_resolve_names_and_refuse_bad_ones() {
         );
     let sc = load_str(&pier, "f.toml", &[]).unwrap();
     assert!(sc.bodies[1].is_fixed());
-    assert_eq!(sc.warnings.len(), 1, "{:?}", sc.warnings);
+    // It is also left behind by the tank (the second warning).
+    assert_eq!(sc.warnings.len(), 2, "{:?}", sc.warnings);
+    assert!(
+        sc.warnings[1].starts_with("body[0] ('pier') is fixed in the world while the tank moves"),
+        "{:?}",
+        sc.warnings[1]
+    );
     for words in [
         "[[friction]] between \"pier\" and \"walls\"",
         "never acts",

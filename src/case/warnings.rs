@@ -21,7 +21,30 @@ pub(super) fn of(case: &Case, dx: f64, h: f64, sound: Sound<'_>) -> Vec<String> 
     out.extend(thin_ghosts(case, dx, h));
     out.extend(fast_flow(case, sound));
     out.extend(idle_friction(case));
+    out.extend(left_behind(case));
     out
+}
+
+/// Fixed bodies in a moving tank: they stay where they are in the world while the tank's walls
+/// and obstacles move (a fixed body is not carried with the tank), and their contact with the
+/// walls is left out, so the walls pass through them.
+fn left_behind(case: &Case) -> Vec<String> {
+    if !case.tank.as_ref().is_some_and(|t| t.motion.is_some()) {
+        return Vec::new();
+    }
+    (case.bodies.iter().enumerate())
+        .filter(|(_, b)| matches!(&b.motion, Motion::Prescribed(p) if p.law == MotionLaw::Fixed))
+        .map(|(i, b)| {
+            format!(
+                "body[{i}] ('{}') is fixed in the world while the tank moves: it is not carried \
+                 with the tank, whose walls and obstacles move past and through it (their \
+                 contact with a fixed body is left out); fix: give it the tank's motion \
+                 (body.motion as tank.motion, with the same pivot), or make a box of it an \
+                 [[obstacle]], which moves with the tank",
+                b.name
+            )
+        })
+        .collect()
 }
 
 /// `[[friction]]` pairs between two things that both move as the case prescribes (the walls, a
