@@ -436,7 +436,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     };
     // Mirror walls have no particles (their TankWall has no layers). A moving tank's walls and
     // obstacles become the body "tank", after every fixed particle.
-    let tank_moves = case.tank.as_ref().is_some_and(|t| t.motion.is_some());
+    let tank_moves = case.tank_moves();
     let mut tank_particles = Vec::new();
     let mut push_wall = |pos: [f64; 3], t: Treatment| {
         let p = Particle {

@@ -111,6 +111,14 @@ pub(super) struct Case {
     pub outlets: Vec<crate::scenario::Outlet>,
 }
 
+impl Case {
+    /// Whether the tank moves (`[tank.motion]`): its walls and obstacles are then the body
+    /// "tank", body 0.
+    pub fn tank_moves(&self) -> bool {
+        self.tank.as_ref().is_some_and(|t| t.motion.is_some())
+    }
+}
+
 /// Allowed range of a number.
 #[derive(Clone, Copy)]
 pub(super) enum Bound {

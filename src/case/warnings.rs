@@ -29,7 +29,7 @@ pub(super) fn of(case: &Case, dx: f64, h: f64, sound: Sound<'_>) -> Vec<String> 
 /// and obstacles move (a fixed body is not carried with the tank), and their contact with the
 /// walls is left out, so the walls pass through them.
 fn left_behind(case: &Case) -> Vec<String> {
-    if !case.tank.as_ref().is_some_and(|t| t.motion.is_some()) {
+    if !case.tank_moves() {
         return Vec::new();
     }
     (case.bodies.iter().enumerate())
@@ -51,7 +51,7 @@ fn left_behind(case: &Case) -> Vec<String> {
 /// moving tank, fixed and prescribed bodies): their contact is left out of the step
 /// (interaction.wgsl, `contact_counts`), so the coefficient never acts.
 fn idle_friction(case: &Case) -> Vec<String> {
-    let tank_moves = case.tank.as_ref().is_some_and(|t| t.motion.is_some());
+    let tank_moves = case.tank_moves();
     // The name `between` gives a kinematic group, or None for one that moves under its load.
     let kinematic = |g: ContactGroup| -> Option<String> {
         match g {
