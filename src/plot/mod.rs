@@ -360,29 +360,34 @@ fn header_columns(path: &Path) -> Option<Vec<String>> {
 pub fn read_table_column(path: &Path, column: &str) -> Result<Series> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    parse_table_column(&text, &path.display().to_string(), column)
+}
+
+/// [`read_table_column`] of the text of a table; `name` (a file path) is used in errors.
+pub fn parse_table_column(text: &str, name: &str, column: &str) -> Result<Series> {
     let mut lines = text
         .lines()
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'));
     let header = lines
         .next()
-        .ok_or_else(|| anyhow!("{}: no header line (and no data)", path.display()))?
+        .ok_or_else(|| anyhow!("{name}: no header line (and no data)"))?
         .1;
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
     let col = names
         .iter()
         .position(|c| *c == column)
-        .ok_or_else(|| anyhow!("{}: no column {column:?} in {header:?}", path.display()))?;
+        .ok_or_else(|| anyhow!("{name}: no column {column:?} in {header:?}"))?;
     let points = lines
         .map(|(i, l)| {
             let fields: Vec<&str> = l.split(',').collect();
             let num = |k: usize| -> Result<f64> {
                 let s = fields
                     .get(k)
-                    .ok_or_else(|| anyhow!("{}:{}: too few columns", path.display(), i + 1))?;
+                    .ok_or_else(|| anyhow!("{name}:{}: too few columns", i + 1))?;
                 s.trim()
                     .parse()
-                    .map_err(|_| anyhow!("{}:{}: {s:?} is not a number", path.display(), i + 1))
+                    .map_err(|_| anyhow!("{name}:{}: {s:?} is not a number", i + 1))
             };
             Ok((num(0)?, num(col)?))
         })

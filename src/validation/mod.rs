@@ -4,7 +4,8 @@
 //! directory), the `--set` overrides of the quick and the full mode, the reference with its
 //! citation, and the function that turns the run's outputs (probe CSVs, body CSVs, run.json)
 //! into metrics and figures. The metrics live in one file per case family ([`hydrostatic`],
-//! [`dam_break`], [`lobovsky`], [`bodies`], [`sloshing`], [`plate`], [`gate`]); the integration tests
+//! [`dam_break`], [`lobovsky`], [`bodies`], [`sloshing`], [`plate`], [`gate`], [`spheric`]); the
+//! integration tests
 //! (`tests/validation/`) call
 //! the same functions, so a bound asserted in CI and a row of the report are the same code.
 //!
@@ -20,6 +21,7 @@ pub mod lobovsky;
 pub mod plate;
 mod report;
 pub mod sloshing;
+pub mod spheric;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -268,6 +270,15 @@ pub static CASES: &[Case] = &[
         citation: gate::CITATION,
         overrides: gate::overrides,
         evaluate: gate::evaluate,
+    },
+    Case {
+        name: "dam_break_3d",
+        file: "cases/dam_break_3d.toml",
+        text: include_str!("../../cases/dam_break_3d.toml"),
+        reference: spheric::REFERENCE,
+        citation: spheric::CITATION,
+        overrides: spheric::overrides,
+        evaluate: spheric::evaluate,
     },
 ];
 

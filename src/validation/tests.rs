@@ -521,3 +521,55 @@ fn gate_band_metric_from_synthetic_point_tables() {
     assert_eq!(by.verdict(), Verdict::Fail, "{by:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// SPHERIC Test 2: probes that read the experiment itself (at its own sample times) give no
+/// difference and the measured impact time; P1 late by 20 ms reads the impact 5 % late
+/// (0.42 / 0.40 s) and a difference at P1 only. Nothing is judged before a full GPU run.
+#[test]
+fn spheric_metrics_from_synthetic_probes() {
+    let case = find("dam_break_3d").unwrap();
+    assert!(case.overrides(Mode::Quick).is_none(), "a GPU's run");
+    let sc = case.scenario(&case.overrides(Mode::Full).unwrap()).unwrap();
+    assert_eq!(sc.time.probe_every_s, spheric::PROBE_EVERY_S);
+    for (tag, delay) in [("spheric", 0.0), ("spheric-late", 0.02)] {
+        let dir = temp_dir(tag);
+        for (probe, column) in spheric::SERIES {
+            let shift = if probe == "P1" { delay } else { 0.0 };
+            let unit = if probe.starts_with('P') {
+                "pressure_pa"
+            } else {
+                "height_m"
+            };
+            let mut table = format!("t_s,{unit}\n");
+            for (t, v) in spheric::experiment(column).unwrap() {
+                let _ = writeln!(table, "{},{v}", t + shift);
+            }
+            std::fs::write(dir.join(PROBES_DIR).join(format!("{probe}.csv")), table).unwrap();
+        }
+        write_run_json(&dir, &summary(case.name, 0));
+        let eval = case.evaluate(&sc, &dir, Mode::Full).unwrap();
+        assert_eq!(eval.metrics.len(), 1 + 8 + 1);
+        assert!(eval.metrics.iter().all(|m| m.verdict() == Verdict::Info));
+        let impact = eval
+            .metrics
+            .iter()
+            .find(|m| m.name.starts_with("P1: impact time"))
+            .unwrap();
+        let rms = |probe: &str| {
+            eval.metrics
+                .iter()
+                .find(|m| m.name.starts_with(&format!("{probe}: RMS")))
+                .unwrap()
+                .value
+        };
+        // The experiment's P1 reaches 10 % of its peak at its sample of 0.40002 s.
+        assert!((impact.value - delay / 0.40002).abs() < 1e-9, "{impact:?}");
+        for (probe, _) in spheric::SERIES {
+            let expected_zero = probe != "P1" || delay == 0.0;
+            assert_eq!(rms(probe) == 0.0, expected_zero, "{probe}: {}", rms(probe));
+        }
+        assert!(delay == 0.0 || rms("P1") > 0.01, "{}", rms("P1"));
+        assert_eq!(eval.figures.len(), 8);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,127 @@
+//! 3D dam break with an obstacle, SPHERIC Test 2 (Kleefsman et al. 2005, the MARIN experiment;
+//! `cases/dam_break_3d.toml`): pressures P1 and P3 on the box's face towards the water, P5 and
+//! P7 on its top, and water heights H1–H4 along the tank's middle, against the experiment over
+//! its 6 s record. Full mode only (180 000 particles at the shipped dx = 0.02 m, a GPU's run).
+//! No row is judged yet: the bounds wait for the first full run on a GPU (docs/validation.md).
+
+use std::path::Path;
+
+use anyhow::{anyhow, Result};
+
+use super::{
+    lost_particles, probe_series, reference_curve, sim_curve, Evaluation, Figure, Metric, Mode,
+    Unit,
+};
+use crate::plot::{compare, parse_table_column};
+use crate::scenario::Scenario;
+
+pub const REFERENCE: &str = "tests/data/spheric2_kleefsman_coarse_0p02s.csv";
+pub const CITATION: &str = "Kleefsman et al. (2005), J. Comput. Phys. 206:363–393, SPHERIC \
+     Test 2 (MARIN experiment), raw samples every 0.02 s";
+const DATA: &str = include_str!("../../tests/data/spheric2_kleefsman_coarse_0p02s.csv");
+
+/// Each probe of the case file compared, and its column in the reference.
+pub const SERIES: [(&str, &str); 8] = [
+    ("P1", "P1_Pa"),
+    ("P3", "P3_Pa"),
+    ("P5", "P5_Pa"),
+    ("P7", "P7_Pa"),
+    ("H1", "H1_geom_eq_xlsH3_m"),
+    ("H2", "H2_m"),
+    ("H3", "H3_geom_eq_xlsH1_m"),
+    ("H4", "H4_m"),
+];
+/// The probes' sampling in full mode, s: the impact at P1 rises within one of the reference's
+/// 0.02 s samples.
+pub const PROBE_EVERY_S: f64 = 0.005;
+/// The impact at P1: the first time its pressure reaches this share of the experiment's peak.
+pub const IMPACT_SHARE: f64 = 0.1;
+
+/// Full mode: the shipped case, probes every [`PROBE_EVERY_S`]. Quick mode does not run it.
+pub fn overrides(mode: Mode) -> Option<Vec<String>> {
+    (mode == Mode::Full).then(|| vec![format!("time.probe_every_s={PROBE_EVERY_S}")])
+}
+
+/// The experiment's series `column` (t [s], value).
+pub fn experiment(column: &str) -> Result<Vec<(f64, f64)>> {
+    Ok(parse_table_column(DATA, REFERENCE, column)?.points)
+}
+
+/// The first time `series` reaches `level`.
+fn arrival(series: &[(f64, f64)], level: f64) -> Option<f64> {
+    series.iter().find(|p| p.1 >= level).map(|p| p.0)
+}
+
+/// (t, value) of the largest value of `series`.
+fn peak(series: &[(f64, f64)]) -> (f64, f64) {
+    series
+        .iter()
+        .filter(|p| p.1.is_finite())
+        .fold((f64::NAN, f64::NEG_INFINITY), |a, p| {
+            if p.1 > a.1 {
+                *p
+            } else {
+                a
+            }
+        })
+}
+
+pub fn evaluate(sc: &Scenario, dir: &Path, _bounds: Mode) -> Result<Evaluation> {
+    let mut metrics = vec![lost_particles(dir, false)?];
+    let mut figures = Vec::new();
+    for (probe, column) in SERIES {
+        let sim = probe_series(dir, probe)?;
+        let exp = experiment(column)?;
+        let e = compare(&sim, &exp)
+            .ok_or_else(|| anyhow!("{probe}: the run does not overlap the experiment's times"))?;
+        let scale = exp.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
+        let (ps, pe) = (peak(&sim), peak(&exp));
+        let unit = if probe.starts_with('P') { "Pa" } else { "m" };
+        metrics.push(Metric {
+            name: format!("{probe}: RMS difference / the experiment's largest value"),
+            value: e.rms_error / scale,
+            unit: Unit::Percent,
+            bound: None,
+            detail: format!(
+                "at {} experimental times in [{:.2}, {:.2}] s; peak {:.4} {unit} at {:.3} s \
+                 vs experiment {:.4} {unit} at {:.3} s",
+                e.points, e.t_start_s, e.t_end_s, ps.1, ps.0, pe.1, pe.0
+            ),
+        });
+        if probe == "P1" {
+            let level = IMPACT_SHARE * pe.1;
+            let (ts, te) = (arrival(&sim, level), arrival(&exp, level));
+            metrics.push(Metric {
+                name: format!(
+                    "P1: impact time (first p ≥ {:.0} % of the measured peak)",
+                    100.0 * IMPACT_SHARE
+                ),
+                value: ts.zip(te).map_or(f64::NAN, |(s, e)| s / e - 1.0),
+                unit: Unit::Percent,
+                bound: None,
+                detail: format!(
+                    "{level:.0} Pa reached at {} s vs experiment {} s (its samples are 0.02 s \
+                     apart)",
+                    ts.map_or("never".into(), |t| format!("{t:.3}")),
+                    te.map_or("never".into(), |t| format!("{t:.3}"))
+                ),
+            });
+        }
+        let what = if unit == "Pa" {
+            "pressure"
+        } else {
+            "water height"
+        };
+        figures.push(Figure {
+            name: probe.into(),
+            title: format!("{}: {what} {probe}", sc.name),
+            x_label: "t [s]".into(),
+            y_label: format!("{what} [{unit}]"),
+            curves: vec![
+                sim_curve("wgsph", sim),
+                reference_curve("Kleefsman et al. (2005)", exp),
+            ],
+        });
+    }
+    Ok(Evaluation { metrics, figures })
+}
