@@ -1,7 +1,8 @@
 //! 3D dam break with an obstacle, SPHERIC Test 2 (Kleefsman et al. 2005, the MARIN experiment;
 //! `cases/dam_break_3d.toml`): pressures P1 and P3 on the box's face towards the water, P5 and
-//! P7 on its top, and water heights H1–H4 along the tank's middle, against the experiment over
-//! its 6 s record. Full mode only (180 000 particles at the shipped dx = 0.02 m, a GPU's run).
+//! P7 on its top (particle probes; P1 and P5 also read by the wall-force sensors W1 and W5),
+//! and water heights H1–H4 along the tank's middle, against the experiment over its 6 s
+//! record. Full mode only (180 000 particles at the shipped dx = 0.02 m, a GPU's run).
 //! No row is judged yet: the bounds wait for the first full run on a GPU (docs/validation.md).
 
 use std::path::Path;
@@ -20,12 +21,15 @@ pub const CITATION: &str = "Kleefsman et al. (2005), J. Comput. Phys. 206:363–
      Test 2 (MARIN experiment), raw samples every 0.02 s";
 const DATA: &str = include_str!("../../tests/data/spheric2_kleefsman_coarse_0p02s.csv");
 
-/// Each probe of the case file compared, and its column in the reference.
-pub const SERIES: [(&str, &str); 8] = [
+/// Each probe of the case file compared, and its column in the reference: the particle probes,
+/// and the wall-force sensors W1 and W5 on the box's faces at P1 and P5.
+pub const SERIES: [(&str, &str); 10] = [
     ("P1", "P1_Pa"),
+    ("W1", "P1_Pa"),
     ("P3", "P3_Pa"),
     ("P5", "P5_Pa"),
     ("P7", "P7_Pa"),
+    ("W5", "P5_Pa"),
     ("H1", "H1_geom_eq_xlsH3_m"),
     ("H2", "H2_m"),
     ("H3", "H3_geom_eq_xlsH1_m"),
@@ -34,7 +38,8 @@ pub const SERIES: [(&str, &str); 8] = [
 /// The probes' sampling in full mode, s: the impact at P1 rises within one of the reference's
 /// 0.02 s samples.
 pub const PROBE_EVERY_S: f64 = 0.005;
-/// The impact at P1: the first time its pressure reaches this share of the experiment's peak.
+/// The impact at P1 (probe and wall sensor): the first time the pressure reaches this share of
+/// the experiment's peak.
 pub const IMPACT_SHARE: f64 = 0.1;
 
 /// Full mode: the shipped case, probes every [`PROBE_EVERY_S`]. Quick mode does not run it.
@@ -76,7 +81,7 @@ pub fn evaluate(sc: &Scenario, dir: &Path, _bounds: Mode) -> Result<Evaluation> 
             .ok_or_else(|| anyhow!("{probe}: the run does not overlap the experiment's times"))?;
         let scale = exp.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
         let (ps, pe) = (peak(&sim), peak(&exp));
-        let unit = if probe.starts_with('P') { "Pa" } else { "m" };
+        let unit = if column.ends_with("_Pa") { "Pa" } else { "m" };
         metrics.push(Metric {
             name: format!("{probe}: RMS difference / the experiment's largest value"),
             value: e.rms_error / scale,
@@ -88,12 +93,12 @@ pub fn evaluate(sc: &Scenario, dir: &Path, _bounds: Mode) -> Result<Evaluation> 
                 e.points, e.t_start_s, e.t_end_s, ps.1, ps.0, pe.1, pe.0
             ),
         });
-        if probe == "P1" {
+        if column == "P1_Pa" {
             let level = IMPACT_SHARE * pe.1;
             let (ts, te) = (arrival(&sim, level), arrival(&exp, level));
             metrics.push(Metric {
                 name: format!(
-                    "P1: impact time (first p ≥ {:.0} % of the measured peak)",
+                    "{probe}: impact time (first p ≥ {:.0} % of P1's measured peak)",
                     100.0 * IMPACT_SHARE
                 ),
                 value: ts.zip(te).map_or(f64::NAN, |(s, e)| s / e - 1.0),
@@ -114,7 +119,7 @@ pub fn evaluate(sc: &Scenario, dir: &Path, _bounds: Mode) -> Result<Evaluation> 
         };
         figures.push(Figure {
             name: probe.into(),
-            title: format!("{}: {what} {probe}", sc.name),
+            title: format!("{}: {what} {probe} (measured: {})", sc.name, &column[..2]),
             x_label: "t [s]".into(),
             y_label: format!("{what} [{unit}]"),
             curves: vec![

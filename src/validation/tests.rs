@@ -535,7 +535,7 @@ fn spheric_metrics_from_synthetic_probes() {
         let dir = temp_dir(tag);
         for (probe, column) in spheric::SERIES {
             let shift = if probe == "P1" { delay } else { 0.0 };
-            let unit = if probe.starts_with('P') {
+            let unit = if column.ends_with("_Pa") {
                 "pressure_pa"
             } else {
                 "height_m"
@@ -548,7 +548,8 @@ fn spheric_metrics_from_synthetic_probes() {
         }
         write_run_json(&dir, &summary(case.name, 0));
         let eval = case.evaluate(&sc, &dir, Mode::Full).unwrap();
-        assert_eq!(eval.metrics.len(), 1 + 8 + 1);
+        // Lost particles; a difference per series; the impact at P1 and at W1.
+        assert_eq!(eval.metrics.len(), 1 + 10 + 2);
         assert!(eval.metrics.iter().all(|m| m.verdict() == Verdict::Info));
         let impact = eval
             .metrics
@@ -569,7 +570,7 @@ fn spheric_metrics_from_synthetic_probes() {
             assert_eq!(rms(probe) == 0.0, expected_zero, "{probe}: {}", rms(probe));
         }
         assert!(delay == 0.0 || rms("P1") > 0.01, "{}", rms("P1"));
-        assert_eq!(eval.figures.len(), 8);
+        assert_eq!(eval.figures.len(), 10);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
