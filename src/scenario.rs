@@ -661,19 +661,6 @@ pub struct Body {
     pub motion: Motion,
 }
 
-impl Body {
-    /// Whether it never moves (`[body.motion] kind = "fixed"`).
-    pub fn is_fixed(&self) -> bool {
-        matches!(&self.motion, Motion::Prescribed(p) if p.law == MotionLaw::Fixed)
-    }
-
-    /// Whether it moves as the case prescribes whatever its load (fixed, sine or series; the
-    /// moving tank too), so that contact with the walls cannot move it.
-    pub fn is_kinematic(&self) -> bool {
-        matches!(&self.motion, Motion::Prescribed(_))
-    }
-}
-
 #[derive(Clone, Debug, PartialEq)]
 pub enum Motion {
     /// Moves under the fluid's force and torque, gravity and contact, from this initial
@@ -687,6 +674,19 @@ pub enum Motion {
     },
     /// Follows a given law whatever the forces: x(t) = pivot + d(t) + R(θ(t) about `axis`)(x0 − pivot).
     Prescribed(Prescribed),
+}
+
+impl Motion {
+    /// Whether the body never moves (`[body.motion] kind = "fixed"`).
+    pub fn is_fixed(&self) -> bool {
+        matches!(self, Motion::Prescribed(p) if p.law == MotionLaw::Fixed)
+    }
+
+    /// Whether the body moves as the case prescribes whatever its load (fixed, sine or series;
+    /// the moving tank too), so that contact with the walls cannot move it.
+    pub fn is_kinematic(&self) -> bool {
+        matches!(self, Motion::Prescribed(_))
+    }
 }
 
 /// A prescribed rigid motion: a displacement d(t) and a rotation θ(t) about a fixed axis

@@ -968,7 +968,7 @@ fn a_kinematic_body_takes_no_contact_from_the_walls_it_rests_on() {
         println!(
             "dim {dim}, {}: {} rows of the pressed box, GPU error {worst:.1e} of RMS; the \
              contact would be {contact_share:.3} of its {} floor rows",
-            if sc.bodies[1].is_fixed() {
+            if sc.bodies[1].motion.is_fixed() {
                 "fixed"
             } else {
                 "rocking"

@@ -1412,7 +1412,7 @@ fn friction_pairs_resolve_names_and_refuse_bad_ones() {
             "density_kg_m3 = 500.0\n[body.motion]\nkind = \"fixed\"\n",
         );
     let sc = load_str(&pier, "f.toml", &[]).unwrap();
-    assert!(sc.bodies[1].is_fixed());
+    assert!(sc.bodies[1].motion.is_fixed());
     // It is also left behind by the tank (the second warning).
     assert_eq!(sc.warnings.len(), 2, "{:?}", sc.warnings);
     assert!(

@@ -33,7 +33,7 @@ fn left_behind(case: &Case) -> Vec<String> {
         return Vec::new();
     }
     (case.bodies.iter().enumerate())
-        .filter(|(_, b)| matches!(&b.motion, Motion::Prescribed(p) if p.law == MotionLaw::Fixed))
+        .filter(|(_, b)| b.motion.is_fixed())
         .map(|(i, b)| {
             format!(
                 "body[{i}] ('{}') is fixed in the world while the tank moves: it is not carried \
@@ -59,7 +59,7 @@ fn idle_friction(case: &Case) -> Vec<String> {
             ContactGroup::Body(0) if tank_moves => Some("walls".into()),
             ContactGroup::Body(k) => {
                 let b = &case.bodies[k - tank_moves as usize];
-                matches!(b.motion, Motion::Prescribed(_)).then(|| b.name.clone())
+                b.motion.is_kinematic().then(|| b.name.clone())
             }
             ContactGroup::Solid(_) => None,
         }

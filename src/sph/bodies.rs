@@ -41,7 +41,7 @@ pub fn initial_motions(sc: &Scenario, first_id: u32) -> Vec<BodyMotion> {
                 first: body.particles.start as u32 - first_id,
                 count,
                 first_group: groups,
-                flags: if body.is_kinematic() {
+                flags: if body.motion.is_kinematic() {
                     BODY_KINEMATIC
                 } else {
                     0

@@ -254,7 +254,7 @@ fn street_flood_strikes_the_building_coarse() {
 fn a_mesh_building_takes_the_flood_load_not_the_streets() {
     let set = ["particles.dx_m=0.04", "time.end_s=1.2"].map(String::from);
     let sc = wgsph::case::load(Path::new("cases/street_flood_mesh_3d.toml"), &set).unwrap();
-    assert!(sc.bodies[0].is_fixed());
+    assert!(sc.bodies[0].motion.is_fixed());
     let mut s = Solver::new(gpu(), &sc).unwrap();
     let gauge = sc
         .probes

@@ -362,7 +362,7 @@ fn a_wall_pressure_probe_on_a_removed_body_names_bodies_in_its_fix() {
                  normal = [-1.0, 0.0]\nradius_m = 0.05\n";
     let with_body = format!("{BASE}\n{probe}\n{body}");
     let sc = load_str(&with_body, "cases/t.toml", &[]).unwrap();
-    assert!(sc.bodies[0].is_fixed());
+    assert!(sc.bodies[0].motion.is_fixed());
     assert_err(
         &format!("{BASE}\n{probe}"),
         &[],
