@@ -28,7 +28,6 @@
 
 var<workgroup> wg_force: array<vec3<f32>, WG>;
 var<workgroup> wg_torque: array<vec3<f32>, WG>;
-var<workgroup> wg_speed: array<f32, WG>;
 
 @compute @workgroup_size(WG)
 fn body_move(
@@ -57,16 +56,9 @@ fn body_move(
     }
     // Workgroup max, then one atomic per workgroup, as in integrate.wgsl's `correct` (which
     // runs later in the step, before the time step is chosen from the maximum).
-    wg_speed[li] = speed;
-    workgroupBarrier();
-    for (var s = WG / 2u; s > 0u; s >>= 1u) {
-        if (li < s) {
-            wg_speed[li] = max(wg_speed[li], wg_speed[li + s]);
-        }
-        workgroupBarrier();
-    }
+    let largest = workgroup_max(li, vec2<f32>(speed, 0.0));
     if (li == 0u) {
-        atomicMax(&state.max_speed_bits, bitcast<u32>(wg_speed[0]));
+        atomicMax(&state.max_speed_bits, bitcast<u32>(largest.x));
     }
 }
 

@@ -19,8 +19,6 @@
 @group(0) @binding(9) var<storage, read> energy_rate: array<f32>;
 @group(0) @binding(10) var<storage, read> mirror_planes: array<MirrorPlane>;
 
-var<workgroup> wg_speed: array<f32, WG>;
-var<workgroup> wg_accel: array<f32, WG>;
 
 fn all_finite(v: vec4<f32>) -> bool {
     // NaN fails every comparison; |inf| fails the bound.
@@ -141,21 +139,12 @@ fn correct(
             speed = sound_speed_of(vr.w) + length(vr.xyz);
         }
     }
-    // Workgroup max, then one atomic per workgroup (max is order-independent: deterministic).
-    wg_speed[li] = speed;
-    wg_accel[li] = accel;
-    workgroupBarrier();
-    for (var s = WG / 2u; s > 0u; s >>= 1u) {
-        if (li < s) {
-            wg_speed[li] = max(wg_speed[li], wg_speed[li + s]);
-            wg_accel[li] = max(wg_accel[li], wg_accel[li + s]);
-        }
-        workgroupBarrier();
-    }
+    // Workgroup max, then one atomic per workgroup.
+    let largest = workgroup_max(li, vec2<f32>(speed, accel));
     if (li == 0u) {
         // Non-negative f32 order like their bit patterns.
-        atomicMax(&state.max_speed_bits, bitcast<u32>(wg_speed[0]));
-        atomicMax(&state.max_accel_bits, bitcast<u32>(wg_accel[0]));
+        atomicMax(&state.max_speed_bits, bitcast<u32>(largest.x));
+        atomicMax(&state.max_accel_bits, bitcast<u32>(largest.y));
     }
 }
 

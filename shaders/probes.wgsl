@@ -159,8 +159,6 @@ fn ordered_bits(f: f32) -> u32 {
     return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
 }
 
-var<workgroup> wg_front: array<f32, WG>;
-
 // Front probes: max over fluid of (x − origin)·axis. The host zeroes `probe_out` first
 // (0 is below every ordered value).
 @compute @workgroup_size(WG)
@@ -181,18 +179,11 @@ fn probe_front(
         if (def.kind != PROBE_FRONT) {
             continue;
         }
-        wg_front[li] = select(-3.0e38, dot(x - def.point, def.axis), fluid);
-        workgroupBarrier();
-        for (var s = WG / 2u; s > 0u; s >>= 1u) {
-            if (li < s) {
-                wg_front[li] = max(wg_front[li], wg_front[li + s]);
-            }
-            workgroupBarrier();
-        }
+        let reach = select(-3.0e38, dot(x - def.point, def.axis), fluid);
+        let largest = workgroup_max(li, vec2<f32>(reach, 0.0));
         if (li == 0u) {
-            atomicMax(&probe_out[k], ordered_bits(wg_front[0]));
+            atomicMax(&probe_out[k], ordered_bits(largest.x));
         }
-        workgroupBarrier();
     }
 }
 

@@ -16,6 +16,8 @@ pub const NEIGHBOURS: &str = include_str!("../../shaders/lib/neighbours.wgsl");
 pub const MLS: &str = include_str!("../../shaders/lib/mls.wgsl");
 /// The fluid interpolated at a point (`shaders/lib/fluid_at.wgsl`; needs `MLS`).
 pub const FLUID_AT: &str = include_str!("../../shaders/lib/fluid_at.wgsl");
+/// A maximum over the workgroup before one atomic (`shaders/lib/workgroup_max.wgsl`).
+pub const WORKGROUP_MAX: &str = include_str!("../../shaders/lib/workgroup_max.wgsl");
 
 /// One shader file per pass, named like its Rust module in `src/sph`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,7 +87,9 @@ impl Pass {
         match self {
             Pass::Ghost | Pass::OpenBoundaries => &[NEIGHBOURS, MLS, FLUID_AT],
             Pass::DensityFilter => &[NEIGHBOURS, MLS],
-            Pass::Interaction | Pass::Elastic | Pass::Probes => &[NEIGHBOURS],
+            Pass::Interaction | Pass::Elastic => &[NEIGHBOURS],
+            Pass::Probes => &[NEIGHBOURS, WORKGROUP_MAX],
+            Pass::Integrate | Pass::Bodies => &[WORKGROUP_MAX],
             _ => &[],
         }
     }
