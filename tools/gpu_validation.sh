@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# The runs that wait for a GPU (docs/validation.md, "The GPU runs"): benchmarks of the 3D cases,
+# `wgsph validate --full` case by case (the fluid–solid cases first), the 3D sloshing test and
+# the street flood at their shipped dx. Each item runs under what is left of one time budget
+# (and at most ITEM_CAP_S), so a short lease still returns every item that finished and the
+# progress log of the one that did not; the summary marks each item's exit status (124: out of
+# time), none is left out silently.
+#
+# Usage: tools/gpu_validation.sh WORK_DIR [BUDGET_S]
+#   WGSPH             the engine (default target/release/wgsph; build it from this checkout)
+#   VALIDATION_TESTS  the validation test binary, for the 3D sloshing test (built by
+#                     `cargo test --release --test validation --no-run`); skipped without it
+#   ITEMS             the items to run, in order (default: all, as listed below)
+#   ITEM_CAP_S        the most one item may take (default 300)
+# Writes WORK_DIR/summary.txt (one line per item: name, exit status, seconds, then the
+# validate report's judged rows) and WORK_DIR/results.tar.gz (logs, reports, probe CSVs, plots
+# and run.json files; no particle files). Run from the repository root (the cases are read
+# from cases/, the reference data from tests/data/).
+set -uo pipefail
+
+work=${1:?usage: tools/gpu_validation.sh WORK_DIR [BUDGET_S]}
+budget=${2:-540}
+wgsph=${WGSPH:-target/release/wgsph}
+tests=${VALIDATION_TESTS:-}
+cap=${ITEM_CAP_S:-300}
+all="info bench_dam_break_3d bench_dam_break_3d_1M bench_street_flood_3d
+validate:floating_box_2d validate:water_entry_cylinder_2d validate:water_entry_cylinder_2d_rho1000
+validate:sloshing_2d validate:oscillating_plate_2d validate:oscillating_plate_tl_2d
+validate:elastic_gate_2d sloshing_3d street_flood_3d validate:dam_break_3d
+validate:hydrostatic_2d validate:dam_break_2d validate:dam_break_lobovsky_2d"
+items=${ITEMS:-$all}
+
+[ -x "$wgsph" ] || { echo "no engine at $wgsph: cargo build --release, or set WGSPH" >&2; exit 2; }
+mkdir -p "$work"
+summary="$work/summary.txt"
+: >"$summary"
+start=$(date +%s)
+
+# The command of one item (run in $work/<item>/, log in $work/<item>.log).
+command_of() {
+    local item=$1 dir=$2
+    case $item in
+    info) echo "$wgsph info" ;;
+    bench_dam_break_3d) echo "$wgsph bench cases/dam_break_3d.toml --steps 500 --stages" ;;
+    # 1.05 M particles: bytes per particle and throughput at scale.
+    bench_dam_break_3d_1M) echo "$wgsph bench cases/dam_break_3d.toml --set particles.dx_m=0.01 --steps 300" ;;
+    bench_street_flood_3d) echo "$wgsph bench cases/street_flood_3d.toml --steps 500" ;;
+    validate:*) echo "$wgsph validate --full --case ${item#validate:} --out $dir" ;;
+    sloshing_3d)
+        [ -n "$tests" ] || return 1
+        echo "$tests --ignored --exact sloshing::sloshing_3d_transducers_follow_the_experiment --nocapture"
+        ;;
+    street_flood_3d) echo "$wgsph run cases/street_flood_3d.toml --out $dir" ;;
+    *) return 1 ;;
+    esac
+}
+
+for item in $items; do
+    name=${item//:/_}
+    dir="$work/$name"
+    left=$((budget - ($(date +%s) - start)))
+    if ! cmd=$(command_of "$item" "$dir"); then
+        echo "$item: skipped (unknown item, or no VALIDATION_TESTS for it)" | tee -a "$summary"
+        continue
+    fi
+    if [ "$left" -lt 20 ]; then
+        echo "$item: not run (budget spent)" | tee -a "$summary"
+        continue
+    fi
+    limit=$((left < cap ? left : cap))
+    t0=$(date +%s)
+    # SIGINT first: the engine stops at a step's end and keeps its outputs.
+    timeout --signal=INT --kill-after=15 "$limit" $cmd >"$work/$name.log" 2>&1
+    rc=$?
+    echo "$item: exit $rc in $(($(date +%s) - t0)) s (limit $limit s)" | tee -a "$summary"
+    # The report's rows (or, without a report, how far the run got), a bench's result.
+    {
+        if [ -f "$dir/report.md" ]; then
+            grep -E '^- (adapter|result)|\| (PASS|FAIL|info) \|' "$dir/report.md"
+        else
+            grep -v XDG_RUNTIME_DIR "$work/$name.log" | tail -n 12
+        fi
+    } | sed 's/^/    /' >>"$summary"
+
+done
+
+(cd "$work" && find . -name particles -prune -o -name snapshots -prune -o -type f \
+    \( -name '*.log' -o -name '*.md' -o -name '*.csv' -o -name '*.png' -o -name run.json \
+    -o -name summary.txt \) -print | tar -czf results.tar.gz -T -)
+echo "total $(($(date +%s) - start)) s; $work/summary.txt, $work/results.tar.gz ($(du -h "$work/results.tar.gz" | cut -f1))"
