@@ -130,6 +130,12 @@ enum Command {
             wgsph::validation::CASES.iter().map(|c| c.name)
         ))]
         cases: Vec<String>,
+        /// Evaluate a case's earlier run in DIR/<case> instead of running it again, where that
+        /// run completed with this mode's set-up (its run.json and validate_overrides.txt, its
+        /// particle counts and end time); other cases run. To judge again after changing a
+        /// metric, or to judge runs made on another machine (a GPU's, copied back).
+        #[arg(long)]
+        reuse: bool,
     },
     /// List the adapters wgpu sees and their limits.
     Info,
@@ -335,13 +341,15 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             full,
             out,
             cases,
+            reuse,
         } => {
             use wgsph::validation::{self, Mode};
             let mode = if full { Mode::Full } else { Mode::Quick };
             let selected = validation::select(mode, &cases)?;
             let ctx = context(cli.adapter)?;
-            let report =
-                validation::validate(&ctx, mode, &selected, &out, &mut || progress(false, bars))?;
+            let report = validation::validate(&ctx, mode, &selected, &out, reuse, &mut || {
+                progress(false, bars)
+            })?;
             print!("{}", report.table());
             println!(
                 "{}: wrote {}",

@@ -13,9 +13,11 @@
 #   ITEMS             the items to run, in order (default: all, as listed below)
 #   ITEM_CAP_S        the most one item may take (default 300)
 # Writes WORK_DIR/summary.txt (one line per item: name, exit status, seconds, then the
-# validate report's judged rows) and WORK_DIR/results.tar.gz (logs, reports, probe CSVs, plots
-# and run.json files; no particle files). Run from the repository root (the cases are read
-# from cases/, the reference data from tests/data/).
+# validate report's judged rows), WORK_DIR/validate/report.md (every validate case that
+# completed, judged together) and WORK_DIR/results.tar.gz (logs, reports, probe CSVs, plots and
+# run files; no particle files). Unpacked elsewhere, `wgsph validate --full --reuse --out
+# validate` judges those runs again without running them. Run from the repository root (the
+# cases are read from cases/, the reference data from tests/data/).
 set -uo pipefail
 
 work=${1:?usage: tools/gpu_validation.sh WORK_DIR [BUDGET_S]}
@@ -45,7 +47,7 @@ command_of() {
     # 1.05 M particles: bytes per particle and throughput at scale.
     bench_dam_break_3d_1M) echo "$wgsph bench cases/dam_break_3d.toml --set particles.dx_m=0.01 --steps 300" ;;
     bench_street_flood_3d) echo "$wgsph bench cases/street_flood_3d.toml --steps 500" ;;
-    validate:*) echo "$wgsph validate --full --case ${item#validate:} --out $dir" ;;
+    validate:*) echo "$wgsph validate --full --case ${item#validate:} --out $work/validate" ;;
     sloshing_3d)
         [ -n "$tests" ] || return 1
         echo "$tests --ignored --exact sloshing::sloshing_3d_transducers_follow_the_experiment --nocapture"
@@ -58,6 +60,8 @@ command_of() {
 for item in $items; do
     name=${item//:/_}
     dir="$work/$name"
+    # validate's report.md holds the last case's rows: none left from the case before.
+    [[ $item == validate:* ]] && dir="$work/validate" && rm -f "$dir/report.md"
     left=$((budget - ($(date +%s) - start)))
     if ! cmd=$(command_of "$item" "$dir"); then
         echo "$item: skipped (unknown item, or no VALIDATION_TESTS for it)" | tee -a "$summary"
@@ -84,7 +88,18 @@ for item in $items; do
 
 done
 
+# One report of every validate case whose run completed (evaluated again, not run: --reuse).
+completed=()
+for item in $items; do
+    [[ $item == validate:* ]] && [ -f "$work/validate/${item#validate:}/validate_overrides.txt" ] &&
+        completed+=(--case "${item#validate:}")
+done
+if [ ${#completed[@]} -gt 0 ]; then
+    "$wgsph" validate --full --reuse --out "$work/validate" "${completed[@]}" >"$work/validate_all.log" 2>&1
+    echo "validate, completed cases judged together: exit $? ($work/validate/report.md)" | tee -a "$summary"
+fi
+
 (cd "$work" && find . -name particles -prune -o -name snapshots -prune -o -type f \
     \( -name '*.log' -o -name '*.md' -o -name '*.csv' -o -name '*.png' -o -name run.json \
-    -o -name summary.txt \) -print | tar -czf results.tar.gz -T -)
+    -o -name summary.txt -o -name validate_overrides.txt \) -print | tar -czf results.tar.gz -T -)
 echo "total $(($(date +%s) - start)) s; $work/summary.txt, $work/results.tar.gz ($(du -h "$work/results.tar.gz" | cut -f1))"

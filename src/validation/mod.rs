@@ -33,7 +33,7 @@ use crate::output::{RunSummary, PROBES_DIR, RUN_SUMMARY_FILE};
 use crate::plot::{self, Curve, PLOTS_DIR};
 use crate::progress::Progress;
 use crate::run::RunOptions;
-use crate::scenario::Scenario;
+use crate::scenario::{Kind, Scenario};
 
 pub use report::{Report, REPORT_FILE};
 
@@ -337,6 +337,8 @@ pub struct CaseOutcome {
     pub plots: Vec<PathBuf>,
     /// Wall time of the whole case (run, evaluation, plots), seconds.
     pub wall_s: f64,
+    /// Whether an earlier run in `dir` was evaluated rather than a new one made (`--reuse`).
+    pub reused: bool,
 }
 
 impl CaseOutcome {
@@ -347,13 +349,16 @@ impl CaseOutcome {
 }
 
 /// Runs `case` with `overrides` into `dir`, then evaluates it with the bounds of `bounds` and
-/// draws its figures into `dir/plots`. Never fails: what goes wrong is the outcome's `failure`.
+/// draws its figures into `dir/plots`. With `reuse`, a completed earlier run of the same set-up
+/// in `dir` ([`reusable_run`]) is evaluated instead of running again. Never fails: what goes
+/// wrong is the outcome's `failure`.
 pub fn run_case(
     ctx: &GpuContext,
     case: &Case,
     overrides: &[String],
     bounds: Mode,
     dir: &Path,
+    reuse: bool,
     progress: &mut dyn Progress,
 ) -> CaseOutcome {
     let start = Instant::now();
@@ -369,8 +374,9 @@ pub fn run_case(
         failure: None,
         plots: Vec::new(),
         wall_s: 0.0,
+        reused: false,
     };
-    if let Err(e) = run_and_evaluate(ctx, case, bounds, progress, &mut outcome) {
+    if let Err(e) = run_and_evaluate(ctx, case, bounds, reuse, progress, &mut outcome) {
         outcome.failure = Some(format!("{e:#}"));
     }
     outcome.wall_s = start.elapsed().as_secs_f64();
@@ -381,16 +387,39 @@ fn run_and_evaluate(
     ctx: &GpuContext,
     case: &Case,
     bounds: Mode,
+    reuse: bool,
     progress: &mut dyn Progress,
     outcome: &mut CaseOutcome,
 ) -> Result<()> {
     let sc = case.scenario(&outcome.overrides)?;
     let dir = outcome.dir.clone();
-    let report = crate::run::run(ctx, &sc, &dir, &RunOptions::default(), progress)?;
-    outcome.summary = Some(report.summary);
-    if let Some(e) = report.stopped {
-        // The metrics of a run cut short would compare part of a series: none are given.
-        bail!("run stopped: {e:#}");
+    let earlier = if reuse {
+        reusable_run(&sc, &outcome.overrides, &dir)
+    } else {
+        Err("not asked to".into())
+    };
+    match earlier {
+        Ok(summary) => {
+            log::info!(
+                "{}: evaluating the earlier run in {}",
+                sc.name,
+                dir.display()
+            );
+            outcome.summary = Some(summary);
+            outcome.reused = true;
+        }
+        Err(why) => {
+            if reuse {
+                log::info!("{}: running again ({why})", sc.name);
+            }
+            let report = crate::run::run(ctx, &sc, &dir, &RunOptions::default(), progress)?;
+            outcome.summary = Some(report.summary);
+            if let Some(e) = report.stopped {
+                // The metrics of a run cut short would compare part of a series: none are given.
+                bail!("run stopped: {e:#}");
+            }
+            write_overrides(&dir, &outcome.overrides)?;
+        }
     }
     let eval = case
         .evaluate(&sc, &dir, bounds)
@@ -398,6 +427,68 @@ fn run_and_evaluate(
     outcome.metrics = eval.metrics;
     outcome.plots = draw(&dir, &eval.figures)?;
     Ok(())
+}
+
+/// The overrides a completed validation run was made with, one per line, beside its run.json.
+pub const OVERRIDES_FILE: &str = "validate_overrides.txt";
+
+fn write_overrides(dir: &Path, overrides: &[String]) -> Result<()> {
+    let path = dir.join(OVERRIDES_FILE);
+    let text: String = overrides.iter().map(|o| format!("{o}\n")).collect();
+    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// The run summary of the earlier run in `dir` when it can stand for a run of `sc` made with
+/// `overrides`: it completed, it is of this case, with these overrides (`OVERRIDES_FILE`,
+/// written after a validation run completes), the particle counts `sc` gives and its end time.
+/// Otherwise why not. The case file's other fields are not compared: edit one and run again.
+pub fn reusable_run(
+    sc: &Scenario,
+    overrides: &[String],
+    dir: &Path,
+) -> std::result::Result<RunSummary, String> {
+    let s = run_summary(dir).map_err(|e| format!("{e:#}"))?;
+    let path = dir.join(OVERRIDES_FILE);
+    let written = std::fs::read_to_string(&path)
+        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let counts = |s: &RunSummary| {
+        [
+            s.particles_fluid,
+            s.particles_wall,
+            s.particles_solid,
+            s.particles_inlet,
+        ]
+    };
+    let expected = [
+        sc.count(Kind::Fluid),
+        sc.boundary_count(),
+        sc.solid_count(),
+        sc.count(Kind::Inlet),
+    ]
+    .map(|n| n as u64);
+    let end = sc.time.end_s;
+    if s.status != "completed" {
+        Err(format!("the run did not complete: {}", s.status))
+    } else if s.case != sc.name {
+        Err(format!("the run is of case {}", s.case))
+    } else if !written.lines().eq(overrides.iter().map(String::as_str)) {
+        Err(format!(
+            "it was made with other overrides ({})",
+            path.display()
+        ))
+    } else if counts(&s) != expected {
+        Err(format!(
+            "its particle counts (fluid, boundary, solid, inlet) {:?} are not the case's {expected:?}",
+            counts(&s)
+        ))
+    } else if (s.simulated_time_s - end).abs() > 1e-6 * end.max(1.0) {
+        Err(format!(
+            "it ended at t = {} s, not the case's {end} s",
+            s.simulated_time_s
+        ))
+    } else {
+        Ok(s)
+    }
 }
 
 /// Draws `figures` into `dir/plots`; returns the PNG paths.
@@ -416,12 +507,14 @@ pub fn draw(dir: &Path, figures: &[Figure]) -> Result<Vec<PathBuf>> {
 }
 
 /// Runs `cases` in `mode` into `out/<case>`, writes `out/report.md` and returns the report.
+/// With `reuse`, a case's completed earlier run there is evaluated instead ([`reusable_run`]).
 /// `progress` gives the progress display of each run.
 pub fn validate(
     ctx: &GpuContext,
     mode: Mode,
     cases: &[&Case],
     out: &Path,
+    reuse: bool,
     progress: &mut dyn FnMut() -> Box<dyn Progress>,
 ) -> Result<Report> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
@@ -444,7 +537,7 @@ pub fn validate(
                 .join(" "),
             dir.display()
         );
-        let o = run_case(ctx, case, &overrides, mode, &dir, &mut *progress());
+        let o = run_case(ctx, case, &overrides, mode, &dir, reuse, &mut *progress());
         for m in &o.metrics {
             log::info!("{}: {} = {}", o.name, m.name, report::value_text(m));
         }

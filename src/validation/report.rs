@@ -174,8 +174,9 @@ impl Report {
             if let Some(r) = &c.summary {
                 let _ = writeln!(
                     s,
-                    "- run: {}; t = {:.4} s, {} steps, {} fluid + {} boundary + {} solid particles, {:.1} s in the time loop",
-                    r.status, r.simulated_time_s, r.steps, r.particles_fluid, r.particles_wall, r.particles_solid, r.wall_time_s
+                    "- run: {}; t = {:.4} s, {} steps, {} fluid + {} boundary + {} solid particles, {:.1} s in the time loop{}",
+                    r.status, r.simulated_time_s, r.steps, r.particles_fluid, r.particles_wall, r.particles_solid, r.wall_time_s,
+                    if c.reused { format!(" (an earlier run on {}, evaluated again: `--reuse`)", r.adapter) } else { String::new() }
                 );
             }
             if let Some(f) = &c.failure {

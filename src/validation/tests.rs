@@ -85,6 +85,7 @@ fn hydrostatic_outcome(tag: &str, factor: f64) -> CaseOutcome {
         failure: None,
         plots,
         wall_s: 1.5,
+        reused: false,
     }
 }
 
@@ -170,6 +171,7 @@ fn a_case_that_stops_is_a_fail_row_with_its_reason() {
         failure: Some("run stopped: non-finite fluid at step 12 (t = 0.01 s)".into()),
         plots: vec![],
         wall_s: 0.1,
+        reused: false,
     };
     let r = report(vec![stopped]);
     assert_eq!(r.exit_status(), 1);
@@ -590,4 +592,43 @@ fn spheric_metrics_from_synthetic_probes() {
         assert_eq!(eval.figures.len(), 10);
         std::fs::remove_dir_all(&dir).unwrap();
     }
+}
+
+#[test]
+fn reuse_takes_only_a_completed_run_of_the_same_set_up() {
+    let case = find("hydrostatic_2d").unwrap();
+    let overrides = case.overrides(Mode::Quick).unwrap();
+    let sc = case.scenario(&overrides).unwrap();
+    let dir = temp_dir("reuse");
+    let mut s = summary(case.name, 0);
+    s.particles_fluid = sc.count(crate::scenario::Kind::Fluid) as u64;
+    s.particles_wall = sc.boundary_count() as u64;
+    s.simulated_time_s = sc.time.end_s;
+    write_run_json(&dir, &s);
+    // Without the overrides file (a run made by `wgsph run`, or one that did not complete).
+    let why = reusable_run(&sc, &overrides, &dir).unwrap_err();
+    assert!(why.contains(OVERRIDES_FILE), "{why}");
+    write_overrides(&dir, &overrides).unwrap();
+    assert_eq!(reusable_run(&sc, &overrides, &dir), Ok(s.clone()));
+    // Another mode's overrides, a stopped run, other particle counts, another end time.
+    let full = case.overrides(Mode::Full).unwrap();
+    assert!(reusable_run(&sc, &full, &dir)
+        .unwrap_err()
+        .contains("overrides"));
+    let changed: [(&str, fn(&mut RunSummary)); 4] = [
+        ("did not complete", |s| {
+            s.status = "stopped: non-finite fluid".into()
+        }),
+        ("particle counts", |s| s.particles_fluid += 1),
+        ("particle counts", |s| s.particles_inlet = 7),
+        ("ended at", |s| s.simulated_time_s *= 0.5),
+    ];
+    for (expected, change) in changed {
+        let mut other = s.clone();
+        change(&mut other);
+        write_run_json(&dir, &other);
+        let why = reusable_run(&sc, &overrides, &dir).unwrap_err();
+        assert!(why.contains(expected), "{why}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -238,6 +238,7 @@ pub fn validate_case(
         &overrides,
         bounds,
         &dir,
+        false,
         &mut wgsph::progress::LogLines::default(),
     );
     println!("{}", rows(&o));
