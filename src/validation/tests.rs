@@ -615,7 +615,8 @@ fn reuse_takes_only_a_completed_run_of_the_same_set_up() {
     assert!(reusable_run(&sc, &full, &dir)
         .unwrap_err()
         .contains("overrides"));
-    let changed: [(&str, fn(&mut RunSummary)); 4] = [
+    type Change = fn(&mut RunSummary);
+    let changed: [(&str, Change); 4] = [
         ("did not complete", |s| {
             s.status = "stopped: non-finite fluid".into()
         }),
