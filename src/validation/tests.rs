@@ -294,15 +294,23 @@ fn dam_break_front_equal_to_the_experiment_has_no_error() {
             .take_while(|p| p.0 < 3.2),
     );
     let si: Vec<(f64, f64)> = pts.iter().map(|&(t, z)| (t / scale, z * a)).collect();
-    let f = dam_break::front(&sc, &si).unwrap();
+    let f = dam_break::front(&sc, &si, &dam_break::DATA).unwrap();
     assert!(f.speed_error().abs() < 1e-9, "{}", f.speed_error());
     assert!(f.worst_position_error().abs() < 1e-9);
     assert_eq!(f.positions.len(), 4);
     // 10 % ahead everywhere: +10 % position error, and the speed too (Z scaled by 1.1).
     let ahead: Vec<(f64, f64)> = si.iter().map(|&(t, x)| (t, 1.1 * x)).collect();
-    let f = dam_break::front(&sc, &ahead).unwrap();
+    let f = dam_break::front(&sc, &ahead, &dam_break::DATA).unwrap();
     assert!((f.worst_position_error() - 0.1).abs() < 1e-9);
     assert!((f.speed_error() - 0.1).abs() < 1e-9);
+    // Koshizuka & Oka's points (T ≤ 3 from T = 0) against their own front: no error either.
+    let ko: Vec<(f64, f64)> = (dam_break::KO_DATA.points().unwrap().into_iter())
+        .take_while(|p| p.0 < 3.2)
+        .map(|(t, z)| (t / scale, z * a))
+        .collect();
+    let f = dam_break::front(&sc, &ko, &dam_break::KO_DATA).unwrap();
+    assert!(f.speed_error().abs() < 1e-9 && f.worst_position_error().abs() < 1e-9);
+    assert_eq!(f.positions.len(), 8);
 }
 
 /// The floating box and the water entry from synthetic body tables.
