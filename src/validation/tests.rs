@@ -558,8 +558,15 @@ fn spheric_metrics_from_synthetic_probes() {
         }
         write_run_json(&dir, &summary(case.name, 0));
         let eval = case.evaluate(&sc, &dir, Mode::Full).unwrap();
-        // Lost particles; a difference per series; the impact at P1 and at W1.
-        assert_eq!(eval.metrics.len(), 1 + 10 + 2);
+        // Lost particles; a difference per series; the impact at P1 and at W1, the bore's
+        // arrival at H3 and H2 (unshifted: no error).
+        assert_eq!(eval.metrics.len(), 1 + 10 + 2 + 2);
+        for gauge in spheric::BORE_GAUGES {
+            let row = (eval.metrics.iter())
+                .find(|m| m.name.starts_with(&format!("{gauge}: bore arrival")))
+                .unwrap();
+            assert_eq!(row.value, 0.0, "{row:?}");
+        }
         assert!(eval.metrics.iter().all(|m| m.verdict() == Verdict::Info));
         let impact = eval
             .metrics
