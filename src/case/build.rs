@@ -18,7 +18,7 @@ use super::validate::{Aabb, Case, Sound, Treatment, WallSettings};
 
 /// Tolerance for "inside" tests of user boxes [m].
 const TOL: f64 = 1e-9;
-const AXES: [&str; 3] = ["x", "y", "z"];
+pub(super) const AXES: [&str; 3] = ["x", "y", "z"];
 
 fn inside(b: &Aabb, outer: &Aabb, dim: usize) -> Option<usize> {
     (0..dim).find(|&a| b.min[a] < outer.min[a] - TOL || b.max[a] > outer.max[a] + TOL)

@@ -307,9 +307,10 @@ fn dam_break_2d_builds() {
 fn dam_break_3d_builds() {
     let s = load_str(DAM_3D, "cases/dam_break_3d.toml", &[]).unwrap();
     check_invariants(&s);
-    let fluid = s.count(Kind::Fluid);
-    assert!((61 * 50 * 27..=61 * 50 * 28).contains(&fluid), "{fluid}");
-    // The box: 8 x 20 x 8 lattice points.
+    // dx = 0.55/30: the column is exactly 30 layers high (67 x 55 across the tank's 1.0 m).
+    assert_eq!(s.count(Kind::Fluid), 67 * 55 * 30);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    // The box: 9 x 22 x 9 lattice points.
     let in_box = s
         .particles
         .iter()
@@ -322,23 +323,33 @@ fn dam_break_3d_builds() {
                 && p.pos[1] < 0.8
         })
         .count();
-    assert_eq!(in_box, 8 * 20 * 8);
+    assert_eq!(in_box, 9 * 22 * 9);
     assert_eq!(s.probes.len(), 14);
-    // The force sensors on the box, at y = 0.5 between the lattice's columns at 0.49 and 0.51:
-    // each takes both, equally near.
-    for (name, columns) in [("W1", 2.0), ("W5", 2.0)] {
+    // The force sensors on the box, at y = 0.5 between the lattice's columns at 0.486 and
+    // 0.504: each takes the one nearest.
+    let dx = 0.55 / 30.0;
+    for name in ["W1", "W5"] {
         let p = s.probes.iter().find(|p| p.name == name).unwrap();
         let ProbeKind::WallPressure(patch) = p.kind else {
             panic!("{p:?}");
         };
-        assert!(
-            (patch.area - columns * 0.02 * 0.02).abs() < 1e-12,
-            "{name}: {patch:?}"
-        );
+        assert!((patch.area - dx * dx).abs() < 1e-9, "{name}: {patch:?}");
     }
     assert!(s.walls.reactions);
     assert_eq!(s.physics.gravity, [0.0, 0.0, -9.81]);
-    assert!((s.physics.h - 0.03).abs() < 1e-12);
+    assert!((s.physics.h - 1.5 * dx).abs() < 1e-9);
+    // At dx = 0.02 the column would round to 28 layers (0.56 m): a warning.
+    let coarse = load_str(
+        DAM_3D,
+        "cases/dam_break_3d.toml",
+        &sets(&["particles.dx_m=0.02"]),
+    )
+    .unwrap();
+    assert!(
+        coarse.warnings.len() == 1 && coarse.warnings[0].contains("0.56 m of water (+1.8 %)"),
+        "{:?}",
+        coarse.warnings
+    );
     assert!(s.particles.len() < 250_000);
 }
 

@@ -3,7 +3,7 @@
 //! P7 on its top (particle probes; P1 and P5 also read by the wall-force sensors W1 and W5),
 //! and water heights H1–H4 along the tank's middle, against the experiment over its 6 s
 //! record (pressures averaged over the reference's 0.02 s sample spacing). Full mode only
-//! (180 000 particles at the shipped dx = 0.02 m, a GPU's run). No row is judged yet: the
+//! (223 848 particles at the shipped dx = 0.55/30 m, a GPU's run). No row is judged yet: the
 //! bounds wait for the first full run on a GPU (docs/validation.md).
 
 use std::fmt::Write as _;
@@ -43,9 +43,9 @@ pub const PROBE_EVERY_S: f64 = 0.005;
 /// The gauges the front passes before the box, whose bore arrival is timed.
 pub const BORE_GAUGES: [&str; 2] = ["H3", "H2"];
 /// The bore's arrival at a gauge: the first time the water there stands this high, m. The
-/// experiment's front has a tip a few millimetres thick ahead of its bore, which a run at the
-/// shipped dx = 0.02 m does not resolve (docs/validation.md): 2.5 spacings up, the bore is
-/// timed rather than the tip.
+/// experiment's front has a tip a few millimetres thick ahead of its bore, which runs at
+/// dx ≈ 0.02 m do not resolve (docs/validation.md): 2.5–3 spacings up, the bore is timed
+/// rather than the tip.
 pub const BORE_LEVEL_M: f64 = 0.05;
 /// Moving-average window of the simulated pressures, s: the reference's sample spacing. With
 /// c0 = 10 √(gH) ≈ 23 m/s the impact rings at the artificial sound's period over the front's

@@ -478,3 +478,35 @@ fn speeds_above_a_tenth_of_the_sound_speed_load_with_a_warning() {
         "{w:?}"
     );
 }
+
+/// A fluid block whose extent is not close to a whole number of spacings loads with a warning
+/// giving the water it holds and two spacings that divide it; within 1.5 % it loads without.
+#[test]
+fn fluid_blocks_that_round_to_other_sizes_load_with_a_warning() {
+    let warnings = |over: &[&str]| load_str(BASE, "c.toml", &sets(over)).unwrap().warnings;
+    // 0.5 m at dx = 0.1: 5 spacings exactly.
+    assert!(warnings(&[]).is_empty());
+    // 0.55 m high at dx = 0.1: 6 layers (round half away from zero), 0.6 m of water.
+    let w = warnings(&["fluid_block[0].max_m=[0.5, 0.55]"]);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert_eq!(
+        w[0],
+        "fluid_block[0] is 0.55 m along y but is filled with 6 spacings of dx = 0.1 m: 0.6 m \
+         of water (+9.1 %), which moves its hydrostatic pressure and wave speed as much; fix: \
+         a particles.dx_m that divides 0.55 m (such as 0.0916667 or 0.11), or a block of a \
+         whole number of spacings"
+    );
+    // Both axes, short: 0.44 m holds 4 spacings (0.4 m).
+    let w = warnings(&["fluid_block[0].max_m=[0.44, 0.44]"]);
+    assert!(
+        w.len() == 2 && w[0].contains("along x") && w[1].contains("0.4 m of water (-9.1 %)"),
+        "{w:?}"
+    );
+    // 0.507 m: 5 spacings, 1.4 % short, under the 1.5 % that warns; 0.508 m, 1.6 %, over.
+    assert!(warnings(&["fluid_block[0].max_m=[0.507, 0.5]"]).is_empty());
+    let w = warnings(&["fluid_block[0].max_m=[0.508, 0.5]"]);
+    assert!(
+        w.len() == 1 && w[0].contains("0.5 m of water (-1.6 %)"),
+        "{w:?}"
+    );
+}
