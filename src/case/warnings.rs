@@ -169,7 +169,7 @@ const BLOCK_ROUNDING: f64 = 0.015;
 fn rounded_blocks(case: &Case, dx: f64) -> Vec<String> {
     let mut out = Vec::new();
     for (i, b) in case.blocks.iter().enumerate() {
-        for a in 0..case.dim {
+        for (a, axis) in AXES.iter().enumerate().take(case.dim) {
             let len = b.bx.max[a] - b.bx.min[a];
             let n = super::lattice::cells(len, dx);
             let filled = n * dx;
@@ -184,7 +184,7 @@ fn rounded_blocks(case: &Case, dx: f64) -> Vec<String> {
                  as much; fix: a particles.dx_m that divides {} m (such as {} or {}), or a \
                  block of a whole number of spacings",
                 num(len),
-                AXES[a],
+                axis,
                 num(dx),
                 num(round3(filled)),
                 100.0 * (filled / len - 1.0),
