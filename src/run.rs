@@ -99,6 +99,11 @@ pub struct RunOptions {
     pub lose_device_after_s: Option<f64>,
 }
 
+/// `checkpoint::fingerprint` of `sc` as run.json records it.
+pub fn fingerprint_hex(sc: &Scenario) -> String {
+    format!("{:016x}", fingerprint(sc))
+}
+
 /// What a finished (or stopped) run reports.
 pub struct RunReport {
     pub summary: RunSummary,
@@ -503,6 +508,7 @@ impl<'a> Runner<'a> {
                 (None, None) => "completed".into(),
             },
             warnings: sc.warnings.clone(),
+            fingerprint: Some(fingerprint_hex(sc)),
         };
         self.outputs.out.write_run_summary(&summary)?;
         Ok(RunReport {

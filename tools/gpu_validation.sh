@@ -91,7 +91,8 @@ done
 # One report of every validate case whose run completed (evaluated again, not run: --reuse).
 completed=()
 for item in $items; do
-    [[ $item == validate:* ]] && [ -f "$work/validate/${item#validate:}/validate_overrides.txt" ] &&
+    [[ $item == validate:* ]] &&
+        grep -q '"status": "completed"' "$work/validate/${item#validate:}/run.json" 2>/dev/null &&
         completed+=(--case "${item#validate:}")
 done
 if [ ${#completed[@]} -gt 0 ]; then
@@ -101,5 +102,5 @@ fi
 
 (cd "$work" && find . -name particles -prune -o -name snapshots -prune -o -type f \
     \( -name '*.log' -o -name '*.md' -o -name '*.csv' -o -name '*.png' -o -name run.json \
-    -o -name summary.txt -o -name validate_overrides.txt \) -print | tar -czf results.tar.gz -T -)
+    -o -name summary.txt \) -print | tar -czf results.tar.gz -T -)
 echo "total $(($(date +%s) - start)) s; $work/summary.txt, $work/results.tar.gz ($(du -h "$work/results.tar.gz" | cut -f1))"

@@ -37,6 +37,11 @@ pub struct RunSummary {
     /// The case's warnings (`Scenario::warnings`).
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// What the run was set up with: the scenario's fingerprint (`checkpoint::fingerprint`:
+    /// physics, walls, probes, bodies and every particle), 16 hex digits. `wgsph validate
+    /// --reuse` takes a run whose fingerprint is the case's.
+    #[serde(default)]
+    pub fingerprint: Option<String>,
 }
 
 pub(crate) fn write_run_summary(path: &Path, summary: &RunSummary) -> Result<(), OutputError> {
@@ -56,6 +61,7 @@ mod tests {
 
     fn sample() -> RunSummary {
         RunSummary {
+            fingerprint: Some("0123456789abcdef".into()),
             case: "dam_break_2d".into(),
             adapter: "NVIDIA H100 \"quoted\"".into(),
             backend: "Vulkan".into(),

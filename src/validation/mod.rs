@@ -32,8 +32,8 @@ use crate::gpu::GpuContext;
 use crate::output::{RunSummary, PROBES_DIR, RUN_SUMMARY_FILE};
 use crate::plot::{self, Curve, PLOTS_DIR};
 use crate::progress::Progress;
-use crate::run::RunOptions;
-use crate::scenario::{Kind, Scenario};
+use crate::run::{fingerprint_hex, RunOptions};
+use crate::scenario::Scenario;
 
 pub use report::{Report, REPORT_FILE};
 
@@ -394,7 +394,7 @@ fn run_and_evaluate(
     let sc = case.scenario(&outcome.overrides)?;
     let dir = outcome.dir.clone();
     let earlier = if reuse {
-        reusable_run(&sc, &outcome.overrides, &dir)
+        reusable_run(&sc, &dir)
     } else {
         Err("not asked to".into())
     };
@@ -418,7 +418,6 @@ fn run_and_evaluate(
                 // The metrics of a run cut short would compare part of a series: none are given.
                 bail!("run stopped: {e:#}");
             }
-            write_overrides(&dir, &outcome.overrides)?;
         }
     }
     let eval = case
@@ -429,58 +428,22 @@ fn run_and_evaluate(
     Ok(())
 }
 
-/// The overrides a completed validation run was made with, one per line, beside its run.json.
-pub const OVERRIDES_FILE: &str = "validate_overrides.txt";
-
-fn write_overrides(dir: &Path, overrides: &[String]) -> Result<()> {
-    let path = dir.join(OVERRIDES_FILE);
-    let text: String = overrides.iter().map(|o| format!("{o}\n")).collect();
-    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))
-}
-
-/// The run summary of the earlier run in `dir` when it can stand for a run of `sc` made with
-/// `overrides`: it completed, it is of this case, with these overrides (`OVERRIDES_FILE`,
-/// written after a validation run completes), the particle counts `sc` gives and its end time.
-/// Otherwise why not. The case file's other fields are not compared: edit one and run again.
-pub fn reusable_run(
-    sc: &Scenario,
-    overrides: &[String],
-    dir: &Path,
-) -> std::result::Result<RunSummary, String> {
+/// The run summary of the earlier run in `dir` when it can stand for a run of `sc`: it
+/// completed, it is of this case, its fingerprint is `sc`'s (the same physics, walls, probes,
+/// bodies and particles, so the same overrides and resolution) and it ended at `sc`'s end time.
+/// Otherwise why not.
+pub fn reusable_run(sc: &Scenario, dir: &Path) -> std::result::Result<RunSummary, String> {
     let s = run_summary(dir).map_err(|e| format!("{e:#}"))?;
-    let path = dir.join(OVERRIDES_FILE);
-    let written = std::fs::read_to_string(&path)
-        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-    let counts = |s: &RunSummary| {
-        [
-            s.particles_fluid,
-            s.particles_wall,
-            s.particles_solid,
-            s.particles_inlet,
-        ]
-    };
-    let expected = [
-        sc.count(Kind::Fluid),
-        sc.boundary_count(),
-        sc.solid_count(),
-        sc.count(Kind::Inlet),
-    ]
-    .map(|n| n as u64);
     let end = sc.time.end_s;
     if s.status != "completed" {
         Err(format!("the run did not complete: {}", s.status))
     } else if s.case != sc.name {
         Err(format!("the run is of case {}", s.case))
-    } else if !written.lines().eq(overrides.iter().map(String::as_str)) {
-        Err(format!(
-            "it was made with other overrides ({})",
-            path.display()
-        ))
-    } else if counts(&s) != expected {
-        Err(format!(
-            "its particle counts (fluid, boundary, solid, inlet) {:?} are not the case's {expected:?}",
-            counts(&s)
-        ))
+    } else if s.fingerprint.as_deref() != Some(fingerprint_hex(sc).as_str()) {
+        Err(match &s.fingerprint {
+            None => "its run.json records no fingerprint (a run before they were written)".into(),
+            Some(f) => format!("it was set up otherwise (fingerprint {f}, not the case's)"),
+        })
     } else if (s.simulated_time_s - end).abs() > 1e-6 * end.max(1.0) {
         Err(format!(
             "it ended at t = {} s, not the case's {end} s",

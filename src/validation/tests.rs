@@ -34,6 +34,7 @@ fn summary(case: &str, excluded: u64) -> RunSummary {
         outputs: 1,
         status: "completed".into(),
         warnings: Vec::new(),
+        fingerprint: None,
     }
 }
 
@@ -612,38 +613,44 @@ fn spheric_metrics_from_synthetic_probes() {
 #[test]
 fn reuse_takes_only_a_completed_run_of_the_same_set_up() {
     let case = find("hydrostatic_2d").unwrap();
-    let overrides = case.overrides(Mode::Quick).unwrap();
-    let sc = case.scenario(&overrides).unwrap();
+    let sc = case
+        .scenario(&case.overrides(Mode::Quick).unwrap())
+        .unwrap();
     let dir = temp_dir("reuse");
     let mut s = summary(case.name, 0);
-    s.particles_fluid = sc.count(crate::scenario::Kind::Fluid) as u64;
-    s.particles_wall = sc.boundary_count() as u64;
     s.simulated_time_s = sc.time.end_s;
+    // A run.json without a fingerprint (written before they were).
     write_run_json(&dir, &s);
-    // Without the overrides file (a run made by `wgsph run`, or one that did not complete).
-    let why = reusable_run(&sc, &overrides, &dir).unwrap_err();
-    assert!(why.contains(OVERRIDES_FILE), "{why}");
-    write_overrides(&dir, &overrides).unwrap();
-    assert_eq!(reusable_run(&sc, &overrides, &dir), Ok(s.clone()));
-    // Another mode's overrides, a stopped run, other particle counts, another end time.
-    let full = case.overrides(Mode::Full).unwrap();
-    assert!(reusable_run(&sc, &full, &dir)
+    let why = reusable_run(&sc, &dir).unwrap_err();
+    assert!(why.contains("no fingerprint"), "{why}");
+    s.fingerprint = Some(crate::run::fingerprint_hex(&sc));
+    write_run_json(&dir, &s);
+    assert_eq!(reusable_run(&sc, &dir), Ok(s.clone()));
+    // The full mode's set-up (another resolution and end time), and one setting changed.
+    let full = case.scenario(&case.overrides(Mode::Full).unwrap()).unwrap();
+    assert!(reusable_run(&full, &dir)
         .unwrap_err()
-        .contains("overrides"));
+        .contains("set up otherwise"));
+    let mut alpha = case.overrides(Mode::Quick).unwrap();
+    alpha.push("physics.alpha=0.05".into());
+    let other = case.scenario(&alpha).unwrap();
+    assert!(reusable_run(&other, &dir)
+        .unwrap_err()
+        .contains("set up otherwise"));
+    // A stopped run, another case's, one that ended early.
     type Change = fn(&mut RunSummary);
-    let changed: [(&str, Change); 4] = [
+    let changed: [(&str, Change); 3] = [
         ("did not complete", |s| {
             s.status = "stopped: non-finite fluid".into()
         }),
-        ("particle counts", |s| s.particles_fluid += 1),
-        ("particle counts", |s| s.particles_inlet = 7),
+        ("of case", |s| s.case = "dam_break_2d".into()),
         ("ended at", |s| s.simulated_time_s *= 0.5),
     ];
     for (expected, change) in changed {
         let mut other = s.clone();
         change(&mut other);
         write_run_json(&dir, &other);
-        let why = reusable_run(&sc, &overrides, &dir).unwrap_err();
+        let why = reusable_run(&sc, &dir).unwrap_err();
         assert!(why.contains(expected), "{why}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
