@@ -131,9 +131,9 @@ enum Command {
         ))]
         cases: Vec<String>,
         /// Evaluate a case's earlier run in DIR/<case> instead of running it again, where its
-        /// run.json says it completed with this mode's set-up (the scenario's fingerprint) and
-        /// end time; other cases run. To judge again after changing a metric, or to judge runs
-        /// made on another machine (a GPU's, copied back).
+        /// run.json says it completed with this mode's overrides, particle counts and end time;
+        /// other cases run. To judge again after changing a metric, or to judge runs made on
+        /// another machine (a GPU's, copied back).
         #[arg(long)]
         reuse: bool,
     },

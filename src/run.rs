@@ -99,6 +99,18 @@ pub struct RunOptions {
     pub lose_device_after_s: Option<f64>,
 }
 
+/// The particles of `sc` as run.json counts them: fluid, boundary (every wall treatment),
+/// elastic solid, inlet.
+pub fn particle_counts(sc: &Scenario) -> [u64; 4] {
+    [
+        sc.count(Kind::Fluid),
+        sc.boundary_count(),
+        sc.solid_count(),
+        sc.count(Kind::Inlet),
+    ]
+    .map(|n| n as u64)
+}
+
 /// `checkpoint::fingerprint` of `sc` as run.json records it.
 pub fn fingerprint_hex(sc: &Scenario) -> String {
     format!("{:016x}", fingerprint(sc))
@@ -485,15 +497,16 @@ impl<'a> Runner<'a> {
             log::warn!("interrupted at t = {t:.6} s{resume_hint}");
         }
         let n = sc.particles.len() as f64;
+        let counts = particle_counts(sc);
         let summary = RunSummary {
             case: sc.name.clone(),
             adapter: self.ctx.info.name.clone(),
             backend: format!("{:?}", self.ctx.info.backend),
             dimension: sc.physics.dim,
-            particles_fluid: sc.count(Kind::Fluid) as u64,
-            particles_wall: sc.boundary_count() as u64,
-            particles_solid: sc.solid_count() as u64,
-            particles_inlet: sc.count(Kind::Inlet) as u64,
+            particles_fluid: counts[0],
+            particles_wall: counts[1],
+            particles_solid: counts[2],
+            particles_inlet: counts[3],
             particles_excluded: end.excluded,
             particles_drained: end.drained,
             steps: end.steps,
@@ -508,6 +521,7 @@ impl<'a> Runner<'a> {
                 (None, None) => "completed".into(),
             },
             warnings: sc.warnings.clone(),
+            overrides: self.options.source.as_ref().map(|s| s.overrides.clone()),
             fingerprint: Some(fingerprint_hex(sc)),
         };
         self.outputs.out.write_run_summary(&summary)?;

@@ -37,9 +37,14 @@ pub struct RunSummary {
     /// The case's warnings (`Scenario::warnings`).
     #[serde(default)]
     pub warnings: Vec<String>,
-    /// What the run was set up with: the scenario's fingerprint (`checkpoint::fingerprint`:
-    /// physics, walls, probes, bodies and every particle), 16 hex digits. `wgsph validate
-    /// --reuse` takes a run whose fingerprint is the case's.
+    /// The `--set` overrides the case was loaded with, where the run knows them (`wgsph run`,
+    /// `resume`, `validate`; None through the library without a `CaseSource`). `wgsph validate
+    /// --reuse` takes a run made with its mode's overrides.
+    #[serde(default)]
+    pub overrides: Option<Vec<String>>,
+    /// The scenario's fingerprint (`checkpoint::fingerprint`: physics, walls, probes, bodies
+    /// and every particle), 16 hex digits: the same case and overrides built by another engine
+    /// version, or on another machine whose libm rounds a density differently, differ here.
     #[serde(default)]
     pub fingerprint: Option<String>,
 }
@@ -61,6 +66,7 @@ mod tests {
 
     fn sample() -> RunSummary {
         RunSummary {
+            overrides: Some(vec!["time.end_s=1".into()]),
             fingerprint: Some("0123456789abcdef".into()),
             case: "dam_break_2d".into(),
             adapter: "NVIDIA H100 \"quoted\"".into(),

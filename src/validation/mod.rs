@@ -28,6 +28,7 @@ use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context, Result};
 
+use crate::checkpoint::CaseSource;
 use crate::gpu::GpuContext;
 use crate::output::{RunSummary, PROBES_DIR, RUN_SUMMARY_FILE};
 use crate::plot::{self, Curve, PLOTS_DIR};
@@ -394,7 +395,7 @@ fn run_and_evaluate(
     let sc = case.scenario(&outcome.overrides)?;
     let dir = outcome.dir.clone();
     let earlier = if reuse {
-        reusable_run(&sc, &dir)
+        reusable_run(&sc, &outcome.overrides, &dir)
     } else {
         Err("not asked to".into())
     };
@@ -412,7 +413,15 @@ fn run_and_evaluate(
             if reuse {
                 log::info!("{}: running again ({why})", sc.name);
             }
-            let report = crate::run::run(ctx, &sc, &dir, &RunOptions::default(), progress)?;
+            // The case's file and overrides go into run.json (and checkpoints) with the run.
+            let options = RunOptions {
+                source: Some(CaseSource {
+                    path: case.file.into(),
+                    overrides: outcome.overrides.clone(),
+                }),
+                ..RunOptions::default()
+            };
+            let report = crate::run::run(ctx, &sc, &dir, &options, progress)?;
             outcome.summary = Some(report.summary);
             if let Some(e) = report.stopped {
                 // The metrics of a run cut short would compare part of a series: none are given.
@@ -428,30 +437,58 @@ fn run_and_evaluate(
     Ok(())
 }
 
-/// The run summary of the earlier run in `dir` when it can stand for a run of `sc`: it
-/// completed, it is of this case, its fingerprint is `sc`'s (the same physics, walls, probes,
-/// bodies and particles, so the same overrides and resolution) and it ended at `sc`'s end time.
-/// Otherwise why not.
-pub fn reusable_run(sc: &Scenario, dir: &Path) -> std::result::Result<RunSummary, String> {
+/// The run summary of the earlier run in `dir` when it can stand for a run of `sc` loaded with
+/// `overrides`: it completed, it is of this case, made with these overrides (run.json records
+/// them), with the particle counts `sc` has and to `sc`'s end time. Otherwise why not. A
+/// different scenario fingerprint (another engine version or machine) is logged, not refused:
+/// the run is judged as it was made.
+pub fn reusable_run(
+    sc: &Scenario,
+    overrides: &[String],
+    dir: &Path,
+) -> std::result::Result<RunSummary, String> {
     let s = run_summary(dir).map_err(|e| format!("{e:#}"))?;
+    let counts = |s: &RunSummary| {
+        [
+            s.particles_fluid,
+            s.particles_wall,
+            s.particles_solid,
+            s.particles_inlet,
+        ]
+    };
+    let expected = crate::run::particle_counts(sc);
     let end = sc.time.end_s;
     if s.status != "completed" {
-        Err(format!("the run did not complete: {}", s.status))
+        return Err(format!("the run did not complete: {}", s.status));
     } else if s.case != sc.name {
-        Err(format!("the run is of case {}", s.case))
-    } else if s.fingerprint.as_deref() != Some(fingerprint_hex(sc).as_str()) {
-        Err(match &s.fingerprint {
-            None => "its run.json records no fingerprint (a run before they were written)".into(),
-            Some(f) => format!("it was set up otherwise (fingerprint {f}, not the case's)"),
-        })
+        return Err(format!("the run is of case {}", s.case));
+    } else if s.overrides.as_deref() != Some(overrides) {
+        return Err(match &s.overrides {
+            None => "its run.json records no overrides (a run before they were written)".into(),
+            Some(o) => format!("it was made with other overrides: {o:?}"),
+        });
+    } else if counts(&s) != expected {
+        return Err(format!(
+            "its particle counts (fluid, boundary, solid, inlet) {:?} are not the case's \
+             {expected:?}",
+            counts(&s)
+        ));
     } else if (s.simulated_time_s - end).abs() > 1e-6 * end.max(1.0) {
-        Err(format!(
+        return Err(format!(
             "it ended at t = {} s, not the case's {end} s",
             s.simulated_time_s
-        ))
-    } else {
-        Ok(s)
+        ));
     }
+    let here = fingerprint_hex(sc);
+    if s.fingerprint.as_deref() != Some(here.as_str()) {
+        log::info!(
+            "{}: the earlier run's scenario fingerprint {:?} is not this build's {here} (another \
+             engine version or machine): judged as it was made",
+            sc.name,
+            s.fingerprint
+        );
+    }
+    Ok(s)
 }
 
 /// Draws `figures` into `dir/plots`; returns the PNG paths.

@@ -34,6 +34,7 @@ fn summary(case: &str, excluded: u64) -> RunSummary {
         outputs: 1,
         status: "completed".into(),
         warnings: Vec::new(),
+        overrides: None,
         fingerprint: None,
     }
 }
@@ -613,44 +614,50 @@ fn spheric_metrics_from_synthetic_probes() {
 #[test]
 fn reuse_takes_only_a_completed_run_of_the_same_set_up() {
     let case = find("hydrostatic_2d").unwrap();
-    let sc = case
-        .scenario(&case.overrides(Mode::Quick).unwrap())
-        .unwrap();
+    let overrides = case.overrides(Mode::Quick).unwrap();
+    let sc = case.scenario(&overrides).unwrap();
     let dir = temp_dir("reuse");
     let mut s = summary(case.name, 0);
+    [
+        s.particles_fluid,
+        s.particles_wall,
+        s.particles_solid,
+        s.particles_inlet,
+    ] = crate::run::particle_counts(&sc);
     s.simulated_time_s = sc.time.end_s;
-    // A run.json without a fingerprint (written before they were).
+    // A run.json without overrides (written before they were, or through the library).
     write_run_json(&dir, &s);
-    let why = reusable_run(&sc, &dir).unwrap_err();
-    assert!(why.contains("no fingerprint"), "{why}");
+    let why = reusable_run(&sc, &overrides, &dir).unwrap_err();
+    assert!(why.contains("no overrides"), "{why}");
+    s.overrides = Some(overrides.clone());
+    write_run_json(&dir, &s);
+    // Taken whatever its fingerprint (another machine's libm may round a density otherwise).
+    assert_eq!(reusable_run(&sc, &overrides, &dir), Ok(s.clone()));
     s.fingerprint = Some(crate::run::fingerprint_hex(&sc));
     write_run_json(&dir, &s);
-    assert_eq!(reusable_run(&sc, &dir), Ok(s.clone()));
-    // The full mode's set-up (another resolution and end time), and one setting changed.
-    let full = case.scenario(&case.overrides(Mode::Full).unwrap()).unwrap();
-    assert!(reusable_run(&full, &dir)
-        .unwrap_err()
-        .contains("set up otherwise"));
-    let mut alpha = case.overrides(Mode::Quick).unwrap();
+    assert_eq!(reusable_run(&sc, &overrides, &dir), Ok(s.clone()));
+    // The full mode's overrides; one more; a stopped run, another case's, other particle
+    // counts, one that ended early.
+    let full = case.overrides(Mode::Full).unwrap();
+    let why = reusable_run(&sc, &full, &dir).unwrap_err();
+    assert!(why.contains("other overrides"), "{why}");
+    let mut alpha = overrides.clone();
     alpha.push("physics.alpha=0.05".into());
-    let other = case.scenario(&alpha).unwrap();
-    assert!(reusable_run(&other, &dir)
-        .unwrap_err()
-        .contains("set up otherwise"));
-    // A stopped run, another case's, one that ended early.
+    assert!(reusable_run(&sc, &alpha, &dir).is_err());
     type Change = fn(&mut RunSummary);
-    let changed: [(&str, Change); 3] = [
+    let changed: [(&str, Change); 4] = [
         ("did not complete", |s| {
             s.status = "stopped: non-finite fluid".into()
         }),
         ("of case", |s| s.case = "dam_break_2d".into()),
+        ("particle counts", |s| s.particles_inlet = 7),
         ("ended at", |s| s.simulated_time_s *= 0.5),
     ];
     for (expected, change) in changed {
         let mut other = s.clone();
         change(&mut other);
         write_run_json(&dir, &other);
-        let why = reusable_run(&sc, &dir).unwrap_err();
+        let why = reusable_run(&sc, &overrides, &dir).unwrap_err();
         assert!(why.contains(expected), "{why}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
