@@ -19,7 +19,6 @@
 @group(0) @binding(9) var<storage, read> energy_rate: array<f32>;
 @group(0) @binding(10) var<storage, read> mirror_planes: array<MirrorPlane>;
 
-
 fn all_finite(v: vec4<f32>) -> bool {
     // NaN fails every comparison; |inf| fails the bound.
     return all(abs(v) < vec4<f32>(3.0e38));
