@@ -3,7 +3,7 @@
 //! P7 on its top (particle probes; P1 and P5 also read by the wall-force sensors W1 and W5),
 //! and water heights H1–H4 along the tank's middle, against the experiment over its 6 s
 //! record (pressures averaged over the reference's 0.02 s sample spacing). Full mode only
-//! (223 848 particles at the shipped dx = 0.55/30 m, a GPU's run). No row is judged yet: the
+//! (303 852 particles at the shipped dx = 0.55/34 m, a GPU's run). No row is judged yet: the
 //! bounds wait for the first full run on a GPU (docs/validation.md).
 
 use std::fmt::Write as _;
