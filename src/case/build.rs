@@ -634,10 +634,16 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     }
 
     let points = super::probes::resolve_points(ctx, &case.points, &particles, &bodies, dim, dx)?;
+    // Lattice points of each obstacle along each axis.
+    let obstacle_points: Vec<[f64; 3]> = obstacle_ranges
+        .iter()
+        .map(|(lo, hi)| [0, 1, 2].map(|a| hi[a] - lo[a] + 1.0))
+        .collect();
     let warnings = super::warnings::of(
         &case,
         dx,
         h,
+        &obstacle_points,
         super::warnings::Sound {
             c0,
             field: sound_path,

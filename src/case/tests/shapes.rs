@@ -372,17 +372,20 @@ fn thin_fixed_ghost_parts_load_with_a_warning() {
         "shape = \"polygon\"\nvertices_m = [[0.72, 0.43], [0.99, 0.7], [0.72, 0.97], [0.45, 0.7]]";
     assert!(warnings(&case_2d(&format!("{diamond}\n{ghost}"))).is_empty());
 
+    // On the lattice (points at (i + 1/2) dx), so that only its thickness warns.
     let obstacle = |max_x: f64| {
         BASE.replace("dx_m = 0.1", "dx_m = 0.0625")
-            + &format!("\n[[obstacle]]\nmin_m = [0.6, 0.0]\nmax_m = [{max_x}, 0.3]\n{ghost}\n")
+            + &format!("\n[[obstacle]]\nmin_m = [0.625, 0.0]\nmax_m = [{max_x}, 0.3125]\n{ghost}\n")
     };
-    let w = warnings(&obstacle(0.8));
+    let w = warnings(&obstacle(0.8125));
     assert_eq!(w.len(), 1, "{w:?}");
     assert!(
-        w[0].starts_with("obstacle[0] ([0.6, 0.0] to [0.8, 0.3]) has fixed ghosts and is 0.2"),
+        w[0].starts_with(
+            "obstacle[0] ([0.625, 0.0] to [0.8125, 0.3125]) has fixed ghosts and is 0.1875"
+        ),
         "{w:?}"
     );
-    assert!(warnings(&obstacle(0.9)).is_empty());
+    assert!(warnings(&obstacle(0.9375)).is_empty());
 
     // A mesh, in 3D: a plate 0.125 m thick, and a block 0.4 m thick.
     let dir = folder("thin");
@@ -479,10 +482,11 @@ fn speeds_above_a_tenth_of_the_sound_speed_load_with_a_warning() {
     );
 }
 
-/// A fluid block whose extent is not close to a whole number of spacings loads with a warning
-/// giving the water it holds and two spacings that divide it; within 1.5 % it loads without.
+/// A fluid block or obstacle whose extent is not close to a whole number of spacings loads with
+/// a warning giving what it holds (and, for a block, two spacings that divide it); within 1.5 %
+/// it loads without.
 #[test]
-fn fluid_blocks_that_round_to_other_sizes_load_with_a_warning() {
+fn blocks_and_obstacles_that_round_to_other_sizes_load_with_a_warning() {
     let warnings = |over: &[&str]| load_str(BASE, "c.toml", &sets(over)).unwrap().warnings;
     // 0.5 m at dx = 0.1: 5 spacings exactly.
     assert!(warnings(&[]).is_empty());
@@ -507,6 +511,27 @@ fn fluid_blocks_that_round_to_other_sizes_load_with_a_warning() {
     let w = warnings(&["fluid_block[0].max_m=[0.508, 0.5]"]);
     assert!(
         w.len() == 1 && w[0].contains("0.5 m of water (-1.6 %)"),
+        "{w:?}"
+    );
+    // An obstacle is the lattice points inside its box: 0.6..0.8 holds two (0.2 m), 0.6..0.74
+    // one (0.1 m, -29 %).
+    let obstacle = |max_x: f64| {
+        load_str(
+            &format!("{BASE}\n[[obstacle]]\nmin_m = [0.6, 0.0]\nmax_m = [{max_x}, 0.3]\n"),
+            "c.toml",
+            &[],
+        )
+        .unwrap()
+        .warnings
+    };
+    assert!(obstacle(0.8).is_empty());
+    let w = obstacle(0.74);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with(
+            "obstacle[0] is 0.14 m along x but holds 1 lattice points of dx = 0.1 m: its \
+             particles span 0.1 m (-28.6 %)"
+        ),
         "{w:?}"
     );
 }
