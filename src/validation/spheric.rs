@@ -24,7 +24,9 @@ pub const CITATION: &str = "Kleefsman et al. (2005), J. Comput. Phys. 206:363–
 const DATA: &str = include_str!("../../tests/data/spheric2_kleefsman_coarse_0p02s.csv");
 
 /// Each probe of the case file compared, and its column in the reference: the particle probes,
-/// and the wall-force sensors W1 and W5 on the box's faces at P1 and P5.
+/// and the wall-force sensors W1 and W5 on the box's faces at P1 and P5. W5 lies within 2h of
+/// the front face, so its column of wall particles also takes that face's impact (a suction
+/// along +z with no water on the top; docs/validation.md): read its row with that in mind.
 pub const SERIES: [(&str, &str); 10] = [
     ("P1", "P1_Pa"),
     ("W1", "P1_Pa"),
