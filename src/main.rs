@@ -346,8 +346,9 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             use wgsph::validation::{self, Mode};
             let mode = if full { Mode::Full } else { Mode::Quick };
             let selected = validation::select(mode, &cases)?;
-            let ctx = context(cli.adapter)?;
-            let report = validation::validate(&ctx, mode, &selected, &out, reuse, &mut || {
+            // Opened by the first case that runs: a report of reused runs needs no adapter.
+            let gpu = validation::Gpu::lazy(|| context(cli.adapter));
+            let report = validation::validate(&gpu, mode, &selected, &out, reuse, &mut || {
                 progress(false, bars)
             })?;
             print!("{}", report.table());

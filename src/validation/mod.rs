@@ -23,6 +23,7 @@ mod report;
 pub mod sloshing;
 pub mod spheric;
 
+use std::cell::OnceCell;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -349,12 +350,54 @@ impl CaseOutcome {
     }
 }
 
+/// The GPU context of a validation: one given, or one opened when the first case runs, so that
+/// a report whose every case evaluates an earlier run (`--reuse`) needs no adapter at all.
+pub enum Gpu<'a> {
+    Given(&'a GpuContext),
+    Lazy {
+        open: Box<dyn Fn() -> Result<GpuContext> + 'a>,
+        opened: OnceCell<GpuContext>,
+    },
+}
+
+impl<'a> Gpu<'a> {
+    /// A context that `open` makes at its first use.
+    pub fn lazy(open: impl Fn() -> Result<GpuContext> + 'a) -> Self {
+        Gpu::Lazy {
+            open: Box::new(open),
+            opened: OnceCell::new(),
+        }
+    }
+
+    /// The context, opened now if it was not.
+    pub fn get(&self) -> Result<&GpuContext> {
+        match self {
+            Gpu::Given(ctx) => Ok(ctx),
+            Gpu::Lazy { open, opened } => {
+                if opened.get().is_none() {
+                    let ctx = open()?;
+                    let _ = opened.set(ctx);
+                }
+                Ok(opened.get().expect("set above"))
+            }
+        }
+    }
+
+    /// The adapter's description, or None when no case needed one.
+    pub fn describe(&self) -> Option<String> {
+        match self {
+            Gpu::Given(ctx) => Some(ctx.describe()),
+            Gpu::Lazy { opened, .. } => opened.get().map(GpuContext::describe),
+        }
+    }
+}
+
 /// Runs `case` with `overrides` into `dir`, then evaluates it with the bounds of `bounds` and
 /// draws its figures into `dir/plots`. With `reuse`, a completed earlier run of the same set-up
 /// in `dir` ([`reusable_run`]) is evaluated instead of running again. Never fails: what goes
 /// wrong is the outcome's `failure`.
 pub fn run_case(
-    ctx: &GpuContext,
+    gpu: &Gpu,
     case: &Case,
     overrides: &[String],
     bounds: Mode,
@@ -377,7 +420,7 @@ pub fn run_case(
         wall_s: 0.0,
         reused: false,
     };
-    if let Err(e) = run_and_evaluate(ctx, case, bounds, reuse, progress, &mut outcome) {
+    if let Err(e) = run_and_evaluate(gpu, case, bounds, reuse, progress, &mut outcome) {
         outcome.failure = Some(format!("{e:#}"));
     }
     outcome.wall_s = start.elapsed().as_secs_f64();
@@ -385,7 +428,7 @@ pub fn run_case(
 }
 
 fn run_and_evaluate(
-    ctx: &GpuContext,
+    gpu: &Gpu,
     case: &Case,
     bounds: Mode,
     reuse: bool,
@@ -421,7 +464,7 @@ fn run_and_evaluate(
                 }),
                 ..RunOptions::default()
             };
-            let report = crate::run::run(ctx, &sc, &dir, &options, progress)?;
+            let report = crate::run::run(gpu.get()?, &sc, &dir, &options, progress)?;
             outcome.summary = Some(report.summary);
             if let Some(e) = report.stopped {
                 // The metrics of a run cut short would compare part of a series: none are given.
@@ -510,7 +553,7 @@ pub fn draw(dir: &Path, figures: &[Figure]) -> Result<Vec<PathBuf>> {
 /// With `reuse`, a case's completed earlier run there is evaluated instead ([`reusable_run`]).
 /// `progress` gives the progress display of each run.
 pub fn validate(
-    ctx: &GpuContext,
+    gpu: &Gpu,
     mode: Mode,
     cases: &[&Case],
     out: &Path,
@@ -537,7 +580,7 @@ pub fn validate(
                 .join(" "),
             dir.display()
         );
-        let o = run_case(ctx, case, &overrides, mode, &dir, reuse, &mut *progress());
+        let o = run_case(gpu, case, &overrides, mode, &dir, reuse, &mut *progress());
         for m in &o.metrics {
             log::info!("{}: {} = {}", o.name, m.name, report::value_text(m));
         }
@@ -548,7 +591,9 @@ pub fn validate(
     }
     let report = Report {
         mode,
-        adapter: ctx.describe(),
+        adapter: gpu
+            .describe()
+            .unwrap_or_else(|| "none opened: every case evaluated an earlier run".into()),
         cases: outcomes,
     };
     report.write(out)?;

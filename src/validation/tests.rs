@@ -662,3 +662,51 @@ fn reuse_takes_only_a_completed_run_of_the_same_set_up() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_report_of_reused_runs_opens_no_adapter() {
+    let case = find("hydrostatic_2d").unwrap();
+    let overrides = case.overrides(Mode::Quick).unwrap();
+    let sc = case.scenario(&overrides).unwrap();
+    let out = temp_dir("reuse-no-adapter");
+    let dir = out.join(case.name);
+    std::fs::create_dir_all(dir.join(PROBES_DIR)).unwrap();
+    let exact = |depth: f64| 1000.0 * 9.81 * depth;
+    write_probe(&dir, "p_bottom", "pressure_pa", 0.01, 2.0, |_| exact(0.45));
+    write_probe(&dir, "p_floor", "pressure_pa", 0.01, 2.0, |_| exact(0.5));
+    let mut s = summary(case.name, 0);
+    [
+        s.particles_fluid,
+        s.particles_wall,
+        s.particles_solid,
+        s.particles_inlet,
+    ] = crate::run::particle_counts(&sc);
+    s.simulated_time_s = sc.time.end_s;
+    s.overrides = Some(overrides);
+    write_run_json(&dir, &s);
+    let opened = std::cell::Cell::new(0);
+    let gpu = Gpu::lazy(|| {
+        opened.set(opened.get() + 1);
+        bail!("no adapter in this test")
+    });
+    let mut progress = || Box::new(crate::progress::LogLines::default()) as Box<dyn Progress>;
+    let report = validate(&gpu, Mode::Quick, &[case], &out, true, &mut progress).unwrap();
+    assert_eq!(opened.get(), 0);
+    assert!(
+        report.adapter.starts_with("none opened"),
+        "{}",
+        report.adapter
+    );
+    let o = &report.cases[0];
+    assert!(o.reused && o.failure.is_none(), "{o:?}");
+    assert!(report.passed(), "{}", report.table());
+    // Without its run.json the case runs: the opener is called and its error is the case's
+    // FAIL row, not a panic.
+    std::fs::remove_file(dir.join(RUN_SUMMARY_FILE)).unwrap();
+    let report = validate(&gpu, Mode::Quick, &[case], &out, true, &mut progress).unwrap();
+    assert_eq!(opened.get(), 1);
+    let failure = report.cases[0].failure.as_deref().unwrap_or_default();
+    assert!(failure.contains("no adapter in this test"), "{failure}");
+    assert!(!report.passed());
+    std::fs::remove_dir_all(&out).unwrap();
+}

@@ -233,7 +233,7 @@ pub fn validate_case(
     let dir = Scratch::new(&format!("validate-{name}-{tag}"));
     let overrides = case.overrides(resolution).expect("run in this mode");
     let o = wgsph::validation::run_case(
-        gpu(),
+        &wgsph::validation::Gpu::Given(gpu()),
         case,
         &overrides,
         bounds,
