@@ -356,7 +356,7 @@ pub enum Gpu<'a> {
     Given(&'a GpuContext),
     Lazy {
         open: Box<dyn Fn() -> Result<GpuContext> + 'a>,
-        opened: OnceCell<GpuContext>,
+        opened: Box<OnceCell<GpuContext>>,
     },
 }
 
@@ -365,7 +365,7 @@ impl<'a> Gpu<'a> {
     pub fn lazy(open: impl Fn() -> Result<GpuContext> + 'a) -> Self {
         Gpu::Lazy {
             open: Box::new(open),
-            opened: OnceCell::new(),
+            opened: Box::default(),
         }
     }
 
