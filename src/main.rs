@@ -106,6 +106,19 @@ enum Command {
         /// drawing and comparing (default: raw samples).
         #[arg(long, value_name = "SECONDS")]
         smooth: Option<f64>,
+        /// Also draw every particle file (particles/particles_NNNNNN.vtu) as
+        /// DIR/snapshots/NNNNNN.png, the pictures `wgsph run --snapshots` draws (3D: the x-z
+        /// slice through the middle of the domain). The case is loaded again from the file and
+        /// overrides run.json records.
+        #[arg(long)]
+        snapshots: bool,
+        /// Colour of the fluid in the snapshots (default: pressure).
+        #[arg(long, value_name = "pressure|speed", requires = "snapshots")]
+        snapshot_field: Option<SnapshotField>,
+        /// The run's case file, where run.json does not record it or it has moved (the
+        /// overrides still come from run.json).
+        #[arg(long, value_name = "FILE", requires = "snapshots")]
+        case: Option<PathBuf>,
     },
     /// Run the shipped validation cases, compare each with its reference data and write
     /// DIR/report.md: a table (case, metric, error, bound, PASS/FAIL), wall times and PNG plots
@@ -301,7 +314,20 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             probes,
             t_max,
             smooth,
+            snapshots,
+            snapshot_field,
+            case,
         } => {
+            if snapshots {
+                let sc = wgsph::run::scenario_of_run(&dir, case.as_deref())?;
+                let field = snapshot_field.unwrap_or_default();
+                let pngs = wgsph::plot::snapshot::draw_particle_files(&dir, &sc, field)?;
+                println!(
+                    "wrote {} snapshots into {}",
+                    pngs.len(),
+                    dir.join(wgsph::output::SNAPSHOTS_DIR).display()
+                );
+            }
             let opts = wgsph::plot::PlotOptions {
                 references,
                 label,

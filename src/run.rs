@@ -111,6 +111,51 @@ pub fn particle_counts(sc: &Scenario) -> [u64; 4] {
     .map(|n| n as u64)
 }
 
+/// The scenario of the run in `dir`, loaded again as its run.json records it: its case file
+/// (or `case` in its place) with its overrides. A validation case whose file is not on disk
+/// here is loaded from the copy built into the binary. Errors when run.json lacks what is
+/// needed, or when the case as loaded now has other particle counts than the run had (the
+/// file changed since): the drawings would not be of that run.
+pub fn scenario_of_run(dir: &Path, case: Option<&Path>) -> Result<Scenario> {
+    let s = RunSummary::read(dir)?;
+    let overrides = s.overrides.clone().unwrap_or_default();
+    let file = match (case, &s.case_file) {
+        (Some(c), _) => c.to_path_buf(),
+        (None, Some(f)) => f.into(),
+        (None, None) => bail!(
+            "{} does not record the run's case file (a run made before it was recorded, or \
+             through the library): pass it with --case FILE",
+            dir.join(crate::output::RUN_SUMMARY_FILE).display()
+        ),
+    };
+    let built_in = crate::validation::CASES
+        .iter()
+        .find(|c| c.name == s.case && Path::new(c.file) == file);
+    let sc = match built_in {
+        Some(c) if case.is_none() && !file.is_file() => c.scenario(&overrides)?,
+        _ => crate::case::load(&file, &overrides)?,
+    };
+    let (had, has) = (
+        [
+            s.particles_fluid,
+            s.particles_wall,
+            s.particles_solid,
+            s.particles_inlet,
+        ],
+        particle_counts(&sc),
+    );
+    if had != has {
+        bail!(
+            "{} with {overrides:?} now gives {has:?} particles (fluid, boundary, solid, inlet), \
+             the run in {} had {had:?}: the case changed since the run; pass the file it was \
+             made with as --case FILE",
+            file.display(),
+            dir.display()
+        );
+    }
+    Ok(sc)
+}
+
 /// `checkpoint::fingerprint` of `sc` as run.json records it.
 pub fn fingerprint_hex(sc: &Scenario) -> String {
     format!("{:016x}", fingerprint(sc))
@@ -523,6 +568,11 @@ impl<'a> Runner<'a> {
             warnings: sc.warnings.clone(),
             overrides: self.options.source.as_ref().map(|s| s.overrides.clone()),
             fingerprint: Some(fingerprint_hex(sc)),
+            case_file: self
+                .options
+                .source
+                .as_ref()
+                .map(|s| s.path.to_string_lossy().into_owned()),
         };
         self.outputs.out.write_run_summary(&summary)?;
         Ok(RunReport {

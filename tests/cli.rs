@@ -130,6 +130,61 @@ fn snapshots_are_pngs_and_log_lines_go_to_stderr_off_a_terminal() {
     assert!(out.join("particles/particles_000002.vtu").is_file());
 }
 
+/// `wgsph plot DIR --snapshots` draws, from the particle files, the PNGs the run drew: byte for
+/// byte. The case comes from run.json (or `--case`); a case that no longer gives the run's
+/// particles is refused with a message.
+#[test]
+fn plot_snapshots_draws_from_the_particle_files_what_the_run_drew() {
+    let (_, out) = run_hydrostatic("plot-pngs", "warn", &["--snapshots"]);
+    let names = ["000000.png", "000001.png", "000002.png"];
+    let read = |name: &str| std::fs::read(out.join("snapshots").join(name)).unwrap();
+    let drawn_by_the_run: Vec<Vec<u8>> = names.iter().map(|n| read(n)).collect();
+    std::fs::remove_dir_all(out.join("snapshots")).unwrap();
+    let plot = |args: &[&str]| {
+        let o = wgsph()
+            .arg("plot")
+            .arg(&*out)
+            .args(args)
+            .env("RUST_LOG", "warn")
+            .output()
+            .unwrap();
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        (o.status.success(), text)
+    };
+    let (ok, text) = plot(&["--snapshots"]);
+    assert!(ok && text.contains("wrote 3 snapshots"), "{text}");
+    for (name, run) in names.iter().zip(&drawn_by_the_run) {
+        assert!(read(name) == *run, "{name} differs from the run's");
+    }
+    let (ok, text) = plot(&["--snapshots", "--snapshot-field", "speed"]);
+    assert!(ok, "{text}");
+    assert!(
+        read(names[2]) != drawn_by_the_run[2],
+        "speed drawn as pressure"
+    );
+    // A run.json that does not name its case file: --case names it.
+    let json = out.join("run.json");
+    let mut summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    summary.as_object_mut().unwrap().remove("case_file");
+    std::fs::write(&json, summary.to_string()).unwrap();
+    let (ok, text) = plot(&["--snapshots"]);
+    assert!(!ok && text.contains("--case FILE"), "{text}");
+    let (ok, text) = plot(&["--snapshots", "--case", "cases/hydrostatic_2d.toml"]);
+    assert!(ok, "{text}");
+    assert!(read(names[0]) == drawn_by_the_run[0]);
+    // Another case: other particles, refused.
+    let (ok, text) = plot(&["--snapshots", "--case", "cases/dam_break_2d.toml"]);
+    assert!(
+        !ok && text.contains("the case changed since the run"),
+        "{text}"
+    );
+}
+
 #[test]
 fn quiet_prints_nothing_but_errors() {
     // --quiet wins over RUST_LOG.

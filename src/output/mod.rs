@@ -18,6 +18,7 @@
 //! ```
 
 mod atomic;
+mod particle_file;
 mod probes_csv;
 mod pvd;
 mod run_summary;
@@ -28,6 +29,7 @@ use std::io;
 use std::path::{Path, PathBuf};
 
 pub use atomic::write_atomic;
+pub use particle_file::{particle_files, ParticleFile};
 pub use probes_csv::ProbeWriter;
 pub use run_summary::RunSummary;
 
@@ -88,6 +90,9 @@ pub enum OutputError {
         name: String,
         reason: &'static str,
     },
+    /// A file the engine wrote cannot be read back (`reason` says why).
+    #[error("cannot read {}: {reason}", path.display())]
+    Read { path: PathBuf, reason: String },
 }
 
 impl OutputError {
@@ -439,10 +444,10 @@ mod tests {
             };
             let p = out.write_snapshot(&snap).unwrap();
             assert_eq!(p, base.join(format!("particles/particles_{k:06}.vtu")));
-            let v = vtu::reader::Vtu::parse(&std::fs::read(&p).unwrap());
+            let v = vtu::reader::Vtu::parse(&std::fs::read(&p).unwrap()).unwrap();
             assert_eq!(v.number_of_points, n);
-            assert_eq!(v.u32s("id"), id);
-            let pts = v.f64s("Points", 3);
+            assert_eq!(v.u32s("id").unwrap(), id);
+            let pts = v.f64s("Points", 3).unwrap();
             assert_eq!(pts[3 * (n - 1)], pos[n - 1][0]);
             assert_eq!(pts[1], 1e8 + 1.0 / 3.0);
 

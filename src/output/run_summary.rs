@@ -47,6 +47,23 @@ pub struct RunSummary {
     /// version, or on another machine whose libm rounds a density differently, differ here.
     #[serde(default)]
     pub fingerprint: Option<String>,
+    /// The case file the run was loaded from, as the run was given it (absolute for `wgsph
+    /// run`; a validation case's path in the repository), where the run knows it. `wgsph plot
+    /// --snapshots` loads the case from it with `overrides` to draw the particle files.
+    #[serde(default)]
+    pub case_file: Option<String>,
+}
+
+impl RunSummary {
+    /// Reads `DIR/run.json`; errors name the file.
+    pub fn read(dir: &Path) -> Result<Self, OutputError> {
+        let path = dir.join(super::RUN_SUMMARY_FILE);
+        let text = std::fs::read_to_string(&path).map_err(|e| OutputError::io("read", &path, e))?;
+        serde_json::from_str(&text).map_err(|e| OutputError::Read {
+            path,
+            reason: e.to_string(),
+        })
+    }
 }
 
 pub(crate) fn write_run_summary(path: &Path, summary: &RunSummary) -> Result<(), OutputError> {
@@ -68,6 +85,7 @@ mod tests {
         RunSummary {
             overrides: Some(vec!["time.end_s=1".into()]),
             fingerprint: Some("0123456789abcdef".into()),
+            case_file: Some("/cases/x.toml".into()),
             case: "dam_break_2d".into(),
             adapter: "NVIDIA H100 \"quoted\"".into(),
             backend: "Vulkan".into(),

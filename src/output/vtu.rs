@@ -226,8 +226,9 @@ pub(crate) fn write_vtu(w: &mut dyn Write, snap: &Snapshot) -> io::Result<()> {
     Ok(())
 }
 
-/// Minimal reader for the files written above (tests only).
-#[cfg(test)]
+/// Reads the files written above back (`wgsph plot --snapshots`, the tests). Only this writer's
+/// layout is understood: raw appended arrays with UInt64 byte counts, little-endian. Errors say
+/// what is wrong in words; the caller names the file.
 pub(crate) mod reader {
     use std::collections::HashMap;
 
@@ -238,6 +239,8 @@ pub(crate) mod reader {
     }
 
     pub struct Vtu {
+        /// The XML before the appended data (what the tests check the structure of).
+        #[cfg_attr(not(test), allow(dead_code))]
         pub header: String,
         pub number_of_points: usize,
         pub number_of_cells: usize,
@@ -251,58 +254,73 @@ pub(crate) mod reader {
         Some(elem[start..start + len].to_string())
     }
 
+    fn number(elem: &str, name: &str) -> Result<usize, String> {
+        attr(elem, name)
+            .and_then(|v| v.parse().ok())
+            .ok_or_else(|| format!("no whole-number {name} in `{}`", elem.trim()))
+    }
+
+    const CLOSING: &[u8] = b"\n  </AppendedData>\n</VTKFile>\n";
+
     impl Vtu {
-        pub fn parse(bytes: &[u8]) -> Vtu {
+        pub fn parse(bytes: &[u8]) -> Result<Vtu, String> {
             let marker = b"<AppendedData encoding=\"raw\">";
             let m = bytes
                 .windows(marker.len())
                 .position(|w| w == marker)
-                .expect("AppendedData element");
-            let header = std::str::from_utf8(&bytes[..m]).unwrap().to_string();
-            let us = m + bytes[m..].iter().position(|&b| b == b'_').unwrap();
-            let base = us + 1;
-            assert!(bytes[m + marker.len()..us]
+                .ok_or("no raw <AppendedData> element (not a file wgsph wrote, or cut short)")?;
+            let header = std::str::from_utf8(&bytes[..m])
+                .map_err(|_| "the XML header is not UTF-8")?
+                .to_string();
+            let us = m + bytes[m..]
                 .iter()
-                .all(|b| b.is_ascii_whitespace()));
-            assert!(bytes.ends_with(b"</AppendedData>\n</VTKFile>\n"));
-
-            // Well-formedness of the XML part (enough for our fixed structure).
-            assert!(
-                header.starts_with("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\"")
-            );
-            assert!(header.contains("byte_order=\"LittleEndian\""));
-            assert!(header.contains("header_type=\"UInt64\""));
-            for tag in [
-                "UnstructuredGrid",
-                "Piece",
-                "PointData",
-                "Points",
-                "Cells",
-                "FieldData",
-            ] {
-                let open = header.matches(&format!("<{tag}>")).count()
-                    + header.matches(&format!("<{tag} ")).count();
-                let close = header.matches(&format!("</{tag}>")).count();
-                assert_eq!((open, close), (1, 1), "tag {tag}");
+                .position(|&b| b == b'_')
+                .ok_or("no '_' opening the appended data")?;
+            if !bytes[m + marker.len()..us]
+                .iter()
+                .all(|b| b.is_ascii_whitespace())
+            {
+                return Err("text between <AppendedData> and its '_'".into());
             }
-            let piece = header.lines().find(|l| l.contains("<Piece ")).unwrap();
-            let number_of_points: usize = attr(piece, "NumberOfPoints").unwrap().parse().unwrap();
-            let number_of_cells: usize = attr(piece, "NumberOfCells").unwrap().parse().unwrap();
+            let base = us + 1;
+            for (needle, what) in [
+                (
+                    "<VTKFile type=\"UnstructuredGrid\"",
+                    "an UnstructuredGrid file",
+                ),
+                ("byte_order=\"LittleEndian\"", "little-endian"),
+                ("header_type=\"UInt64\"", "UInt64 block headers"),
+            ] {
+                if !header.contains(needle) {
+                    return Err(format!("the header does not declare {what}"));
+                }
+            }
+            let piece = header
+                .lines()
+                .find(|l| l.contains("<Piece "))
+                .ok_or("no <Piece> element")?;
+            let number_of_points = number(piece, "NumberOfPoints")?;
+            let number_of_cells = number(piece, "NumberOfCells")?;
 
             let mut arrays = HashMap::new();
             let mut last_end = 0usize;
             for line in header.lines().filter(|l| l.contains("<DataArray ")) {
-                assert!(line.trim_end().ends_with("/>"), "{line}");
-                assert_eq!(attr(line, "format").as_deref(), Some("appended"));
-                let name = attr(line, "Name").unwrap();
-                let vtk_type = attr(line, "type").unwrap();
-                let components = attr(line, "NumberOfComponents")
-                    .map(|c| c.parse().unwrap())
-                    .unwrap_or(1);
-                let offset: usize = attr(line, "offset").unwrap().parse().unwrap();
-                let at = base + offset;
-                let len = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
-                let data = bytes[at + 8..at + 8 + len].to_vec();
+                let name =
+                    attr(line, "Name").ok_or_else(|| format!("no Name in `{}`", line.trim()))?;
+                if attr(line, "format").as_deref() != Some("appended") {
+                    return Err(format!("array {name} is not in the appended section"));
+                }
+                let vtk_type =
+                    attr(line, "type").ok_or_else(|| format!("array {name} has no type"))?;
+                let components = match attr(line, "NumberOfComponents") {
+                    Some(_) => number(line, "NumberOfComponents")?,
+                    None => 1,
+                };
+                let at = base + number(line, "offset")?;
+                let cut = || format!("array {name} runs past the end of the file (cut short?)");
+                let count = bytes.get(at..at + 8).ok_or_else(cut)?;
+                let len = u64::from_le_bytes(count.try_into().expect("8 bytes")) as usize;
+                let data = bytes.get(at + 8..at + 8 + len).ok_or_else(cut)?.to_vec();
                 last_end = last_end.max(at + 8 + len);
                 let prev = arrays.insert(
                     name.clone(),
@@ -312,54 +330,81 @@ pub(crate) mod reader {
                         data,
                     },
                 );
-                assert!(prev.is_none(), "duplicate array {name}");
+                if prev.is_some() {
+                    return Err(format!("array {name} appears twice"));
+                }
             }
-            // Nothing but the closing tags after the last block.
-            assert_eq!(&bytes[last_end..], b"\n  </AppendedData>\n</VTKFile>\n");
-            Vtu {
+            if bytes.get(last_end..) != Some(CLOSING) {
+                return Err(
+                    "the file does not end with its closing tags after the last array \
+                            (cut short, or written by something else)"
+                        .into(),
+                );
+            }
+            Ok(Vtu {
                 header,
                 number_of_points,
                 number_of_cells,
                 arrays,
-            }
+            })
         }
 
-        pub fn array(&self, name: &str, vtk_type: &str, components: usize) -> &[u8] {
+        /// The bytes of array `name`, which must have this type and number of components.
+        pub fn array(
+            &self,
+            name: &str,
+            vtk_type: &str,
+            components: usize,
+        ) -> Result<&[u8], String> {
             let a = self
                 .arrays
                 .get(name)
-                .unwrap_or_else(|| panic!("array {name}"));
-            assert_eq!(a.vtk_type, vtk_type, "type of {name}");
-            assert_eq!(a.components, components, "components of {name}");
-            &a.data
+                .ok_or_else(|| format!("no array {name}"))?;
+            if (a.vtk_type.as_str(), a.components) != (vtk_type, components) {
+                return Err(format!(
+                    "array {name} is {} × {}, not {vtk_type} × {components}",
+                    a.vtk_type, a.components
+                ));
+            }
+            Ok(&a.data)
         }
 
-        pub fn f64s(&self, name: &str, comps: usize) -> Vec<f64> {
-            self.array(name, "Float64", comps)
-                .chunks_exact(8)
-                .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
-                .collect()
+        /// Array `name` as `T` values, `components` per point (per tuple for field data).
+        fn values<const N: usize, T>(
+            &self,
+            name: &str,
+            vtk_type: &str,
+            components: usize,
+            from: fn([u8; N]) -> T,
+        ) -> Result<Vec<T>, String> {
+            let data = self.array(name, vtk_type, components)?;
+            if data.len() % N != 0 {
+                return Err(format!(
+                    "array {name}'s {} bytes are not whole values",
+                    data.len()
+                ));
+            }
+            Ok(data
+                .chunks_exact(N)
+                .map(|c| from(c.try_into().expect("N bytes")))
+                .collect())
         }
 
-        pub fn f32s(&self, name: &str, comps: usize) -> Vec<f32> {
-            self.array(name, "Float32", comps)
-                .chunks_exact(4)
-                .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
-                .collect()
+        pub fn f64s(&self, name: &str, comps: usize) -> Result<Vec<f64>, String> {
+            self.values(name, "Float64", comps, f64::from_le_bytes)
         }
 
-        pub fn u32s(&self, name: &str) -> Vec<u32> {
-            self.array(name, "UInt32", 1)
-                .chunks_exact(4)
-                .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
-                .collect()
+        pub fn f32s(&self, name: &str, comps: usize) -> Result<Vec<f32>, String> {
+            self.values(name, "Float32", comps, f32::from_le_bytes)
         }
 
-        pub fn i32s(&self, name: &str) -> Vec<i32> {
-            self.array(name, "Int32", 1)
-                .chunks_exact(4)
-                .map(|c| i32::from_le_bytes(c.try_into().unwrap()))
-                .collect()
+        pub fn u32s(&self, name: &str) -> Result<Vec<u32>, String> {
+            self.values(name, "UInt32", 1, u32::from_le_bytes)
+        }
+
+        #[cfg(test)]
+        pub fn i32s(&self, name: &str) -> Result<Vec<i32>, String> {
+            self.values(name, "Int32", 1, i32::from_le_bytes)
         }
     }
 }
@@ -423,13 +468,13 @@ mod tests {
         let n = 20_000; // several encoding chunks per array
         let o = Owned::new(n);
         let bytes = to_bytes(&o.snap(0.125));
-        let v = Vtu::parse(&bytes);
+        let v = Vtu::parse(&bytes).unwrap();
         assert_eq!(v.number_of_points, n);
         assert_eq!(v.number_of_cells, n);
         assert_eq!(v.arrays.len(), 10);
 
-        let pts = v.f64s("Points", 3);
-        let ids = v.u32s("id");
+        let pts = v.f64s("Points", 3).unwrap();
+        let ids = v.u32s("id").unwrap();
         assert_eq!(pts.len(), 3 * n);
         assert_eq!(ids, o.id);
         for i in [0, 1, 2, n / 2, n - 1] {
@@ -441,31 +486,80 @@ mod tests {
         let all_pos: Vec<f64> = o.pos.iter().flatten().copied().collect();
         assert_eq!(pts, all_pos);
         let all_vel: Vec<f32> = o.vel.iter().flatten().copied().collect();
-        assert_eq!(v.f32s("velocity", 3), all_vel);
-        assert_eq!(v.f32s("density", 1), o.rho);
-        assert_eq!(v.f32s("pressure", 1), o.p);
-        assert_eq!(v.u32s("kind"), o.kind);
-        assert_eq!(v.i32s("connectivity"), (0..n as i32).collect::<Vec<_>>());
-        assert_eq!(v.i32s("offsets"), (1..=n as i32).collect::<Vec<_>>());
-        assert!(v.array("types", "UInt8", 1).iter().all(|&t| t == 1));
-        assert_eq!(v.array("types", "UInt8", 1).len(), n);
-        assert_eq!(v.f64s("TimeValue", 1), vec![0.125]);
+        assert_eq!(v.f32s("velocity", 3).unwrap(), all_vel);
+        assert_eq!(v.f32s("density", 1).unwrap(), o.rho);
+        assert_eq!(v.f32s("pressure", 1).unwrap(), o.p);
+        assert_eq!(v.u32s("kind").unwrap(), o.kind);
+        assert_eq!(
+            v.i32s("connectivity").unwrap(),
+            (0..n as i32).collect::<Vec<_>>()
+        );
+        assert_eq!(
+            v.i32s("offsets").unwrap(),
+            (1..=n as i32).collect::<Vec<_>>()
+        );
+        assert!(v
+            .array("types", "UInt8", 1)
+            .unwrap()
+            .iter()
+            .all(|&t| t == 1));
+        assert_eq!(v.array("types", "UInt8", 1).unwrap().len(), n);
+        assert_eq!(v.f64s("TimeValue", 1).unwrap(), vec![0.125]);
         assert!(v
             .header
             .contains("<PointData Scalars=\"density\" Vectors=\"velocity\">"));
+        // Well-formed XML for this fixed structure: each element opened and closed once.
+        assert!(v
+            .header
+            .starts_with("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\""));
+        for tag in [
+            "UnstructuredGrid",
+            "Piece",
+            "PointData",
+            "Points",
+            "Cells",
+            "FieldData",
+        ] {
+            let open = v.header.matches(&format!("<{tag}>")).count()
+                + v.header.matches(&format!("<{tag} ")).count();
+            let close = v.header.matches(&format!("</{tag}>")).count();
+            assert_eq!((open, close), (1, 1), "tag {tag}");
+        }
+        assert!(v
+            .header
+            .lines()
+            .filter(|l| l.contains("<DataArray "))
+            .all(|l| l.trim_end().ends_with("/>")));
+    }
+
+    #[test]
+    fn a_cut_or_foreign_file_is_an_error_not_a_panic() {
+        let bytes = to_bytes(&Owned::new(100).snap(0.5));
+        for cut in [0, 10, 200, bytes.len() / 2, bytes.len() - 1] {
+            assert!(Vtu::parse(&bytes[..cut]).is_err(), "cut at {cut}");
+        }
+        let v = Vtu::parse(&bytes).unwrap();
+        let err = v.f32s("Points", 3).unwrap_err();
+        assert!(err.contains("Float64"), "{err}");
+        assert!(v.u32s("no such array").is_err());
+        let mut big_offset = bytes.clone();
+        let at = String::from_utf8_lossy(&bytes).find("offset=\"").unwrap() + 8;
+        big_offset[at] = b'9';
+        big_offset.splice(at..at, *b"99999999");
+        assert!(Vtu::parse(&big_offset).is_err());
     }
 
     #[test]
     fn zero_particles() {
         let o = Owned::new(0);
         let bytes = to_bytes(&o.snap(0.0));
-        let v = Vtu::parse(&bytes);
+        let v = Vtu::parse(&bytes).unwrap();
         assert_eq!(v.number_of_points, 0);
         assert_eq!(v.number_of_cells, 0);
         assert_eq!(v.arrays.len(), 10);
-        assert!(v.f64s("Points", 3).is_empty());
-        assert!(v.u32s("id").is_empty());
-        assert!(v.i32s("offsets").is_empty());
+        assert!(v.f64s("Points", 3).unwrap().is_empty());
+        assert!(v.u32s("id").unwrap().is_empty());
+        assert!(v.i32s("offsets").unwrap().is_empty());
     }
 
     #[test]
@@ -474,13 +568,13 @@ mod tests {
         o.pos[1] = [f64::NAN, f64::INFINITY, -0.0];
         o.p[2] = f32::NAN;
         let bytes = to_bytes(&o.snap(f64::NAN));
-        let v = Vtu::parse(&bytes);
-        let pts = v.f64s("Points", 3);
+        let v = Vtu::parse(&bytes).unwrap();
+        let pts = v.f64s("Points", 3).unwrap();
         assert!(
             pts[3].is_nan() && pts[4] == f64::INFINITY && pts[5].to_bits() == (-0.0f64).to_bits()
         );
-        assert!(v.f32s("pressure", 1)[2].is_nan());
-        assert!(v.f64s("TimeValue", 1)[0].is_nan());
+        assert!(v.f32s("pressure", 1).unwrap()[2].is_nan());
+        assert!(v.f64s("TimeValue", 1).unwrap()[0].is_nan());
     }
 
     #[test]
@@ -488,7 +582,7 @@ mod tests {
         let n = 1000;
         let o = Owned::new(n);
         let bytes = to_bytes(&o.snap(1.0));
-        let v = Vtu::parse(&bytes);
+        let v = Vtu::parse(&bytes).unwrap();
         let data: usize = v.arrays.values().map(|a| a.data.len() + 8).sum();
         // 24 + 12 + 4 + 4 + 4 + 4 + 4 + 4 + 1 bytes per particle, plus the time value.
         assert_eq!(data, n * 61 + 16 + 9 * 8);

@@ -10,15 +10,15 @@
 
 use std::fmt;
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::{register_font, write_png};
-use crate::output::Snapshot;
+use crate::output::{particle_files, ParticleFile, Snapshot, SNAPSHOTS_DIR};
 use crate::scenario::{Domain, Kind, Scenario};
 use crate::sph::EXCLUDED;
 
@@ -136,6 +136,37 @@ impl ColorScale {
         let t = ((value - self.min) / (self.max - self.min)).clamp(0.0, 1.0);
         ColorMap::<RGBColor, f64>::get_color(&ViridisRGB, t)
     }
+}
+
+/// Draws every particle file of the run of `sc` in `dir` (`DIR/particles/particles_NNNNNN.vtu`)
+/// as `DIR/snapshots/NNNNNN.png` with the view and colour scale the run itself draws with
+/// `--snapshots`: the same pictures, after the run (`wgsph plot DIR --snapshots`). One file in
+/// memory at a time. Returns the PNGs written.
+pub fn draw_particle_files(
+    dir: &Path,
+    sc: &Scenario,
+    field: SnapshotField,
+) -> Result<Vec<PathBuf>> {
+    let view = SnapshotView::for_scenario(sc, field)?;
+    let files = particle_files(dir)?;
+    if files.is_empty() {
+        bail!(
+            "no particle files (particles/particles_NNNNNN.vtu) in {}",
+            dir.display()
+        );
+    }
+    let pngs = dir.join(SNAPSHOTS_DIR);
+    std::fs::create_dir_all(&pngs).with_context(|| format!("cannot create {}", pngs.display()))?;
+    files
+        .iter()
+        .map(|(index, file)| {
+            let particles = ParticleFile::read(file)?;
+            let png = pngs.join(format!("{index:06}.png"));
+            view.write_png(&png, &particles.snapshot())
+                .with_context(|| format!("drawing {}", file.display()))?;
+            Ok(png)
+        })
+        .collect()
 }
 
 /// Pixels of the layout (see [`SnapshotView::render`]).

@@ -31,7 +31,7 @@ use anyhow::{anyhow, bail, Context, Result};
 
 use crate::checkpoint::CaseSource;
 use crate::gpu::GpuContext;
-use crate::output::{RunSummary, PROBES_DIR, RUN_SUMMARY_FILE};
+use crate::output::{RunSummary, PROBES_DIR};
 use crate::plot::{self, Curve, PLOTS_DIR};
 use crate::progress::Progress;
 use crate::run::{fingerprint_hex, RunOptions};
@@ -490,7 +490,7 @@ pub fn reusable_run(
     overrides: &[String],
     dir: &Path,
 ) -> std::result::Result<RunSummary, String> {
-    let s = run_summary(dir).map_err(|e| format!("{e:#}"))?;
+    let s = RunSummary::read(dir).map_err(|e| e.to_string())?;
     let counts = |s: &RunSummary| {
         [
             s.particles_fluid,
@@ -620,14 +620,6 @@ pub fn table_series(dir: &Path, table: &str, column: &str) -> Result<Vec<(f64, f
     Ok(plot::read_table_column(&path, column)?.points)
 }
 
-/// `DIR/run.json`.
-pub fn run_summary(dir: &Path) -> Result<RunSummary> {
-    let path = dir.join(RUN_SUMMARY_FILE);
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("cannot read {}", path.display()))?;
-    serde_json::from_str(&text).with_context(|| format!("cannot parse {}", path.display()))
-}
-
 /// Reference data embedded at build time: `file` (relative to the repository root) and its text.
 pub struct Reference {
     pub file: &'static str,
@@ -644,7 +636,7 @@ impl Reference {
 /// Fluid particles that left the domain or went non-finite (run.json), which none should.
 /// `judged`: with the bound 0, or only reported.
 pub fn lost_particles(dir: &Path, judged: bool) -> Result<Metric> {
-    let s = run_summary(dir)?;
+    let s = RunSummary::read(dir)?;
     Ok(Metric {
         name: "fluid particles lost".into(),
         value: s.particles_excluded as f64,

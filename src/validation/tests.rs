@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::*;
-use crate::output::RunSummary;
+use crate::output::{RunSummary, RUN_SUMMARY_FILE};
 
 fn temp_dir(tag: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("wgsph-validation-{tag}-{}", std::process::id()));
@@ -36,6 +36,7 @@ fn summary(case: &str, excluded: u64) -> RunSummary {
         warnings: Vec::new(),
         overrides: None,
         fingerprint: None,
+        case_file: None,
     }
 }
 
