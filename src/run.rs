@@ -12,7 +12,7 @@ use anyhow::{bail, Context, Result};
 use crate::body;
 use crate::checkpoint::{fingerprint, CaseSource, Checkpoint, OutputState, CHECKPOINT_FILE};
 use crate::gpu::GpuContext;
-use crate::output::{OutputDir, ProbeWriter, RunSummary, Snapshot, SNAPSHOTS_DIR};
+use crate::output::{OutputDir, ProbeWriter, RunSummary, SNAPSHOTS_DIR};
 use crate::plot::snapshot::{SnapshotField, SnapshotView};
 use crate::progress::{Progress, RunStatus};
 use crate::scenario::{Kind, ProbeKind, Scenario};
@@ -182,29 +182,9 @@ struct ParticleOutputs {
 impl ParticleOutputs {
     fn write(&mut self, solver: &Solver) -> Result<()> {
         let p = solver.read_particles()?;
-        let mut extra = match &p.energy {
-            Some(e) => vec![("energy", e.as_slice())],
-            None => vec![],
-        };
-        // Deviatoric stress components of elastic solids (zero for other particles).
-        let names = ["tau_xx", "tau_yy", "tau_zz", "tau_xy", "tau_xz", "tau_yz"];
-        let tau: Vec<Vec<f32>> = match &p.stress {
-            Some(s) => (0..6).map(|c| s.iter().map(|t| t[c]).collect()).collect(),
-            None => Vec::new(),
-        };
-        for (name, v) in names.iter().zip(&tau) {
-            extra.push((name, v.as_slice()));
-        }
-        let snap = Snapshot {
-            time_s: solver.time(),
-            pos: &p.pos,
-            vel: &p.vel,
-            rho: &p.rho,
-            pressure: &p.pressure,
-            kind: &p.kind,
-            id: &p.id,
-            extra: &extra,
-        };
+        let extra = p.extra_arrays();
+        let extra: Vec<(&str, &[f32])> = extra.iter().map(|(n, v)| (*n, v.as_slice())).collect();
+        let snap = p.snapshot(solver.time(), &extra);
         let index = self.out.snapshot_count();
         self.out.write_snapshot(&snap)?;
         if let Some(view) = &self.png {

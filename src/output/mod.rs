@@ -29,7 +29,7 @@ use std::io;
 use std::path::{Path, PathBuf};
 
 pub use atomic::write_atomic;
-pub use particle_file::{particle_files, ParticleFile};
+pub use particle_file::{particle_files, ParticleFile, Particles};
 pub use probes_csv::ProbeWriter;
 pub use run_summary::RunSummary;
 

@@ -1,22 +1,70 @@
-//! A run's particle files read back (`DIR/particles/particles_NNNNNN.vtu`, as
-//! [`super::OutputDir::write_snapshot`] wrote them): what drawing a snapshot after the run needs
-//! (`wgsph plot DIR --snapshots`).
+//! The particles of one output, and a run's particle files read back
+//! (`DIR/particles/particles_NNNNNN.vtu`, as [`super::OutputDir::write_snapshot`] wrote them):
+//! what drawing a snapshot after the run needs (`wgsph plot DIR --snapshots`).
 
 use std::path::{Path, PathBuf};
 
 use super::vtu::reader::Vtu;
 use super::{OutputError, Snapshot, PARTICLES_DIR};
 
-/// The arrays of one particle file (the extra per-particle scalars are not read).
-#[derive(Debug)]
-pub struct ParticleFile {
-    pub time_s: f64,
+/// Particles read back for output, in id order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Particles {
     pub pos: Vec<[f64; 3]>,
     pub vel: Vec<[f32; 3]>,
     pub rho: Vec<f32>,
     pub pressure: Vec<f32>,
+    /// 0 fluid, 1 wall, 15 excluded.
     pub kind: Vec<u32>,
     pub id: Vec<u32>,
+    /// Specific internal energy [J/kg], when the energy equation is on.
+    pub energy: Option<Vec<f32>>,
+    /// Deviatoric stress τ (xx, yy, zz, xy, xz, yz) [Pa], when the case has solids (zeros for
+    /// other particles).
+    pub stress: Option<Vec<[f32; 6]>>,
+}
+
+/// The particle files' names of the six components of [`Particles::stress`].
+const STRESS_NAMES: [&str; 6] = ["tau_xx", "tau_yy", "tau_zz", "tau_xy", "tau_xz", "tau_yz"];
+const ENERGY_NAME: &str = "energy";
+
+impl Particles {
+    /// The per-particle scalars beyond the fixed arrays, named as in the particle files: the
+    /// energy, then the stress components, where the run has them.
+    pub fn extra_arrays(&self) -> Vec<(&'static str, Vec<f32>)> {
+        let mut extra = Vec::new();
+        if let Some(e) = &self.energy {
+            extra.push((ENERGY_NAME, e.clone()));
+        }
+        if let Some(s) = &self.stress {
+            for (c, name) in STRESS_NAMES.iter().enumerate() {
+                extra.push((*name, s.iter().map(|t| t[c]).collect()));
+            }
+        }
+        extra
+    }
+
+    /// The snapshot of these particles at `time_s`, with `extra` (e.g. of
+    /// [`Particles::extra_arrays`]) as its further scalars.
+    pub fn snapshot<'a>(&'a self, time_s: f64, extra: &'a [(&'a str, &'a [f32])]) -> Snapshot<'a> {
+        Snapshot {
+            time_s,
+            pos: &self.pos,
+            vel: &self.vel,
+            rho: &self.rho,
+            pressure: &self.pressure,
+            kind: &self.kind,
+            id: &self.id,
+            extra,
+        }
+    }
+}
+
+/// One particle file read back: its time and particles (energy and stress where written).
+#[derive(Debug)]
+pub struct ParticleFile {
+    pub time_s: f64,
+    pub particles: Particles,
 }
 
 impl ParticleFile {
@@ -38,52 +86,45 @@ impl ParticleFile {
                 v.number_of_cells
             ));
         }
-        let triples = |name: &str, flat: Vec<f64>| -> Result<Vec<[f64; 3]>, String> {
-            check_len(name, flat.len(), 3 * n)?;
-            Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
-        };
-        let pos = triples("Points", v.f64s("Points", 3)?)?;
-        let vel_flat = v.f32s("velocity", 3)?;
-        check_len("velocity", vel_flat.len(), 3 * n)?;
-        let vel = vel_flat
-            .chunks_exact(3)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect();
-        let scalar = |name: &str| -> Result<Vec<f32>, String> {
-            let a = v.f32s(name, 1)?;
-            check_len(name, a.len(), n)?;
+        let sized = |name: &str, a: Vec<f32>, per: usize| -> Result<Vec<f32>, String> {
+            check_len(name, a.len(), per * n)?;
             Ok(a)
         };
-        let (rho, pressure) = (scalar("density")?, scalar("pressure")?);
+        let points = v.f64s("Points", 3)?;
+        check_len("Points", points.len(), 3 * n)?;
+        let vel = sized("velocity", v.f32s("velocity", 3)?, 3)?;
         let (kind, id) = (v.u32s("kind")?, v.u32s("id")?);
         check_len("kind", kind.len(), n)?;
         check_len("id", id.len(), n)?;
+        let optional = |name: &str| -> Result<Option<Vec<f32>>, String> {
+            match v.arrays.contains_key(name) {
+                true => Ok(Some(sized(name, v.f32s(name, 1)?, 1)?)),
+                false => Ok(None),
+            }
+        };
+        // The six components, or none of them.
+        let stress = STRESS_NAMES
+            .iter()
+            .map(|name| optional(name))
+            .collect::<Result<Option<Vec<_>>, _>>()?
+            .map(|c| (0..n).map(|i| std::array::from_fn(|k| c[k][i])).collect());
         let time = v.f64s("TimeValue", 1)?;
         let &[time_s] = time.as_slice() else {
             return Err(format!("TimeValue has {} values, not 1", time.len()));
         };
         Ok(ParticleFile {
             time_s,
-            pos,
-            vel,
-            rho,
-            pressure,
-            kind,
-            id,
+            particles: Particles {
+                pos: points.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+                vel: vel.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+                rho: sized("density", v.f32s("density", 1)?, 1)?,
+                pressure: sized("pressure", v.f32s("pressure", 1)?, 1)?,
+                kind,
+                id,
+                energy: optional(ENERGY_NAME)?,
+                stress,
+            },
         })
-    }
-
-    pub fn snapshot(&self) -> Snapshot<'_> {
-        Snapshot {
-            time_s: self.time_s,
-            pos: &self.pos,
-            vel: &self.vel,
-            rho: &self.rho,
-            pressure: &self.pressure,
-            kind: &self.kind,
-            id: &self.id,
-            extra: &[],
-        }
     }
 }
 
@@ -127,43 +168,47 @@ mod tests {
     use super::super::OutputDir;
     use super::*;
 
+    /// `n` particles with every array, energy and stress included.
+    fn particles(n: u32) -> Particles {
+        Particles {
+            pos: (0..n).map(|i| [i as f64 / 3.0, -1e-7, 2.5]).collect(),
+            vel: (0..n).map(|i| [i as f32, 0.5, -0.25]).collect(),
+            rho: (0..n).map(|i| 1000.0 + i as f32).collect(),
+            pressure: (0..n).map(|i| i as f32 * 9.81).collect(),
+            kind: (0..n).map(|i| i % 2).collect(),
+            id: (0..n).rev().collect(),
+            energy: Some((0..n).map(|i| i as f32 * 0.5).collect()),
+            stress: Some(
+                (0..n)
+                    .map(|i| std::array::from_fn(|c| (i * 6 + c as u32) as f32))
+                    .collect(),
+            ),
+        }
+    }
+
     #[test]
     fn particle_files_read_back_what_was_written() {
         let dir = temp_dir("particle-file");
         let mut out = OutputDir::create(&dir).unwrap();
-        let n = 50;
-        let pos: Vec<[f64; 3]> = (0..n).map(|i| [i as f64 / 3.0, -1e-7, 2.5]).collect();
-        let vel: Vec<[f32; 3]> = (0..n).map(|i| [i as f32, 0.5, f32::NAN]).collect();
-        let rho: Vec<f32> = (0..n).map(|i| 1000.0 + i as f32).collect();
-        let pressure: Vec<f32> = (0..n).map(|i| i as f32 * 9.81).collect();
-        let kind: Vec<u32> = (0..n).map(|i| i % 2).collect();
-        let id: Vec<u32> = (0..n).rev().collect();
-        let energy = vec![1.0f32; n as usize];
-        for k in 0..2 {
-            let snap = Snapshot {
-                time_s: 0.25 * k as f64,
-                pos: &pos,
-                vel: &vel,
-                rho: &rho,
-                pressure: &pressure,
-                kind: &kind,
-                id: &id,
-                extra: &[("energy", &energy)],
-            };
-            out.write_snapshot(&snap).unwrap();
+        let all = particles(50);
+        let bare = Particles {
+            energy: None,
+            stress: None,
+            ..all.clone()
+        };
+        for (k, p) in [&bare, &all].into_iter().enumerate() {
+            let extra = p.extra_arrays();
+            let extra: Vec<(&str, &[f32])> =
+                extra.iter().map(|(n, v)| (*n, v.as_slice())).collect();
+            out.write_snapshot(&p.snapshot(0.25 * k as f64, &extra))
+                .unwrap();
         }
         std::fs::write(dir.join(PARTICLES_DIR).join("notes.txt"), "x").unwrap();
         let files = particle_files(&dir).unwrap();
         assert_eq!(files.iter().map(|f| f.0).collect::<Vec<_>>(), [0, 1]);
-        let p = ParticleFile::read(&files[1].1).unwrap();
-        assert_eq!(p.time_s, 0.25);
-        assert_eq!((&p.pos, &p.rho, &p.pressure), (&pos, &rho, &pressure));
-        assert_eq!((&p.kind, &p.id), (&kind, &id));
-        assert!(p
-            .vel
-            .iter()
-            .zip(&vel)
-            .all(|(a, b)| a[0] == b[0] && a[2].is_nan()));
+        let read = |k: usize| ParticleFile::read(&files[k].1).unwrap();
+        assert_eq!((read(0).time_s, read(0).particles), (0.0, bare));
+        assert_eq!((read(1).time_s, read(1).particles), (0.25, all));
         // A file cut short: an error naming it.
         let bytes = std::fs::read(&files[0].1).unwrap();
         std::fs::write(&files[0].1, &bytes[..bytes.len() - 40]).unwrap();

@@ -162,7 +162,7 @@ pub fn draw_particle_files(
         .map(|(index, file)| {
             let particles = ParticleFile::read(file)?;
             let png = pngs.join(format!("{index:06}.png"));
-            view.write_png(&png, &particles.snapshot())
+            view.write_png(&png, &particles.particles.snapshot(particles.time_s, &[]))
                 .with_context(|| format!("drawing {}", file.display()))?;
             Ok(png)
         })

@@ -70,22 +70,7 @@ pub struct Unstable {
     pub reason: String,
 }
 
-/// Particles read back for output, in id order.
-#[derive(Clone, Debug, Default)]
-pub struct Particles {
-    pub pos: Vec<[f64; 3]>,
-    pub vel: Vec<[f32; 3]>,
-    pub rho: Vec<f32>,
-    pub pressure: Vec<f32>,
-    /// 0 fluid, 1 wall, 15 excluded.
-    pub kind: Vec<u32>,
-    pub id: Vec<u32>,
-    /// Specific internal energy [J/kg], when the energy equation is on.
-    pub energy: Option<Vec<f32>>,
-    /// Deviatoric stress τ (xx, yy, zz, xy, xz, yz) [Pa], when the case has solids (zeros for
-    /// other particles).
-    pub stress: Option<Vec<[f32; 6]>>,
-}
+pub use crate::output::Particles;
 
 /// (positions, (v, ρ), code words) as stored on the GPU.
 pub type RawParticles = (Vec<Pos>, Vec<[f32; 4]>, Vec<u32>);

@@ -612,20 +612,26 @@ fn spheric_metrics_from_synthetic_probes() {
     }
 }
 
+/// A run.json of a completed run of `sc`: its particle counts and end time (no overrides).
+fn completed_summary(case: &str, sc: &Scenario) -> RunSummary {
+    let mut s = summary(case, 0);
+    [
+        s.particles_fluid,
+        s.particles_wall,
+        s.particles_solid,
+        s.particles_inlet,
+    ] = crate::run::particle_counts(sc);
+    s.simulated_time_s = sc.time.end_s;
+    s
+}
+
 #[test]
 fn reuse_takes_only_a_completed_run_of_the_same_set_up() {
     let case = find("hydrostatic_2d").unwrap();
     let overrides = case.overrides(Mode::Quick).unwrap();
     let sc = case.scenario(&overrides).unwrap();
     let dir = temp_dir("reuse");
-    let mut s = summary(case.name, 0);
-    [
-        s.particles_fluid,
-        s.particles_wall,
-        s.particles_solid,
-        s.particles_inlet,
-    ] = crate::run::particle_counts(&sc);
-    s.simulated_time_s = sc.time.end_s;
+    let mut s = completed_summary(case.name, &sc);
     // A run.json without overrides (written before they were, or through the library).
     write_run_json(&dir, &s);
     let why = reusable_run(&sc, &overrides, &dir).unwrap_err();
@@ -675,14 +681,7 @@ fn a_report_of_reused_runs_opens_no_adapter() {
     let exact = |depth: f64| 1000.0 * 9.81 * depth;
     write_probe(&dir, "p_bottom", "pressure_pa", 0.01, 2.0, |_| exact(0.45));
     write_probe(&dir, "p_floor", "pressure_pa", 0.01, 2.0, |_| exact(0.5));
-    let mut s = summary(case.name, 0);
-    [
-        s.particles_fluid,
-        s.particles_wall,
-        s.particles_solid,
-        s.particles_inlet,
-    ] = crate::run::particle_counts(&sc);
-    s.simulated_time_s = sc.time.end_s;
+    let mut s = completed_summary(case.name, &sc);
     s.overrides = Some(overrides);
     write_run_json(&dir, &s);
     let opened = std::cell::Cell::new(0);
