@@ -14,9 +14,9 @@
 #   ITEM_CAP_S        the most one item may take (default 300)
 # Writes WORK_DIR/summary.txt (one line per item: name, exit status, seconds, then the
 # validate report's judged rows), WORK_DIR/validate/report.md (every validate case that
-# completed, judged together) and WORK_DIR/results.tar.gz (logs, reports, probe CSVs, plots and
-# run files; no particle files). Unpacked elsewhere, `wgsph validate --full --reuse --out
-# validate` judges those runs again without running them. Run from the repository root (the
+# completed, judged together) and WORK_DIR/results.tar.gz (logs, reports, probe CSVs, plots,
+# run files and every fifth snapshot of the 3D runs; no particle files). Unpacked elsewhere,
+# `wgsph validate --full --reuse --out validate` judges those runs again without running them. Run from the repository root (the
 # cases are read from cases/, the reference data from tests/data/).
 set -uo pipefail
 
@@ -100,7 +100,16 @@ if [ ${#completed[@]} -gt 0 ]; then
     echo "validate, completed cases judged together: exit $? ($work/validate/report.md)" | tee -a "$summary"
 fi
 
-(cd "$work" && find . -name particles -prune -o -name snapshots -prune -o -type f \
-    \( -name '*.log' -o -name '*.md' -o -name '*.csv' -o -name '*.png' -o -name run.json \
-    -o -name summary.txt \) -print | tar -czf results.tar.gz -T -)
+# Pictures of the 3D runs (the particle files stay here): every output drawn, every fifth in
+# the archive (x–z slices through the middle, coloured by pressure).
+for dir in "$work/validate/dam_break_3d" "$work/street_flood_3d"; do
+    [ -f "$dir/run.json" ] && [ -d "$dir/particles" ] || continue
+    "$wgsph" plot "$dir" --snapshots >>"$work/snapshots.log" 2>&1
+    echo "snapshots of ${dir#"$work"/}: exit $?" | tee -a "$summary"
+done
+
+(cd "$work" && find . -name particles -prune -o -type f \( \
+    \( -path '*/snapshots/*' -name '*[05].png' \) -o \( ! -path '*/snapshots/*' \( -name '*.log' \
+    -o -name '*.md' -o -name '*.csv' -o -name '*.png' -o -name run.json -o -name summary.txt \) \) \
+    \) -print | tar -czf results.tar.gz -T -)
 echo "total $(($(date +%s) - start)) s; $work/summary.txt, $work/results.tar.gz ($(du -h "$work/results.tar.gz" | cut -f1))"
