@@ -12,10 +12,10 @@ use anyhow::{bail, Context, Result};
 use crate::body;
 use crate::checkpoint::{fingerprint, CaseSource, Checkpoint, OutputState, CHECKPOINT_FILE};
 use crate::gpu::GpuContext;
-use crate::output::{OutputDir, ProbeWriter, RunSummary, SNAPSHOTS_DIR};
+use crate::output::{OutputDir, ParticleFile, ProbeWriter, RunSummary, SNAPSHOTS_DIR};
 use crate::plot::snapshot::{SnapshotField, SnapshotView};
 use crate::progress::{Progress, RunStatus};
-use crate::scenario::{Kind, ProbeKind, Scenario};
+use crate::scenario::{Kind, OutputBoundary, ProbeKind, Scenario};
 use crate::sph::{check_capacity, Solver};
 
 /// Column name of a probe's CSV.
@@ -177,16 +177,30 @@ pub struct RunReport {
 struct ParticleOutputs {
     out: OutputDir,
     png: Option<SnapshotView>,
+    /// With `time.output_boundary = "first"`: the positions of that first output (every
+    /// particle, in id order); the later outputs leave out the boundary particles still there.
+    first_pos: Option<Vec<[f64; 3]>>,
+    boundary_first: bool,
 }
 
 impl ParticleOutputs {
     fn write(&mut self, solver: &Solver) -> Result<()> {
         let p = solver.read_particles()?;
-        let extra = p.extra_arrays();
-        let extra: Vec<(&str, &[f32])> = extra.iter().map(|(n, v)| (*n, v.as_slice())).collect();
-        let snap = p.snapshot(solver.time(), &extra);
         let index = self.out.snapshot_count();
-        self.out.write_snapshot(&snap)?;
+        let fewer = match &self.first_pos {
+            Some(first) if self.boundary_first => Some(p.without_unmoved_boundary(first)),
+            _ => None,
+        };
+        let written = fewer.as_ref().unwrap_or(&p);
+        let extra = written.extra_arrays();
+        let extra: Vec<(&str, &[f32])> = extra.iter().map(|(n, v)| (*n, v.as_slice())).collect();
+        self.out
+            .write_snapshot(&written.snapshot(solver.time(), &extra))?;
+        if self.boundary_first && self.first_pos.is_none() {
+            self.first_pos = Some(p.pos.clone());
+        }
+        // The picture is of every particle.
+        let snap = p.snapshot(solver.time(), &[]);
         if let Some(view) = &self.png {
             let path = self
                 .out
@@ -364,6 +378,13 @@ pub fn resume(
         .context("restoring the checkpoint")?;
     let o = ck.outputs;
     runner.outputs.out.resume_series(o.snapshots)?;
+    if runner.outputs.boundary_first {
+        // The later outputs leave out what the first one holds: read it back.
+        let first = dir
+            .join(crate::output::PARTICLES_DIR)
+            .join("particles_000000.vtu");
+        runner.outputs.first_pos = Some(ParticleFile::read(&first)?.particles.pos);
+    }
     runner.probes.restore(&o.probe_tables)?;
     runner.bodies.csv.restore(&o.body_tables)?;
     runner.next_output = o.next_output_s;
@@ -454,7 +475,12 @@ impl<'a> Runner<'a> {
             solver,
             probes,
             bodies,
-            outputs: ParticleOutputs { out, png },
+            outputs: ParticleOutputs {
+                out,
+                png,
+                first_pos: None,
+                boundary_first: sc.time.output_boundary == OutputBoundary::First,
+            },
             next_output: sc.time.output_every_s.min(sc.time.end_s),
             next_checkpoint_sim: options.checkpoint.every_sim_s,
             wall_before: 0.0,

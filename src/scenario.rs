@@ -41,6 +41,22 @@ impl Kind {
     pub fn is_boundary(self) -> bool {
         !self.is_fluid() && !self.is_solid() && self != Kind::Inlet
     }
+
+    /// The kind of a code word's kind field (None: excluded, or not a kind).
+    pub fn from_code(kind: u32) -> Option<Kind> {
+        [
+            Kind::Fluid,
+            Kind::Wall,
+            Kind::GhostNoSlip,
+            Kind::GhostFreeSlip,
+            Kind::Repulsive,
+            Kind::Solid,
+            Kind::SolidClamped,
+            Kind::Inlet,
+        ]
+        .into_iter()
+        .find(|k| *k as u32 == kind)
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -138,6 +154,21 @@ pub struct TimeControl {
     pub probe_every_s: f64,
     /// Courant number for the time step.
     pub cfl: f64,
+    /// Which particle outputs hold the boundary particles that have not moved.
+    pub output_boundary: OutputBoundary,
+}
+
+/// Which particle outputs hold the boundary particles still where they started (fixed walls,
+/// obstacles and bodies; a moving tank's or body's particles are in every output anyway).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OutputBoundary {
+    /// Every output holds every particle.
+    #[default]
+    Every,
+    /// Only the first output (`particles_000000.vtu`) holds them: the later files are about
+    /// the fluid's size in a 3D case of many walls. Their density and pressure are then only
+    /// in the first file; `wgsph plot --snapshots` takes them from it.
+    First,
 }
 
 /// Axis-aligned box; particles leaving it are excluded from the run.

@@ -185,6 +185,58 @@ fn plot_snapshots_draws_from_the_particle_files_what_the_run_drew() {
     );
 }
 
+/// `time.output_boundary = "first"`: the later particle files leave out the tank's walls,
+/// which have not moved, and keep the fluid and the floating box's particles, which have; the
+/// pictures drawn from them afterwards are the run's own.
+#[test]
+fn later_outputs_leave_out_the_unmoved_walls() {
+    let out = temp_dir("output-boundary");
+    let o = wgsph()
+        .args([
+            "run",
+            "cases/floating_box_2d.toml",
+            "--snapshots",
+            "--quiet",
+        ])
+        .args(["--set", "particles.dx_m=0.02", "--set", "time.end_s=0.08"])
+        .args(["--set", "time.output_every_s=0.04"])
+        .args(["--set", "time.output_boundary=\"first\""])
+        .arg("--out")
+        .arg(&*out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let read = |k: usize| {
+        let file = out.join(format!("particles/particles_{k:06}.vtu"));
+        wgsph::output::ParticleFile::read(&file).unwrap().particles
+    };
+    let (first, last) = (read(0), read(2));
+    let count =
+        |p: &wgsph::output::Particles, kind: u32| p.kind.iter().filter(|k| **k == kind).count();
+    // The fluid (kind 0) and the box's fixed-ghost particles (kind 2) in both, the tank's
+    // dynamic walls (kind 1) only in the first.
+    assert!(count(&first, 1) > 100, "{} walls", count(&first, 1));
+    assert_eq!(count(&last, 1), 0);
+    assert_eq!(count(&last, 0), count(&first, 0));
+    assert!(count(&last, 2) > 0 && count(&last, 2) == count(&first, 2));
+    assert_eq!(last.id.len(), count(&last, 0) + count(&last, 2));
+    let pngs: Vec<Vec<u8>> = (0..3)
+        .map(|k| std::fs::read(out.join(format!("snapshots/{k:06}.png"))).unwrap())
+        .collect();
+    std::fs::remove_dir_all(out.join("snapshots")).unwrap();
+    let o = wgsph()
+        .arg("plot")
+        .arg(&*out)
+        .arg("--snapshots")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for (k, png) in pngs.iter().enumerate() {
+        let again = std::fs::read(out.join(format!("snapshots/{k:06}.png"))).unwrap();
+        assert!(again == *png, "snapshot {k} differs from the run's");
+    }
+}
+
 #[test]
 fn quiet_prints_nothing_but_errors() {
     // --quiet wins over RUST_LOG.

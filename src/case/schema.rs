@@ -178,6 +178,15 @@ pub(super) struct RawTime {
     pub output_every_s: f64,
     pub probe_every_s: Option<f64>,
     pub cfl: Option<f64>,
+    pub output_boundary: Option<OutputBoundaryName>,
+}
+
+/// Which particle outputs hold the boundary particles that have not moved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum OutputBoundaryName {
+    Every,
+    First,
 }
 
 #[derive(Debug, Deserialize)]
@@ -485,6 +494,11 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "probe_every_s = 0.005",
     ),
     f("time.cfl", "the Courant number in (0, 1]", "cfl = 0.2"),
+    f(
+        "time.output_boundary",
+        "which particle outputs hold the boundary particles that have not moved: every or first",
+        "output_boundary = \"first\"",
+    ),
     f("tank", "the [tank] table", "[tank] with min_m and max_m"),
     f(
         "tank.min_m",

@@ -694,6 +694,12 @@ fn bad_numbers_are_refused() {
             &["time.cfl", "(0, 1]"],
         ),
         (
+            "output_every_s = 0.1",
+            "output_every_s = 0.1\noutput_boundary = \"firs\"",
+            12,
+            &["time.output_boundary = \"firs\"", "\"every\", \"first\""],
+        ),
+        (
             "sound_speed_coef = 10.0",
             "sound_speed_coef = 10.0\nrho0_kg_m3 = 0",
             8,

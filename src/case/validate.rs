@@ -3,16 +3,16 @@
 //! Geometric checks that need several fields at once live in `build.rs`.
 
 use crate::scenario::{
-    DeltaSphForm, DensityFilter, FrictionPair, GhostCorrection, KernelKind, Probe, RepulsiveForm,
-    TimeControl, Viscosity, DEFAULT_FRICTION_SLIP,
+    DeltaSphForm, DensityFilter, FrictionPair, GhostCorrection, KernelKind, OutputBoundary, Probe,
+    RepulsiveForm, TimeControl, Viscosity, DEFAULT_FRICTION_SLIP,
 };
 
 use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::probes::Checked;
 use super::schema::{
-    DeltaSphFormName, DensityFilterName, GhostCorrectionName, KernelName, RawCase, RawPhysics,
-    RepulsiveFormName, SlipName, ViscosityName, WallName,
+    DeltaSphFormName, DensityFilterName, GhostCorrectionName, KernelName, OutputBoundaryName,
+    RawCase, RawPhysics, RepulsiveFormName, SlipName, ViscosityName, WallName,
 };
 
 /// An axis-aligned box (3 components; in 2D the third is 0).
@@ -457,6 +457,10 @@ pub(super) fn validate(
         output_every_s,
         probe_every_s,
         cfl,
+        output_boundary: match t.output_boundary {
+            None | Some(OutputBoundaryName::Every) => OutputBoundary::Every,
+            Some(OutputBoundaryName::First) => OutputBoundary::First,
+        },
     };
 
     // Geometry.

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use super::vtu::reader::Vtu;
 use super::{OutputError, Snapshot, PARTICLES_DIR};
+use crate::scenario::Kind;
 
 /// Particles read back for output, in id order.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -44,6 +45,45 @@ impl Particles {
         extra
     }
 
+    /// These particles less the boundary particles (walls, obstacles and bodies, of any wall
+    /// treatment) that stand where they stood in the first output, `first_pos` (a run's every
+    /// particle in id order, as these are): what a later output holds with
+    /// `time.output_boundary = "first"`.
+    pub fn without_unmoved_boundary(&self, first_pos: &[[f64; 3]]) -> Particles {
+        let unmoved = |i: usize| {
+            Kind::from_code(self.kind[i]).is_some_and(Kind::is_boundary)
+                && first_pos.get(i).map(|x| x.map(f64::to_bits))
+                    == Some(self.pos[i].map(f64::to_bits))
+        };
+        let picks: Vec<(&Particles, usize)> = (0..self.id.len())
+            .filter(|&i| !unmoved(i))
+            .map(|i| (self, i))
+            .collect();
+        gather(&picks)
+    }
+
+    /// A later output that left out unmoved boundary particles, completed with those of
+    /// `first` (every id `first` has and `self` lacks), in id order: the inverse of
+    /// [`Particles::without_unmoved_boundary`].
+    pub fn completed_from(&self, first: &Particles) -> Particles {
+        let mut picks = Vec::with_capacity(first.id.len().max(self.id.len()));
+        let mut k = 0;
+        for i in 0..first.id.len() {
+            while k < self.id.len() && self.id[k] < first.id[i] {
+                picks.push((self, k));
+                k += 1;
+            }
+            if k < self.id.len() && self.id[k] == first.id[i] {
+                picks.push((self, k));
+                k += 1;
+            } else {
+                picks.push((first, i));
+            }
+        }
+        picks.extend((k..self.id.len()).map(|k| (self, k)));
+        gather(&picks)
+    }
+
     /// The snapshot of these particles at `time_s`, with `extra` (e.g. of
     /// [`Particles::extra_arrays`]) as its further scalars.
     pub fn snapshot<'a>(&'a self, time_s: f64, extra: &'a [(&'a str, &'a [f32])]) -> Snapshot<'a> {
@@ -57,6 +97,30 @@ impl Particles {
             id: &self.id,
             extra,
         }
+    }
+}
+
+/// The particles `picks` name, (source, index), in that order; energy and stress where every
+/// source has them.
+fn gather(picks: &[(&Particles, usize)]) -> Particles {
+    fn each<T: Copy>(picks: &[(&Particles, usize)], f: impl Fn(&Particles) -> &[T]) -> Vec<T> {
+        picks.iter().map(|(p, i)| f(p)[*i]).collect()
+    }
+    Particles {
+        pos: each(picks, |p| &p.pos),
+        vel: each(picks, |p| &p.vel),
+        rho: each(picks, |p| &p.rho),
+        pressure: each(picks, |p| &p.pressure),
+        kind: each(picks, |p| &p.kind),
+        id: each(picks, |p| &p.id),
+        energy: picks
+            .iter()
+            .map(|(p, i)| p.energy.as_ref().map(|e| e[*i]))
+            .collect(),
+        stress: picks
+            .iter()
+            .map(|(p, i)| p.stress.as_ref().map(|s| s[*i]))
+            .collect(),
     }
 }
 
@@ -184,6 +248,52 @@ mod tests {
                     .collect(),
             ),
         }
+    }
+
+    /// Unmoved boundary particles are left out, everything else kept (a moved boundary
+    /// particle, fluid, solids, excluded ones); completing from the first output gives back the
+    /// whole set in id order.
+    #[test]
+    fn unmoved_boundary_is_left_out_and_completed_back() {
+        let first = Particles {
+            id: (0..12).collect(),
+            ..particles(12)
+        };
+        let mut later = first.clone();
+        // kinds by id order: 1 wall (unmoved), 1 wall (moved by 1e-12 m), 0 fluid (unmoved),
+        // 2–4 ghost and repulsive (unmoved), 5 solid, 7 inlet, 15 excluded (unmoved)
+        let kinds = [1, 1, 0, 2, 3, 4, 5, 7, 15, 1, 0, 4];
+        later.kind = kinds.to_vec();
+        later.pos[1][0] += 1e-12;
+        for (i, v) in later.vel.iter_mut().enumerate() {
+            v[1] = -(i as f32);
+        }
+        let fewer = later.without_unmoved_boundary(&first.pos);
+        let kept: Vec<u32> = fewer.kind.clone();
+        assert_eq!(kept, [1, 0, 5, 7, 15, 0], "{fewer:?}");
+        assert_eq!(fewer.id, [1, 2, 6, 7, 8, 10]);
+        assert_eq!(fewer.stress.as_ref().map(Vec::len), Some(6));
+        let mut first_with_kinds = first.clone();
+        first_with_kinds.kind = kinds.to_vec();
+        // The first output holds the unmoved ones as they were (same position, kind; their
+        // velocity and pressure from then).
+        let back = fewer.completed_from(&first_with_kinds);
+        assert_eq!(back.id, later.id);
+        assert_eq!(back.pos, later.pos);
+        assert_eq!(back.kind, later.kind);
+        for i in 0..12 {
+            let from_later = fewer.id.contains(&later.id[i]);
+            let want = if from_later {
+                later.vel[i]
+            } else {
+                first.vel[i]
+            };
+            assert_eq!(back.vel[i], want, "particle {i}");
+        }
+        // Nothing left out: the same particles back.
+        let all = later.without_unmoved_boundary(&[]);
+        assert_eq!(all, later);
+        assert_eq!(all.completed_from(&first_with_kinds), later);
     }
 
     #[test]

@@ -140,8 +140,9 @@ impl ColorScale {
 
 /// Draws every particle file of the run of `sc` in `dir` (`DIR/particles/particles_NNNNNN.vtu`)
 /// as `DIR/snapshots/NNNNNN.png` with the view and colour scale the run itself draws with
-/// `--snapshots`: the same pictures, after the run (`wgsph plot DIR --snapshots`). One file in
-/// memory at a time. Returns the PNGs written.
+/// `--snapshots`: the same pictures, after the run (`wgsph plot DIR --snapshots`). A file that
+/// left out the unmoved boundary particles (`time.output_boundary = "first"`) is completed with
+/// those of the first file. Returns the PNGs written.
 pub fn draw_particle_files(
     dir: &Path,
     sc: &Scenario,
@@ -157,16 +158,26 @@ pub fn draw_particle_files(
     }
     let pngs = dir.join(SNAPSHOTS_DIR);
     std::fs::create_dir_all(&pngs).with_context(|| format!("cannot create {}", pngs.display()))?;
-    files
-        .iter()
-        .map(|(index, file)| {
-            let particles = ParticleFile::read(file)?;
-            let png = pngs.join(format!("{index:06}.png"));
-            view.write_png(&png, &particles.particles.snapshot(particles.time_s, &[]))
-                .with_context(|| format!("drawing {}", file.display()))?;
-            Ok(png)
-        })
-        .collect()
+    let mut first: Option<ParticleFile> = None;
+    let mut written = Vec::with_capacity(files.len());
+    for (index, file) in &files {
+        let read = ParticleFile::read(file)?;
+        let whole = first
+            .as_ref()
+            .filter(|f| read.particles.id.len() < f.particles.id.len());
+        let particles = match whole {
+            Some(f) => &read.particles.completed_from(&f.particles),
+            None => &read.particles,
+        };
+        let png = pngs.join(format!("{index:06}.png"));
+        view.write_png(&png, &particles.snapshot(read.time_s, &[]))
+            .with_context(|| format!("drawing {}", file.display()))?;
+        written.push(png);
+        if first.is_none() {
+            first = Some(read);
+        }
+    }
+    Ok(written)
 }
 
 /// Pixels of the layout (see [`SnapshotView::render`]).

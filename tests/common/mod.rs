@@ -140,6 +140,7 @@ pub fn scenario(
             output_every_s: 0.1,
             probe_every_s: 0.1,
             cfl: 0.2,
+            output_boundary: Default::default(),
         },
         walls: WallParams::defaults(physics_dx, 0.5, 9.81),
         periodic: [false; 3],
