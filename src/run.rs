@@ -380,9 +380,7 @@ pub fn resume(
     runner.outputs.out.resume_series(o.snapshots)?;
     if runner.outputs.boundary_first {
         // The later outputs leave out what the first one holds: read it back.
-        let first = dir
-            .join(crate::output::PARTICLES_DIR)
-            .join("particles_000000.vtu");
+        let first = crate::output::particle_file_path(dir, 0);
         runner.outputs.first_pos = Some(ParticleFile::read(&first)?.particles.pos);
     }
     runner.probes.restore(&o.probe_tables)?;

@@ -165,6 +165,16 @@ impl Snapshot<'_> {
     }
 }
 
+/// The name of the particle file of output `index`: `particles_NNNNNN.vtu` (6 digits, from 0).
+pub fn particle_file_name(index: usize) -> String {
+    format!("particles_{index:06}.vtu")
+}
+
+/// `DIR/particles/particles_NNNNNN.vtu` of output `index` of the run in `dir`.
+pub fn particle_file_path(dir: &Path, index: usize) -> PathBuf {
+    dir.join(PARTICLES_DIR).join(particle_file_name(index))
+}
+
 /// An output directory: owns the snapshot series and creates probe writers.
 #[derive(Debug)]
 pub struct OutputDir {
@@ -212,11 +222,8 @@ impl OutputDir {
     /// references it. Returns the path of the .vtu.
     pub fn write_snapshot(&mut self, snap: &Snapshot) -> Result<PathBuf, OutputError> {
         let index = self.snapshots.len();
-        let rel = format!("{PARTICLES_DIR}/particles_{index:06}.vtu");
-        let vtu_path = self
-            .dir
-            .join(PARTICLES_DIR)
-            .join(format!("particles_{index:06}.vtu"));
+        let rel = format!("{PARTICLES_DIR}/{}", particle_file_name(index));
+        let vtu_path = particle_file_path(&self.dir, index);
         snap.validate(&vtu_path)?;
         write_atomic(&vtu_path, |w| vtu::write_vtu(w, snap))?;
         // The .vtu is complete and in place: from now on it belongs to the series, even if

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use super::vtu::reader::Vtu;
-use super::{OutputError, Snapshot, PARTICLES_DIR};
+use super::{particle_file_name, OutputError, Snapshot, PARTICLES_DIR};
 use crate::scenario::Kind;
 
 /// Particles read back for output, in id order.
@@ -212,12 +212,14 @@ pub fn particle_files(dir: &Path) -> Result<Vec<(usize, PathBuf)>, OutputError> 
         let path = entry
             .map_err(|e| OutputError::io("read", &folder, e))?
             .path();
-        let index = path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .and_then(|n| n.strip_prefix("particles_")?.strip_suffix(".vtu"))
-            .filter(|digits| digits.len() == 6)
-            .and_then(|digits| digits.parse().ok());
+        // The names `particle_file_name` gives, and no others.
+        let index = path.file_name().and_then(|n| n.to_str()).and_then(|name| {
+            let digits = name.strip_prefix("particles_")?.strip_suffix(".vtu")?;
+            digits
+                .parse()
+                .ok()
+                .filter(|&i| particle_file_name(i) == name)
+        });
         if let Some(index) = index {
             files.push((index, path));
         }
