@@ -235,6 +235,11 @@ fn later_outputs_leave_out_the_unmoved_walls() {
         let again = std::fs::read(out.join(format!("snapshots/{k:06}.png"))).unwrap();
         assert!(again == *png, "snapshot {k} differs from the run's");
     }
+    // Without the first file the walls are nowhere: refused, not drawn without them.
+    std::fs::remove_file(out.join("particles/particles_000000.vtu")).unwrap();
+    let o = wgsph().arg("plot").arg(&*out).arg("--snapshots").output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && stderr.contains("the first output"), "{stderr}");
 }
 
 #[test]

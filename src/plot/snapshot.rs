@@ -162,18 +162,23 @@ pub fn draw_particle_files(
     let mut written = Vec::with_capacity(files.len());
     for (index, file) in &files {
         let read = ParticleFile::read(file)?;
-        let whole = first
-            .as_ref()
-            .filter(|f| read.particles.id.len() < f.particles.id.len());
-        let particles = match whole {
-            Some(f) => &read.particles.completed_from(&f.particles),
-            None => &read.particles,
+        let partial = read.particles.id.len() < sc.particles.len();
+        let particles = match (&first, partial) {
+            (_, false) => &read.particles,
+            (Some(f), true) => &read.particles.completed_from(&f.particles),
+            (None, true) => bail!(
+                "{} holds {} of the run's {} particles (time.output_boundary = \"first\" left \
+                 out the unmoved walls), and the first output, which holds them, is missing",
+                file.display(),
+                read.particles.id.len(),
+                sc.particles.len()
+            ),
         };
         let png = pngs.join(format!("{index:06}.png"));
         view.write_png(&png, &particles.snapshot(read.time_s, &[]))
             .with_context(|| format!("drawing {}", file.display()))?;
         written.push(png);
-        if first.is_none() {
+        if *index == 0 {
             first = Some(read);
         }
     }
