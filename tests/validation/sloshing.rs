@@ -8,7 +8,7 @@ use std::path::Path;
 use wgsph::progress::LogLines;
 use wgsph::run::RunOptions;
 use wgsph::validation::sloshing::{
-    transducers, window, Comparison, MEAN_BOUND, P2_HYDROSTATIC_KPA,
+    dx_m, transducers, window, Comparison, MEAN_BOUND, P2_HYDROSTATIC_KPA,
 };
 use wgsph::validation::Mode;
 
@@ -56,7 +56,12 @@ fn report(dir: &Path, mode: Mode) -> (Comparison, Comparison) {
 #[test]
 fn sloshing_transducer_2_follows_the_experiment_coarse() {
     let w = window(Mode::Quick);
-    let dir = run("cases/sloshing_2d.toml", "0.02", w.to_s, "coarse");
+    let dir = run(
+        "cases/sloshing_2d.toml",
+        dx_m(Mode::Quick),
+        w.to_s,
+        "coarse",
+    );
     // The first pitch period (t < π s) without the first half second of start-up.
     let (p2, _) = report(&dir, Mode::Quick);
     assert!(p2.samples >= 7);
@@ -73,10 +78,10 @@ fn sloshing_transducer_2_follows_the_experiment_coarse() {
 }
 
 #[test]
-#[ignore = "10 s of sloshing at dx = 0.01: 86 635 steps, about 45 min on lavapipe; passes (measured 19.1 % and 18.1 %, docs/validation.md)"]
+#[ignore = "10 s of sloshing at dx = 0.465/46: 16 min on lavapipe; passes (measured 12.8 % and 21.5 %, docs/validation.md)"]
 fn sloshing_transducers_follow_the_experiment_fine() {
     let w = window(Mode::Full);
-    let dir = run("cases/sloshing_2d.toml", "0.01", w.to_s, "fine");
+    let dir = run("cases/sloshing_2d.toml", dx_m(Mode::Full), w.to_s, "fine");
     // As in the PySPH comparison of this case: after the start-up, t in [3, 10] s.
     let (p2, p8) = report(&dir, Mode::Full);
     assert!(p2.fluctuation_error < w.bound_2, "transducer 2");
