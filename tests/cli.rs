@@ -237,9 +237,17 @@ fn later_outputs_leave_out_the_unmoved_walls() {
     }
     // Without the first file the walls are nowhere: refused, not drawn without them.
     std::fs::remove_file(out.join("particles/particles_000000.vtu")).unwrap();
-    let o = wgsph().arg("plot").arg(&*out).arg("--snapshots").output().unwrap();
+    let o = wgsph()
+        .arg("plot")
+        .arg(&*out)
+        .arg("--snapshots")
+        .output()
+        .unwrap();
     let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && stderr.contains("the first output"), "{stderr}");
+    assert!(
+        !o.status.success() && stderr.contains("the first output"),
+        "{stderr}"
+    );
 }
 
 #[test]
