@@ -48,7 +48,12 @@
 // particles do (their velocity, ρ0, no δ-SPH term) and get nothing here.
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
 // get nothing here; unless WALL_REACTIONS (a case with wall-pressure probes, probes.wgsl): then
-// every fixed boundary particle also gets the fluid's force on it, as a moving body's does.
+// every fixed boundary particle also gets the fluid's force on it, as a moving body's does; one
+// under a sensor (`wall_sensors`, the first whose patch holds it) only the force of the fluid
+// over the sensor's face (`faces_sensor`: in front of it, not beyond its edge), as a transducer
+// feels the water on its own face: at a convex edge the particles under a sensor on one face
+// also carry the water pressing on the other, which reads as suction on a dry top
+// (docs/validation.md, SPHERIC W5). Its dρ/dt still sums every fluid neighbour.
 // Particles of moving bodies get the force per unit mass of their fluid neighbours, the opposite
 // of what the fluid receives from them: for dynamic and fixed-ghost body particles
 // −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (a ghost with its interpolated P_g and its
@@ -72,6 +77,7 @@
 @group(0) @binding(8) var<storage, read> body_particles: array<BodyParticle>;
 @group(0) @binding(9) var<storage, read> solid: array<SolidState>;
 @group(0) @binding(10) var<storage, read> bodies: array<BodyMotion>;
+@group(0) @binding(11) var<storage, read> wall_sensors: array<WallSensor>;
 
 // The state of particle i that every pair term needs.
 struct Particle {
@@ -325,6 +331,7 @@ fn fixed_ghost_velocity(kind: u32, id: u32, v_f: vec3<f32>) -> GhostVelocity {
 
 const NO_PLANE: u32 = 0xFFFFFFFFu;
 const NO_BODY: u32 = 0xFFFFFFFFu;
+const NO_SENSOR: u32 = 0xFFFFFFFFu;
 
 // Whether boundary particle `id_j` belongs to a fixed wall or to a body other than `body_i`
 // (contact between a body and itself is not a thing).
@@ -473,6 +480,19 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     }
     let pi = Particle(v_i, vr_i.w, pressure_of(vr_i.w) / (vr_i.w * vr_i.w));
     let support2 = 4.0 * params.h * params.h;
+    // Under a sensor on a fixed wall, only the fluid over the sensor's face loads i.
+    var sensor = NO_SENSOR;
+    var x_i = vec3<f32>(0.0);
+    if (WALL_REACTIONS && reacts && !on_body) {
+        x_i = domain_pos(p_i);
+        for (var k = 0u; k < arrayLength(&wall_sensors); k++) {
+            let s = wall_sensors[k];
+            if (in_wall_patch(s.point, s.normal, s.radius, x_i)) {
+                sensor = k;
+                break;
+            }
+        }
+    }
     // The rigid velocity a body particle presents in contact (friction only).
     var v_contact_i = vec3<f32>(0.0);
     if (on_body && (params.friction != 0.0 || params.friction_groups != 0u)) {
@@ -494,17 +514,21 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             if (!fluid_i) {
                 if (kind_j == KIND_FLUID) {
                     let vr_j = velrho[j];
+                    let loads = sensor == NO_SENSOR || faces_sensor(wall_sensors[sensor], x_i - x_ij);
                     if (!reacts) {
                         // Fixed dynamic wall particle: continuity only.
                         r.w += params.mass * dot(pi.v - vr_j.xyz, x_ij * kernel_f(sqrt(r2) / params.h));
                     } else if (is_repulsive(kind_i)) {
                         // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
-                        r += vec4<f32>(repulsion(x_ij, r2), 0.0);
+                        if (loads) {
+                            r += vec4<f32>(repulsion(x_ij, r2), 0.0);
+                        }
                     } else {
                         // The reaction to the fluid's pressure and viscous force; a dynamic
                         // body particle also its dρ/dt (ghosts have none).
                         let pr = pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, 0.0, 1.0).rate;
-                        r += select(vec4<f32>(pr.xyz, 0.0), pr, kind_i == KIND_WALL);
+                        let force = select(vec3<f32>(0.0), pr.xyz, loads);
+                        r += vec4<f32>(force, select(0.0, pr.w, kind_i == KIND_WALL));
                     }
                 } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
                     // Contact with an elastic solid.

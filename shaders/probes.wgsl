@@ -95,8 +95,9 @@ fn probe_height(x: vec3<f32>) -> f32 {
 // Σ_j a_j·n over the boundary particles j of a wall patch, a_j their rate (the fluid's force per
 // unit fluid mass, interaction.wgsl with WALL_REACTIONS; for a body's particles also any contact
 // force); the host multiplies by −m/area. The rates are those of the last step's interaction,
-// at its predicted state, in the current cell order. The patch (WallPatch in scenario.rs): no
-// fluid or solid particle, (x_j − point)·n in [−3h, h], distance across n below the radius.
+// at its predicted state, in the current cell order; on a fixed wall only the fluid's in front
+// of the wall's first layer (interaction.wgsl). The patch: no fluid or solid particle,
+// `in_wall_patch` (lib/wall_patch.wgsl).
 // The cells of the patch's box are visited once each (a particle counts in its own cell only),
 // in a fixed order: the same state gives the same sum.
 fn probe_wall_force(def: ProbeDef) -> f32 {
@@ -124,10 +125,7 @@ fn probe_wall_force(def: ProbeDef) -> f32 {
                     if (kind == KIND_FLUID || kind == KIND_EXCLUDED || kind == KIND_INLET || is_solid(kind) || any(cell_of(pos[j]) != c)) {
                         continue;
                     }
-                    let r = domain_pos(pos[j]) - def.point;
-                    let d = dot(r, def.axis);
-                    let t2 = dot(r, r) - d * d;
-                    if (d >= -3.0 * params.h && d <= params.h && t2 < def.radius * def.radius) {
+                    if (in_wall_patch(def.point, def.axis, def.radius, domain_pos(pos[j]))) {
                         sum += dot(rate[j].xyz, def.axis);
                     }
                 }

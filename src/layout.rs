@@ -160,6 +160,21 @@ pub struct ProbeDef {
     pub radius: f32,
 }
 
+/// Mirrors `WallSensor` in shaders/lib/wall_patch.wgsl: a wall-pressure probe's patch on a
+/// fixed wall (`scenario::WallPatch`), in domain coordinates.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct WallSensor {
+    pub point: [f32; 3],
+    pub radius: f32,
+    pub normal: [f32; 3],
+    pub face: f32,
+    pub over_lo: [f32; 3],
+    pub pad0: u32,
+    pub over_hi: [f32; 3],
+    pub pad1: u32,
+}
+
 /// Mirrors `MirrorPlane` in shaders/interaction.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
@@ -523,6 +538,12 @@ mod tests {
             "ProbeDef",
             ProbeDef,
             [point, kind, axis, radius]
+        );
+        check_layout!(
+            Pass::Interaction,
+            "WallSensor",
+            WallSensor,
+            [point, radius, normal, face, over_lo, over_hi]
         );
         check_layout!(
             Pass::Interaction,

@@ -208,7 +208,21 @@ pub struct WallPatch {
     pub radius: f64,
     /// Area of the columns taken [m² in 3D, m in 2D]: their number times dx^(dim − 1).
     pub area: f64,
+    /// (x − point)·normal of the wall's face, half a spacing in front of the columns' first
+    /// layer of particles. On a fixed wall the patch's particles take the force only of the
+    /// fluid in front of it ([`WallParams::sensors`]): at a convex edge the fluid beside the
+    /// other face does not load the sensor.
+    pub face: f64,
+    /// The face's extent around the sensor along the lattice axes across an axis-aligned
+    /// normal, where an edge lies within 2h + `radius` of it (±[`FACE_UNBOUNDED`] otherwise,
+    /// and along the normal): only fluid over the face, within [`Self::over_lo`,
+    /// `Self::over_hi`], loads the patch, not the water beyond the edge.
+    pub over_lo: [f64; 3],
+    pub over_hi: [f64; 3],
 }
+
+/// A face's extent where no edge limits it (finite, so that f32 comparisons stay ordinary).
+pub const FACE_UNBOUNDED: f64 = 1e30;
 
 /// A tracked material point (`[[probe]] kind = "point"`): the particle of an elastic solid or
 /// a rigid body nearest to the given point at t = 0. Its position and displacement are written
@@ -277,6 +291,14 @@ pub struct WallParams {
     /// repulsive particles would pay a neighbour sum they otherwise skip (dynamic walls sum
     /// over their neighbours for dρ/dt anyway).
     pub reactions: bool,
+    /// The patches of the wall-pressure probes on fixed walls (those without a body), in
+    /// probe order. With `reactions`, a fixed wall's particle in one of them (the first that
+    /// [`WallPatch::holds`] it) takes the force only of the fluid that
+    /// [`WallPatch::faces`] it, as a transducer feels only the water on its face: near a
+    /// convex edge the particles under the sensor also carry the load of the water against
+    /// the other face. Its dρ/dt still sums every fluid neighbour. Bodies' particles always
+    /// take the whole force (it moves the body).
+    pub sensors: Vec<WallPatch>,
 }
 
 /// What takes part in contact, for friction by pair: the fixed walls (tank, obstacles), a rigid
@@ -325,6 +347,86 @@ impl WallPatch {
     /// spacing) and h in front of it (a face given half a spacing off).
     pub fn depth(h: f64) -> (f64, f64) {
         (-3.0 * h, h)
+    }
+
+    /// Whether a boundary particle at `x` belongs to the patch: (x − point)·normal within
+    /// [`Self::depth`] and closer than `radius` to the normal line (`in_wall_patch` in
+    /// shaders/lib/wall_patch.wgsl).
+    pub fn holds(&self, x: [f64; 3], h: f64) -> bool {
+        let (behind, front) = Self::depth(h);
+        let (d, t2) = Self::coordinates(self.point, self.normal, x);
+        d >= behind && d <= front && t2 < self.radius * self.radius
+    }
+
+    /// Whether fluid at `x` loads the patch's particles: it lies in front of the wall's face,
+    /// (x − point)·normal > `face`, and over it (within `over_lo`, `over_hi`).
+    pub fn faces(&self, x: [f64; 3]) -> bool {
+        Self::coordinates(self.point, self.normal, x).0 > self.face
+            && (0..3).all(|a| x[a] >= self.over_lo[a] && x[a] <= self.over_hi[a])
+    }
+
+    /// The extent of the face whose first layer of boundary particles lies at
+    /// (x − point)·normal = `layer`, from the particle of that layer nearest to `point`, along
+    /// each lattice axis across an axis-aligned `normal`: a march of dx steps through that
+    /// layer, up to `reach` m; the edge is half a spacing beyond the last particle. Unbounded
+    /// where the march reaches `reach`, and everywhere for a normal off the lattice axes.
+    fn face_extent(
+        particles: &[Particle],
+        point: [f64; 3],
+        normal: [f64; 3],
+        layer: f64,
+        dim: usize,
+        dx: f64,
+        reach: f64,
+    ) -> ([f64; 3], [f64; 3]) {
+        let mut lo = [-FACE_UNBOUNDED; 3];
+        let mut hi = [FACE_UNBOUNDED; 3];
+        let Some(axis) = (0..dim).find(|&a| (normal[a].abs() - 1.0).abs() < 1e-9) else {
+            return (lo, hi);
+        };
+        let window = reach + 2.0 * dx;
+        let first: Vec<[f64; 3]> = particles
+            .iter()
+            .filter(|p| p.kind.is_boundary())
+            .filter(|p| {
+                let (d, t2) = Self::coordinates(point, normal, p.pos);
+                (d - layer).abs() < 0.25 * dx && t2 < window * window
+            })
+            .map(|p| p.pos)
+            .collect();
+        let across = |q: &[f64; 3]| Self::coordinates(point, normal, *q).1;
+        let Some(start) = first
+            .iter()
+            .min_by(|a, b| across(a).total_cmp(&across(b)))
+            .copied()
+        else {
+            return (lo, hi);
+        };
+        let steps = (reach / dx).ceil() as usize;
+        for a in (0..dim).filter(|&a| a != axis) {
+            for sign in [-1.0, 1.0] {
+                let at = |k: usize| {
+                    let mut x = start;
+                    x[a] += sign * k as f64 * dx;
+                    x
+                };
+                let held = |x: [f64; 3]| {
+                    first
+                        .iter()
+                        .any(|q| (0..dim).all(|b| (q[b] - x[b]).abs() < 0.25 * dx))
+                };
+                let Some(last) = (1..=steps).find(|&k| !held(at(k))).map(|k| k - 1) else {
+                    continue;
+                };
+                let edge = start[a] + sign * (last as f64 + 0.5) * dx;
+                if sign < 0.0 {
+                    lo[a] = edge;
+                } else {
+                    hi[a] = edge;
+                }
+            }
+        }
+        (lo, hi)
     }
 
     /// The normal coordinate d = (x − point)·normal of `x` and its squared distance from the
@@ -404,9 +506,26 @@ impl WallPatch {
             .iter()
             .map(|c| c.across)
             .fold(f64::INFINITY, f64::min);
-        let mut columns: Vec<[i64; 3]> = taken.iter().map(|c| c.column).collect();
-        columns.sort_unstable();
-        columns.dedup();
+        // Each column's outermost particle, the first one the fluid meets.
+        let mut tops: Vec<([i64; 3], f64)> = Vec::new();
+        for c in &taken {
+            match tops.iter_mut().find(|(column, _)| *column == c.column) {
+                Some((_, top)) => *top = top.max(c.d),
+                None => tops.push((c.column, c.d)),
+            }
+        }
+        // The wall's first layer is the lowest of them: a column that runs into a concave
+        // corner also holds the other wall's particles, in front of this wall's face.
+        let first_layer = tops.iter().map(|t| t.1).fold(f64::INFINITY, f64::min);
+        let (over_lo, over_hi) = Self::face_extent(
+            particles,
+            point,
+            normal,
+            first_layer,
+            dim,
+            dx,
+            2.0 * h + radius,
+        );
         Some(WallPatch {
             point,
             normal,
@@ -415,7 +534,10 @@ impl WallPatch {
             } else {
                 reach
             },
-            area: columns.len() as f64 * dx.powi(dim as i32 - 1),
+            area: tops.len() as f64 * dx.powi(dim as i32 - 1),
+            face: first_layer + 0.5 * dx,
+            over_lo,
+            over_hi,
         })
     }
 }
@@ -435,6 +557,7 @@ impl WallParams {
             friction_pairs: Vec::new(),
             mirror_planes: Vec::new(),
             reactions: false,
+            sensors: Vec::new(),
         }
     }
 }

@@ -311,6 +311,153 @@ fn wall_reactions_and_wall_pressure_match_reference() {
     }
 }
 
+/// A sensor on a step's top near its edge, with fluid beside the step: the particles under it
+/// take the force only of the fluid over the top's face (GPU against the reference). Dry on
+/// top, with water beside the step below and above the top's level, it reads exactly 0 where,
+/// summing every fluid neighbour, the same column reads the water against the side and
+/// beyond the edge. The walls' dρ/dt still sums every fluid
+/// neighbour (the interaction's rates against the reference's). Dynamic walls with the sensor
+/// 1.3 dx from the edge (its column 1.5 dx in, as the SPHERIC box's W5), repulsive ones with
+/// it at the edge's column (the repulsion reaches 1.5 dx here).
+#[test]
+fn a_sensor_at_a_convex_edge_takes_only_the_fluid_on_its_face() {
+    for (dim, wall, from_edge) in [
+        (2, Kind::Wall, 1.3),
+        (3, Kind::Wall, 1.3),
+        (3, Kind::Repulsive, 0.4),
+    ] {
+        for wet_top in [false, true] {
+            let dx = 0.02;
+            let domain = 0.4;
+            let (o, step) = (0.5 * (domain - BLOCK), 0.16);
+            let up = dim as usize - 1;
+            let mut rng = Rng(31 + dim as u64);
+            let mut max = [BLOCK; 3];
+            if dim == 2 {
+                max[2] = 0.0;
+            }
+            let mut parts = Vec::new();
+            for p in lattice(dim, dx, [0.0; 3], max) {
+                let in_step = p[0] < step && p[up] < step;
+                // Dry on top: no water over the step, water beside it at every height.
+                if !in_step && !wet_top && p[up] > step && p[0] < step {
+                    continue;
+                }
+                let mut pos = p;
+                let mut vel = [0.0; 3];
+                for a in 0..dim as usize {
+                    pos[a] += o + if in_step {
+                        0.0
+                    } else {
+                        rng.range(-0.2, 0.2) * dx
+                    };
+                    if !in_step {
+                        vel[a] = rng.range(-0.5, 0.5);
+                    }
+                }
+                parts.push(Particle {
+                    pos,
+                    vel,
+                    rho: 1000.0 * (1.0 + rng.range(0.0, 0.02)),
+                    kind: if in_step { wall } else { Kind::Fluid },
+                });
+            }
+            let mut dmax = [domain; 3];
+            if dim == 2 {
+                dmax[2] = 0.0;
+            }
+            let mut sc = scenario(
+                physics(dim, dx, 15.0),
+                parts,
+                Domain {
+                    min: [0.0; 3],
+                    max: dmax,
+                },
+                vec![],
+            );
+            let h = sc.physics.h;
+            let mut point = [o + step - from_edge * dx, o + 0.5 * BLOCK, o + 0.5 * BLOCK];
+            point[up] = o + step;
+            if dim == 2 {
+                point[2] = 0.0;
+            }
+            let mut normal = [0.0; 3];
+            normal[up] = 1.0;
+            let patch =
+                WallPatch::resolve(&sc.particles, point, normal, 0.005, dim as usize, dx, h)
+                    .unwrap();
+            // One column, its first layer half a spacing under the top.
+            assert!((patch.area - dx.powi(dim as i32 - 1)).abs() < 1e-12);
+            assert!(patch.face.abs() < 1e-12);
+            // The top's edge, 1.5 dx from the column (or 0.5 dx), bounds it; nothing else
+            // within 2h + radius does.
+            assert!((patch.over_hi[0] - (o + step)).abs() < 1e-12, "{patch:?}");
+            assert_eq!(patch.over_lo[0], -FACE_UNBOUNDED);
+            assert!(
+                (0..3)
+                    .filter(|&a| a != 0)
+                    .all(|a| patch.over_lo[a] == -FACE_UNBOUNDED
+                        && patch.over_hi[a] == FACE_UNBOUNDED)
+            );
+            sc.walls.reactions = true;
+            sc.walls.sensors = vec![patch];
+            // A repulsion that reaches the water on the top (1 ± 0.3 dx above the column).
+            sc.walls.repulsive_r0 = 1.5 * dx;
+            sc.probes = vec![Probe {
+                name: "top".into(),
+                kind: ProbeKind::WallPressure(patch),
+                body: None,
+            }];
+            let solver = Solver::new(gpu(), &sc).unwrap();
+            let (parts, _) = gpu_particles_and_codes(&solver);
+            let gpu_p = solver.sample_probes().unwrap()[0];
+            let space = reference::Space::of(&sc);
+            let cpu = reference::interaction::rates(&sc.physics, &sc.walls, &space, &parts);
+            let cpu_p = reference::probes::wall_pressure(&sc.physics, &parts, &cpu, &patch);
+            let mut every = sc.walls.clone();
+            every.sensors.clear();
+            let all = reference::interaction::rates(&sc.physics, &every, &space, &parts);
+            let all_p = reference::probes::wall_pressure(&sc.physics, &parts, &all, &patch);
+            let (e_acc, e_rho) = interaction_errors(&sc);
+            println!(
+                "dim {dim} {wall:?} wet top {wet_top}: sensor GPU {gpu_p:.3} CPU {cpu_p:.3} Pa,                  every fluid neighbour {all_p:.3} Pa; accel err {e_acc:.2e}, drho err {e_rho:.2e}"
+            );
+            assert!(e_acc < 2e-4, "acceleration error {e_acc}");
+            assert!(e_rho < 2e-4, "density-rate error {e_rho}");
+            // Only the patch's forces change, never a dρ/dt.
+            for (k, (a, b)) in cpu.iter().zip(&all).enumerate() {
+                let held = patch.holds(parts[k].pos, h) && parts[k].kind != reference::FLUID;
+                assert_eq!(a[3], b[3], "dρ/dt of particle {k}");
+                if !held {
+                    assert_eq!(a, b, "rates of particle {k}, outside the patch");
+                }
+            }
+            assert!(
+                all_p.abs() > 1.0,
+                "the column carries the side's water: {all_p} Pa"
+            );
+            if wet_top {
+                assert!(
+                    cpu_p > 1.0,
+                    "the water on the top presses on it: {cpu_p} Pa"
+                );
+                assert!(
+                    (gpu_p - cpu_p).abs() < 1e-4 * cpu_p.abs(),
+                    "{gpu_p} against {cpu_p}"
+                );
+                // The side's water is left out (in 3D it is 0.08 % of the reading).
+                assert!(
+                    (cpu_p - all_p).abs() > 1e-6 * all_p.abs(),
+                    "{cpu_p} against {all_p}"
+                );
+            } else {
+                assert_eq!(gpu_p, 0.0);
+                assert_eq!(cpu_p, 0.0);
+            }
+        }
+    }
+}
+
 #[test]
 fn one_step_matches_reference() {
     for s in setups() {

@@ -639,7 +639,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         .iter()
         .map(|(lo, hi)| [0, 1, 2].map(|a| hi[a] - lo[a] + 1.0))
         .collect();
-    let warnings = super::warnings::of(
+    let mut warnings = super::warnings::of(
         &case,
         dx,
         h,
@@ -651,6 +651,9 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     );
     let mut probes = case.probes;
     super::probes::resolve_wall_patches(ctx, &mut probes, &particles, dim, dx, h)?;
+    warnings.extend(super::probes::sensors_sharing_particles(
+        &probes, &particles, dx, h,
+    ));
     let physics = Physics {
         dim: dim as u32,
         dx,
@@ -679,6 +682,14 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     walls.reactions = probes
         .iter()
         .any(|p| matches!(p.kind, ProbeKind::WallPressure(_)));
+    walls.sensors = probes
+        .iter()
+        .filter(|p| p.body.is_none())
+        .filter_map(|p| match p.kind {
+            ProbeKind::WallPressure(patch) => Some(patch),
+            _ => None,
+        })
+        .collect();
     let n_particles = particles.len();
     Ok(Scenario {
         name: case.name,

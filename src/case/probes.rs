@@ -2,7 +2,7 @@
 //! case's dimension (padded to 3 components), a non-zero front axis (normalised); and the
 //! choice of the particle a `"point"` probe follows.
 
-use crate::scenario::{Body, Particle, Probe, ProbeKind, TrackedPoint, WallPatch};
+use crate::scenario::{Body, Particle, Probe, ProbeKind, TrackedPoint, WallPatch, FACE_UNBOUNDED};
 
 use super::error::CaseError;
 use super::locate::Ctx;
@@ -175,6 +175,9 @@ pub(super) fn probe(
                 radius,
                 // Resolved against the particles (`resolve_wall_patches`).
                 area: 0.0,
+                face: 0.0,
+                over_lo: [-FACE_UNBOUNDED; 3],
+                over_hi: [FACE_UNBOUNDED; 3],
             })
         }
     };
@@ -281,6 +284,54 @@ pub(super) fn resolve_wall_patches(
         }
     }
     Ok(())
+}
+
+/// A warning for each pair of wall-pressure probes on fixed walls that hold a boundary particle
+/// in common while their faces differ (sensors on two faces of an edge, closer to it than their
+/// columns are deep): such a particle takes the force of the fluid over the first one's face
+/// only (`WallParams::sensors`), and the second reads that in its sum.
+pub(super) fn sensors_sharing_particles(
+    probes: &[Probe],
+    particles: &[Particle],
+    dx: f64,
+    h: f64,
+) -> Vec<String> {
+    let fixed: Vec<(usize, &Probe, &WallPatch)> = (probes.iter().enumerate())
+        .filter(|(_, p)| p.body.is_none())
+        .filter_map(|(i, p)| match &p.kind {
+            ProbeKind::WallPressure(patch) => Some((i, p, patch)),
+            _ => None,
+        })
+        .collect();
+    let mut out = Vec::new();
+    for (a, &(i, pi, si)) in fixed.iter().enumerate() {
+        for &(j, pj, sj) in &fixed[a + 1..] {
+            let n_dot = (0..3).map(|k| si.normal[k] * sj.normal[k]).sum::<f64>();
+            let offset = (0..3)
+                .map(|k| (sj.point[k] - si.point[k]) * si.normal[k])
+                .sum::<f64>();
+            let same_face = n_dot > 1.0 - 1e-9 && (offset + sj.face - si.face).abs() < 1e-6 * dx;
+            let shared = || {
+                particles
+                    .iter()
+                    .filter(|p| p.kind.is_boundary())
+                    .any(|p| si.holds(p.pos, h) && sj.holds(p.pos, h))
+            };
+            if !same_face && shared() {
+                out.push(format!(
+                    "probe[{i}] ('{}') and probe[{j}] ('{}') sum over some of the same wall \
+                     particles, whose faces differ (an edge or a step between them): those \
+                     particles take only the force of the fluid over probe[{i}]'s face, \
+                     so probe[{j}] reads that there; fix: move the sensors apart, each more than \
+                     3 h = {:.4} m behind the other's face, or give them smaller radius_m",
+                    pi.name,
+                    pj.name,
+                    3.0 * h
+                ));
+            }
+        }
+    }
+    out
 }
 
 /// The particle each point probe follows: the nearest particle of an elastic solid or a rigid

@@ -206,7 +206,48 @@ fn hydrostatic_2d_builds() {
     };
     assert!((patch.area - 0.08).abs() < 1e-12, "{patch:?}");
     assert!((patch.radius - 0.04).abs() < 1e-12, "{patch:?}");
+    // The floor's face, half a spacing above its first layer, is the point's.
+    assert!(patch.face.abs() < 1e-12, "{patch:?}");
     assert!(s.walls.reactions);
+    assert_eq!(s.walls.sensors, vec![patch]);
+}
+
+/// Two wall-pressure sensors on the two faces of a block's edge, nearer to it than their
+/// columns are deep, share particles: a warning names both. Apart, or meeting at a concave
+/// corner (floor and wall), they do not.
+#[test]
+fn sensors_sharing_particles_at_an_edge_are_warned() {
+    let case = |side_y: f64, floor_x: f64| {
+        format!(
+            "dimension = 2\n[particles]\ndx_m = 0.02\n[physics]\nsound_speed_m_s = 20.0\n\
+             [time]\nend_s = 0.1\noutput_every_s = 0.1\n\
+             [tank]\nmin_m = [0.0, 0.0]\nmax_m = [1.0, 0.6]\nopen_top = true\n\
+             [[fluid_block]]\nmin_m = [0.0, 0.0]\nmax_m = [0.4, 0.2]\n\
+             [[obstacle]]\nmin_m = [0.4, 0.0]\nmax_m = [0.6, 0.3]\n\
+             [[probe]]\nname = \"top\"\nkind = \"wall_pressure\"\npoint_m = [0.426, 0.3]\n\
+             normal = [0.0, 1.0]\nradius_m = 0.005\n\
+             [[probe]]\nname = \"side\"\nkind = \"wall_pressure\"\npoint_m = [0.4, {side_y}]\n\
+             normal = [-1.0, 0.0]\nradius_m = 0.005\n\
+             [[probe]]\nname = \"floor\"\nkind = \"wall_pressure\"\npoint_m = [{floor_x}, 0.0]\n\
+             normal = [0.0, 1.0]\nradius_m = 0.005\n"
+        )
+    };
+    let shared = |side_y: f64, floor_x: f64| -> Vec<String> {
+        let s = load_str(&case(side_y, floor_x), "cases/t.toml", &[]).unwrap();
+        assert_eq!(s.walls.sensors.len(), 3);
+        s.warnings
+            .into_iter()
+            .filter(|w| w.contains("same wall particles"))
+            .collect()
+    };
+    let near = shared(0.274, 0.2);
+    assert_eq!(near.len(), 1, "{near:?}");
+    assert!(
+        near[0].contains("probe[0] ('top') and probe[1] ('side')"),
+        "{near:?}"
+    );
+    // Low on the side, and the floor sensor in the concave corner beside it.
+    assert!(shared(0.02, 0.39).is_empty());
 }
 
 /// A wall-pressure probe: its fields, and a patch of wall particles to sum over. Narrower than

@@ -18,6 +18,8 @@ pub const MLS: &str = include_str!("../../shaders/lib/mls.wgsl");
 pub const FLUID_AT: &str = include_str!("../../shaders/lib/fluid_at.wgsl");
 /// A maximum over the workgroup before one atomic (`shaders/lib/workgroup_max.wgsl`).
 pub const WORKGROUP_MAX: &str = include_str!("../../shaders/lib/workgroup_max.wgsl");
+/// A wall-pressure sensor's patch of boundary particles (`shaders/lib/wall_patch.wgsl`).
+pub const WALL_PATCH: &str = include_str!("../../shaders/lib/wall_patch.wgsl");
 
 /// One shader file per pass, named like its Rust module in `src/sph`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -87,8 +89,9 @@ impl Pass {
         match self {
             Pass::Ghost | Pass::OpenBoundaries => &[NEIGHBOURS, MLS, FLUID_AT],
             Pass::DensityFilter => &[NEIGHBOURS, MLS],
-            Pass::Interaction | Pass::Elastic => &[NEIGHBOURS],
-            Pass::Probes => &[NEIGHBOURS, WORKGROUP_MAX],
+            Pass::Interaction => &[NEIGHBOURS, WALL_PATCH],
+            Pass::Elastic => &[NEIGHBOURS],
+            Pass::Probes => &[NEIGHBOURS, WORKGROUP_MAX, WALL_PATCH],
             Pass::Integrate | Pass::Bodies => &[WORKGROUP_MAX],
             _ => &[],
         }

@@ -227,6 +227,13 @@ pub fn rates_and_energy(
                     && !matches!(pi.kind, FLUID | EXCLUDED | INLET)
                     && !super::elastic::is_solid(pi.kind));
             if pi.kind == WALL || reacts {
+                // A fixed wall's particle under a wall-pressure sensor takes the force of the
+                // fluid on the sensor's face only (`WallParams::sensors`).
+                let sensor = if reacts && !on_body {
+                    walls.sensors.iter().find(|s| s.holds(pi.pos, h))
+                } else {
+                    None
+                };
                 // A body's ghost reacts with the velocity the fluid sees in viscosity.
                 let pb = match pi.kind {
                     GHOST_NO_SLIP | GHOST_FREE_SLIP => RefParticle {
@@ -242,15 +249,21 @@ pub fn rates_and_energy(
                         continue;
                     }
                     if pj.kind == FLUID {
+                        let loads = sensor.is_none_or(|s| s.faces(pj.pos));
                         if reacts && pi.kind == REPULSIVE {
                             // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
-                            let f = repulsion(ph, walls, x_ij);
-                            add(&mut r, [f[0], f[1], f[2], 0.0]);
+                            if loads {
+                                let f = repulsion(ph, walls, x_ij);
+                                add(&mut r, [f[0], f[1], f[2], 0.0]);
+                            }
                         } else if reacts {
                             // The fluid's force on it too (and a dynamic particle's dρ/dt).
                             let mut pr = pair.rates(&pb, x_ij, pj.vel, pj.vel, pj.rho, 0.0, 1.0).0;
                             if pi.kind != WALL {
                                 pr[3] = 0.0;
+                            }
+                            if !loads {
+                                pr[..3].fill(0.0);
                             }
                             add(&mut r, pr);
                         } else {

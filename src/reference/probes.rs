@@ -72,17 +72,13 @@ pub fn wall_pressure(
     rates: &[[f64; 4]],
     patch: &WallPatch,
 ) -> f64 {
-    let (behind, front) = WallPatch::depth(ph.h);
     let sum: f64 = parts
         .iter()
         .zip(rates)
         .filter(|(p, _)| {
             !matches!(p.kind, FLUID | EXCLUDED | INLET) && !super::elastic::is_solid(p.kind)
         })
-        .filter(|(p, _)| {
-            let (d, t2) = WallPatch::coordinates(patch.point, patch.normal, p.pos);
-            d >= behind && d <= front && t2 < patch.radius * patch.radius
-        })
+        .filter(|(p, _)| patch.holds(p.pos, ph.h))
         .map(|(_, r)| (0..3).map(|a| r[a] * patch.normal[a]).sum::<f64>())
         .sum();
     -ph.particle_mass * sum / patch.area

@@ -3,7 +3,7 @@
 
 use crate::gpu::buffers::{storage, storage_init, uniform_init};
 use crate::layout::{
-    BodyMotion, BodyParticle, MirrorPlane, Params, Pos, ProbeDef, SimState, SolidState,
+    BodyMotion, BodyParticle, MirrorPlane, Params, Pos, ProbeDef, SimState, SolidState, WallSensor,
 };
 
 pub struct ParticleBuffers {
@@ -32,6 +32,9 @@ pub struct ParticleBuffers {
     pub probes: wgpu::Buffer,
     pub probe_out: wgpu::Buffer,
     pub mirror_planes: wgpu::Buffer,
+    /// The wall-pressure probes' patches on fixed walls (`WallParams::sensors`); one that
+    /// holds no particle when there are none.
+    pub wall_sensors: wgpu::Buffer,
     /// (e, de/dt) per particle, 2 parities, and the new de/dt: one element each when the
     /// energy equation is off.
     pub energy: [wgpu::Buffer; 2],
@@ -57,6 +60,18 @@ const EMPTY_PROBES: [ProbeDef; 1] = [ProbeDef {
     radius: 0.0,
 }];
 
+/// Stand-in for a run without wall sensors: a patch of radius 0 holds no particle.
+const NO_SENSOR: WallSensor = WallSensor {
+    point: [0.0; 3],
+    radius: 0.0,
+    normal: [0.0; 3],
+    face: 0.0,
+    over_lo: [0.0; 3],
+    pad0: 0,
+    over_hi: [0.0; 3],
+    pad1: 0,
+};
+
 pub struct InitialParticles<'a> {
     pub pos: &'a [Pos],
     pub velrho: &'a [[f32; 4]],
@@ -68,16 +83,28 @@ pub struct InitialParticles<'a> {
     pub solid: &'a [SolidState],
 }
 
+/// The case's fixed tables, in domain coordinates.
+pub struct CaseTables<'a> {
+    pub probes: &'a [ProbeDef],
+    pub mirror_planes: &'a [MirrorPlane],
+    /// The wall-pressure probes' patches on fixed walls.
+    pub wall_sensors: &'a [WallSensor],
+}
+
 impl ParticleBuffers {
     pub fn new(
         device: &wgpu::Device,
         params: &Params,
         slots: u32,
         init: &InitialParticles,
-        probes: &[ProbeDef],
-        planes: &[MirrorPlane],
+        tables: &CaseTables,
         energy: bool,
     ) -> Self {
+        let CaseTables {
+            probes,
+            mirror_planes: planes,
+            wall_sensors: sensors,
+        } = *tables;
         let n = init.pos.len() as u32;
         let vec4 = 16 * n as u64;
         let words = 4 * n as u64;
@@ -168,6 +195,15 @@ impl ParticleBuffers {
             } else {
                 storage_init(device, "mirror planes", planes)
             },
+            wall_sensors: storage_init(
+                device,
+                "wall sensors",
+                if sensors.is_empty() {
+                    &[NO_SENSOR]
+                } else {
+                    sensors
+                },
+            ),
         }
     }
 
@@ -185,6 +221,7 @@ impl ParticleBuffers {
             &self.probes,
             &self.probe_out,
             &self.mirror_planes,
+            &self.wall_sensors,
             &self.energy_rate,
             &self.body_particles,
             &self.body_motions,

@@ -28,6 +28,7 @@ impl Interaction {
                 (8, &b.body_particles),
                 (9, &b.solid),
                 (10, &b.body_motions),
+                (11, &b.wall_sensors),
             ]
         };
         let bind = [

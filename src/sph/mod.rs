@@ -34,7 +34,7 @@ use crate::scenario::{
     Scenario, SolidFormulation, Viscosity,
 };
 use bodies::Bodies;
-use buffers::{InitialParticles, ParticleBuffers};
+use buffers::{CaseTables, InitialParticles, ParticleBuffers};
 use cell_list::CellList;
 use density_filter::DensityFilter;
 use elastic::Elastic;
@@ -85,6 +85,24 @@ fn mirror_planes(sc: &Scenario, origin: [f64; 3]) -> Vec<crate::layout::MirrorPl
             no_slip: m.no_slip as u32,
             normal: m.normal.map(|x| x as f32),
             pad: 0,
+        })
+        .collect()
+}
+
+/// The fixed walls' wall-pressure sensors (`WallParams::sensors`) in domain coordinates.
+fn wall_sensors(sc: &Scenario, origin: [f64; 3]) -> Vec<crate::layout::WallSensor> {
+    sc.walls
+        .sensors
+        .iter()
+        .map(|s| crate::layout::WallSensor {
+            point: [0, 1, 2].map(|a| (s.point[a] - origin[a]) as f32),
+            radius: s.radius as f32,
+            normal: s.normal.map(|x| x as f32),
+            face: s.face as f32,
+            over_lo: [0, 1, 2].map(|a| (s.over_lo[a] - origin[a]) as f32),
+            pad0: 0,
+            over_hi: [0, 1, 2].map(|a| (s.over_hi[a] - origin[a]) as f32),
+            pad1: 0,
         })
         .collect()
 }
@@ -348,6 +366,7 @@ impl Solver {
         let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let defs = probes::probe_defs(&sc.probes, grid.origin);
         let planes = mirror_planes(sc, grid.origin);
+        let sensors = wall_sensors(sc, grid.origin);
         let body_particles = bodies::body_particles(sc);
         let body_motions = bodies::initial_motions(sc, body_id_base);
         let solid = solid_states(sc)?;
@@ -363,8 +382,11 @@ impl Solver {
                 body_motions: &body_motions,
                 solid: &solid,
             },
-            &defs,
-            &planes,
+            &CaseTables {
+                probes: &defs,
+                mirror_planes: &planes,
+                wall_sensors: &sensors,
+            },
             ph.energy,
         );
         let module = |pass| ShaderModule::new(&device, pass, cfg);

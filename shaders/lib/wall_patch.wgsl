@@ -1,0 +1,29 @@
+// The boundary particles a wall-pressure sensor sums over (WallPatch in scenario.rs): the
+// probe's column test (probes.wgsl) and, on fixed walls, the interaction's choice of the fluid
+// that loads them (interaction.wgsl).
+
+// A wall-pressure probe's patch on a fixed wall, in domain coordinates.
+struct WallSensor {
+    point: vec3<f32>,   // on the wall's face
+    radius: f32,        // across the normal
+    normal: vec3<f32>,  // unit, into the fluid
+    face: f32,          // (x − point)·normal of the wall's face
+    over_lo: vec3<f32>, // the face's extent where an edge is near (WallPatch::over_lo)
+    over_hi: vec3<f32>,
+}
+
+// Whether fluid at x loads the sensor's particles: in front of its face and over it, not
+// beyond an edge.
+fn faces_sensor(s: WallSensor, x: vec3<f32>) -> bool {
+    return dot(x - s.point, s.normal) > s.face && all(x >= s.over_lo) && all(x <= s.over_hi);
+}
+
+// Whether a boundary particle at x belongs to the patch: (x − point)·normal in [−3h, h] (every
+// particle the fluid reaches, 2h from the nearest fluid, and a face given half a spacing off)
+// and closer than `radius` to the normal line through `point`.
+fn in_wall_patch(point: vec3<f32>, normal: vec3<f32>, radius: f32, x: vec3<f32>) -> bool {
+    let r = x - point;
+    let d = dot(r, normal);
+    let t2 = dot(r, r) - d * d;
+    return d >= -3.0 * params.h && d <= params.h && t2 < radius * radius;
+}
