@@ -49,11 +49,11 @@
 // Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
 // get nothing here; unless WALL_REACTIONS (a case with wall-pressure probes, probes.wgsl): then
 // every fixed boundary particle also gets the fluid's force on it, as a moving body's does; one
-// under a sensor (`wall_sensors`, the first whose patch holds it) only the force of the fluid
-// over the sensor's face (`faces_sensor`: in front of it, not beyond its edge), as a transducer
-// feels the water on its own face: at a convex edge the particles under a sensor on one face
-// also carry the water pressing on the other, which reads as suction on a dry top
-// (docs/validation.md, SPHERIC W5). Its dρ/dt still sums every fluid neighbour.
+// under a sensor (`owning_sensor`) only the force of the fluid over the sensor's face
+// (`faces_sensor`: in front of it, not beyond its edge), as a transducer feels the water on its
+// own face: at a convex edge the particles under a sensor on one face also carry the water
+// pressing on the other, which reads as suction on a dry top (docs/validation.md, SPHERIC W5).
+// Its dρ/dt still sums every fluid neighbour.
 // Particles of moving bodies get the force per unit mass of their fluid neighbours, the opposite
 // of what the fluid receives from them: for dynamic and fixed-ghost body particles
 // −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (a ghost with its interpolated P_g and its
@@ -331,7 +331,6 @@ fn fixed_ghost_velocity(kind: u32, id: u32, v_f: vec3<f32>) -> GhostVelocity {
 
 const NO_PLANE: u32 = 0xFFFFFFFFu;
 const NO_BODY: u32 = 0xFFFFFFFFu;
-const NO_SENSOR: u32 = 0xFFFFFFFFu;
 
 // Whether boundary particle `id_j` belongs to a fixed wall or to a body other than `body_i`
 // (contact between a body and itself is not a thing).
@@ -485,13 +484,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     var x_i = vec3<f32>(0.0);
     if (WALL_REACTIONS && reacts && !on_body) {
         x_i = domain_pos(p_i);
-        for (var k = 0u; k < arrayLength(&wall_sensors); k++) {
-            let s = wall_sensors[k];
-            if (in_wall_patch(s.point, s.normal, s.radius, x_i)) {
-                sensor = k;
-                break;
-            }
-        }
+        sensor = owning_sensor(x_i);
     }
     // The rigid velocity a body particle presents in contact (friction only).
     var v_contact_i = vec3<f32>(0.0);

@@ -8,7 +8,10 @@ struct ProbeDef {
     kind: u32,          // PROBE_*
     axis: vec3<f32>,    // unit vector: a front's direction, a wall patch's normal (into the fluid)
     radius: f32,        // a wall patch's radius across its normal
+    face: u32,          // a fixed wall patch's face (WallSensor::face_id), else NO_FACE
 }
+
+const NO_FACE: u32 = 0xFFFFFFFFu;
 
 const PROBE_PRESSURE: u32 = 0u;
 const PROBE_HEIGHT: u32 = 1u;
@@ -22,6 +25,7 @@ const PROBE_WALL_PRESSURE: u32 = 3u;
 @group(0) @binding(5) var<storage, read> probes: array<ProbeDef>;
 @group(0) @binding(6) var<storage, read_write> probe_out: array<atomic<u32>>;
 @group(0) @binding(9) var<storage, read> rate: array<vec4<f32>>;
+@group(0) @binding(10) var<storage, read> wall_sensors: array<WallSensor>;
 
 struct KernelSums {
     volume: f32,        // Σ_j W V_j over fluid (the Shepard denominator)
@@ -95,9 +99,10 @@ fn probe_height(x: vec3<f32>) -> f32 {
 // Σ_j a_j·n over the boundary particles j of a wall patch, a_j their rate (the fluid's force per
 // unit fluid mass, interaction.wgsl with WALL_REACTIONS; for a body's particles also any contact
 // force); the host multiplies by −m/area. The rates are those of the last step's interaction,
-// at its predicted state, in the current cell order; on a fixed wall only the fluid's in front
-// of the wall's first layer (interaction.wgsl). The patch: no fluid or solid particle,
-// `in_wall_patch` (lib/wall_patch.wgsl).
+// at its predicted state, in the current cell order; on a fixed wall only the fluid's over the
+// face of the sensor the particle belongs to (interaction.wgsl). The patch: no fluid or solid
+// particle, `in_wall_patch` (lib/wall_patch.wgsl), and on a fixed wall not a particle that
+// belongs to a sensor of another face (`owning_sensor`: at an edge, the one it is nearer).
 // The cells of the patch's box are visited once each (a particle counts in its own cell only),
 // in a fixed order: the same state gives the same sum.
 fn probe_wall_force(def: ProbeDef) -> f32 {
@@ -125,9 +130,18 @@ fn probe_wall_force(def: ProbeDef) -> f32 {
                     if (kind == KIND_FLUID || kind == KIND_EXCLUDED || kind == KIND_INLET || is_solid(kind) || any(cell_of(pos[j]) != c)) {
                         continue;
                     }
-                    if (in_wall_patch(def.point, def.axis, def.radius, domain_pos(pos[j]))) {
-                        sum += dot(rate[j].xyz, def.axis);
+                    let x = domain_pos(pos[j]);
+                    if (!in_wall_patch(def.point, def.axis, def.radius, x)) {
+                        continue;
                     }
+                    // A fixed wall's particle that belongs to another face's sensor is its.
+                    if (def.face != NO_FACE && !is_body_particle(code[j] & ID_MASK)) {
+                        let owner = owning_sensor(x);
+                        if (owner != NO_SENSOR && wall_sensors[owner].face_id != def.face) {
+                            continue;
+                        }
+                    }
+                    sum += dot(rate[j].xyz, def.axis);
                 }
             }
         }

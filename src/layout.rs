@@ -158,7 +158,13 @@ pub struct ProbeDef {
     pub kind: u32,
     pub axis: [f32; 3],
     pub radius: f32,
+    /// A wall-pressure probe's face on a fixed wall (`WallSensor::face_id`), else `NO_FACE`.
+    pub face: u32,
+    pub pad: [u32; 3],
 }
+
+/// `ProbeDef::face` of a probe that is not a fixed wall's sensor.
+pub const NO_FACE: u32 = u32::MAX;
 
 /// Mirrors `WallSensor` in shaders/lib/wall_patch.wgsl: a wall-pressure probe's patch on a
 /// fixed wall (`scenario::WallPatch`), in domain coordinates.
@@ -170,7 +176,7 @@ pub struct WallSensor {
     pub normal: [f32; 3],
     pub face: f32,
     pub over_lo: [f32; 3],
-    pub pad0: u32,
+    pub face_id: u32,
     pub over_hi: [f32; 3],
     pub pad1: u32,
 }
@@ -537,13 +543,13 @@ mod tests {
             Pass::Probes,
             "ProbeDef",
             ProbeDef,
-            [point, kind, axis, radius]
+            [point, kind, axis, radius, face]
         );
         check_layout!(
             Pass::Interaction,
             "WallSensor",
             WallSensor,
-            [point, radius, normal, face, over_lo, over_hi]
+            [point, radius, normal, face, over_lo, face_id, over_hi]
         );
         check_layout!(
             Pass::Interaction,

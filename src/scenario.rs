@@ -292,12 +292,12 @@ pub struct WallParams {
     /// over their neighbours for dρ/dt anyway).
     pub reactions: bool,
     /// The patches of the wall-pressure probes on fixed walls (those without a body), in
-    /// probe order. With `reactions`, a fixed wall's particle in one of them (the first that
-    /// [`WallPatch::holds`] it) takes the force only of the fluid that
-    /// [`WallPatch::faces`] it, as a transducer feels only the water on its face: near a
-    /// convex edge the particles under the sensor also carry the load of the water against
-    /// the other face. Its dρ/dt still sums every fluid neighbour. Bodies' particles always
-    /// take the whole force (it moves the body).
+    /// probe order. With `reactions`, a fixed wall's particle in one of them (its sensor,
+    /// [`Self::sensor_of`]) takes the force only of the fluid that [`WallPatch::faces`] it, as
+    /// a transducer feels only the water on its face: near a convex edge the particles under
+    /// the sensor also carry the load of the water against the other face. Its dρ/dt still
+    /// sums every fluid neighbour. Bodies' particles always take the whole force (it moves the
+    /// body).
     pub sensors: Vec<WallPatch>,
 }
 
@@ -318,6 +318,34 @@ pub struct FrictionPair {
 }
 
 impl WallParams {
+    /// The sensor (index into `sensors`) a fixed wall's boundary particle at `x` belongs to: of
+    /// those whose patch holds it, the one whose face it lies least deep behind (the first of
+    /// those within h/100 of that: f32 rounding on the GPU then agrees on ties). At an edge a
+    /// particle near one face and deep behind the other counts for the first only
+    /// (`sensor_faces`).
+    pub fn sensor_of(&self, x: [f64; 3], h: f64) -> Option<usize> {
+        let mut best: Option<(usize, f64)> = None;
+        for (k, s) in self.sensors.iter().enumerate() {
+            let depth = s.depth_behind_face(x);
+            if s.holds(x, h) && best.is_none_or(|(_, d)| depth < d - 0.01 * h) {
+                best = Some((k, depth));
+            }
+        }
+        best.map(|(k, _)| k)
+    }
+
+    /// Each sensor's face: the index of the first sensor on the same face. A sensor sums only
+    /// the particles that belong to a sensor of its own face ([`Self::sensor_of`]).
+    pub fn sensor_faces(&self) -> Vec<u32> {
+        (0..self.sensors.len())
+            .map(|k| {
+                (0..=k)
+                    .find(|&j| self.sensors[j].same_face(&self.sensors[k]))
+                    .unwrap_or(k) as u32
+            })
+            .collect()
+    }
+
     /// The Coulomb μ between two contact groups: their pair's, in either order, else the
     /// walls' `friction`.
     pub fn friction_between(&self, a: ContactGroup, b: ContactGroup) -> f64 {
@@ -356,6 +384,19 @@ impl WallPatch {
         let (behind, front) = Self::depth(h);
         let (d, t2) = Self::coordinates(self.point, self.normal, x);
         d >= behind && d <= front && t2 < self.radius * self.radius
+    }
+
+    /// How deep `x` lies behind the face, `face` − (x − point)·normal.
+    pub fn depth_behind_face(&self, x: [f64; 3]) -> f64 {
+        self.face - Self::coordinates(self.point, self.normal, x).0
+    }
+
+    /// Whether `other` lies on the same face (the same plane, to 1e-9 m).
+    pub fn same_face(&self, other: &WallPatch) -> bool {
+        let n_dot = (0..3)
+            .map(|a| self.normal[a] * other.normal[a])
+            .sum::<f64>();
+        n_dot > 1.0 - 1e-9 && (self.depth_behind_face(other.point) + other.face).abs() < 1e-9
     }
 
     /// Whether fluid at `x` loads the patch's particles: it lies in front of the wall's face,

@@ -294,8 +294,8 @@ fn wall_reactions_and_wall_pressure_match_reference() {
             &reference::Space::of(&sc),
             &parts,
         );
-        let cpu_p =
-            [patch, whole].map(|p| reference::probes::wall_pressure(&sc.physics, &parts, &cpu, &p));
+        let cpu_p = [patch, whole]
+            .map(|p| reference::probes::wall_pressure(&sc.physics, &sc.walls, &parts, &cpu, &p));
         let (e_acc, e_rho) = interaction_errors(&sc);
         let e_p = [0, 1].map(|k| (gpu_p[k] - cpu_p[k]).abs() / cpu_p[k].abs());
         println!(
@@ -399,39 +399,78 @@ fn a_sensor_at_a_convex_edge_takes_only_the_fluid_on_its_face() {
                     .all(|a| patch.over_lo[a] == -FACE_UNBOUNDED
                         && patch.over_hi[a] == FACE_UNBOUNDED)
             );
+            // And one on the step's side as far below the top: the columns share a particle
+            // 1.5 dx (0.5 dx) behind both faces, which belongs to the first, the top's.
+            let mut side_point = point;
+            side_point[0] = o + step;
+            side_point[up] = o + step - from_edge * dx;
+            let mut side_normal = [0.0; 3];
+            side_normal[0] = 1.0;
+            let side = WallPatch::resolve(
+                &sc.particles,
+                side_point,
+                side_normal,
+                0.005,
+                dim as usize,
+                dx,
+                h,
+            )
+            .unwrap();
+            let both = |x: [f64; 3]| patch.holds(x, h) && side.holds(x, h);
+            assert_eq!(sc.particles.iter().filter(|p| both(p.pos)).count(), 1);
             sc.walls.reactions = true;
-            sc.walls.sensors = vec![patch];
+            sc.walls.sensors = vec![patch, side];
             // A repulsion that reaches the water on the top (1 ± 0.3 dx above the column).
             sc.walls.repulsive_r0 = 1.5 * dx;
-            sc.probes = vec![Probe {
-                name: "top".into(),
-                kind: ProbeKind::WallPressure(patch),
-                body: None,
-            }];
+            sc.probes = [("top", patch), ("side", side)]
+                .map(|(name, p)| Probe {
+                    name: name.into(),
+                    kind: ProbeKind::WallPressure(p),
+                    body: None,
+                })
+                .to_vec();
             let solver = Solver::new(gpu(), &sc).unwrap();
             let (parts, _) = gpu_particles_and_codes(&solver);
-            let gpu_p = solver.sample_probes().unwrap()[0];
+            let gpu_p = solver.sample_probes().unwrap();
             let space = reference::Space::of(&sc);
             let cpu = reference::interaction::rates(&sc.physics, &sc.walls, &space, &parts);
-            let cpu_p = reference::probes::wall_pressure(&sc.physics, &parts, &cpu, &patch);
+            let cpu_p = [patch, side].map(|p| {
+                reference::probes::wall_pressure(&sc.physics, &sc.walls, &parts, &cpu, &p)
+            });
             let mut every = sc.walls.clone();
             every.sensors.clear();
             let all = reference::interaction::rates(&sc.physics, &every, &space, &parts);
-            let all_p = reference::probes::wall_pressure(&sc.physics, &parts, &all, &patch);
+            let all_p = reference::probes::wall_pressure(&sc.physics, &every, &parts, &all, &patch);
             let (e_acc, e_rho) = interaction_errors(&sc);
             println!(
-                "dim {dim} {wall:?} wet top {wet_top}: sensor GPU {gpu_p:.3} CPU {cpu_p:.3} Pa,                  every fluid neighbour {all_p:.3} Pa; accel err {e_acc:.2e}, drho err {e_rho:.2e}"
+                "dim {dim} {wall:?} wet top {wet_top}: top and side sensors GPU {gpu_p:.3?} CPU \
+                 {cpu_p:.3?} Pa, the top's column summing every fluid neighbour {all_p:.3} Pa; \
+                 accel err {e_acc:.2e}, drho err {e_rho:.2e}"
             );
             assert!(e_acc < 2e-4, "acceleration error {e_acc}");
             assert!(e_rho < 2e-4, "density-rate error {e_rho}");
-            // Only the patch's forces change, never a dρ/dt.
+            // Only the patches' forces change, never a dρ/dt.
             for (k, (a, b)) in cpu.iter().zip(&all).enumerate() {
-                let held = patch.holds(parts[k].pos, h) && parts[k].kind != reference::FLUID;
+                let x = parts[k].pos;
+                let held =
+                    (patch.holds(x, h) || side.holds(x, h)) && parts[k].kind != reference::FLUID;
                 assert_eq!(a[3], b[3], "dρ/dt of particle {k}");
                 if !held {
-                    assert_eq!(a, b, "rates of particle {k}, outside the patch");
+                    assert_eq!(a, b, "rates of particle {k}, outside the patches");
                 }
             }
+            // The side's water presses on its sensor, whose shared particle is the top's (the
+            // repulsive side's only particle within the repulsion's reach: it reads 0).
+            if wall == Kind::Wall {
+                assert!(cpu_p[1] > 1.0, "side {} Pa", cpu_p[1]);
+            }
+            assert!(
+                (gpu_p[1] - cpu_p[1]).abs() <= 1e-4 * cpu_p[1].abs(),
+                "side {} against {}",
+                gpu_p[1],
+                cpu_p[1]
+            );
+            let (gpu_p, cpu_p) = (gpu_p[0], cpu_p[0]);
             assert!(
                 all_p.abs() > 1.0,
                 "the column carries the side's water: {all_p} Pa"

@@ -1,6 +1,8 @@
 // The boundary particles a wall-pressure sensor sums over (WallPatch in scenario.rs): the
-// probe's column test (probes.wgsl) and, on fixed walls, the interaction's choice of the fluid
-// that loads them (interaction.wgsl).
+// probe's column test (probes.wgsl) and, on fixed walls, the sensor each particle belongs to
+// and the fluid that loads it (interaction.wgsl). The pass declares `wall_sensors`.
+
+const NO_SENSOR: u32 = 0xFFFFFFFFu;
 
 // A wall-pressure probe's patch on a fixed wall, in domain coordinates.
 struct WallSensor {
@@ -9,6 +11,7 @@ struct WallSensor {
     normal: vec3<f32>,  // unit, into the fluid
     face: f32,          // (x − point)·normal of the wall's face
     over_lo: vec3<f32>, // the face's extent where an edge is near (WallPatch::over_lo)
+    face_id: u32,       // the first sensor on the same face (WallParams::sensor_faces)
     over_hi: vec3<f32>,
 }
 
@@ -26,4 +29,22 @@ fn in_wall_patch(point: vec3<f32>, normal: vec3<f32>, radius: f32, x: vec3<f32>)
     let d = dot(r, normal);
     let t2 = dot(r, r) - d * d;
     return d >= -3.0 * params.h && d <= params.h && t2 < radius * radius;
+}
+
+// The sensor a fixed wall's particle at x belongs to (WallParams::sensor_of): of those whose
+// patch holds it, the one whose face it lies least deep behind, the first of those within
+// h/100 of that (so that f32 rounding does not split a tie); NO_SENSOR for none.
+fn owning_sensor(x: vec3<f32>) -> u32 {
+    var best = NO_SENSOR;
+    var best_depth = 0.0;
+    for (var k = 0u; k < arrayLength(&wall_sensors); k++) {
+        let s = wall_sensors[k];
+        let depth = s.face - dot(x - s.point, s.normal);
+        let nearer = depth < best_depth - 0.01 * params.h;
+        if (in_wall_patch(s.point, s.normal, s.radius, x) && (best == NO_SENSOR || nearer)) {
+            best = k;
+            best_depth = depth;
+        }
+    }
+    return best;
 }

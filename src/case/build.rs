@@ -651,9 +651,6 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     );
     let mut probes = case.probes;
     super::probes::resolve_wall_patches(ctx, &mut probes, &particles, dim, dx, h)?;
-    warnings.extend(super::probes::sensors_sharing_particles(
-        &probes, &particles, dx, h,
-    ));
     let physics = Physics {
         dim: dim as u32,
         dx,
@@ -690,6 +687,9 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             _ => None,
         })
         .collect();
+    warnings.extend(super::probes::sensors_meeting_at_edges(
+        &probes, &walls, &particles, h,
+    ));
     let n_particles = particles.len();
     Ok(Scenario {
         name: case.name,

@@ -2,7 +2,9 @@
 //! case's dimension (padded to 3 components), a non-zero front axis (normalised); and the
 //! choice of the particle a `"point"` probe follows.
 
-use crate::scenario::{Body, Particle, Probe, ProbeKind, TrackedPoint, WallPatch, FACE_UNBOUNDED};
+use crate::scenario::{
+    Body, Particle, Probe, ProbeKind, TrackedPoint, WallParams, WallPatch, FACE_UNBOUNDED,
+};
 
 use super::error::CaseError;
 use super::locate::Ctx;
@@ -286,52 +288,52 @@ pub(super) fn resolve_wall_patches(
     Ok(())
 }
 
-/// A warning for each pair of wall-pressure probes on fixed walls that hold a boundary particle
-/// in common while their faces differ (sensors on two faces of an edge, closer to it than their
-/// columns are deep): such a particle takes the force of the fluid over the first one's face
-/// only (`WallParams::sensors`), and the second reads that in its sum.
-pub(super) fn sensors_sharing_particles(
+/// A warning for each pair of wall-pressure probes on fixed walls that meet at an edge: a wall
+/// particle in both columns, within 2h of the face of the one it does not belong to
+/// (`WallParams::sensor_of`: it belongs to the face it lies less deep behind), carries water
+/// of that face which that sensor then misses.
+pub(super) fn sensors_meeting_at_edges(
     probes: &[Probe],
+    walls: &WallParams,
     particles: &[Particle],
-    dx: f64,
     h: f64,
 ) -> Vec<String> {
-    let fixed: Vec<(usize, &Probe, &WallPatch)> = (probes.iter().enumerate())
-        .filter(|(_, p)| p.body.is_none())
-        .filter_map(|(i, p)| match &p.kind {
-            ProbeKind::WallPressure(patch) => Some((i, p, patch)),
-            _ => None,
-        })
+    // Probe index and name of each sensor, in the order of `walls.sensors`.
+    let names: Vec<(usize, &str)> = (probes.iter().enumerate())
+        .filter(|(_, p)| p.body.is_none() && matches!(p.kind, ProbeKind::WallPressure(_)))
+        .map(|(i, p)| (i, p.name.as_str()))
         .collect();
-    let mut out = Vec::new();
-    for (a, &(i, pi, si)) in fixed.iter().enumerate() {
-        for &(j, pj, sj) in &fixed[a + 1..] {
-            let n_dot = (0..3).map(|k| si.normal[k] * sj.normal[k]).sum::<f64>();
-            let offset = (0..3)
-                .map(|k| (sj.point[k] - si.point[k]) * si.normal[k])
-                .sum::<f64>();
-            let same_face = n_dot > 1.0 - 1e-9 && (offset + sj.face - si.face).abs() < 1e-6 * dx;
-            let shared = || {
-                particles
-                    .iter()
-                    .filter(|p| p.kind.is_boundary())
-                    .any(|p| si.holds(p.pos, h) && sj.holds(p.pos, h))
-            };
-            if !same_face && shared() {
-                out.push(format!(
-                    "probe[{i}] ('{}') and probe[{j}] ('{}') sum over some of the same wall \
-                     particles, whose faces differ (an edge or a step between them): those \
-                     particles take only the force of the fluid over probe[{i}]'s face, \
-                     so probe[{j}] reads that there; fix: move the sensors apart, each more than \
-                     3 h = {:.4} m behind the other's face, or give them smaller radius_m",
-                    pi.name,
-                    pj.name,
-                    3.0 * h
-                ));
+    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    for p in particles.iter().filter(|p| p.kind.is_boundary()) {
+        let Some(owner) = walls.sensor_of(p.pos, h) else {
+            continue;
+        };
+        for (k, s) in walls.sensors.iter().enumerate() {
+            if k != owner
+                && s.holds(p.pos, h)
+                && !s.same_face(&walls.sensors[owner])
+                && s.depth_behind_face(p.pos) < 2.0 * h
+                && !pairs.contains(&(owner, k))
+            {
+                pairs.push((owner, k));
             }
         }
     }
-    out
+    pairs.sort_unstable();
+    pairs
+        .into_iter()
+        .map(|(owner, k)| {
+            let ((i, a), (j, b)) = (names[owner], names[k]);
+            format!(
+                "probe[{j}] ('{b}') and probe[{i}] ('{a}') meet at an edge: wall particles \
+                 within 2h = {:.4} m of probe[{j}]'s face lie in both columns and count for \
+                 probe[{i}]'s face, which they are nearer, so probe[{j}] misses the water \
+                 they carry; fix: move the sensors apart, each more than 2h behind the other's \
+                 face, or give them smaller radius_m",
+                2.0 * h
+            )
+        })
+        .collect()
 }
 
 /// The particle each point probe follows: the nearest particle of an elastic solid or a rigid

@@ -230,7 +230,7 @@ pub fn rates_and_energy(
                 // A fixed wall's particle under a wall-pressure sensor takes the force of the
                 // fluid on the sensor's face only (`WallParams::sensors`).
                 let sensor = if reacts && !on_body {
-                    walls.sensors.iter().find(|s| s.holds(pi.pos, h))
+                    walls.sensor_of(pi.pos, h).map(|k| &walls.sensors[k])
                 } else {
                     None
                 };

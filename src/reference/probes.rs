@@ -1,7 +1,7 @@
 //! Twin of shaders/probes.wgsl.
 
 use super::{dot, kernel, pressure, sub, RefParticle, EXCLUDED, FLUID, INLET};
-use crate::scenario::{Physics, WallPatch};
+use crate::scenario::{Physics, WallParams, WallPatch};
 
 /// (Σ W V, Σ P W V) over fluid particles at x.
 fn sums(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> (f64, f64) {
@@ -65,20 +65,29 @@ pub fn front(parts: &[RefParticle], origin: [f64; 3], axis: [f64; 3]) -> f64 {
 }
 
 /// Pressure on a wall patch: −m Σ_j a_j·n / area over the patch's boundary particles j
-/// (`WallPatch`), a_j their rates from `interaction::rates` with `walls.reactions`.
+/// (`WallPatch`), a_j their rates from `interaction::rates` with `walls.reactions`; a fixed
+/// wall's particle that belongs to a sensor of another face (`WallParams::sensor_of`) is left
+/// out.
 pub fn wall_pressure(
     ph: &Physics,
+    walls: &WallParams,
     parts: &[RefParticle],
     rates: &[[f64; 4]],
     patch: &WallPatch,
 ) -> f64 {
+    let elsewhere = |p: &RefParticle| {
+        p.body.is_none()
+            && walls
+                .sensor_of(p.pos, ph.h)
+                .is_some_and(|k| !walls.sensors[k].same_face(patch))
+    };
     let sum: f64 = parts
         .iter()
         .zip(rates)
         .filter(|(p, _)| {
             !matches!(p.kind, FLUID | EXCLUDED | INLET) && !super::elastic::is_solid(p.kind)
         })
-        .filter(|(p, _)| patch.holds(p.pos, ph.h))
+        .filter(|(p, _)| patch.holds(p.pos, ph.h) && !elsewhere(p))
         .map(|(_, r)| (0..3).map(|a| r[a] * patch.normal[a]).sum::<f64>())
         .sum();
     -ph.particle_mass * sum / patch.area

@@ -58,6 +58,8 @@ const EMPTY_PROBES: [ProbeDef; 1] = [ProbeDef {
     kind: 0,
     axis: [0.0; 3],
     radius: 0.0,
+    face: crate::layout::NO_FACE,
+    pad: [0; 3],
 }];
 
 /// Stand-in for a run without wall sensors: a patch of radius 0 holds no particle.
@@ -67,7 +69,7 @@ const NO_SENSOR: WallSensor = WallSensor {
     normal: [0.0; 3],
     face: 0.0,
     over_lo: [0.0; 3],
-    pad0: 0,
+    face_id: 0,
     over_hi: [0.0; 3],
     pad1: 0,
 };

@@ -91,16 +91,15 @@ fn mirror_planes(sc: &Scenario, origin: [f64; 3]) -> Vec<crate::layout::MirrorPl
 
 /// The fixed walls' wall-pressure sensors (`WallParams::sensors`) in domain coordinates.
 fn wall_sensors(sc: &Scenario, origin: [f64; 3]) -> Vec<crate::layout::WallSensor> {
-    sc.walls
-        .sensors
-        .iter()
-        .map(|s| crate::layout::WallSensor {
+    (sc.walls.sensors.iter())
+        .zip(sc.walls.sensor_faces())
+        .map(|(s, face_id)| crate::layout::WallSensor {
             point: [0, 1, 2].map(|a| (s.point[a] - origin[a]) as f32),
             radius: s.radius as f32,
             normal: s.normal.map(|x| x as f32),
             face: s.face as f32,
             over_lo: [0, 1, 2].map(|a| (s.over_lo[a] - origin[a]) as f32),
-            pad0: 0,
+            face_id,
             over_hi: [0, 1, 2].map(|a| (s.over_hi[a] - origin[a]) as f32),
             pad1: 0,
         })
@@ -205,6 +204,8 @@ pub struct Solver {
     points: Option<PointTracker>,
     /// The case's probes and the bodies' centres at t = 0, when a probe moves with a body.
     attached_probes: Option<(Vec<crate::scenario::Probe>, Vec<[f64; 3]>)>,
+    /// Each probe's face on a fixed wall (`probes::probe_faces`).
+    probe_faces: Vec<u32>,
     /// Moving bodies: the GPU part, the host dynamics, and the buffer the state and the
     /// per-workgroup loads are read back into after every step.
     bodies: Option<(Bodies, BodySet, wgpu::Buffer)>,
@@ -364,7 +365,8 @@ impl Solver {
         // Allocation failures are caught here to name what was being allocated; later ones
         // reach `faults`.
         let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let defs = probes::probe_defs(&sc.probes, grid.origin);
+        let probe_faces = probes::probe_faces(&sc.probes, &sc.walls);
+        let defs = probes::probe_defs(&sc.probes, grid.origin, &probe_faces);
         let planes = mirror_planes(sc, grid.origin);
         let sensors = wall_sensors(sc, grid.origin);
         let body_particles = bodies::body_particles(sc);
@@ -493,6 +495,7 @@ impl Solver {
             total_lagrangian,
             probes,
             points,
+            probe_faces,
             attached_probes: sc.probes.iter().any(|p| p.body.is_some()).then(|| {
                 (
                     sc.probes.clone(),
@@ -881,7 +884,7 @@ impl Solver {
                     None => p.clone(),
                 })
                 .collect();
-            let defs = probes::probe_defs(&placed, self.grid.origin);
+            let defs = probes::probe_defs(&placed, self.grid.origin, &self.probe_faces);
             self.queue
                 .write_buffer(&self.buffers.probes, 0, bytemuck::cast_slice(&defs));
         }

@@ -8,8 +8,8 @@ use crate::body::Pose;
 use crate::gpu::buffers::{read, storage, storage_init};
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::Kernel;
-use crate::layout::{Pos, ProbeDef};
-use crate::scenario::{Probe, ProbeKind, TrackedPoint, WallPatch};
+use crate::layout::{Pos, ProbeDef, NO_FACE};
+use crate::scenario::{Probe, ProbeKind, TrackedPoint, WallParams, WallPatch};
 use glam::DVec3;
 
 pub const PROBE_PRESSURE: u32 = 0;
@@ -17,20 +17,37 @@ pub const PROBE_HEIGHT: u32 = 1;
 pub const PROBE_FRONT: u32 = 2;
 pub const PROBE_WALL_PRESSURE: u32 = 3;
 
-/// GPU definitions of the probes, in domain coordinates (from the domain's min corner).
-pub fn probe_defs(probes: &[Probe], origin: [f64; 3]) -> Vec<ProbeDef> {
-    let rel = |p: &[f64; 3]| [0, 1, 2].map(|a| (p[a] - origin[a]) as f32);
+/// Each probe's face: for a wall-pressure probe on a fixed wall (one of `walls.sensors`), its
+/// sensor's face (`WallParams::sensor_faces`); `NO_FACE` for every other probe.
+pub fn probe_faces(probes: &[Probe], walls: &WallParams) -> Vec<u32> {
+    let faces = walls.sensor_faces();
     probes
         .iter()
         .map(|p| match &p.kind {
+            ProbeKind::WallPressure(patch) if p.body.is_none() => (walls.sensors.iter())
+                .position(|s| s == patch)
+                .map_or(NO_FACE, |k| faces[k]),
+            _ => NO_FACE,
+        })
+        .collect()
+}
+
+/// GPU definitions of the probes, in domain coordinates (from the domain's min corner);
+/// `faces` from [`probe_faces`].
+pub fn probe_defs(probes: &[Probe], origin: [f64; 3], faces: &[u32]) -> Vec<ProbeDef> {
+    let rel = |p: &[f64; 3]| [0, 1, 2].map(|a| (p[a] - origin[a]) as f32);
+    (probes.iter().zip(faces))
+        .map(|(p, &face)| match &p.kind {
             ProbeKind::Pressure { point } => ProbeDef {
                 point: rel(point),
                 kind: PROBE_PRESSURE,
+                face,
                 ..Default::default()
             },
             ProbeKind::Height { base } => ProbeDef {
                 point: rel(base),
                 kind: PROBE_HEIGHT,
+                face,
                 ..Default::default()
             },
             ProbeKind::Front { origin: o, axis } => {
@@ -39,7 +56,8 @@ pub fn probe_defs(probes: &[Probe], origin: [f64; 3]) -> Vec<ProbeDef> {
                     point: rel(o),
                     kind: PROBE_FRONT,
                     axis: axis.map(|a| (a / norm) as f32),
-                    radius: 0.0,
+                    face,
+                    ..Default::default()
                 }
             }
             ProbeKind::WallPressure(patch) => ProbeDef {
@@ -47,6 +65,8 @@ pub fn probe_defs(probes: &[Probe], origin: [f64; 3]) -> Vec<ProbeDef> {
                 kind: PROBE_WALL_PRESSURE,
                 axis: patch.normal.map(|a| a as f32),
                 radius: patch.radius as f32,
+                face,
+                pad: [0; 3],
             },
         })
         .collect()
@@ -125,6 +145,7 @@ impl Probes {
                 (5, &b.probes),
                 (6, &b.probe_out),
                 (9, &b.rate),
+                (10, &b.wall_sensors),
             ]
         };
         Ok(Self {
