@@ -253,6 +253,30 @@ fn fourtakas_diffusion_at_hydrostatic_rest_matches_reference() {
     }
 }
 
+/// Wall-pressure probes on `patches`, read on the GPU and by the reference from the GPU's own
+/// particle state (the warm-up's): the two readings, that state and the reference's rates.
+fn wall_pressures(
+    sc: &mut Scenario,
+    patches: &[WallPatch],
+) -> (Vec<f64>, Vec<f64>, Vec<RefParticle>, Vec<[f64; 4]>) {
+    sc.probes = (patches.iter().enumerate())
+        .map(|(k, p)| Probe {
+            name: format!("p{k}"),
+            kind: ProbeKind::WallPressure(*p),
+            body: None,
+        })
+        .collect();
+    let solver = Solver::new(gpu(), sc).unwrap();
+    let (parts, _) = gpu_particles_and_codes(&solver);
+    let gpu_p = solver.sample_probes().unwrap();
+    let space = reference::Space::of(sc);
+    let cpu = reference::interaction::rates(&sc.physics, &sc.walls, &space, &parts);
+    let cpu_p = (patches.iter())
+        .map(|p| reference::probes::wall_pressure(&sc.physics, &sc.walls, &parts, &cpu, p))
+        .collect();
+    (gpu_p, cpu_p, parts, cpu)
+}
+
 /// With wall reactions on, the fixed walls' particles take the fluid's force (as bodies' do), and
 /// a wall-pressure probe on the floor sums it: both against the reference, the probe on the
 /// GPU's own rates' state (the warm-up's), dense and sparse (hash-colliding) grids.
@@ -278,24 +302,7 @@ fn wall_reactions_and_wall_pressure_match_reference() {
         // And the whole floor: a patch whose box of cells reaches past the domain's edge (on
         // the dense grids).
         let whole = WallPatch::resolve(&sc.particles, point, normal, BLOCK, dim, dx, h).unwrap();
-        sc.probes = [("floor", patch), ("whole", whole)]
-            .map(|(name, p)| Probe {
-                name: name.into(),
-                kind: ProbeKind::WallPressure(p),
-                body: None,
-            })
-            .to_vec();
-        let solver = Solver::new(gpu(), &sc).unwrap();
-        let (parts, _) = gpu_particles_and_codes(&solver);
-        let gpu_p = solver.sample_probes().unwrap();
-        let cpu = reference::interaction::rates(
-            &sc.physics,
-            &sc.walls,
-            &reference::Space::of(&sc),
-            &parts,
-        );
-        let cpu_p = [patch, whole]
-            .map(|p| reference::probes::wall_pressure(&sc.physics, &sc.walls, &parts, &cpu, &p));
+        let (gpu_p, cpu_p, ..) = wall_pressures(&mut sc, &[patch, whole]);
         let (e_acc, e_rho) = interaction_errors(&sc);
         let e_p = [0, 1].map(|k| (gpu_p[k] - cpu_p[k]).abs() / cpu_p[k].abs());
         println!(
@@ -422,21 +429,8 @@ fn a_sensor_at_a_convex_edge_takes_only_the_fluid_on_its_face() {
             sc.walls.sensors = vec![patch, side];
             // A repulsion that reaches the water on the top (1 ± 0.3 dx above the column).
             sc.walls.repulsive_r0 = 1.5 * dx;
-            sc.probes = [("top", patch), ("side", side)]
-                .map(|(name, p)| Probe {
-                    name: name.into(),
-                    kind: ProbeKind::WallPressure(p),
-                    body: None,
-                })
-                .to_vec();
-            let solver = Solver::new(gpu(), &sc).unwrap();
-            let (parts, _) = gpu_particles_and_codes(&solver);
-            let gpu_p = solver.sample_probes().unwrap();
+            let (gpu_p, cpu_p, parts, cpu) = wall_pressures(&mut sc, &[patch, side]);
             let space = reference::Space::of(&sc);
-            let cpu = reference::interaction::rates(&sc.physics, &sc.walls, &space, &parts);
-            let cpu_p = [patch, side].map(|p| {
-                reference::probes::wall_pressure(&sc.physics, &sc.walls, &parts, &cpu, &p)
-            });
             let mut every = sc.walls.clone();
             every.sensors.clear();
             let all = reference::interaction::rates(&sc.physics, &every, &space, &parts);
