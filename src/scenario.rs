@@ -941,3 +941,53 @@ impl Scenario {
             .sum()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2D pillar 4 dx wide and 6 dx high, lattice points at (i + ½) dx.
+    fn pillar(dx: f64) -> Vec<Particle> {
+        let mut out = Vec::new();
+        for i in 0..4 {
+            for j in 0..6 {
+                out.push(Particle {
+                    pos: [(i as f64 + 0.5) * dx, (j as f64 + 0.5) * dx, 0.0],
+                    vel: [0.0; 3],
+                    rho: 1000.0,
+                    kind: Kind::Wall,
+                });
+            }
+        }
+        out
+    }
+
+    /// On a pillar's top narrower than the reach both edges bound the face; on its side only
+    /// the top's edge does within the reach (the bottom lies beyond it); a normal off the
+    /// lattice axes gets no extent. The face sits half a spacing above the first layer.
+    #[test]
+    fn a_face_extends_to_the_edges_within_reach() {
+        let (dx, h) = (0.01, 0.013);
+        let parts = pillar(dx);
+        let top = WallPatch::resolve(&parts, [0.02, 0.06, 0.0], [0.0, 1.0, 0.0], 0.004, 2, dx, h)
+            .unwrap();
+        assert!(top.face.abs() < 1e-12, "{top:?}");
+        assert!((top.over_lo[0] - 0.0).abs() < 1e-12 && (top.over_hi[0] - 0.04).abs() < 1e-12);
+        assert_eq!(
+            (top.over_lo[1], top.over_hi[1]),
+            (-FACE_UNBOUNDED, FACE_UNBOUNDED)
+        );
+        // Water over the top loads it, water beside the pillar above its top does not.
+        assert!(top.faces([0.02, 0.065, 0.0]) && !top.faces([0.045, 0.065, 0.0]));
+        assert!(!top.faces([0.02, 0.059, 0.0]));
+        let side = WallPatch::resolve(&parts, [0.04, 0.05, 0.0], [1.0, 0.0, 0.0], 0.004, 2, dx, h)
+            .unwrap();
+        assert!((side.over_hi[1] - 0.06).abs() < 1e-12, "{side:?}");
+        assert_eq!(side.over_lo[1], -FACE_UNBOUNDED);
+        let n = std::f64::consts::FRAC_1_SQRT_2;
+        let slanted =
+            WallPatch::resolve(&parts, [0.04, 0.06, 0.0], [n, n, 0.0], 0.004, 2, dx, h).unwrap();
+        assert_eq!(slanted.over_lo, [-FACE_UNBOUNDED; 3]);
+        assert_eq!(slanted.over_hi, [FACE_UNBOUNDED; 3]);
+    }
+}
