@@ -178,7 +178,7 @@ pub struct WallSensor {
     pub over_lo: [f32; 3],
     pub face_id: u32,
     pub over_hi: [f32; 3],
-    pub pad1: u32,
+    pub pad: u32,
 }
 
 /// Mirrors `MirrorPlane` in shaders/interaction.wgsl.

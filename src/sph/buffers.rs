@@ -71,7 +71,7 @@ const NO_SENSOR: WallSensor = WallSensor {
     over_lo: [0.0; 3],
     face_id: 0,
     over_hi: [0.0; 3],
-    pad1: 0,
+    pad: 0,
 };
 
 pub struct InitialParticles<'a> {

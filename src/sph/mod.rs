@@ -101,7 +101,7 @@ fn wall_sensors(sc: &Scenario, origin: [f64; 3]) -> Vec<crate::layout::WallSenso
             over_lo: [0, 1, 2].map(|a| (s.over_lo[a] - origin[a]) as f32),
             face_id,
             over_hi: [0, 1, 2].map(|a| (s.over_hi[a] - origin[a]) as f32),
-            pad1: 0,
+            pad: 0,
         })
         .collect()
 }
