@@ -1,71 +1,16 @@
-// The neighbour sum of weakly-compressible SPH, one invocation per particle (gather, no
-// atomics), in cell order. Writes rate = (dv/dt, dρ/dt).
-//
-// Continuity (the seed's eq. 1; Monaghan 1992):  dρ_i/dt = Σ_j m_j v_ij·∇_i W_ij
-//   + δ-SPH diffusion between fluid particles (Molteni & Colagrossi 2009, eq. 8):
-//     δ h c0 Σ_j 2 (ρ_i − ρ_j − ρ^H_ij) (x_ij·∇_i W_ij)/(r² + η²) V_j
-//     with ρ^H_ij = ρ0((1 + ρ0 g·x_ij/B)^(1/γ) − 1), the hydrostatic part of ρ_i − ρ_j, when
-//     HYDROSTATIC_DIFFUSION (Fourtakas et al. 2019; 0 otherwise), g without its components
-//     along periodic axes (no pressure gradient can balance those: a body force driving a
-//     periodic channel is no hydrostatics). Without it the term
-//     drains the density of the fluid next to a floor, whose fluid neighbours all lie above it
-//     and are lighter, and a tank at rest sinks steadily (0.7 mm/s in 0.465 m of water).
-//   + the seed's density-rate correction between materials, m_j v_ij·∇_i W_ij (ρ_i/ρ_j), used
-//     for fluid–ghost pairs.
-// Momentum (the seed's eq. 2 with σ = −P I; Monaghan 1992):
-//   dv_i/dt = −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij + g
-//   artificial viscosity Π_ij = −α c0 μ_ij / ρ̄_ij, μ_ij = h v_ij·x_ij/(r² + η²) when v_ij·x_ij < 0
-//   (Monaghan 1992, eq. 4.2), or laminar viscosity (Lo & Shao 2002, eq. 8; Morris et al. 1997):
-//   Σ_j m_j 4ν (x_ij·∇_i W_ij) / ((ρ_i + ρ_j)(r² + η²)) v_ij
-// Walls, by kind of the neighbour j of a fluid particle:
-//   dynamic boundary particles (Crespo et al. 2007) and fixed ghosts (values set by ghost.wgsl)
-//   enter the sums like fluid; repulsive particles exert only the Lennard-Jones force
-//   D((r0/r)^12 − (r0/r)^4) x_ij/r² for r < r0 (Monaghan 1994, eq. 3.2), or the smooth
-//   Monaghan & Kajtar (2009) force; mirror planes add, for
-//   each fluid j near the image of i, the ghost x_g = 2x_w − x_j with p_g = p_j, ρ_g = ρ_j and
-//   v_g = v_j with its normal part reversed (free-slip) or v_g = −v_j (no-slip), the latter in
-//   the viscous terms only; near an edge also the double image across both planes, near a 3D
-//   vertex the triple image across all three.
-// Fluid–solid pairs (elastic solids, Kind::Solid/SolidClamped), from either side: the solid
-//   particle acts as a ghost of its body (the seed's improved interface, third ghost kind) with
-//   the fluid pressure interpolated at it, P_g (ghost.wgsl, `interface_p`), its own velocity,
-//   mass m_s and density:
-//     dv_i/dt += −m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij   (fluid and solid i)
-//     dρ_i/dt += m_j v_ij·∇_i W_ij (ρ_i/ρ_j)                   (fluid i only)
-//   with P = P_g on the solid side, the fluid's viscosity (Π_ij with the fluid's α and c0, or
-//   the laminar term), and the seed's density-rate correction ρ_i/ρ_j between materials of
-//   different density. A solid particle's density (its volumetric strain) follows its own
-//   body's motion only (elastic.wgsl): with the fluid's relative velocity in it, a column
-//   clamped in still water pumped energy in and blew up within 0.1 s. The solid's own stress
-//   (its pressure and τ) stays inside the solid: with it in these terms, the solid's large
-//   deviatoric stresses push the fluid along the interface and the run blows up within
-//   milliseconds (the elastic gate). The pair terms are equal and opposite
-//   (m_i dv_i = −m_j dv_j): momentum is conserved across the interface. Solid particles get
-//   these fluid terms here and contact (the repulsive law below, per unit mass) from boundary
-//   particles of walls and bodies and from particles of other elastic bodies; elastic.wgsl
-//   (or total_lagrangian.wgsl) adds the forces within the body and gravity.
-// Inlet buffer particles (open_boundaries.wgsl) enter a fluid particle's sums as dynamic boundary
-// particles do (their velocity, ρ0, no δ-SPH term) and get nothing here.
-// Dynamic wall particles get only dρ/dt, from fluid neighbours; ghosts and repulsive particles
-// get nothing here; unless WALL_REACTIONS (a case with wall-pressure probes, probes.wgsl): then
-// every fixed boundary particle also gets the fluid's force on it, as a moving body's does; one
-// under a sensor (`owning_sensor`) only the force of the fluid over the sensor's face
-// (`faces_sensor`: in front of it, not beyond its edge), as a transducer feels the water on its
-// own face: at a convex edge the particles under a sensor on one face also carry the water
-// pressing on the other, which reads as suction on a dry top (docs/validation.md, SPHERIC W5).
-// Its dρ/dt still sums every fluid neighbour.
-// Particles of moving bodies get the force per unit mass of their fluid neighbours, the opposite
-// of what the fluid receives from them: for dynamic and fixed-ghost body particles
-// −Σ_j m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij (a ghost with its interpolated P_g and its
-// viscous velocity), for repulsive ones Σ_j F(x_ij); and a contact force from boundary
-// particles of other bodies and of the fixed walls and from elastic solids' particles (the
-// repulsive law above, Monaghan 1994, with Coulomb friction: `contact`):
-// bodies.wgsl sums both into the body's force and torque. A body's fixed ghosts move with it:
-// continuity sees the body's rigid velocity at the ghost, v_wall = u_c + ω × (R r), and the
-// no-slip viscous velocity is 2 v_wall − v_f.
-// Energy (the seed's eq. 3 with σ = −P I, when ENERGY): de_i/dt = ½ Σ_j m_j (P_i/ρ_i² + P_j/ρ_j²
-//   + Π_ij) v_ij·∇_i W_ij (Monaghan 1992, eq. 2.19 with the artificial-viscosity heating);
-//   laminar viscous heating is not included.
+// The neighbour sum of weakly-compressible SPH, one invocation per particle in cell order
+// (gather, no atomics): rate = (dv/dt, dρ/dt), and de/dt when ENERGY. Equations as numbered in
+// docs/equations.md; why each term is written so: docs/design/interaction.md.
+//   continuity, eq. 1 (Monaghan 1992), with δ-SPH between fluid particles, eq. 20 (Molteni &
+//     Colagrossi 2009; Fourtakas et al. 2019), and the seed's density-rate correction for
+//     fluid–ghost and fluid–solid pairs, eq. 14;
+//   momentum, eq. 2 with σ = −P I, with artificial viscosity, eq. 18 (Monaghan 1992), or
+//     laminar viscosity, eq. 19 (Morris et al. 1997; Lo & Shao 2002); energy, eq. 3;
+//   walls: dynamic particles, eq. 22 (Crespo et al. 2007); fixed ghosts, eqs. 13 and 15 (values
+//     from ghost.wgsl); repulsive particles, eq. 23 (Monaghan 1994; Monaghan & Kajtar 2009);
+//     mirror planes, eq. 12; fluid–solid pairs, eq. 28 (the seed's third ghost kind);
+//   the reaction of the fluid's force on body particles (and fixed-wall particles, when
+//     WALL_REACTIONS), which bodies.wgsl sums for eqs. 5–6; contact with friction, eq. 24.
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;
