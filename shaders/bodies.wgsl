@@ -1,18 +1,15 @@
-// Moving bodies (rigid, free or prescribed). The host integrates each body in f64
-// (src/body/) and uploads its motion for the step; here the GPU
+// Moving bodies (rigid, free or prescribed). The host integrates each body in f64 (src/body/,
+// docs/equations.md eqs. 5–6) and uploads its motion for the step; here the GPU
 //   body_move:  places every body particle a at x_a = x_c + R r_a with u_a = u_c + ω × (R r_a)
-//               (the seed's rigid-body kinematics), after the predictor and before the sort,
-//               and puts c_a + |u_a| into the time step's max-reduction (integrate.wgsl): a
-//               ghost's stored velocity is the fluid's, not the body's it moves with;
+//               (eq. 4), after the predictor and before the sort, and puts c_a + |u_a| into
+//               the time step's max-reduction (eq. 31; a ghost's stored velocity is the fluid's);
 //   body_index: after the sort, records where each body particle now is (body_slot);
-//   body_force: after the interaction, sums per workgroup the force m a_a that the fluid (and
-//               contact) exerts on each body particle and its moment (R r_a) × m a_a about the
-//               centre of mass. Each workgroup covers particles of one body only; the host
+//   body_force: after the interaction, sums per workgroup the force m a_a on each body particle
+//               and its moment (R r_a) × m a_a about the centre of mass (eqs. 5–6); the host
 //               finishes the sums in f64, in workgroup order (deterministic).
-// Body particles are dynamic, fixed-ghost or repulsive boundary particles: the interaction
-// gives each the force of its fluid neighbours (interaction.wgsl), the opposite of what the
-// fluid receives from it, so momentum is exchanged pairwise. A ghost's stored velocity is the
-// fluid's interpolated at it (ghost.wgsl), replaced here by the rigid one every step.
+// Body particles are dynamic, fixed-ghost or repulsive boundary particles; the interaction
+// gives each the reaction of its fluid neighbours' force (interaction.wgsl), so momentum is
+// exchanged pairwise. Design notes: docs/design/bodies.md.
 
 @group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;

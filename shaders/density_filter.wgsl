@@ -1,21 +1,13 @@
-// Density re-initialisation of the fluid (Colagrossi & Landrini 2003), every N steps after the
-// corrector, on the sorted arrays of the step:
-//   Shepard: ρ_i = Σ_j m_j W_ij / Σ_j W_ij V_j,                  V_j = m_j/ρ_j
-//   MLS:     ρ_i = Σ_j m_j W^MLS_ij,  W^MLS_ij = (β0 + β·x_ij/h) W_ij,  β = A⁻¹ e1,
-//            A = Σ_j W_ij V_j [1, x_ij/h][1, x_ij/h]ᵀ (shaders/lib/mls.wgsl; Colagrossi &
-//            Landrini 2003; Rabczuk, Belytschko & Xiao 2004)
-// j runs over i itself and every fluid, dynamic-wall and ghost particle within 2h; repulsive
-// particles carry no density (the interaction ignores theirs) and excluded ones are gone.
-// MLS falls back to Shepard where mls_solve finds A ill-conditioned (a pivot below
-// MLS_MIN_PIVOT·A00) or the MLS density is not positive and finite; Shepard falls back to the
-// old density if ever its result is not (it cannot be for finite data: j = i is always there).
-//
-// Two dispatches, so that no particle reads an already-filtered neighbour: `density_filter_*`
-// writes the new density into `filtered` (the `rate_sorted` buffer, free after the corrector),
-// `apply_density` copies it into velrho.w of the fluid. `filter_gate` (one invocation, after the
-// time-step kernel) decides whether this step filters: it writes the indirect dispatch size of
-// the two kernels, the full grid on every `every`-th step with dt > 0 (state.steps counts them)
-// and zero otherwise, so a step that does not filter costs one invocation.
+// Density re-initialisation of the fluid (Colagrossi & Landrini 2003), docs/equations.md
+// eq. 9, every N steps after the corrector, on the sorted arrays of the step: Shepard, eq. 10,
+// or first-order MLS, eq. 11 (shaders/lib/mls.wgsl; Rabczuk, Belytschko & Xiao 2004), over i
+// itself and its fluid, dynamic-wall, inlet-buffer and ghost neighbours within 2h (`counts`).
+// MLS falls back to Shepard where A is ill-conditioned or the MLS density is not positive and
+// finite; Shepard falls back to the old density.
+// Two dispatches, so that no particle reads a filtered neighbour: `density_filter_*` writes
+// `filtered`, `apply_density` copies it into velrho.w; `filter_gate` writes their indirect
+// dispatch size (the full grid on every `every`-th step, zero otherwise).
+// Design notes: docs/design/density_filter.md.
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;

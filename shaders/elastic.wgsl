@@ -1,32 +1,15 @@
-// Hypoelastic solid particles (Gray, Monaghan & Swift 2001, CMAME 190:6641; "GMS" below), one
-// invocation per particle, after the fluid interaction pass, whose rates of solid particles
-// (the fluid's force on them, interaction.wgsl) this pass adds to. Here solid particles
-// interact with solid particles of their own elastic body.
-//
-// Equation numbers are not quoted (no copy of the paper at hand): "GMS §2" is its continuum
-// model (continuity, momentum with σ = −p I + τ, Jaumann stress rate, linear EOS), "GMS §4" its
-// SPH equations and the artificial stress.
-// With σ = −p I + τ, p = c_s² (ρ − ρs) (linear EOS, GMS §2, c_s² = K/ρs):
-//   continuity (GMS §4):   dρ_i/dt = Σ_j m_j v_ij·∇_i W_ij
-//   momentum (GMS §4): dv_i/dt = Σ_j m_j (σ_i/ρ_i² + σ_j/ρ_j² − Π_ij I
-//                                         + (R_i + R_j) f_ij^n)·∇_i W_ij + g
-//     Π_ij = −α c_s μ_ij/ρ̄_ij, μ_ij = h v_ij·x_ij/(r² + η²) for v_ij·x_ij < 0, else 0 (Monaghan
-//     1992; written with −Π so that Π ≥ 0 repels, as in interaction.wgsl);
-//     artificial stress (Monaghan 2000, JCP 159:290; GMS §4): f_ij = W_ij/W(Δp),
-//     n = 4, R_i from the principal stresses σ'_aa: R'_aa = −ε σ'_aa/ρ_i² where σ'_aa > 0,
-//     else 0, rotated back (see artificial_stress: 2D and 3D).
-//   velocity gradient (GMS §4): (∇v)^ab_i = ∂v^a/∂x^b = Σ_j (m_j/ρ_j)(v_j − v_i)^a ∂_b W_ij,
-//     ∂_b W_ij the b component of ∇_i W_ij = x_ij F(r_ij); the sum runs over solid particles of
-//     i's body (clamped ones included);
-//   strain rate ε̇ = ½(∇v + ∇vᵀ), rotation rate Ω = ½(∇v − ∇vᵀ), i.e. Ω^ab = ½(∂v^a/∂x^b −
-//     ∂v^b/∂x^a);
-//   Jaumann rate (GMS §2): dτ/dt = 2μ (ε̇ − ⅓ tr(ε̇) I) + τ Ωᵀ + Ω τ, i.e.
-//     dτ^ab/dt = 2μ(ε̇^ab − ⅓δ^ab ε̇^cc) + τ^ac Ω^bc + Ω^ac τ^cb.
-//   In 2D this is plane strain: ε̇_zz = 0 but ⅓ tr(ε̇) still enters τ_zz, which is stored (the
-//   deviator stays trace-free) and does not act on the in-plane momentum.
-// The material (ρs, c_s, μ, α, ε, particle mass m) is the body's, params.solid_materials.
-// Clamped particles get all three rates; integrate.wgsl keeps their position and velocity fixed
-// and integrates their density and stress (stress_predict / stress_correct below).
+// Hypoelastic (updated-Lagrangian) solid particles (Gray, Monaghan & Swift 2001, "GMS"), one
+// invocation per particle after interaction.wgsl, whose rates of solid particles (the fluid's
+// load, contact) this pass adds to; pairs are within one elastic body. Equations as numbered in
+// docs/equations.md:
+//   σ = −p I + τ, p = c_s² (ρ − ρs), eq. 25 (GMS);
+//   continuity and momentum with artificial viscosity and artificial stress, eq. 26 (GMS;
+//     Monaghan 1992); artificial stress, eq. 27 (Monaghan 2000; GMS), its principal frame by
+//     Jacobi rotations (Press et al., Numerical Recipes §11.1);
+//   velocity gradient, strain rate and rotation rate, eq. 8; Jaumann rate of τ, eq. 7 (GMS);
+//   τ's predictor and corrector (`stress_predict`, `stress_correct`), eq. 30.
+// Plane strain in 2D. The material is the body's (params.solid_materials). Clamped particles
+// get all rates; integrate.wgsl holds their position and velocity. docs/design/elastic.md.
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;

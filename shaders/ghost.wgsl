@@ -1,21 +1,14 @@
 // Fixed ghost particles, the seed's improved fluid–solid interface: ghosts are generated once
-// inside walls and bodies and never move relative to their solid (a body's ghosts move with it,
-// bodies.wgsl); each step their pressure and velocity are interpolated from the fluid with a
-// corrected kernel W^I (Shepard here; MLS where the case asks for it and the moment matrix is
-// well conditioned):
-//   P_g = Σ_j P_j W^I_gj V_j,   no-slip v_g = 2 v_wall − Σ_j v_j W^I_gj V_j,
-// the latter applied in the viscous terms (interaction.wgsl, which knows v_wall: zero for fixed
-// walls, the body's rigid velocity at the ghost for a body); continuity sees v_wall.
-// Hydrostatic correction (Adami, Hu & Adams 2012, eq. 27): each fluid pressure is carried to
-// the ghost along gravity before it is interpolated, P_j + ρ_j (g − a_w)·(x_g − x_j), so a ghost
-// below the fluid sees the hydrostatic increase (g points down) and a hydrostatic field is
-// exact; a_w is the acceleration of the wall at the ghost (zero for fixed walls; a body's
-// a_c + α × R r + ω × (ω × R r), so fluid accelerated with the body is carried correctly too).
-// Free-slip ghosts use the interpolated velocity itself in the viscous terms (no tangential
-// shear from the wall).
-// The interpolation itself (`fluid_at`, with its fallbacks) is lib/fluid_at.wgsl, shared with
-// the inlets' extrapolated buffer pressure (open_boundaries.wgsl).
-// ρ_g follows from P_g by the inverse Tait equation, so the interaction pass sees P_g.
+// inside walls and bodies and never move relative to their solid. Each step `ghost_interpolate`
+// sets their pressure and velocity from the fluid with the corrected kernel W^I (Shepard or
+// MLS; lib/fluid_at.wgsl). Equations as numbered in docs/equations.md:
+//   P_g, eq. 13, with the hydrostatic correction along g − a_wall, eq. 21 (Adami, Hu & Adams
+//     2012); ρ_g from P_g by the inverse Tait equation, eq. 17;
+//   the interpolated fluid velocity, from which interaction.wgsl makes the no-slip or
+//     free-slip ghost velocity, eq. 15.
+// `solid_interface_pressure` gives each elastic solid particle (the seed's third ghost kind)
+// the interface pressure P_g of eqs. 13 and 21 for the fluid–solid terms, eq. 28.
+// Design notes: docs/design/ghost.md.
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;

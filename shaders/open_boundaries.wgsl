@@ -1,23 +1,11 @@
-// Open boundaries, after the predictor and before the cell-list sort, on the arrays the
-// predictor wrote: velocity inlets place their particles (`inlet_flow`), outlets remove the
-// fluid that entered them (`outlet_drain`).
-//
-// Inlets (`[[inlet]]`, docs/cases.md "Inlets"): the buffer particles' place, velocity and kind
-// at the time the predictor has just moved to, t + dt.
-// An inlet is a lattice of columns on its plane and layers behind it, laid out layer-major:
-// particle k = id − first_id is column k mod n_columns of layer k / n_columns, at the signed
-// distance s(t) = −(layer + ½) spacing + speed t from the plane along its normal. By s:
-//   s < −thickness  dormant: excluded, in no cell (the excluded slot), waiting;
-//   −thickness ≤ s < 0  buffer (KIND_INLET): at its place, velocity speed n, density ρ0 (zero
-//     pressure) or, for an open channel's inflow, the Tait density of the hydrostatic pressure
-//     below the buffer's top, or, extrapolated, the fluid's pressure at its mirror image
-//     (`inlet_pressure`, after the sort); seen by the fluid as a neighbour (interaction.wgsl,
-//     as a dynamic boundary particle), getting no rates;
-//   s ≥ 0  fluid, from then on integrated as any fluid particle.
-// s is a function of time alone, so nothing accumulates and a restart is exact. The rule is
-// stateless: a dormant particle joins when s is in the buffer's range (one step moves a
-// particle by speed dt, far less than the thickness ≥ 2h, so none is skipped), and an excluded
-// particle whose s is past the plane has been fluid and left the domain: it stays excluded.
+// Open boundaries, docs/equations.md eq. 32, after the predictor and before the cell-list sort:
+// velocity inlets place their particles (`inlet_flow`), outlets remove the fluid that entered
+// them (`outlet_drain`). An inlet particle's signed distance s(t) from its plane, a function
+// of time alone, makes it dormant (excluded), a buffer particle (KIND_INLET, seen by the fluid
+// as a dynamic boundary particle, eq. 22) or fluid. `inlet_pressure`, after the sort, sets an
+// extrapolated buffer's density from the fluid's pressure at its mirror image (lib/fluid_at.wgsl,
+// eqs. 13 and 21, inverse Tait eq. 17; after Tafuni et al. 2018).
+// Case syntax: docs/cases.md "Inlets", "Outlets". Design notes: docs/design/open_boundaries.md.
 
 struct InletDef {
     normal: vec3<f32>,          // unit, the direction of the inflow

@@ -1,35 +1,14 @@
-// Total-Lagrangian (TL) elastic solid: St Venant–Kirchhoff SPH on the reference lattice X (the
-// initial positions) with a neighbour list fixed at the start, the formulation that
-// tools/plate_twin studied (`tl=1 ls=2 gq=1`, its src/tl.rs; the plate's period within
-// +2.4…+4.4 % of Euler–Bernoulli at H/dx = 5…10, energy conserving, no artificial viscosity or
-// stress). Its f64 twin is src/reference/total_lagrangian.rs, which also computes the setup
-// uploaded here once (lists, weights).
-//
-// Setup (host, f64): for each solid particle i and neighbour j (same body, |X_j − X_i| < 2h),
-// Δ = X_j − X_i, p_ij = [Δ/h, ½Δ⊗Δ/h²], W0_ij = W(|Δ|),
-//   A_i = Σ_j W0_ij p_ij p_ijᵀ,  w_ij = V γ_ij = W0_ij [A_i⁻¹ p_ij]_(first d rows) / h,
-// the weighted least-squares gradient exact for quadratic fields (also at the free surface).
-// Per evaluation, four passes over the TL particles (k below is the TL index, i = tl_slot[k]
-// the particle's current slot in the sorted arrays):
-//   tl_deform:   H_i = Σ_j ((x_j − x_i) − (X_j − X_i)) ⊗ w_ij,  F_i = I + H_i
-//   tl_gradient: E = ½(H + Hᵀ + HᵀH) (= ½(FᵀF − I)),
-//                D_i^k = Σ_j (E_j − E_i) w_ij^k,  T_i^k = (dx²/12)(λ tr D_i^k I + 2G D_i^k)
-//   tl_stress:   S2_i = Σ_j Σ_k (T_j^k w_ji^k − T_i^k w_ij^k),  S_i = λ tr E_i I + 2G E_i,
-//                P_i = F_i (S_i + S2_i)
-//   tl_accel:    ρ0 a_i = Σ_j (P_i w_ij − P_j w_ji), added to rate (with g); dρ/dt = 0
-// The momentum is the exact negative gradient of the discrete energy Σ_i V ψ(F_i) + V dx²/24
-// Σ_k D_i^k : C : D_i^k; the second term is the cell quadrature term (the energy of a strain
-// varying linearly across the particle's square cell, which one-point quadrature misses; for
-// bending it restores Σ dx z_j² = H³/12 (1 − (dx/H)²)). Plane strain in 2D (F_zz = 1, λ and G
-// of the 3D material). With integrate.wgsl's predictor–corrector, which is velocity Verlet when
-// a depends on the positions only, the scheme is symplectic.
-//
-// Particles are re-sorted every step: tl_index (after the sort) records the slot of every TL
-// particle (the total-Lagrangian solids' particles have consecutive ids from tlp.first_id), as
-// body_index does for body particles. Everything else is indexed by TL index. A case may also
-// hold updated-Lagrangian solids (elastic.wgsl), whose particles are not in the TL lists.
-// Clamped particles get F and stress (they are neighbours) and a rate that integrate.wgsl
-// ignores.
+// Total-Lagrangian (TL) elastic solid, docs/equations.md eq. 29: St Venant–Kirchhoff SPH on
+// the reference lattice X, with a neighbour list and quadratic least-squares gradient weights
+// w_ij fixed at the start (computed on the host in f64 by src/reference/total_lagrangian.rs,
+// also the f64 twin). Per evaluation (k the TL index, i = tl_slot[k] its slot after the sort):
+//   tl_index:    the slot of every TL particle, after the sort;
+//   tl_deform:   the displacement gradient H = F − I;
+//   tl_gradient: the Green strain E and the cell-quadrature stresses T^k;
+//   tl_stress:   the first Piola–Kirchhoff stress P = F (S + S2), S of St Venant–Kirchhoff;
+//   tl_accel:    ρ0 a_i = Σ_j (P_i w_ij − P_j w_ji), added to rate with g; dρ/dt = 0.
+// Plane strain in 2D. Symplectic with integrate.wgsl's predictor–corrector (eq. 30).
+// Design notes: docs/design/total_lagrangian.md.
 
 struct TlParams {
     n: u32,
