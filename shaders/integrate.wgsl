@@ -1,11 +1,11 @@
-// Time integration: velocity Verlet with a predicted velocity for the velocity-dependent terms
-// (a predictor–corrector; symplectic for the conservative part):
+// Time integration (docs/equations.md eq. 30): velocity Verlet with a predicted velocity for the
+// velocity-dependent terms (a predictor–corrector; symplectic for the conservative part):
 //   predict:  x_{n+1} = x_n + dt v_n + ½dt² a_n,  v* = v_n + dt a_n,  ρ* = ρ_n + dt Dρ_n
 //   (evaluate a_{n+1}, Dρ_{n+1} at x_{n+1}, v*, ρ*)
 //   correct:  v_{n+1} = v* + ½dt (a_{n+1} − a_n),  ρ_{n+1} = ρ* + ½dt (Dρ_{n+1} − Dρ_n)
 // i.e. v_{n+1} = v_n + ½dt (a_n + a_{n+1}) and likewise for ρ (trapezoidal rule).
-// Variable dt from the CFL, force and viscous conditions (Monaghan 1989; Morris et al. 1997),
-// computed on the GPU by a max-reduction, so no per-particle data leaves the GPU.
+// Variable dt from the CFL, force and viscous conditions (eq. 31; Monaghan 1989; Morris et al.
+// 1997), computed on the GPU by a max-reduction, so no per-particle data leaves the GPU.
 
 @group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;

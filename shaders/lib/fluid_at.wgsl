@@ -1,13 +1,13 @@
-// The fluid interpolated at a point with the corrected kernel W^I: Shepard, or first-order MLS
-// where the case asks for it (walls.ghost_correction) and the moment matrix is well
-// conditioned. Used by the fixed ghosts and elastic solids (ghost.wgsl) and by inlet buffers
-// whose pressure is taken from the fluid (open_boundaries.wgsl). The pass file declares `pos`,
-// `velrho`, `code` and `cell_start` (sorted arrays, after the cell-list sort).
-// Only fluid particles count. Hydrostatic correction (Adami, Hu & Adams 2012, eq. 27): each
-// fluid pressure is carried to the point along g_eff before it is interpolated,
-// P_j + ρ_j g_eff·(x − x_j), so a hydrostatic field is exact.
-// Fallbacks: MLS → Shepard where the moment matrix is ill-conditioned; no fluid in reach →
-// P = 0 and a velocity of 0.
+// The fluid interpolated at a point with the corrected kernel W^I (docs/equations.md eq. 13):
+// Shepard, eq. 10, or first-order MLS, eq. 11, where the case asks for it
+// (walls.ghost_correction) and the moment matrix is well conditioned. Used by the fixed ghosts
+// and elastic solids (ghost.wgsl) and by inlet buffers whose pressure is taken from the fluid
+// (open_boundaries.wgsl). The pass file declares `pos`, `velrho`, `code` and `cell_start`
+// (sorted arrays, after the cell-list sort). Only fluid particles count. Hydrostatic
+// correction, eq. 21 (Adami, Hu & Adams 2012): each fluid pressure is carried to the point
+// along g_eff before it is interpolated, P_j + ρ_j g_eff·(x − x_j), so a hydrostatic field is
+// exact. Fallbacks: MLS → Shepard where the moment matrix is ill-conditioned; no fluid in
+// reach → P = 0 and a velocity of 0.
 
 // ρ from P by the inverse Tait equation; the base is kept positive for any pressure.
 fn density_of(p: f32) -> f32 {

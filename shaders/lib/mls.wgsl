@@ -1,8 +1,8 @@
-// First-order moving least squares (Colagrossi & Landrini 2003, §2.3; Rabczuk, Belytschko &
-// Xiao 2004): W^MLS_ij = (β0 + β·(x_i − x_j)/h) W_ij with β = A⁻¹ e1,
-// A = Σ_j W_ij V_j [1, x_ij/h][1, x_ij/h]ᵀ. Positions are scaled by h so that every entry of A
-// is of order Σ W V ~ 1 and one pivot threshold fits all rows. In 2D the z row and column are
-// the identity. No bindings: composed after common.wgsl by the passes that need it.
+// First-order moving least squares, docs/equations.md eq. 11 (Colagrossi & Landrini 2003,
+// §2.3; Rabczuk, Belytschko & Xiao 2004): W^MLS_ij = (β0 + β·(x_i − x_j)/h) W_ij with
+// β = A⁻¹ e1, A = Σ_j W_ij V_j [1, x_ij/h][1, x_ij/h]ᵀ. Positions are scaled by h so that every
+// entry of A is of order Σ W V ~ 1 and one pivot threshold fits all rows. In 2D the z row and
+// column are the identity. No bindings: composed after common.wgsl by the passes that need it.
 
 fn mls_basis(x_ij: vec3<f32>) -> vec4<f32> {
     let y = x_ij / params.h;
