@@ -161,7 +161,7 @@ fn timestep() {
     if (max_accel > 0.0) {
         dt = min(dt, params.cfl * sqrt(params.h / max_accel));
     }
-    if (VISCOSITY == 1u) {
+    if (VISCOSITY == VISCOSITY_LAMINAR) {
         dt = min(dt, 0.125 * params.h * params.h / params.nu);
     }
     state.dt_cfl = dt;

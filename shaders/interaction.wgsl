@@ -80,7 +80,7 @@ fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_cont: vec3<f32>, v_visc:
         + params.delta_coef * 2.0 * psi * f_ij * r2 / (r2 + params.eta2) * params.mass / rho_j;
     var acc = vec3<f32>(0.0);
     var pi_ij = 0.0;
-    if (VISCOSITY == 0u) {
+    if (VISCOSITY == VISCOSITY_ARTIFICIAL) {
         let vx = dot(w_ij, x_ij);
         if (vx < 0.0) {
             let mu = params.h * vx / (r2 + params.eta2);
@@ -107,7 +107,7 @@ fn interface_rates(b_i: f32, v_i: vec3<f32>, rho_i: f32, b_j: f32, v_j: vec3<f32
     let v_ij = v_i - v_j;
     let drho = m_j * dot(v_ij, dw_ij) * rho_i / rho_j;
     var acc = -m_j * (b_i + b_j) * dw_ij;
-    if (VISCOSITY == 0u) {
+    if (VISCOSITY == VISCOSITY_ARTIFICIAL) {
         let vx = dot(v_ij, x_ij);
         if (vx < 0.0) {
             let mu = params.h * vx / (r2 + params.eta2);
@@ -236,7 +236,7 @@ fn contact_velocity(j: u32) -> vec3<f32> {
 // or Monaghan & Kajtar (2009, eq. 3.1 with equal masses): (K/β) x/r² Φ(r/h), Φ the Wendland C4
 // shape (1.77/32)(1 + 5q/2 + 2q²)(2 − q)^5, q < 2.
 fn repulsion(x_ij: vec3<f32>, r2: f32) -> vec3<f32> {
-    if (params.repulsive_form == 1u) {
+    if (params.repulsive_form == REPULSIVE_MONAGHAN_KAJTAR) {
         let q = sqrt(r2) / params.h;
         if (q >= 2.0 || r2 <= 0.0) {
             return vec3<f32>(0.0);

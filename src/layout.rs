@@ -313,19 +313,25 @@ pub struct TlPair {
 mod tests {
     use super::*;
     use crate::gpu::kernel::parse;
-    use crate::gpu::shader::{compose, Pass, Present, ShaderConfig};
+    use crate::gpu::shader::Shader;
+    use crate::scenario::KernelKind;
+    use crate::sph::initial::Present;
+    use crate::sph::passes::SHADERS;
+    use crate::sph::shader::{compose, ShaderConfig, ViscosityForm};
+    use crate::sph::total_lagrangian;
+    use crate::sph::{bodies, elastic, integrate, interaction, open_boundaries, probes};
     use wgpu::naga;
 
     /// (size, [(member name, offset)]) of a struct type named `name` in the composed `pass`.
-    fn reflect(pass: Pass, name: &str) -> (u32, Vec<(String, u32)>) {
-        let (module, _) = parse(&compose(pass, ShaderConfig::default()), pass.name()).unwrap();
+    fn reflect(pass: &Shader, name: &str) -> (u32, Vec<(String, u32)>) {
+        let (module, _) = parse(&compose(pass, ShaderConfig::default()), pass.name).unwrap();
         let mut layouter = naga::proc::Layouter::default();
         layouter.update(module.to_ctx()).unwrap();
         let (handle, ty) = module
             .types
             .iter()
             .find(|(_, t)| t.name.as_deref() == Some(name))
-            .unwrap_or_else(|| panic!("{name} not in {}", pass.name()));
+            .unwrap_or_else(|| panic!("{name} not in {}", pass.name));
         let members = match &ty.inner {
             naga::TypeInner::Struct { members, .. } => members
                 .iter()
@@ -357,7 +363,7 @@ mod tests {
     #[test]
     fn params_matches_wgsl() {
         check_layout!(
-            Pass::Interaction,
+            &interaction::SHADER,
             "Params",
             Params,
             [
@@ -408,17 +414,17 @@ mod tests {
             ]
         );
         check_layout!(
-            Pass::Interaction,
+            &interaction::SHADER,
             "SolidMaterial",
             SolidMaterial,
             [rho0, c2, mu, mass, alpha, eps, lambda, total_lagrangian]
         );
         assert_eq!(
-            wgsl_u32(Pass::Interaction, "MAX_SOLID_MATERIALS") as usize,
+            wgsl_u32(&interaction::SHADER, "MAX_SOLID_MATERIALS") as usize,
             MAX_SOLID_MATERIALS
         );
         assert_eq!(
-            4 * wgsl_u32(Pass::Interaction, "FRICTION_TABLE_VECTORS") as usize,
+            4 * wgsl_u32(&interaction::SHADER, "FRICTION_TABLE_VECTORS") as usize,
             MAX_FRICTION_GROUPS * MAX_FRICTION_GROUPS
         );
     }
@@ -426,15 +432,15 @@ mod tests {
     #[test]
     fn solid_structs_match_wgsl() {
         check_layout!(
-            Pass::Elastic,
+            &elastic::SHADER,
             "SolidState",
             SolidState,
             [tau_a, tau_b, body, rate_a, rate_b, interface_p, material]
         );
-        check_layout!(Pass::Elastic, "SymRate", SymRate, [a, b]);
+        check_layout!(&elastic::SHADER, "SymRate", SymRate, [a, b]);
         // Pass-local, allocated by size only.
         assert_eq!(
-            reflect(Pass::Elastic, "SolidTerms").0 as u64,
+            reflect(&elastic::SHADER, "SolidTerms").0 as u64,
             crate::sph::elastic::TERMS_BYTES
         );
     }
@@ -442,13 +448,13 @@ mod tests {
     #[test]
     fn total_lagrangian_structs_match_wgsl() {
         check_layout!(
-            Pass::TotalLagrangian,
+            &total_lagrangian::SHADER,
             "TlParams",
             TlParams,
             [n, first_id, k2, pad]
         );
         check_layout!(
-            Pass::TotalLagrangian,
+            &total_lagrangian::SHADER,
             "TlPair",
             TlPair,
             [w_ij, j, w_ji, pad0, d0, pad1]
@@ -458,7 +464,7 @@ mod tests {
     #[test]
     fn sim_state_matches_wgsl() {
         check_layout!(
-            Pass::Integrate,
+            &integrate::SHADER,
             "SimState",
             SimState,
             [
@@ -479,13 +485,13 @@ mod tests {
     }
 
     /// The value of the u32 constant `name` in the composed `pass`.
-    fn wgsl_u32(pass: Pass, name: &str) -> u32 {
-        let (module, _) = parse(&compose(pass, ShaderConfig::default()), pass.name()).unwrap();
+    fn wgsl_u32(pass: &Shader, name: &str) -> u32 {
+        let (module, _) = parse(&compose(pass, ShaderConfig::default()), pass.name).unwrap();
         let (_, c) = module
             .constants
             .iter()
             .find(|(_, c)| c.name.as_deref() == Some(name))
-            .unwrap_or_else(|| panic!("{name} not in {}", pass.name()));
+            .unwrap_or_else(|| panic!("{name} not in {}", pass.name));
         match module.global_expressions[c.init] {
             naga::Expression::Literal(naga::Literal::U32(v)) => v,
             ref e => panic!("{name} is {e:?}"),
@@ -495,7 +501,7 @@ mod tests {
     #[test]
     fn body_flags_match_wgsl() {
         assert_eq!(
-            wgsl_u32(Pass::Interaction, "BODY_KINEMATIC"),
+            wgsl_u32(&interaction::SHADER, "BODY_KINEMATIC"),
             BODY_KINEMATIC
         );
     }
@@ -507,19 +513,19 @@ mod tests {
             ("INLET_HYDROSTATIC", INLET_HYDROSTATIC),
             ("INLET_EXTRAPOLATED", INLET_EXTRAPOLATED),
         ] {
-            assert_eq!(wgsl_u32(Pass::OpenBoundaries, name), v, "{name}");
+            assert_eq!(wgsl_u32(&open_boundaries::SHADER, name), v, "{name}");
         }
     }
 
     #[test]
     fn outlet_def_matches_wgsl() {
-        check_layout!(Pass::OpenBoundaries, "OutletDef", OutletDef, [min, max]);
+        check_layout!(&open_boundaries::SHADER, "OutletDef", OutletDef, [min, max]);
     }
 
     #[test]
     fn inlet_def_matches_wgsl() {
         check_layout!(
-            Pass::OpenBoundaries,
+            &open_boundaries::SHADER,
             "InletDef",
             InletDef,
             [
@@ -538,21 +544,21 @@ mod tests {
 
     #[test]
     fn pos_and_probe_match_wgsl() {
-        check_layout!(Pass::Interaction, "Pos", Pos, [off, block]);
+        check_layout!(&interaction::SHADER, "Pos", Pos, [off, block]);
         check_layout!(
-            Pass::Probes,
+            &probes::SHADER,
             "ProbeDef",
             ProbeDef,
             [point, kind, axis, radius, face]
         );
         check_layout!(
-            Pass::Interaction,
+            &interaction::SHADER,
             "WallSensor",
             WallSensor,
             [point, radius, normal, face, over_lo, face_id, over_hi]
         );
         check_layout!(
-            Pass::Interaction,
+            &interaction::SHADER,
             "MirrorPlane",
             MirrorPlane,
             [point, no_slip, normal]
@@ -561,9 +567,9 @@ mod tests {
 
     #[test]
     fn body_structs_match_wgsl() {
-        check_layout!(Pass::Bodies, "BodyParticle", BodyParticle, [r, body]);
+        check_layout!(&bodies::SHADER, "BodyParticle", BodyParticle, [r, body]);
         check_layout!(
-            Pass::Bodies,
+            &bodies::SHADER,
             "BodyMotion",
             BodyMotion,
             [
@@ -591,10 +597,10 @@ mod tests {
 
     #[test]
     fn every_pass_validates_in_2d_and_3d() {
-        for pass in Pass::ALL {
+        for pass in SHADERS {
             for dim in [2, 3] {
-                for kernel in [0, 1] {
-                    for viscosity in [0, 1] {
+                for kernel in [KernelKind::CubicSpline, KernelKind::WendlandC2] {
+                    for viscosity in [ViscosityForm::Artificial, ViscosityForm::Laminar] {
                         // Each flag on and off (wall reactions with each of the others).
                         for (energy, hydrostatic_diffusion, wall_reactions) in [
                             (false, false, false),
@@ -612,7 +618,7 @@ mod tests {
                                     wall_reactions,
                                     present,
                                 };
-                                parse(&compose(pass, cfg), pass.name()).unwrap();
+                                parse(&compose(pass, cfg), pass.name).unwrap();
                             }
                         }
                     }

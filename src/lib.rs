@@ -3,7 +3,11 @@
 pub mod body;
 pub mod case;
 pub mod checkpoint;
+pub mod eos;
 pub mod gpu;
+pub mod grid;
+pub mod kernel;
+pub mod lagrangian;
 pub mod layout;
 pub mod logging;
 pub mod output;

@@ -265,7 +265,7 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                 }),
                 interrupt: Some(interrupt_flag()?),
                 halt_at_s: None,
-                lose_device_after_s: None,
+                ..Default::default()
             };
             let report = wgsph::run::run(&ctx, &sc, &dir, &options, &mut *progress(quiet, bars))?;
             Ok(finish(&report, &dir, quiet))
@@ -300,7 +300,7 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                 }),
                 interrupt: Some(interrupt_flag()?),
                 halt_at_s: None,
-                lose_device_after_s: None,
+                ..Default::default()
             };
             let report =
                 wgsph::run::resume(&ctx, &sc, &dir, &options, &mut *progress(quiet, bars))?;

@@ -760,6 +760,13 @@ impl ElasticMaterial {
         self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
     }
 
+    /// Lamé's first parameter λ = E ν / ((1 + ν)(1 − 2ν)) [Pa] (the 3D material; plane strain
+    /// in 2D).
+    pub fn lame_lambda(&self) -> f64 {
+        let (e, nu) = (self.youngs_modulus, self.poisson_ratio);
+        e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    }
+
     /// Bulk modulus K = E / (3(1 − 2ν)) [Pa].
     pub fn bulk_modulus(&self) -> f64 {
         self.youngs_modulus / (3.0 * (1.0 - 2.0 * self.poisson_ratio))

@@ -1,5 +1,6 @@
 // Shared declarations for every wgsph pass. Composed after the generated constants
-// (DIM, KERNEL, VISCOSITY, WG) and before the pass's own file; see src/gpu/shader.rs.
+// (DIM, KERNEL, VISCOSITY, WG, the method names) and before the pass's own file; see
+// src/sph/shader.rs.
 
 // Run parameters, uploaded once per run. Mirrored by `layout::Params` (size checked by a test
 // against naga's reflection of this struct).
@@ -32,10 +33,10 @@ struct Params {
     n_probes: u32,
     // Walls
     n_mirror_planes: u32,
-    ghost_mls: u32,             // 1: ghosts interpolate with MLS, 0: Shepard
+    ghost_mls: u32,             // GHOST_MLS or GHOST_SHEPARD: how ghosts interpolate
     repulsive_d: f32,           // Lennard-Jones D [m²/s²] (Monaghan 1994)
     repulsive_r0: f32,          // Lennard-Jones cut-off r0 [m]
-    repulsive_form: u32,        // 0 Lennard-Jones (Monaghan 1994), 1 Monaghan & Kajtar (2009)
+    repulsive_form: u32,        // REPULSIVE_LENNARD_JONES (Monaghan 1994) or _MONAGHAN_KAJTAR (2009)
     repulsive_k_over_beta: f32, // Monaghan & Kajtar K/β [m²/s²]
     // Bodies: their particles have the ids body_id_base .. body_id_base + n_body_particles
     body_id_base: u32,          // n_particles when there are no bodies
@@ -331,7 +332,7 @@ fn reflect_point(x: vec3<f32>, plane: MirrorPlane) -> vec3<f32> {
 
 // W(r) for q in [0, 2].
 fn kernel_w(q: f32) -> f32 {
-    if (KERNEL == 0u) {
+    if (KERNEL == KERNEL_CUBIC_SPLINE) {
         // Cubic spline, Monaghan & Lattanzio (1985).
         if (q < 1.0) {
             return params.kernel_norm * (1.0 - 1.5 * q * q + 0.75 * q * q * q);
@@ -347,7 +348,7 @@ fn kernel_w(q: f32) -> f32 {
 // F(r) = W'(r) / r, so that ∇_i W_ij = x_ij F(r_ij). Finite at r = 0 for Wendland.
 fn kernel_f(q: f32) -> f32 {
     let h2 = params.h * params.h;
-    if (KERNEL == 0u) {
+    if (KERNEL == KERNEL_CUBIC_SPLINE) {
         if (q < 1.0) {
             return params.kernel_norm / h2 * (-3.0 + 2.25 * q);
         }

@@ -52,7 +52,7 @@ fn fluid_at(pg: Pos, g_eff: vec3<f32>) -> vec4<f32> {
     }
     // Shepard: the zeroth moments over Σ W V.
     var beta = vec4<f32>(1.0 / volume, 0.0, 0.0, 0.0);
-    if (params.ghost_mls != 0u) {
+    if (params.ghost_mls == GHOST_MLS) {
         let sol = mls_solve(a);
         if (sol.ok) {
             beta = sol.beta;

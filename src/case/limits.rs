@@ -2,8 +2,8 @@
 //! message names the part with the most), the tank's length in spacings, and the extent of
 //! the solver's neighbour grid. Each refusal names the field that makes the case too large.
 
+use crate::grid::Grid;
 use crate::scenario::Domain;
-use crate::sph::grid::Grid;
 
 use super::error::{num, CaseError};
 use super::locate::Ctx;

@@ -1,14 +1,20 @@
-//! A compute kernel: one entry point of a composed shader, its pipeline, and the bindings it
-//! really uses (reflected with naga), so bind groups can be built from one list of buffers.
+//! A compute kernel: one entry point of a composed shader, its pipeline, and the globals it
+//! really uses (reflected with naga) by name, so a bind group is built by asking for each
+//! global's buffer by the name the WGSL gives it: a pass never writes a binding number.
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, Result};
 use wgpu::naga;
 
-use super::shader::{compose, Pass, ShaderConfig};
+/// Buffers by the name of the WGSL global they bind to.
+pub trait Resolve {
+    /// The buffer of the global `name`, or why there is none.
+    fn resolve(&self, name: &str) -> Result<&wgpu::Buffer>;
+}
 
 /// A parsed and validated shader module, shared by the kernels of one pass.
 pub struct ShaderModule {
-    pub pass: Pass,
+    /// The pass's shader name (its file's stem).
+    pub name: &'static str,
     module: wgpu::ShaderModule,
     naga: naga::Module,
     info: naga::valid::ModuleInfo,
@@ -29,16 +35,16 @@ pub fn parse(source: &str, label: &str) -> Result<(naga::Module, naga::valid::Mo
 }
 
 impl ShaderModule {
-    pub fn new(device: &wgpu::Device, pass: Pass, cfg: ShaderConfig) -> Result<Self> {
-        let source = compose(pass, cfg);
-        let label = format!("{}.wgsl", pass.name());
+    /// The module of the composed `source` of shader `name`.
+    pub fn new(device: &wgpu::Device, name: &'static str, source: String) -> Result<Self> {
+        let label = format!("{name}.wgsl");
         let (naga, info) = parse(&source, &label)?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(&label),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
         Ok(Self {
-            pass,
+            name,
             module,
             naga,
             info,
@@ -51,17 +57,17 @@ impl ShaderModule {
             .entry_points
             .iter()
             .position(|e| e.name == entry)
-            .ok_or_else(|| anyhow!("{}.wgsl has no entry point {entry}", self.pass.name()))?;
+            .ok_or_else(|| anyhow!("{}.wgsl has no entry point {entry}", self.name))?;
         let uses = self.info.get_entry_point(index);
-        let mut bindings: Vec<u32> = self
+        let mut bindings: Vec<(u32, String)> = self
             .naga
             .global_variables
             .iter()
             .filter(|(h, _)| !uses[*h].is_empty())
-            .filter_map(|(_, g)| g.binding.as_ref().map(|b| b.binding))
+            .filter_map(|(_, g)| Some((g.binding.as_ref()?.binding, g.name.clone()?)))
             .collect();
         bindings.sort_unstable();
-        let label = format!("{}::{entry}", self.pass.name());
+        let label = format!("{}::{entry}", self.name);
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(&label),
             layout: None,
@@ -81,27 +87,21 @@ impl ShaderModule {
 pub struct Kernel {
     pub label: String,
     pub pipeline: wgpu::ComputePipeline,
-    /// Binding numbers (group 0) the entry point uses.
-    pub bindings: Vec<u32>,
+    /// (binding number in group 0, global's name) of every global the entry point uses.
+    pub bindings: Vec<(u32, String)>,
 }
 
 impl Kernel {
-    /// A bind group from `(binding, buffer)` pairs; pairs the kernel does not use are skipped,
-    /// a binding it uses but that is missing is an error.
-    pub fn bind(
-        &self,
-        device: &wgpu::Device,
-        buffers: &[(u32, &wgpu::Buffer)],
-    ) -> Result<wgpu::BindGroup> {
+    /// A bind group of the buffers `buffers` resolves for the globals the kernel uses; a global
+    /// it cannot resolve is an error naming the kernel and the global.
+    pub fn bind(&self, device: &wgpu::Device, buffers: &impl Resolve) -> Result<wgpu::BindGroup> {
         let mut entries = Vec::with_capacity(self.bindings.len());
-        for &b in &self.bindings {
+        for (b, name) in &self.bindings {
             let buffer = buffers
-                .iter()
-                .find(|(n, _)| *n == b)
-                .map(|(_, buf)| *buf)
-                .with_context(|| format!("kernel {} needs binding {b}", self.label))?;
+                .resolve(name)
+                .map_err(|e| anyhow!("kernel {} reads `{name}`: {e}", self.label))?;
             entries.push(wgpu::BindGroupEntry {
-                binding: b,
+                binding: *b,
                 resource: buffer.as_entire_binding(),
             });
         }
@@ -157,11 +157,11 @@ pub struct ParityKernel {
 
 impl ParityKernel {
     /// Entry point `entry` of `module`, bound to `buffers(p)` for parity p = 0 and 1.
-    pub fn new<'a>(
+    pub fn new<R: Resolve>(
         device: &wgpu::Device,
         module: &ShaderModule,
         entry: &str,
-        buffers: impl Fn(usize) -> Vec<(u32, &'a wgpu::Buffer)>,
+        buffers: impl Fn(usize) -> R,
     ) -> Result<Self> {
         let kernel = module.kernel(device, entry)?;
         let bind = [
@@ -174,5 +174,15 @@ impl ParityKernel {
     /// `invocations` invocations on the arrays of parity `p`.
     pub fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, p: usize, invocations: u32) {
         self.kernel.dispatch(pass, &self.bind[p], invocations);
+    }
+
+    /// `groups` workgroups on the arrays of parity `p`.
+    pub fn dispatch_groups(&self, pass: &mut wgpu::ComputePass<'_>, p: usize, groups: u32) {
+        self.kernel.dispatch_groups(pass, &self.bind[p], groups);
+    }
+
+    /// The pipeline and the bind group of parity `p` (for an indirect dispatch).
+    pub fn bound(&self, p: usize) -> (&wgpu::ComputePipeline, &wgpu::BindGroup) {
+        (&self.kernel.pipeline, &self.bind[p])
     }
 }

@@ -1,6 +1,6 @@
 //! Twin of shaders/cell_list.wgsl: the slot of each particle and the sorted order.
 
-use crate::sph::grid::Grid;
+use crate::grid::Grid;
 
 /// Slot of each particle (given as GPU block + offset), `slots` for excluded ones.
 pub fn keys(grid: &Grid, pos: &[([f32; 3], [u32; 3])], excluded: &[bool]) -> Vec<u32> {

@@ -11,11 +11,11 @@ pub mod elastic;
 pub mod ghost;
 pub mod integrate;
 pub mod interaction;
-pub mod kernel;
 pub mod open_boundaries;
 pub mod probes;
 pub mod total_lagrangian;
 
+use crate::kernel;
 use crate::scenario::{Physics, Viscosity};
 
 /// A particle as the reference sees it.
@@ -51,7 +51,7 @@ pub const EXCLUDED: u32 = crate::layout::KIND_EXCLUDED;
 
 /// Tait equation of state, P = B((ρ/ρ0)^γ − 1).
 pub fn pressure(ph: &Physics, rho: f64) -> f64 {
-    ph.tait_b() * ((rho / ph.rho0).powf(ph.gamma) - 1.0)
+    crate::eos::Tait::of(ph).pressure(rho)
 }
 
 /// c = c0 (ρ/ρ0)^((γ−1)/2).

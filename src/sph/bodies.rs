@@ -6,12 +6,18 @@ use anyhow::Result;
 use glam::{DMat3, DVec3};
 
 use super::buffers::ParticleBuffers;
-use super::grid::Grid;
+use super::shader::WORKGROUP_MAX;
 use crate::body::{Load, Pose};
 use crate::gpu::buffers::{storage, storage_init};
-use crate::gpu::kernel::ShaderModule;
-use crate::gpu::shader::WORKGROUP_SIZE;
-use crate::gpu::Kernel;
+use crate::gpu::kernel::{ParityKernel, ShaderModule};
+use crate::gpu::shader::{Shader, WORKGROUP_SIZE};
+use crate::grid::Grid;
+
+pub const SHADER: Shader = Shader {
+    name: "bodies",
+    source: include_str!("../../shaders/bodies.wgsl"),
+    libs: &[WORKGROUP_MAX],
+};
 use crate::layout::{pack_block, BodyMotion, BodyParticle, BODY_KINEMATIC};
 use crate::scenario::Scenario;
 
@@ -66,12 +72,9 @@ pub struct Bodies {
     pub partials: wgpu::Buffer,
     /// Workgroups of `body_force` (each covers particles of one body).
     groups: u32,
-    body_move: Kernel,
-    body_index: Kernel,
-    body_force: Kernel,
-    bind_move: [wgpu::BindGroup; 2],
-    bind_index: [wgpu::BindGroup; 2],
-    bind_force: [wgpu::BindGroup; 2],
+    body_move: ParityKernel,
+    body_index: ParityKernel,
+    body_force: ParityKernel,
     n_body: u32,
     n: u32,
 }
@@ -93,39 +96,23 @@ impl Bodies {
         let slots: Vec<u32> = (first_id..first_id + n_body).collect();
         let body_slot = storage_init(device, "body slots", &slots);
         let partials = storage(device, "body partials", Self::partials_bytes_for(groups));
-        let body_move = module.kernel(device, "body_move")?;
-        let body_index = module.kernel(device, "body_index")?;
-        let body_force = module.kernel(device, "body_force")?;
-        let bufs = |p: usize| {
-            [
-                (0, &b.params),
-                (1, &b.pos[p]),
-                (2, &b.velrho[p]),
-                (3, &b.code[p]),
-                (4, &b.rate),
-                (5, &b.body_particles),
-                (6, &b.body_motions),
-                (7, &body_slot),
-                (8, &partials),
-                (9, &b.state),
-            ]
-        };
-        let bind = |k: &Kernel| -> Result<[wgpu::BindGroup; 2]> {
-            Ok([k.bind(device, &bufs(0))?, k.bind(device, &bufs(1))?])
+        let bound = |entry: &str| {
+            ParityKernel::new(device, module, entry, |p| {
+                b.at(p)
+                    .with("body_slot", &body_slot)
+                    .with("body_partials", &partials)
+            })
         };
         Ok(Self {
-            bind_move: bind(&body_move)?,
-            bind_index: bind(&body_index)?,
-            bind_force: bind(&body_force)?,
+            body_move: bound("body_move")?,
+            body_index: bound("body_index")?,
+            body_force: bound("body_force")?,
             poses: vec![Pose::default(); motions.len()],
             accels: vec![[DVec3::ZERO; 2]; motions.len()],
             motions,
             motion_buf: b.body_motions.clone(),
             partials,
             groups,
-            body_move,
-            body_index,
-            body_force,
             n_body,
             n: b.n,
         })
@@ -183,19 +170,17 @@ impl Bodies {
 
     /// Moves the body particles of parity `p` (after the predictor, before the sort).
     pub fn encode_move(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.body_move
-            .dispatch(pass, &self.bind_move[p], self.n_body);
+        self.body_move.dispatch(pass, p, self.n_body);
     }
 
     /// Records where the sort put each body particle (parity `p`, after the sort).
     pub fn encode_index(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.body_index.dispatch(pass, &self.bind_index[p], self.n);
+        self.body_index.dispatch(pass, p, self.n);
     }
 
     /// Per-workgroup force and torque sums of parity `p` (after the interaction).
     pub fn encode_force(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.body_force
-            .dispatch_groups(pass, &self.bind_force[p], self.groups);
+        self.body_force.dispatch_groups(pass, p, self.groups);
     }
 
     /// Whether body `b` moves as prescribed, whatever its load (its `BODY_KINEMATIC` flag).

@@ -1,7 +1,10 @@
 //! Every GPU buffer of a run. Particle arrays come in two parities (the cell sort gathers
 //! from one into the other); everything else is single.
 
+use anyhow::{anyhow, Result};
+
 use crate::gpu::buffers::{storage, storage_init, uniform_init};
+use crate::gpu::kernel::Resolve;
 use crate::layout::{
     BodyMotion, BodyParticle, MirrorPlane, Params, Pos, ProbeDef, SimState, SolidState, WallSensor,
 };
@@ -209,6 +212,70 @@ impl ParticleBuffers {
         }
     }
 
+    /// The buffers a pass binds, by WGSL name, with the particle arrays of parity `p`.
+    pub fn at(&self, p: usize) -> Bindings<'_> {
+        Bindings {
+            shared: self,
+            parity: Some(p),
+            own: Vec::new(),
+        }
+    }
+
+    /// The buffers a kernel that reads no particle array binds (asking for one is an error).
+    pub fn unparitied(&self) -> Bindings<'_> {
+        Bindings {
+            shared: self,
+            parity: None,
+            own: Vec::new(),
+        }
+    }
+
+    /// The shared buffer of the WGSL global `name` (`Ok(None)`: no shared buffer has that
+    /// name). Where a name is not the buffer's own it says why the passes call it so.
+    fn named(&self, name: &str, parity: Option<usize>) -> Result<Option<&wgpu::Buffer>> {
+        let single = match name {
+            "params" => Some(&self.params),
+            "state" => Some(&self.state),
+            // The slot histogram, counted atomically, then scanned into the slots' starts.
+            "cell_start" | "counts" => Some(&self.cell_start),
+            "keys" => Some(&self.keys),
+            // The rank within the slot, then the permutation it becomes.
+            "local_rank" | "perm" => Some(&self.local_perm),
+            "provisional" => Some(&self.provisional),
+            // The sort reads the last rates and writes them in the new order, where the
+            // predictor of the next step reads them as the old rates.
+            "rate" | "rate_in" => Some(&self.rate),
+            "rate_out" | "rate_old" => Some(&self.rate_sorted),
+            "probes" => Some(&self.probes),
+            "probe_out" => Some(&self.probe_out),
+            "mirror_planes" => Some(&self.mirror_planes),
+            "wall_sensors" => Some(&self.wall_sensors),
+            "energy_rate" => Some(&self.energy_rate),
+            "body_particles" => Some(&self.body_particles),
+            "bodies" => Some(&self.body_motions),
+            "solid" => Some(&self.solid),
+            _ => None,
+        };
+        if single.is_some() {
+            return Ok(single);
+        }
+        // The particle arrays: `x` and `x_in` of the current parity, `x_out` the other (the
+        // sort gathers from one into the other).
+        let (stem, other) = match name.strip_suffix("_out") {
+            Some(stem) => (stem, true),
+            None => (name.strip_suffix("_in").unwrap_or(name), false),
+        };
+        let pair = match stem {
+            "pos" => &self.pos,
+            "velrho" => &self.velrho,
+            "code" => &self.code,
+            "energy" => &self.energy,
+            _ => return Ok(None),
+        };
+        let p = parity.ok_or_else(|| anyhow!("a particle array, bound without a parity"))?;
+        Ok(Some(&pair[if other { 1 - p } else { p }]))
+    }
+
     /// GPU memory of everything that scales with the run (all buffers above).
     pub fn bytes(&self) -> u64 {
         let mut all: Vec<&wgpu::Buffer> = vec![
@@ -238,5 +305,37 @@ impl ParticleBuffers {
                 .chain(&self.scan_levels),
         );
         all.iter().map(|b| b.size()).sum()
+    }
+}
+
+/// The buffers of one bind group: the shared ones by their WGSL names, with the particle arrays
+/// of one parity (or none), and the pass's own buffers.
+pub struct Bindings<'a> {
+    shared: &'a ParticleBuffers,
+    parity: Option<usize>,
+    own: Vec<(&'static str, &'a wgpu::Buffer)>,
+}
+
+impl<'a> Bindings<'a> {
+    /// Adds a buffer of the pass's own under the WGSL name `name`, which must not be a shared
+    /// buffer's (a pass cannot rebind one).
+    pub fn with(mut self, name: &'static str, buffer: &'a wgpu::Buffer) -> Self {
+        assert!(
+            matches!(self.shared.named(name, Some(0)), Ok(None)),
+            "`{name}` is a shared buffer's name"
+        );
+        self.own.push((name, buffer));
+        self
+    }
+}
+
+impl Resolve for Bindings<'_> {
+    fn resolve(&self, name: &str) -> Result<&wgpu::Buffer> {
+        if let Some((_, b)) = self.own.iter().find(|(n, _)| *n == name) {
+            return Ok(b);
+        }
+        self.shared
+            .named(name, self.parity)?
+            .ok_or_else(|| anyhow!("no buffer of that name"))
     }
 }

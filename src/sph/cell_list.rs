@@ -4,21 +4,49 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
-use crate::gpu::kernel::ShaderModule;
+use crate::gpu::kernel::{ParityKernel, Resolve, ShaderModule};
+use crate::gpu::shader::Shader;
 use crate::gpu::Kernel;
 
+pub const SHADER: Shader = Shader {
+    name: "cell_list",
+    source: include_str!("../../shaders/cell_list.wgsl"),
+    libs: &[],
+};
+
+/// The exclusive scan of the slot counts (shaders/prefix_scan.wgsl).
+pub const SCAN_SHADER: Shader = Shader {
+    name: "prefix_scan",
+    source: include_str!("../../shaders/prefix_scan.wgsl"),
+    libs: &[],
+};
+
+/// One level of the scan: its data and the block sums it writes (and later adds back).
+struct ScanLevel<'a> {
+    data: &'a wgpu::Buffer,
+    block_sums: &'a wgpu::Buffer,
+}
+
+impl Resolve for ScanLevel<'_> {
+    fn resolve(&self, name: &str) -> Result<&wgpu::Buffer> {
+        match name {
+            "data" => Ok(self.data),
+            "block_sums" => Ok(self.block_sums),
+            _ => anyhow::bail!("no buffer of that name in a scan level"),
+        }
+    }
+}
+
 pub struct CellList {
-    cell_key: Kernel,
+    cell_key: ParityKernel,
     scatter: Kernel,
     rank_in_cell: Kernel,
-    reorder: Kernel,
-    reorder_energy: Option<(Kernel, [wgpu::BindGroup; 2])>,
+    reorder: ParityKernel,
+    reorder_energy: Option<ParityKernel>,
     scan_blocks: Kernel,
     scan_add: Kernel,
-    bind_key: [wgpu::BindGroup; 2],
     bind_scatter: wgpu::BindGroup,
     bind_rank: wgpu::BindGroup,
-    bind_reorder: [wgpu::BindGroup; 2],
     /// (scan_blocks, scan_add) bind group of each level.
     bind_scan: Vec<(wgpu::BindGroup, Option<wgpu::BindGroup>)>,
     scan_sizes: Vec<u32>,
@@ -33,89 +61,37 @@ impl CellList {
         b: &ParticleBuffers,
         energy: bool,
     ) -> Result<Self> {
-        let cell_key = cells.kernel(device, "cell_key")?;
-        let reorder_energy = if energy {
-            let k = cells.kernel(device, "reorder_energy")?;
-            let bufs = |p: usize| {
-                [
-                    (0, &b.params),
-                    (8, &b.local_perm),
-                    (18, &b.energy[p]),
-                    (19, &b.energy[1 - p]),
-                ]
-            };
-            let binds = [k.bind(device, &bufs(0))?, k.bind(device, &bufs(1))?];
-            Some((k, binds))
-        } else {
-            None
-        };
+        let parity = |entry: &str| ParityKernel::new(device, cells, entry, |p| b.at(p));
+        let reorder_energy = energy.then(|| parity("reorder_energy")).transpose()?;
         let scatter = cells.kernel(device, "scatter")?;
         let rank_in_cell = cells.kernel(device, "rank_in_cell")?;
-        let reorder = cells.kernel(device, "reorder")?;
         let scan_blocks = scan.kernel(device, "scan_blocks")?;
         let scan_add = scan.kernel(device, "scan_add")?;
-        let common = |p: usize| {
-            vec![
-                (0, &b.params),
-                (1, &b.pos[p]),
-                (2, &b.code[p]),
-                (3, &b.keys),
-                (4, &b.local_perm),
-                (5, &b.cell_start),
-                (6, &b.cell_start),
-                (7, &b.provisional),
-                (8, &b.local_perm),
-            ]
-        };
-        let reorder_bufs = |p: usize| {
-            let q = 1 - p;
-            let mut v = common(p);
-            v.extend([
-                (10, &b.pos[p]),
-                (11, &b.velrho[p]),
-                (12, &b.rate),
-                (13, &b.code[p]),
-                (14, &b.pos[q]),
-                (15, &b.velrho[q]),
-                (16, &b.rate_sorted),
-                (17, &b.code[q]),
-            ]);
-            v
-        };
-        let bind_key = [
-            cell_key.bind(device, &common(0))?,
-            cell_key.bind(device, &common(1))?,
-        ];
-        let bind_scatter = scatter.bind(device, &common(0))?;
-        let bind_rank = rank_in_cell.bind(device, &common(0))?;
-        let bind_reorder = [
-            reorder.bind(device, &reorder_bufs(0))?,
-            reorder.bind(device, &reorder_bufs(1))?,
-        ];
         let mut levels: Vec<&wgpu::Buffer> = vec![&b.cell_start];
         levels.extend(b.scan_levels.iter());
         let mut bind_scan = Vec::new();
         for l in 0..b.scan_sizes.len() - 1 {
-            let bufs = [(1, levels[l]), (2, levels[l + 1])];
+            let level = ScanLevel {
+                data: levels[l],
+                block_sums: levels[l + 1],
+            };
             let add = if l + 2 < levels.len() {
-                Some(scan_add.bind(device, &bufs)?)
+                Some(scan_add.bind(device, &level)?)
             } else {
                 None
             };
-            bind_scan.push((scan_blocks.bind(device, &bufs)?, add));
+            bind_scan.push((scan_blocks.bind(device, &level)?, add));
         }
         Ok(Self {
-            cell_key,
+            cell_key: parity("cell_key")?,
+            bind_scatter: scatter.bind(device, &b.unparitied())?,
+            bind_rank: rank_in_cell.bind(device, &b.unparitied())?,
             scatter,
             rank_in_cell,
-            reorder,
+            reorder: parity("reorder")?,
             reorder_energy,
             scan_blocks,
             scan_add,
-            bind_key,
-            bind_scatter,
-            bind_rank,
-            bind_reorder,
             bind_scan,
             scan_sizes: b.scan_sizes.clone(),
             n: b.n,
@@ -139,7 +115,7 @@ impl CellList {
 
     /// Each particle's cell key, counted into its slot.
     pub fn encode_key(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.cell_key.dispatch(pass, &self.bind_key[p], self.n);
+        self.cell_key.dispatch(pass, p, self.n);
     }
 
     /// Each particle's place in the sorted order: after the slots, then within its cell.
@@ -150,9 +126,9 @@ impl CellList {
 
     /// The particle arrays of parity `p` copied into the other parity in sorted order.
     pub fn encode_reorder(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.reorder.dispatch(pass, &self.bind_reorder[p], self.n);
-        if let Some((k, bind)) = &self.reorder_energy {
-            k.dispatch(pass, &bind[p], self.n);
+        self.reorder.dispatch(pass, p, self.n);
+        if let Some(k) = &self.reorder_energy {
+            k.dispatch(pass, p, self.n);
         }
     }
 

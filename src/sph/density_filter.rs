@@ -6,10 +6,17 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 use super::buffers::ParticleBuffers;
+use super::shader::{MLS, NEIGHBOURS};
 use crate::gpu::buffers::{read, STORAGE};
-use crate::gpu::kernel::{fold_groups, ShaderModule};
-use crate::gpu::shader::WORKGROUP_SIZE;
+use crate::gpu::kernel::{fold_groups, ParityKernel, ShaderModule};
+use crate::gpu::shader::{Shader, WORKGROUP_SIZE};
 use crate::gpu::Kernel;
+
+pub const SHADER: Shader = Shader {
+    name: "density_filter",
+    source: include_str!("../../shaders/density_filter.wgsl"),
+    libs: &[NEIGHBOURS, MLS],
+};
 use crate::scenario::DensityFilter as Mode;
 
 /// Mirror of `FilterCtl` in shaders/density_filter.wgsl.
@@ -24,11 +31,9 @@ struct FilterCtl {
 
 pub struct DensityFilter {
     gate: Kernel,
-    filter: Kernel,
-    apply: Kernel,
+    filter: ParityKernel,
+    apply: ParityKernel,
     bind_gate: wgpu::BindGroup,
-    bind_filter: [wgpu::BindGroup; 2],
-    bind_apply: [wgpu::BindGroup; 2],
     /// Indirect dispatch arguments written by the gate.
     args: wgpu::Buffer,
     /// [`FilterCtl`]: its `last` outlives a step, so checkpoints save it.
@@ -72,31 +77,21 @@ impl DensityFilter {
             usage: STORAGE | wgpu::BufferUsages::INDIRECT,
         });
         let gate = module.kernel(device, "filter_gate")?;
-        let filter = module.kernel(device, entry)?;
-        let apply = module.kernel(device, "apply_density")?;
+        // The filtered densities go through `rate_sorted`, free after the corrector read it.
         let bufs = |p: usize| {
-            [
-                (0, &b.params),
-                (1, &b.pos[p]),
-                (2, &b.velrho[p]),
-                (3, &b.code[p]),
-                (4, &b.cell_start),
-                (5, &b.rate_sorted),
-                (6, &b.state),
-                (7, &ctl),
-                (8, &args),
-            ]
+            b.at(p)
+                .with("filtered", &b.rate_sorted)
+                .with("ctl", &ctl)
+                .with("args", &args)
         };
         Ok(Some(Self {
-            bind_gate: gate.bind(device, &bufs(0))?,
-            bind_filter: [
-                filter.bind(device, &bufs(0))?,
-                filter.bind(device, &bufs(1))?,
-            ],
-            bind_apply: [apply.bind(device, &bufs(0))?, apply.bind(device, &bufs(1))?],
+            bind_gate: gate.bind(
+                device,
+                &b.unparitied().with("ctl", &ctl).with("args", &args),
+            )?,
+            filter: ParityKernel::new(device, module, entry, bufs)?,
+            apply: ParityKernel::new(device, module, "apply_density", bufs)?,
             gate,
-            filter,
-            apply,
             args,
             ctl,
             n: b.n,
@@ -107,12 +102,10 @@ impl DensityFilter {
     /// record after the time-step kernel.
     pub fn encode(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.gate.dispatch_groups(pass, &self.bind_gate, 1);
-        for (kernel, bind) in [
-            (&self.filter, &self.bind_filter),
-            (&self.apply, &self.bind_apply),
-        ] {
-            pass.set_pipeline(&kernel.pipeline);
-            pass.set_bind_group(0, &bind[p], &[]);
+        for kernel in [&self.filter, &self.apply] {
+            let (pipeline, bind) = kernel.bound(p);
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, bind, &[]);
             pass.dispatch_workgroups_indirect(&self.args, 0);
         }
     }
@@ -130,7 +123,7 @@ impl DensityFilter {
 
     /// Filters the arrays of parity `p` now, whatever the step (test hook).
     pub fn encode_now(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.filter.dispatch(pass, &self.bind_filter[p], self.n);
-        self.apply.dispatch(pass, &self.bind_apply[p], self.n);
+        self.filter.dispatch(pass, p, self.n);
+        self.apply.dispatch(pass, p, self.n);
     }
 }

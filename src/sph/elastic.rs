@@ -6,8 +6,16 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
+use super::shader::NEIGHBOURS;
 use crate::gpu::buffers::storage;
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
+use crate::gpu::shader::Shader;
+
+pub const SHADER: Shader = Shader {
+    name: "elastic",
+    source: include_str!("../../shaders/elastic.wgsl"),
+    libs: &[NEIGHBOURS],
+};
 
 /// Bytes of `SolidTerms` (shaders/elastic.wgsl) per solid particle: σ/ρ², R and the body.
 pub(crate) const TERMS_BYTES: u64 = 64;
@@ -34,20 +42,11 @@ impl Elastic {
         let sym_rate = std::mem::size_of::<crate::layout::SymRate>() as u64;
         let stress_rate = storage(device, "stress rate", sym_rate * n_solid.max(1));
         let bufs = |p: usize| {
-            [
-                (0, &b.params),
-                (1, &b.pos[p]),
-                (2, &b.velrho[p]),
-                (3, &b.code[p]),
-                (4, &b.cell_start),
-                (5, &b.rate),
-                (6, &b.solid),
-                (7, &stress_rate),
-                (8, &b.state),
-                (9, &terms),
-            ]
+            b.at(p)
+                .with("stress_rate", &stress_rate)
+                .with("terms", &terms)
         };
-        let bound = |entry: &str| ParityKernel::new(device, module, entry, |p| bufs(p).to_vec());
+        let bound = |entry: &str| ParityKernel::new(device, module, entry, bufs);
         Ok(Self {
             terms: bound("solid_stress_terms")?,
             rates: bound("elastic_rates")?,

@@ -5,7 +5,15 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
+use super::shader::{FLUID_AT, MLS, NEIGHBOURS};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
+use crate::gpu::shader::Shader;
+
+pub const SHADER: Shader = Shader {
+    name: "ghost",
+    source: include_str!("../../shaders/ghost.wgsl"),
+    libs: &[NEIGHBOURS, MLS, FLUID_AT],
+};
 
 pub struct Ghost {
     /// Fixed ghosts, when the case has any.
@@ -23,30 +31,13 @@ impl Ghost {
         fixed_ghosts: bool,
         solids_in_fluid: bool,
     ) -> Result<Self> {
-        let bound = |entry: &str, with_solid: bool| {
-            ParityKernel::new(device, module, entry, |p| {
-                let mut bufs = vec![
-                    (0, &b.params),
-                    (1, &b.pos[p]),
-                    (2, &b.velrho[p]),
-                    (3, &b.code[p]),
-                    (4, &b.cell_start),
-                ];
-                if with_solid {
-                    bufs.push((5, &b.solid));
-                } else {
-                    bufs.push((6, &b.body_particles));
-                    bufs.push((7, &b.body_motions));
-                }
-                bufs
-            })
-        };
+        let bound = |entry: &str| ParityKernel::new(device, module, entry, |p| b.at(p));
         Ok(Self {
             walls: fixed_ghosts
-                .then(|| bound("ghost_interpolate", false))
+                .then(|| bound("ghost_interpolate"))
                 .transpose()?,
             solids: solids_in_fluid
-                .then(|| bound("solid_interface_pressure", true))
+                .then(|| bound("solid_interface_pressure"))
                 .transpose()?,
             n: b.n,
         })

@@ -4,63 +4,44 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
-use crate::gpu::kernel::ShaderModule;
+use super::shader::WORKGROUP_MAX;
+use crate::gpu::kernel::{ParityKernel, ShaderModule};
+use crate::gpu::shader::Shader;
 use crate::gpu::Kernel;
 
+pub const SHADER: Shader = Shader {
+    name: "integrate",
+    source: include_str!("../../shaders/integrate.wgsl"),
+    libs: &[WORKGROUP_MAX],
+};
+
 pub struct Integrate {
-    predict: Kernel,
-    correct: Kernel,
+    predict: ParityKernel,
+    correct: ParityKernel,
     timestep: Kernel,
-    bind_predict: [wgpu::BindGroup; 2],
-    bind_correct: [wgpu::BindGroup; 2],
     bind_timestep: wgpu::BindGroup,
     n: u32,
 }
 
 impl Integrate {
     pub fn new(device: &wgpu::Device, module: &ShaderModule, b: &ParticleBuffers) -> Result<Self> {
-        let predict = module.kernel(device, "predict")?;
-        let correct = module.kernel(device, "correct")?;
         let timestep = module.kernel(device, "timestep")?;
-        let bufs = |p: usize| {
-            [
-                (0, &b.params),
-                (1, &b.pos[p]),
-                (2, &b.velrho[p]),
-                (3, &b.code[p]),
-                (4, &b.rate),
-                (5, &b.rate_sorted),
-                (6, &b.state),
-                (7, &b.cell_start),
-                (8, &b.energy[p]),
-                (9, &b.energy_rate),
-                (10, &b.mirror_planes),
-            ]
-        };
         Ok(Self {
-            bind_predict: [
-                predict.bind(device, &bufs(0))?,
-                predict.bind(device, &bufs(1))?,
-            ],
-            bind_correct: [
-                correct.bind(device, &bufs(0))?,
-                correct.bind(device, &bufs(1))?,
-            ],
-            bind_timestep: timestep.bind(device, &bufs(0))?,
-            predict,
-            correct,
+            predict: ParityKernel::new(device, module, "predict", |p| b.at(p))?,
+            correct: ParityKernel::new(device, module, "correct", |p| b.at(p))?,
+            bind_timestep: timestep.bind(device, &b.unparitied())?,
             timestep,
             n: b.n,
         })
     }
 
     pub fn encode_predict(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.predict.dispatch(pass, &self.bind_predict[p], self.n);
+        self.predict.dispatch(pass, p, self.n);
     }
 
     /// Corrector on parity `p`, then the time-step choice for the next step.
     pub fn encode_correct(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.correct.dispatch(pass, &self.bind_correct[p], self.n);
+        self.correct.dispatch(pass, p, self.n);
         self.timestep.dispatch_groups(pass, &self.bind_timestep, 1);
     }
 }

@@ -3,47 +3,31 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
-use crate::gpu::kernel::ShaderModule;
-use crate::gpu::Kernel;
+use super::shader::{NEIGHBOURS, WALL_PATCH};
+use crate::gpu::kernel::{ParityKernel, ShaderModule};
+use crate::gpu::shader::Shader;
+
+pub const SHADER: Shader = Shader {
+    name: "interaction",
+    source: include_str!("../../shaders/interaction.wgsl"),
+    libs: &[NEIGHBOURS, WALL_PATCH],
+};
 
 pub struct Interaction {
-    kernel: Kernel,
-    bind: [wgpu::BindGroup; 2],
+    kernel: ParityKernel,
     n: u32,
 }
 
 impl Interaction {
     pub fn new(device: &wgpu::Device, module: &ShaderModule, b: &ParticleBuffers) -> Result<Self> {
-        let kernel = module.kernel(device, "interaction")?;
-        let bufs = |p: usize| {
-            [
-                (0, &b.params),
-                (1, &b.pos[p]),
-                (2, &b.velrho[p]),
-                (3, &b.code[p]),
-                (4, &b.cell_start),
-                (5, &b.rate),
-                (6, &b.mirror_planes),
-                (7, &b.energy_rate),
-                (8, &b.body_particles),
-                (9, &b.solid),
-                (10, &b.body_motions),
-                (11, &b.wall_sensors),
-            ]
-        };
-        let bind = [
-            kernel.bind(device, &bufs(0))?,
-            kernel.bind(device, &bufs(1))?,
-        ];
         Ok(Self {
-            kernel,
-            bind,
+            kernel: ParityKernel::new(device, module, "interaction", |p| b.at(p))?,
             n: b.n,
         })
     }
 
     /// Evaluates the rates of the (sorted) arrays of parity `p` into `rate`.
     pub fn encode(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.kernel.dispatch(pass, &self.bind[p], self.n);
+        self.kernel.dispatch(pass, p, self.n);
     }
 }

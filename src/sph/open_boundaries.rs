@@ -8,9 +8,17 @@
 use anyhow::{ensure, Result};
 
 use super::buffers::ParticleBuffers;
-use super::grid::Grid;
+use super::shader::{FLUID_AT, MLS, NEIGHBOURS};
 use crate::gpu::buffers::storage_init;
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
+use crate::gpu::shader::Shader;
+use crate::grid::Grid;
+
+pub const SHADER: Shader = Shader {
+    name: "open_boundaries",
+    source: include_str!("../../shaders/open_boundaries.wgsl"),
+    libs: &[NEIGHBOURS, MLS, FLUID_AT],
+};
 use crate::layout::{
     pack_block, InletDef, OutletDef, Pos, INLET_EXTRAPOLATED, INLET_HYDROSTATIC, INLET_ZERO,
 };
@@ -113,17 +121,10 @@ impl OpenBoundaries {
         let columns = storage_init(device, "inlet columns", &columns);
         let outlets = storage_init(device, "outlets", &outlets);
         let bufs = |p: usize| {
-            vec![
-                (0, &b.params),
-                (1, &b.pos[p]),
-                (2, &b.velrho[p]),
-                (3, &b.code[p]),
-                (4, &b.state),
-                (5, &defs),
-                (6, &columns),
-                (7, &outlets),
-                (8, &b.cell_start),
-            ]
+            b.at(p)
+                .with("inlets", &defs)
+                .with("inlet_columns", &columns)
+                .with("outlets", &outlets)
         };
         let kernel = |entry: &str| ParityKernel::new(device, module, entry, bufs);
         let extrapolated = sc

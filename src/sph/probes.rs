@@ -4,10 +4,17 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
+use super::shader::{NEIGHBOURS, WALL_PATCH, WORKGROUP_MAX};
 use crate::body::Pose;
 use crate::gpu::buffers::{read, storage, storage_init};
-use crate::gpu::kernel::ShaderModule;
-use crate::gpu::Kernel;
+use crate::gpu::kernel::{ParityKernel, ShaderModule};
+use crate::gpu::shader::Shader;
+
+pub const SHADER: Shader = Shader {
+    name: "probes",
+    source: include_str!("../../shaders/probes.wgsl"),
+    libs: &[NEIGHBOURS, WORKGROUP_MAX, WALL_PATCH],
+};
 use crate::layout::{Pos, ProbeDef, NO_FACE};
 use crate::scenario::{Probe, ProbeKind, TrackedPoint, WallParams, WallPatch};
 use glam::DVec3;
@@ -113,10 +120,8 @@ pub fn decode_ordered(bits: u32) -> f32 {
 }
 
 pub struct Probes {
-    points: Kernel,
-    front: Kernel,
-    bind_points: [wgpu::BindGroup; 2],
-    bind_front: [wgpu::BindGroup; 2],
+    points: ParityKernel,
+    front: ParityKernel,
     kinds: Vec<u32>,
     /// What a probe's word is multiplied by: −m/area for wall pressures (the GPU sums the
     /// boundary particles' rates along the normal), 1 otherwise.
@@ -133,29 +138,9 @@ impl Probes {
         defs: &[ProbeDef],
         particle_mass: f64,
     ) -> Result<Self> {
-        let points = module.kernel(device, "probe_points")?;
-        let front = module.kernel(device, "probe_front")?;
-        let bufs = |p: usize| {
-            [
-                (0, &b.params),
-                (1, &b.pos[p]),
-                (2, &b.velrho[p]),
-                (3, &b.code[p]),
-                (4, &b.cell_start),
-                (5, &b.probes),
-                (6, &b.probe_out),
-                (9, &b.rate),
-                (10, &b.wall_sensors),
-            ]
-        };
         Ok(Self {
-            bind_points: [
-                points.bind(device, &bufs(0))?,
-                points.bind(device, &bufs(1))?,
-            ],
-            bind_front: [front.bind(device, &bufs(0))?, front.bind(device, &bufs(1))?],
-            points,
-            front,
+            points: ParityKernel::new(device, module, "probe_points", |p| b.at(p))?,
+            front: ParityKernel::new(device, module, "probe_front", |p| b.at(p))?,
             kinds: defs.iter().map(|d| d.kind).collect(),
             scales: probes
                 .iter()
@@ -179,10 +164,9 @@ impl Probes {
             label: Some("probes"),
             timestamp_writes: None,
         });
-        self.points
-            .dispatch(&mut pass, &self.bind_points[p], self.kinds.len() as u32);
+        self.points.dispatch(&mut pass, p, self.kinds.len() as u32);
         if self.kinds.contains(&PROBE_FRONT) {
-            self.front.dispatch(&mut pass, &self.bind_front[p], self.n);
+            self.front.dispatch(&mut pass, p, self.n);
         }
     }
 
@@ -206,8 +190,7 @@ impl Probes {
 /// Tracked points on the GPU (`track_points` in probes.wgsl): the followed ids in ascending
 /// order (each once) and, for every point of the scenario, its slot in that list.
 pub struct PointTracker {
-    kernel: Kernel,
-    bind: [wgpu::BindGroup; 2],
+    kernel: ParityKernel,
     out: wgpu::Buffer,
     slot_of_point: Vec<usize>,
     slots: usize,
@@ -241,21 +224,10 @@ impl PointTracker {
             "tracked positions",
             (ids.len() * std::mem::size_of::<Pos>()) as u64,
         );
-        let kernel = module.kernel(device, "track_points")?;
-        let bufs = |p: usize| {
-            [
-                (0, &b.params),
-                (1, &b.pos[p]),
-                (3, &b.code[p]),
-                (7, &tracked),
-                (8, &out),
-            ]
-        };
+        let kernel = ParityKernel::new(device, module, "track_points", |p| {
+            b.at(p).with("tracked", &tracked).with("tracked_pos", &out)
+        })?;
         Ok(Some(Self {
-            bind: [
-                kernel.bind(device, &bufs(0))?,
-                kernel.bind(device, &bufs(1))?,
-            ],
             kernel,
             out,
             slot_of_point,
@@ -270,7 +242,7 @@ impl PointTracker {
             label: Some("track points"),
             timestamp_writes: None,
         });
-        self.kernel.dispatch(&mut pass, &self.bind[p], self.n);
+        self.kernel.dispatch(&mut pass, p, self.n);
     }
 
     /// The positions, in the scenario's point order (after [`encode`](Self::encode) was

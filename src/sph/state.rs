@@ -60,7 +60,7 @@ impl Solver {
         } else {
             None
         };
-        let filter_last = match &self.density_filter {
+        let filter_last = match &self.passes.density_filter {
             Some(f) => f.last_applied(&self.device, &self.queue)?,
             None => 0,
         };
@@ -76,7 +76,7 @@ impl Solver {
             code,
             rate: self.read_rates().context("reading rates")?,
             energy,
-            solid: match &self.elastic {
+            solid: match &self.passes.elastic {
                 Some(_) => Some(self.read_solid()?),
                 None => None,
             },
@@ -117,7 +117,7 @@ impl Solver {
             }
             q.write_buffer(&self.buffers.energy[p], 0, bytemuck::cast_slice(e));
         }
-        if s.solid.is_some() != self.elastic.is_some() {
+        if s.solid.is_some() != self.passes.elastic.is_some() {
             bail!("the saved state and this case disagree on elastic solids");
         }
         if let Some(solid) = &s.solid {
@@ -131,11 +131,11 @@ impl Solver {
             q.write_buffer(&self.buffers.solid, 0, bytemuck::cast_slice(solid));
         }
         q.write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&s.sim));
-        if let Some(f) = &self.density_filter {
+        if let Some(f) = &self.passes.density_filter {
             f.set_last_applied(q, s.filter_last);
         }
         match &mut self.bodies {
-            Some((_, host, _)) => host.restore(&s.bodies)?,
+            Some(host) => host.set.restore(&s.bodies)?,
             None if !s.bodies.is_empty() => bail!("the saved state has bodies; this case has none"),
             None => {}
         }

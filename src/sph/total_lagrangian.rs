@@ -13,8 +13,15 @@ use anyhow::Result;
 use super::buffers::ParticleBuffers;
 use crate::gpu::buffers::{read, storage, storage_init, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
+use crate::gpu::shader::Shader;
+
+pub const SHADER: Shader = Shader {
+    name: "total_lagrangian",
+    source: include_str!("../../shaders/total_lagrangian.wgsl"),
+    libs: &[],
+};
+use crate::lagrangian::{cauchy_of, TlSetup};
 use crate::layout::{TlPair, TlParams};
-use crate::reference::total_lagrangian::{cauchy_of, TlSetup};
 use crate::scenario::{Scenario, SolidFormulation};
 
 pub struct TotalLagrangian {
@@ -51,11 +58,11 @@ pub fn setup(sc: &Scenario) -> Result<(std::ops::Range<usize>, TlSetup)> {
 /// TL index + first id.
 fn tl_range(sc: &Scenario) -> Result<std::ops::Range<usize>> {
     let solids = sc.solids.as_ref().expect("a case with solids");
-    let solid = super::solid_range(sc)?;
+    let solid = super::initial::solid_range(sc)?;
     let ids: Vec<usize> = solid
         .filter(|&i| solids.material_of(i).formulation == SolidFormulation::TotalLagrangian)
         .collect();
-    super::consecutive(&ids, "the total-Lagrangian solids")
+    super::initial::consecutive(&ids, "the total-Lagrangian solids")
 }
 
 impl TotalLagrangian {
@@ -108,22 +115,16 @@ impl TotalLagrangian {
         .map(|b| b.size())
         .sum();
         let bufs = |p: usize| {
-            [
-                (0, &b.params),
-                (1, &b.pos[p]),
-                (2, &b.code[p]),
-                (3, &b.rate),
-                (4, &tl_params),
-                (5, &tl_start),
-                (6, &tl_pairs),
-                (7, &tl_slot),
-                (8, &tl_h),
-                (9, &tl_t),
-                (10, &tl_p),
-                (11, &b.solid),
-            ]
+            b.at(p)
+                .with("tlp", &tl_params)
+                .with("tl_start", &tl_start)
+                .with("tl_pairs", &tl_pairs)
+                .with("tl_slot", &tl_slot)
+                .with("tl_h", &tl_h)
+                .with("tl_t", &tl_t)
+                .with("tl_p", &tl_p)
         };
-        let bound = |entry: &str| ParityKernel::new(device, module, entry, |p| bufs(p).to_vec());
+        let bound = |entry: &str| ParityKernel::new(device, module, entry, bufs);
         Ok(Self {
             index: bound("tl_index")?,
             deform: bound("tl_deform")?,

@@ -8,8 +8,8 @@ use proptest::strategy::Strategy;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
 use toml::{Table, Value};
 use wgsph::case::{load_str_limited, CaseError};
+use wgsph::grid::Grid;
 use wgsph::scenario::{Kind, Motion, RepulsiveForm, Scenario};
-use wgsph::sph::grid::Grid;
 
 use crate::doc::{generic, last_key, path_of, required, vector_len, Node, Seed, Seg};
 use crate::values::{finite_number, is_number};

@@ -1,8 +1,19 @@
-//! Smoothing kernels (support 2h, q = r/h): the twin of `kernel_w` / `kernel_f` in
-//! shaders/lib/common.wgsl.
+//! Smoothing kernels in f64 (support 2h, q = r/h): the twin of `kernel_w` / `kernel_f` in
+//! shaders/lib/common.wgsl. Neutral ground: the solver (its parameters) and the f64 reference
+//! both use it, and it uses neither.
 
 use crate::scenario::KernelKind;
-use crate::sph::kernel_norm;
+
+/// SPH kernel normalisation α_d (support 2h) of `kernel` in `dim` dimensions.
+pub fn kernel_norm(kernel: KernelKind, dim: u32, h: f64) -> f64 {
+    use std::f64::consts::PI;
+    match (kernel, dim) {
+        (KernelKind::CubicSpline, 2) => 10.0 / (7.0 * PI * h * h),
+        (KernelKind::CubicSpline, _) => 1.0 / (PI * h * h * h),
+        (KernelKind::WendlandC2, 2) => 7.0 / (4.0 * PI * h * h),
+        (KernelKind::WendlandC2, _) => 21.0 / (16.0 * PI * h * h * h),
+    }
+}
 
 /// W(r).
 pub fn w(kernel: KernelKind, dim: u32, h: f64, r: f64) -> f64 {

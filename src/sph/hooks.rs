@@ -1,0 +1,147 @@
+//! Test hooks (feature `test-hooks`, which the crate's own tests turn on): re-running one pass
+//! on the current arrays, reading what only the tests compare, breaking the device. Not part of
+//! the public API of a default build.
+
+use anyhow::{bail, Result};
+
+use super::Solver;
+use crate::gpu::buffers::read;
+use crate::layout::{SimState, SymRate};
+
+impl Solver {
+    /// Test hook: destroys the device, as a driver reset or an unplugged GPU would.
+    pub fn lose_device(&self) {
+        self.device.destroy();
+    }
+
+    /// Test hook: re-runs the ghost interpolation (fixed ghosts and the solids' interface
+    /// pressure, extrapolated inlet buffers' pressure), the interaction pass and, with solids,
+    /// the elastic rates on the current arrays
+    /// and returns the rates. With `poison`, `rate` (and the stress rates) are first filled with
+    /// NaN so an entry the kernel skips cannot pass.
+    pub fn rerun_interaction(&self, poison: bool) -> Result<Vec<[f32; 4]>> {
+        if poison {
+            let nan = vec![f32::NAN; 4 * self.buffers.n as usize];
+            self.queue
+                .write_buffer(&self.buffers.rate, 0, bytemuck::cast_slice(&nan));
+            if let Some(e) = &self.passes.elastic {
+                let nan = vec![f32::NAN; 8 * self.n_solid as usize];
+                self.queue
+                    .write_buffer(&e.stress_rate, 0, bytemuck::cast_slice(&nan));
+            }
+        }
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("interaction"),
+            });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("interaction"),
+            timestamp_writes: None,
+        });
+        self.passes.ghost.encode(&mut pass, self.parity);
+        if let Some(o) = &self.passes.open_boundaries {
+            o.encode_pressure(&mut pass, self.parity);
+        }
+        self.passes.interaction.encode(&mut pass, self.parity);
+        if let Some(e) = &self.passes.elastic {
+            e.encode_rates(&mut pass, self.parity);
+        }
+        if let Some(t) = &self.passes.total_lagrangian {
+            t.encode_rates(&mut pass, self.parity);
+        }
+        drop(pass);
+        self.queue.submit([encoder.finish()]);
+        self.read_rates()
+    }
+
+    /// Test hook: dτ/dt of the last evaluation, by solid particle as `read_solid`.
+    pub fn read_stress_rates(&self) -> Result<Vec<SymRate>> {
+        let Some(e) = &self.passes.elastic else {
+            bail!("the case has no updated-Lagrangian solids");
+        };
+        read(
+            &self.device,
+            &self.queue,
+            &e.stress_rate,
+            self.n_solid as usize,
+        )
+    }
+
+    /// Test hook: re-runs the interaction and the body sums on the current arrays and returns
+    /// each body's force and torque (about the centre of mass of the last uploaded pose).
+    pub fn rerun_body_loads(&self) -> Result<Vec<crate::body::Load>> {
+        let Some(gpu) = &self.passes.bodies else {
+            bail!("the case has no bodies");
+        };
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("body loads"),
+            });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("body loads"),
+            timestamp_writes: None,
+        });
+        self.passes.interaction.encode(&mut pass, self.parity);
+        gpu.encode_force(&mut pass, self.parity);
+        drop(pass);
+        self.queue.submit([encoder.finish()]);
+        let partials: Vec<[f32; 4]> = read(
+            &self.device,
+            &self.queue,
+            &gpu.partials,
+            gpu.partials_bytes() as usize / 16,
+        )?;
+        Ok(gpu.loads(&partials))
+    }
+
+    /// Test hook: applies the density filter of the case once to the current arrays (whatever
+    /// the step count). With `poison`, the filter's output buffer is first filled with NaN, so a
+    /// fluid particle the filter skips gets a NaN density.
+    pub fn run_density_filter(&mut self, poison: bool) -> Result<()> {
+        let Some(f) = &self.passes.density_filter else {
+            bail!("the case has no density filter");
+        };
+        if poison {
+            let nan = vec![f32::NAN; 4 * self.buffers.n as usize];
+            self.queue
+                .write_buffer(&self.buffers.rate_sorted, 0, bytemuck::cast_slice(&nan));
+        }
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("density filter"),
+            });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("density filter"),
+            timestamp_writes: None,
+        });
+        f.encode_now(&mut pass, self.parity);
+        drop(pass);
+        self.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// Test hook: takes exactly one step of `dt` (no clipping) and returns the new state.
+    pub fn single_step(&mut self, dt: f32) -> Result<SimState> {
+        let mut st = self.rebased_state();
+        st.t_target_rel = f32::MAX;
+        st.dt = dt;
+        self.queue
+            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
+        self.state = st;
+        self.take_steps(1)?;
+        Ok(self.state)
+    }
+
+    /// Test hook: de/dt of the last evaluation (energy equation on), in GPU order.
+    pub fn read_energy_rates(&self) -> Result<Vec<f32>> {
+        read(
+            &self.device,
+            &self.queue,
+            &self.buffers.energy_rate,
+            self.buffers.n as usize,
+        )
+    }
+}

@@ -1,0 +1,174 @@
+//! Every pass of the step, built for one case, and `record_step`: the one list of named passes
+//! in their order. A new pass is added here (its module, its `SHADER` in [`SHADERS`], its place
+//! in the step) and nowhere else.
+
+use anyhow::Result;
+
+use super::bodies::{self, Bodies};
+use super::buffers::ParticleBuffers;
+use super::cell_list::{self, CellList};
+use super::density_filter::{self, DensityFilter};
+use super::elastic::{self, Elastic};
+use super::ghost::{self, Ghost};
+use super::integrate::{self, Integrate};
+use super::interaction::{self, Interaction};
+use super::open_boundaries::{self, OpenBoundaries};
+use super::probes::{self, PointTracker, Probes};
+use super::profile::Recorder;
+use super::shader::{module, ShaderConfig};
+use super::total_lagrangian::{self, TotalLagrangian};
+use crate::gpu::shader::Shader;
+use crate::grid::Grid;
+use crate::layout::{BodyMotion, ProbeDef};
+use crate::scenario::{Kind, Scenario, SolidFormulation};
+
+/// Every pass's shader, for the checks that compose them all.
+pub const SHADERS: [&Shader; 11] = [
+    &cell_list::SHADER,
+    &cell_list::SCAN_SHADER,
+    &interaction::SHADER,
+    &integrate::SHADER,
+    &probes::SHADER,
+    &ghost::SHADER,
+    &density_filter::SHADER,
+    &bodies::SHADER,
+    &elastic::SHADER,
+    &total_lagrangian::SHADER,
+    &open_boundaries::SHADER,
+];
+
+/// The passes of a run; those of what the case lacks are `None`.
+pub struct Passes {
+    pub cell_list: CellList,
+    pub interaction: Interaction,
+    pub ghost: Ghost,
+    pub integrate: Integrate,
+    /// Shepard/MLS density re-initialisation, if the case asks for one.
+    pub density_filter: Option<DensityFilter>,
+    /// Updated-Lagrangian elastic solids.
+    pub elastic: Option<Elastic>,
+    /// Total-Lagrangian elastic solids.
+    pub total_lagrangian: Option<TotalLagrangian>,
+    /// Velocity inlets and outlets.
+    pub open_boundaries: Option<OpenBoundaries>,
+    /// Moving bodies' GPU part (the host dynamics are the solver's).
+    pub bodies: Option<Bodies>,
+    pub probes: Probes,
+    /// Tracked points of bodies.
+    pub points: Option<PointTracker>,
+}
+
+impl Passes {
+    /// The passes `sc` needs, compiled for `cfg`, over `b`; `defs` are the probes' GPU
+    /// definitions and `motions` the bodies' table the buffers were made with.
+    pub fn new(
+        device: &wgpu::Device,
+        sc: &Scenario,
+        cfg: ShaderConfig,
+        grid: &Grid,
+        b: &ParticleBuffers,
+        defs: &[ProbeDef],
+        motions: Vec<BodyMotion>,
+    ) -> Result<Self> {
+        let ph = &sc.physics;
+        let shader = |s: &Shader| module(device, s, cfg);
+        let has_kind = |k: &[Kind]| sc.particles.iter().any(|p| k.contains(&p.kind));
+        let has_formulation = |f| sc.solids.as_ref().is_some_and(|s| s.has(f));
+        let probe_module = shader(&probes::SHADER)?;
+        Ok(Self {
+            cell_list: CellList::new(
+                device,
+                &shader(&cell_list::SHADER)?,
+                &shader(&cell_list::SCAN_SHADER)?,
+                b,
+                ph.energy,
+            )?,
+            interaction: Interaction::new(device, &shader(&interaction::SHADER)?, b)?,
+            ghost: Ghost::new(
+                device,
+                &shader(&ghost::SHADER)?,
+                b,
+                has_kind(&[Kind::GhostNoSlip, Kind::GhostFreeSlip]),
+                has_kind(&[Kind::Fluid]) && has_kind(&[Kind::Solid, Kind::SolidClamped]),
+            )?,
+            density_filter: match ph.density_filter {
+                crate::scenario::DensityFilter::None => None,
+                mode => DensityFilter::new(device, &shader(&density_filter::SHADER)?, b, mode)?,
+            },
+            integrate: Integrate::new(device, &shader(&integrate::SHADER)?, b)?,
+            elastic: has_formulation(SolidFormulation::UpdatedLagrangian)
+                .then(|| Elastic::new(device, &shader(&elastic::SHADER)?, b))
+                .transpose()?,
+            total_lagrangian: has_formulation(SolidFormulation::TotalLagrangian)
+                .then(|| TotalLagrangian::new(device, &shader(&total_lagrangian::SHADER)?, b, sc))
+                .transpose()?,
+            open_boundaries: (!sc.inlets.is_empty() || !sc.outlets.is_empty())
+                .then(|| {
+                    OpenBoundaries::new(device, &shader(&open_boundaries::SHADER)?, b, sc, grid)
+                })
+                .transpose()?,
+            bodies: (!sc.bodies.is_empty())
+                .then(|| {
+                    // The bodies' particles are the last ones (`initial::body_id_base`).
+                    let base = b.n - motions.iter().map(|m| m.count).sum::<u32>();
+                    Bodies::new(device, &shader(&bodies::SHADER)?, b, motions, base)
+                })
+                .transpose()?,
+            probes: Probes::new(device, &probe_module, b, &sc.probes, defs, ph.particle_mass)?,
+            points: PointTracker::new(device, &probe_module, b, &sc.points)?,
+        })
+    }
+
+    /// GPU memory of the passes' own buffers, in bytes.
+    pub fn bytes(&self) -> u64 {
+        self.total_lagrangian.as_ref().map_or(0, |t| t.bytes())
+            + self.elastic.as_ref().map_or(0, |e| e.bytes())
+    }
+
+    /// The stages of one step on the arrays of parity `p`, in order (the sort moves them to
+    /// parity `1 - p`, where the rest of the step works).
+    pub(super) fn record_step(&self, mut r: Recorder<'_>, p: usize) {
+        let q = 1 - p;
+        let bodies = self.bodies.as_ref();
+        r.stage("predict", |pass| self.integrate.encode_predict(pass, p));
+        if let Some(e) = &self.elastic {
+            r.stage("elastic_predict", |pass| e.encode_predict(pass, p));
+        }
+        if let Some(b) = bodies {
+            r.stage("body_move", |pass| b.encode_move(pass, p));
+        }
+        if let Some(o) = &self.open_boundaries {
+            r.stage("open_boundaries", |pass| o.encode(pass, p));
+        }
+        let cells = &self.cell_list;
+        r.stage("sort_key", |pass| cells.encode_key(pass, p));
+        r.stage("sort_scan", |pass| cells.encode_scan(pass));
+        r.stage("sort_scatter", |pass| cells.encode_scatter(pass));
+        r.stage("sort_reorder", |pass| cells.encode_reorder(pass, p));
+        if let Some(t) = &self.total_lagrangian {
+            r.stage("total_lagrangian_index", |pass| t.encode_index(pass, q));
+        }
+        if let Some(b) = bodies {
+            r.stage("body_index", |pass| b.encode_index(pass, q));
+        }
+        r.stage("ghost", |pass| self.ghost.encode(pass, q));
+        if let Some(o) = &self.open_boundaries {
+            r.stage("inlet_pressure", |pass| o.encode_pressure(pass, q));
+        }
+        r.stage("interaction", |pass| self.interaction.encode(pass, q));
+        if let Some(e) = &self.elastic {
+            r.stage("elastic_rates", |pass| e.encode_rates(pass, q));
+            r.stage("elastic_correct", |pass| e.encode_correct(pass, q));
+        }
+        if let Some(t) = &self.total_lagrangian {
+            r.stage("total_lagrangian_rates", |pass| t.encode_rates(pass, q));
+        }
+        if let Some(b) = bodies {
+            r.stage("body_force", |pass| b.encode_force(pass, q));
+        }
+        r.stage("correct", |pass| self.integrate.encode_correct(pass, q));
+        if let Some(f) = &self.density_filter {
+            r.stage("density_filter", |pass| f.encode(pass, q));
+        }
+    }
+}

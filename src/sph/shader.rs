@@ -1,0 +1,229 @@
+//! The physics side of shader composition: the per-case compile-time choices (`ShaderConfig`)
+//! emitted as WGSL constants, `shaders/lib/common.wgsl` and the library files. Each pass module
+//! owns its `SHADER` (its file and the libraries it uses).
+//!
+//! Per-case choices (dimension, kernel, viscosity, which kinds of particle the case has) are
+//! constants of the composed source, so the compiler removes the branches not taken. Choices
+//! among methods are named WGSL constants generated from the Rust enums, never bare codes.
+
+use anyhow::Result;
+
+use super::initial::Present;
+use crate::gpu::kernel::ShaderModule;
+use crate::gpu::shader::{compose as compose_shader, Shader, WORKGROUP_SIZE};
+use crate::scenario::{
+    DeltaSphForm, GhostCorrection, KernelKind, RepulsiveForm, Scenario, Viscosity,
+};
+
+pub const COMMON: &str = include_str!("../../shaders/lib/common.wgsl");
+/// Neighbour search over the cell list (`shaders/lib/neighbours.wgsl`; the pass declares
+/// `cell_start`).
+pub const NEIGHBOURS: &str = include_str!("../../shaders/lib/neighbours.wgsl");
+/// First-order moving least squares (`shaders/lib/mls.wgsl`).
+pub const MLS: &str = include_str!("../../shaders/lib/mls.wgsl");
+/// The fluid interpolated at a point (`shaders/lib/fluid_at.wgsl`; needs `MLS`).
+pub const FLUID_AT: &str = include_str!("../../shaders/lib/fluid_at.wgsl");
+/// A maximum over the workgroup before one atomic (`shaders/lib/workgroup_max.wgsl`).
+pub const WORKGROUP_MAX: &str = include_str!("../../shaders/lib/workgroup_max.wgsl");
+/// A wall-pressure sensor's patch of boundary particles (`shaders/lib/wall_patch.wgsl`).
+pub const WALL_PATCH: &str = include_str!("../../shaders/lib/wall_patch.wgsl");
+
+/// The viscous term of the momentum equation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViscosityForm {
+    /// Monaghan's artificial viscosity Π_ij.
+    Artificial,
+    /// Laminar viscosity (Morris et al. 1997; Lo & Shao 2002).
+    Laminar,
+}
+
+/// A Rust enum's variants as WGSL constants: `(prefix)_(VARIANT)` = its index.
+trait WgslEnum: Copy + PartialEq + 'static {
+    const PREFIX: &'static str;
+    const VARIANTS: &'static [(Self, &'static str)];
+
+    fn code(self) -> u32 {
+        Self::VARIANTS
+            .iter()
+            .position(|(v, _)| *v == self)
+            .expect("every variant is listed") as u32
+    }
+
+    fn name(self) -> String {
+        let (_, name) = Self::VARIANTS[self.code() as usize];
+        format!("{}_{name}", Self::PREFIX)
+    }
+
+    /// `const PREFIX_VARIANT: u32 = k;` for every variant.
+    fn declarations() -> String {
+        (Self::VARIANTS.iter().enumerate())
+            .map(|(k, (_, name))| format!("const {}_{name}: u32 = {k}u;\n", Self::PREFIX))
+            .collect()
+    }
+}
+
+impl WgslEnum for KernelKind {
+    const PREFIX: &'static str = "KERNEL";
+    const VARIANTS: &'static [(Self, &'static str)] = &[
+        (KernelKind::CubicSpline, "CUBIC_SPLINE"),
+        (KernelKind::WendlandC2, "WENDLAND_C2"),
+    ];
+}
+
+impl WgslEnum for ViscosityForm {
+    const PREFIX: &'static str = "VISCOSITY";
+    const VARIANTS: &'static [(Self, &'static str)] = &[
+        (ViscosityForm::Artificial, "ARTIFICIAL"),
+        (ViscosityForm::Laminar, "LAMINAR"),
+    ];
+}
+
+/// Values of `Params::repulsive_form` (a run-time choice: the uniform holds the code).
+impl WgslEnum for RepulsiveForm {
+    const PREFIX: &'static str = "REPULSIVE";
+    const VARIANTS: &'static [(Self, &'static str)] = &[
+        (RepulsiveForm::LennardJones, "LENNARD_JONES"),
+        (RepulsiveForm::MonaghanKajtar, "MONAGHAN_KAJTAR"),
+    ];
+}
+
+/// Values of `Params::ghost_mls`.
+impl WgslEnum for GhostCorrection {
+    const PREFIX: &'static str = "GHOST";
+    const VARIANTS: &'static [(Self, &'static str)] = &[
+        (GhostCorrection::Shepard, "SHEPARD"),
+        (GhostCorrection::Mls, "MLS"),
+    ];
+}
+
+/// The code of a run-time method choice in `Params` (the same numbers the WGSL constants have).
+pub fn repulsive_form_code(f: RepulsiveForm) -> u32 {
+    f.code()
+}
+
+/// The code of `Params::ghost_mls`.
+pub fn ghost_correction_code(c: GhostCorrection) -> u32 {
+    c.code()
+}
+
+/// Compile-time choices of a run, emitted as WGSL constants.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShaderConfig {
+    pub dim: u32,
+    pub kernel: KernelKind,
+    pub viscosity: ViscosityForm,
+    /// Whether the energy equation is integrated.
+    pub energy: bool,
+    /// Whether δ-SPH diffuses only the density's departure from hydrostatics (Fourtakas et al.
+    /// 2019) rather than the whole density difference (Molteni & Colagrossi 2009).
+    pub hydrostatic_diffusion: bool,
+    /// Whether fixed walls' boundary particles get the fluid's force (wall-pressure probes).
+    pub wall_reactions: bool,
+    /// Which particles and walls the case has: a pass compiles out the pair terms of the others.
+    pub present: Present,
+}
+
+impl Default for ShaderConfig {
+    fn default() -> Self {
+        Self {
+            dim: 3,
+            kernel: KernelKind::WendlandC2,
+            viscosity: ViscosityForm::Artificial,
+            energy: false,
+            hydrostatic_diffusion: false,
+            wall_reactions: false,
+            present: Present::ALL,
+        }
+    }
+}
+
+impl ShaderConfig {
+    /// The choices of `sc`.
+    pub fn of(sc: &Scenario) -> Result<ShaderConfig> {
+        let ph = &sc.physics;
+        Ok(ShaderConfig {
+            dim: ph.dim,
+            kernel: ph.kernel,
+            viscosity: match ph.viscosity {
+                Viscosity::Artificial { .. } => ViscosityForm::Artificial,
+                Viscosity::Laminar { .. } => ViscosityForm::Laminar,
+            },
+            energy: ph.energy,
+            hydrostatic_diffusion: ph.delta_sph > 0.0
+                && ph.delta_sph_form == DeltaSphForm::Fourtakas,
+            wall_reactions: sc.walls.reactions,
+            present: Present::of(sc)?,
+        })
+    }
+
+    /// The WGSL constants of these choices, in front of every pass.
+    fn constants(&self) -> String {
+        let p = &self.present;
+        let mut out = String::new();
+        out += &KernelKind::declarations();
+        out += &ViscosityForm::declarations();
+        out += &RepulsiveForm::declarations();
+        out += &GhostCorrection::declarations();
+        out += &format!(
+            "const DIM: u32 = {dim}u;\nconst KERNEL: u32 = {kernel};\n\
+             const VISCOSITY: u32 = {visc};\nconst ENERGY: bool = {energy};\n\
+             const HYDROSTATIC_DIFFUSION: bool = {hydro};\nconst WALL_REACTIONS: bool = {reactions};\n\
+             const SOLIDS: bool = {solids};\nconst FIXED_GHOSTS: bool = {ghosts};\n\
+             const REPULSIVE: bool = {repulsive};\nconst BODIES: bool = {bodies};\n\
+             const MIRRORS: bool = {mirrors};\nconst LONE_SOLID: bool = {lone_solid};\n\
+             const WG: u32 = {wg}u;\n",
+            dim = self.dim,
+            kernel = self.kernel.name(),
+            visc = self.viscosity.name(),
+            energy = self.energy,
+            hydro = self.hydrostatic_diffusion,
+            reactions = self.wall_reactions,
+            solids = p.solids,
+            ghosts = p.fixed_ghosts,
+            repulsive = p.repulsive,
+            bodies = p.bodies,
+            mirrors = p.mirrors,
+            lone_solid = p.lone_solid,
+            wg = WORKGROUP_SIZE,
+        );
+        out
+    }
+}
+
+/// The full WGSL source of `shader` for `cfg`: constants, common.wgsl, libraries, the pass.
+pub fn compose(shader: &Shader, cfg: ShaderConfig) -> String {
+    compose_shader(shader, &format!("{}\n{COMMON}", cfg.constants()))
+}
+
+/// `shader` composed for `cfg`, parsed, validated and created on `device`.
+pub fn module(device: &wgpu::Device, shader: &Shader, cfg: ShaderConfig) -> Result<ShaderModule> {
+    ShaderModule::new(device, shader.name, compose(shader, cfg))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The codes the uniform carries are the WGSL constants' values, variant for variant.
+    #[test]
+    fn method_codes_are_the_wgsl_constants() {
+        let cfg = ShaderConfig::default();
+        let src = compose(&super::super::interaction::SHADER, cfg);
+        for (form, name) in [
+            (RepulsiveForm::LennardJones, "REPULSIVE_LENNARD_JONES"),
+            (RepulsiveForm::MonaghanKajtar, "REPULSIVE_MONAGHAN_KAJTAR"),
+        ] {
+            let decl = format!("const {name}: u32 = {}u;", repulsive_form_code(form));
+            assert!(src.contains(&decl), "{decl}");
+        }
+        for (c, name) in [
+            (GhostCorrection::Shepard, "GHOST_SHEPARD"),
+            (GhostCorrection::Mls, "GHOST_MLS"),
+        ] {
+            let decl = format!("const {name}: u32 = {}u;", ghost_correction_code(c));
+            assert!(src.contains(&decl), "{decl}");
+        }
+        assert!(src.contains("const KERNEL: u32 = KERNEL_WENDLAND_C2;"));
+        assert!(src.contains("const VISCOSITY: u32 = VISCOSITY_ARTIFICIAL;"));
+    }
+}

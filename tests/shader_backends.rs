@@ -1,0 +1,87 @@
+//! Every composed shader variant the shipped cases use (and the all-kinds variant) translates
+//! with naga's own backends to SPIR-V (Vulkan), MSL (Metal), HLSL (DX12) and GLSL (GL compute),
+//! so a shader change that would break another vendor's backend is caught without its device.
+
+use naga::back::{glsl, hlsl, msl, spv};
+use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
+use wgsph::sph::passes::SHADERS;
+use wgsph::sph::shader::{compose, ShaderConfig};
+
+fn cases() -> Vec<std::path::PathBuf> {
+    let mut files: Vec<_> = std::fs::read_dir("cases")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    files.sort();
+    files
+}
+
+/// Every backend's translation of `module`, or the first error with the backend's name.
+fn translate(module: &naga::Module, info: &ModuleInfo) -> Result<(), String> {
+    spv::write_vec(module, info, &spv::Options::default(), None)
+        .map_err(|e| format!("SPIR-V: {e}"))?;
+    msl::write_string(
+        module,
+        info,
+        &msl::Options::default(),
+        &msl::PipelineOptions::default(),
+    )
+    .map_err(|e| format!("MSL: {e}"))?;
+    let hlsl_options = hlsl::Options::default();
+    let hlsl_pipeline = hlsl::PipelineOptions::default();
+    let mut out = String::new();
+    hlsl::Writer::new(&mut out, &hlsl_options, &hlsl_pipeline)
+        .write(module, info, None)
+        .map_err(|e| format!("HLSL: {e}"))?;
+    let glsl_options = glsl::Options {
+        version: glsl::Version::new_gles(310),
+        ..Default::default()
+    };
+    for entry in &module.entry_points {
+        let pipeline = glsl::PipelineOptions {
+            shader_stage: naga::ShaderStage::Compute,
+            entry_point: entry.name.clone(),
+            multiview: None,
+        };
+        let mut out = String::new();
+        glsl::Writer::new(
+            &mut out,
+            module,
+            info,
+            &glsl_options,
+            &pipeline,
+            naga::proc::BoundsCheckPolicies::default(),
+        )
+        .and_then(|mut w| w.write())
+        .map_err(|e| format!("GLSL ({}): {e}", entry.name))?;
+    }
+    Ok(())
+}
+
+#[test]
+fn every_shipped_variant_translates_to_every_backend() {
+    let mut configs = vec![("all kinds".to_string(), ShaderConfig::default())];
+    for file in cases() {
+        let sc = wgsph::case::load(&file, &[]).unwrap();
+        let cfg = ShaderConfig::of(&sc).unwrap();
+        if !configs.iter().any(|(_, c)| *c == cfg) {
+            configs.push((file.display().to_string(), cfg));
+        }
+    }
+    assert!(configs.len() > 5, "{} variants", configs.len());
+    let mut failures = Vec::new();
+    for (what, cfg) in &configs {
+        for shader in SHADERS {
+            let source = compose(shader, *cfg);
+            let module = naga::front::wgsl::parse_str(&source).unwrap();
+            let info = Validator::new(ValidationFlags::all(), Capabilities::empty())
+                .validate(&module)
+                .unwrap();
+            if let Err(e) = translate(&module, &info) {
+                failures.push(format!("{}.wgsl for {what}: {e}", shader.name));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
