@@ -49,7 +49,7 @@ fn set_hydrostatic_coefficients() {
     hydrostatic_series = vec3<f32>(params.rho0 * a, 0.5 * (a - 1.0), (a - 2.0) / 3.0);
 }
 
-// ρ_i − ρ_j less its hydrostatic part ρ^H_i − ρ^H_j (see the header) for the fluid particles i
+// ρ_i − ρ_j less its hydrostatic part ρ^H_i − ρ^H_j (docs/equations.md eq. 20) for the fluid particles i
 // and j at x_ij = x_i − x_j apart: what δ-SPH diffuses. ρ^H_ij = ρ0((1 + ε)^(1/γ) − 1) is
 // summed to third order in ε: |ε| ≤ 2γ g h/c0² is about 0.01 in a case whose c0 keeps it weakly
 // compressible, so the rest, 0.03 ρ0 ε⁴, is far below f32 rounding, and unlike pow(1 + ε, 1/γ) − 1
@@ -99,7 +99,7 @@ fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_cont: vec3<f32>, v_visc:
     return PairRates(vec4<f32>(acc, drho), de);
 }
 
-// (dv/dt, dρ/dt) on i from a neighbour j of the other material (fluid–solid), see the header:
+// (dv/dt, dρ/dt) on i from a neighbour j of the other material (fluid–solid), docs/equations.md eq. 28:
 // b_i, b_j are P/ρ² of each (P_g for the solid), m_j the neighbour's mass.
 fn interface_rates(b_i: f32, v_i: vec3<f32>, rho_i: f32, b_j: f32, v_j: vec3<f32>, rho_j: f32, m_j: f32, x_ij: vec3<f32>, r2: f32) -> vec4<f32> {
     let f_ij = kernel_f(sqrt(r2) / params.h);

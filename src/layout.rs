@@ -498,6 +498,44 @@ mod tests {
         }
     }
 
+    /// Every particle kind has the same code in Rust (`scenario::Kind`), in the WGSL `KIND_*`
+    /// constants and in the f64 reference.
+    #[test]
+    fn particle_kinds_match_wgsl_and_the_reference() {
+        use crate::reference as r;
+        use crate::scenario::Kind;
+        let reference = [
+            r::FLUID,
+            r::WALL,
+            r::GHOST_NO_SLIP,
+            r::GHOST_FREE_SLIP,
+            r::REPULSIVE,
+            r::elastic::SOLID,
+            r::elastic::SOLID_CLAMPED,
+            r::INLET,
+        ];
+        let wgsl = [
+            "KIND_FLUID",
+            "KIND_WALL",
+            "KIND_GHOST_NO_SLIP",
+            "KIND_GHOST_FREE_SLIP",
+            "KIND_REPULSIVE",
+            "KIND_SOLID",
+            "KIND_SOLID_CLAMPED",
+            "KIND_INLET",
+        ];
+        for ((kind, code), name) in Kind::ALL.into_iter().zip(reference).zip(wgsl) {
+            assert_eq!(kind as u32, code, "{kind:?} in the reference");
+            assert_eq!(wgsl_u32(&interaction::SHADER, name), kind as u32, "{name}");
+        }
+        assert_eq!(
+            wgsl_u32(&interaction::SHADER, "KIND_EXCLUDED"),
+            KIND_EXCLUDED
+        );
+        assert_eq!(r::EXCLUDED, KIND_EXCLUDED);
+        assert_eq!(wgsl_u32(&interaction::SHADER, "KIND_SHIFT"), KIND_SHIFT);
+    }
+
     #[test]
     fn body_flags_match_wgsl() {
         assert_eq!(

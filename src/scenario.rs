@@ -15,7 +15,8 @@ pub enum Kind {
     /// Fixed ghost particle (the seed's improved interface), no-slip: pressure and velocity
     /// interpolated from the fluid every step, v_g = 2 v_wall − Σ v_j W^I_gj V_j.
     GhostNoSlip = 2,
-    /// Fixed ghost particle, free-slip: the interpolated velocity's normal part reversed.
+    /// Fixed ghost particle, free-slip: the interpolated fluid velocity itself in the viscous
+    /// terms (the wall's own in continuity).
     GhostFreeSlip = 3,
     /// Repulsive-force boundary particle (Monaghan 1994, Lennard-Jones form).
     Repulsive = 4,
@@ -29,6 +30,18 @@ pub enum Kind {
 }
 
 impl Kind {
+    /// Every kind, in code order.
+    pub const ALL: [Kind; 8] = [
+        Kind::Fluid,
+        Kind::Wall,
+        Kind::GhostNoSlip,
+        Kind::GhostFreeSlip,
+        Kind::Repulsive,
+        Kind::Solid,
+        Kind::SolidClamped,
+        Kind::Inlet,
+    ];
+
     pub fn is_fluid(self) -> bool {
         self == Kind::Fluid
     }
@@ -44,18 +57,7 @@ impl Kind {
 
     /// The kind of a code word's kind field (None: excluded, or not a kind).
     pub fn from_code(kind: u32) -> Option<Kind> {
-        [
-            Kind::Fluid,
-            Kind::Wall,
-            Kind::GhostNoSlip,
-            Kind::GhostFreeSlip,
-            Kind::Repulsive,
-            Kind::Solid,
-            Kind::SolidClamped,
-            Kind::Inlet,
-        ]
-        .into_iter()
-        .find(|k| *k as u32 == kind)
+        Kind::ALL.into_iter().find(|k| *k as u32 == kind)
     }
 }
 

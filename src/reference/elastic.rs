@@ -1,5 +1,5 @@
 //! Twin of shaders/elastic.wgsl (hypoelastic solid particles, Gray, Monaghan & Swift 2001),
-//! brute force over all pairs, f64. See the shader's header for the equations.
+//! brute force over all pairs, f64. The equations: docs/equations.md eqs. 7, 8, 25–27.
 
 use super::{dot, kernel, RefParticle, Space};
 use crate::scenario::{ContactGroup, ElasticMaterial, Physics, SolidFormulation};
