@@ -275,37 +275,7 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             set,
             checkpoint_every,
             quiet,
-        } => {
-            let ck = Checkpoint::read(&dir.join(CHECKPOINT_FILE))?;
-            let Some(source) = ck.source.clone() else {
-                anyhow::bail!(
-                    "{} does not record its case file (it was written through the library): \
-                     resume it with wgsph::run::resume",
-                    dir.join(CHECKPOINT_FILE).display()
-                );
-            };
-            let overrides: Vec<String> = source.overrides.iter().chain(&set).cloned().collect();
-            let sc = wgsph::case::load(&source.path, &overrides)?;
-            let ctx = context(cli.adapter)?;
-            let options = RunOptions {
-                snapshot_png: ck
-                    .snapshot_field
-                    .as_deref()
-                    .map(|f| f.parse().map_err(anyhow::Error::msg))
-                    .transpose()?,
-                checkpoint: checkpoint_every.unwrap_or_else(CheckpointPolicy::default_for_runs),
-                source: Some(CaseSource {
-                    path: source.path,
-                    overrides,
-                }),
-                interrupt: Some(interrupt_flag()?),
-                halt_at_s: None,
-                ..Default::default()
-            };
-            let report =
-                wgsph::run::resume(&ctx, &sc, &dir, &options, &mut *progress(quiet, bars))?;
-            Ok(finish(&report, &dir, quiet))
-        }
+        } => resume(cli.adapter, &dir, set, checkpoint_every, quiet, bars),
         Command::Plot {
             dir,
             references,
@@ -340,23 +310,7 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             for p in &report.pngs {
                 println!("wrote {}", p.display());
             }
-            for e in &report.errors {
-                println!(
-                    "{}{} {} vs {}: {} points, t in [{:.4}, {:.4}] s: RMS error {:.4e}, max |error| {:.4e} at t = {:.4} s, peak {:.4e} (reference {:.4e})",
-                    e.run,
-                    if e.smooth_s > 0.0 { format!(" ({} s average)", e.smooth_s) } else { String::new() },
-                    e.probe,
-                    e.reference,
-                    e.points,
-                    e.t_start_s,
-                    e.t_end_s,
-                    e.rms_error,
-                    e.max_abs_error,
-                    e.t_max_abs_error_s,
-                    e.peak_sim,
-                    e.peak_reference
-                );
-            }
+            report.errors.iter().for_each(print_error_row);
             if let Some(p) = &report.errors_csv {
                 println!("wrote {}", p.display());
             }
@@ -385,70 +339,143 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             );
             Ok(ExitCode::from(report.exit_status()))
         }
-        Command::Info => {
-            let adapters = list_adapters();
-            if adapters.is_empty() {
-                println!("no adapter found; for a software one: apt-get install mesa-vulkan-drivers libvulkan1");
-            }
-            for (info, limits) in adapters {
-                println!(
-                    "{} ({:?}, {:?}, driver {} {})\n  max storage binding {} MiB, max buffer {} MiB, \
-                     storage buffers/stage {}, workgroups/dim {}",
-                    info.name,
-                    info.backend,
-                    info.device_type,
-                    info.driver,
-                    info.driver_info,
-                    limits.max_storage_buffer_binding_size >> 20,
-                    limits.max_buffer_size >> 20,
-                    limits.max_storage_buffers_per_shader_stage,
-                    limits.max_compute_workgroups_per_dimension
-                );
-                let cap = wgsph::sph::capacity(&limits);
-                println!(
-                    "  fits at most {} particles (bound by {})",
-                    cap.particles, cap.bound_by
-                );
-            }
-            let choice = AdapterChoice::resolve(cli.adapter)?;
-            match GpuContext::new(choice) {
-                Ok(ctx) => println!("'{choice}' selects: {}", ctx.describe()),
-                Err(e) => println!("'{choice}' selects nothing: {e:#}"),
-            }
-            Ok(ExitCode::SUCCESS)
-        }
+        Command::Info => info(cli.adapter),
         Command::Bench {
             case,
             steps,
             warmup,
             set,
             stages,
-        } => {
-            let sc = wgsph::case::load(&case, &set)?;
-            let ctx = context(cli.adapter)?;
-            let mut solver =
-                wgsph::sph::Solver::new(&ctx, &sc).context("setting up the GPU solver")?;
-            solver.run_steps(warmup)?;
-            let start = Instant::now();
-            solver.run_steps(steps)?;
-            let wall = start.elapsed().as_secs_f64();
-            let n = solver.particle_count();
-            println!("case            {}", sc.name);
-            println!("adapter         {}", ctx.describe());
-            println!("particles       {n}");
-            println!("steps           {steps}");
-            println!("wall seconds    {wall:.3}");
-            println!("particle-steps/s {:.4e}", steps as f64 * n as f64 / wall);
-            println!(
-                "bytes/particle  {:.1}",
-                solver.gpu_bytes() as f64 / n as f64
-            );
-            if stages {
-                print_stages(&solver.profile_steps(steps)?, steps, n);
-            }
-            Ok(ExitCode::SUCCESS)
-        }
+        } => bench(cli.adapter, &case, &set, steps, warmup, stages),
     }
+}
+
+/// `wgsph info`: every adapter with its limits and capacity, and the one `adapter` selects.
+fn info(adapter: Option<AdapterChoice>) -> Result<ExitCode> {
+    let adapters = list_adapters();
+    if adapters.is_empty() {
+        println!(
+            "no adapter found; for a software one: apt-get install mesa-vulkan-drivers libvulkan1"
+        );
+    }
+    for (info, limits) in adapters {
+        println!(
+            "{} ({:?}, {:?}, driver {} {})\n  max storage binding {} MiB, max buffer {} MiB, \
+             storage buffers/stage {}, workgroups/dim {}",
+            info.name,
+            info.backend,
+            info.device_type,
+            info.driver,
+            info.driver_info,
+            limits.max_storage_buffer_binding_size >> 20,
+            limits.max_buffer_size >> 20,
+            limits.max_storage_buffers_per_shader_stage,
+            limits.max_compute_workgroups_per_dimension
+        );
+        let cap = wgsph::sph::capacity(&limits);
+        println!(
+            "  fits at most {} particles (bound by {})",
+            cap.particles, cap.bound_by
+        );
+    }
+    let choice = AdapterChoice::resolve(adapter)?;
+    match GpuContext::new(choice) {
+        Ok(ctx) => println!("'{choice}' selects: {}", ctx.describe()),
+        Err(e) => println!("'{choice}' selects nothing: {e:#}"),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `wgsph bench`: `steps` steps of `case` after `warmup`, particle-steps per second and bytes
+/// per particle, and with `stages` each stage's GPU time.
+fn bench(
+    adapter: Option<AdapterChoice>,
+    case: &std::path::Path,
+    set: &[String],
+    steps: u64,
+    warmup: u64,
+    stages: bool,
+) -> Result<ExitCode> {
+    let sc = wgsph::case::load(case, set)?;
+    let ctx = context(adapter)?;
+    let mut solver = wgsph::sph::Solver::new(&ctx, &sc).context("setting up the GPU solver")?;
+    solver.run_steps(warmup)?;
+    let start = Instant::now();
+    solver.run_steps(steps)?;
+    let wall = start.elapsed().as_secs_f64();
+    let n = solver.particle_count();
+    println!("case            {}", sc.name);
+    println!("adapter         {}", ctx.describe());
+    println!("particles       {n}");
+    println!("steps           {steps}");
+    println!("wall seconds    {wall:.3}");
+    println!("particle-steps/s {:.4e}", steps as f64 * n as f64 / wall);
+    println!(
+        "bytes/particle  {:.1}",
+        solver.gpu_bytes() as f64 / n as f64
+    );
+    if stages {
+        print_stages(&solver.profile_steps(steps)?, steps, n);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `wgsph resume DIR`: the run continued from its checkpoint, with `set` over its overrides.
+fn resume(
+    adapter: Option<AdapterChoice>,
+    dir: &std::path::Path,
+    set: Vec<String>,
+    checkpoint_every: Option<CheckpointPolicy>,
+    quiet: bool,
+    bars: &MultiProgress,
+) -> Result<ExitCode> {
+    let ck = Checkpoint::read(&dir.join(CHECKPOINT_FILE))?;
+    let Some(source) = ck.source.clone() else {
+        anyhow::bail!(
+            "{} does not record its case file (it was written through the library): \
+             resume it with wgsph::run::resume",
+            dir.join(CHECKPOINT_FILE).display()
+        );
+    };
+    let overrides: Vec<String> = source.overrides.iter().chain(&set).cloned().collect();
+    let sc = wgsph::case::load(&source.path, &overrides)?;
+    let ctx = context(adapter)?;
+    let options = RunOptions {
+        snapshot_png: ck
+            .snapshot_field
+            .as_deref()
+            .map(|f| f.parse().map_err(anyhow::Error::msg))
+            .transpose()?,
+        checkpoint: checkpoint_every.unwrap_or_else(CheckpointPolicy::default_for_runs),
+        source: Some(CaseSource {
+            path: source.path,
+            overrides,
+        }),
+        interrupt: Some(interrupt_flag()?),
+        halt_at_s: None,
+        ..Default::default()
+    };
+    let report = wgsph::run::resume(&ctx, &sc, dir, &options, &mut *progress(quiet, bars))?;
+    Ok(finish(&report, dir, quiet))
+}
+
+/// One line of `wgsph plot --reference`'s errors.
+fn print_error_row(e: &wgsph::plot::ErrorSummary) {
+    println!(
+        "{}{} {} vs {}: {} points, t in [{:.4}, {:.4}] s: RMS error {:.4e}, max |error| {:.4e} at t = {:.4} s, peak {:.4e} (reference {:.4e})",
+        e.run,
+        if e.smooth_s > 0.0 { format!(" ({} s average)", e.smooth_s) } else { String::new() },
+        e.probe,
+        e.reference,
+        e.points,
+        e.t_start_s,
+        e.t_end_s,
+        e.rms_error,
+        e.max_abs_error,
+        e.t_max_abs_error_s,
+        e.peak_sim,
+        e.peak_reference
+    );
 }
 
 /// The GPU time of each stage per step, its share of the stages' sum, and per particle.
