@@ -10,27 +10,12 @@ use crate::scenario::{
 };
 
 use super::bodies::Shape;
+use super::check::{fmt_box, inside, point_inside, Aabb, Treatment, AXES, TOL};
 use super::error::{num, CaseError};
 use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
 use super::limits;
 use super::locate::Ctx;
-use super::validate::{Aabb, Case, Sound, Treatment, WallSettings};
-
-/// Tolerance for "inside" tests of user boxes [m].
-const TOL: f64 = 1e-9;
-pub(super) const AXES: [&str; 3] = ["x", "y", "z"];
-
-fn inside(b: &Aabb, outer: &Aabb, dim: usize) -> Option<usize> {
-    (0..dim).find(|&a| b.min[a] < outer.min[a] - TOL || b.max[a] > outer.max[a] + TOL)
-}
-
-fn point_inside(p: [f64; 3], b: &Aabb, dim: usize) -> bool {
-    (0..dim).all(|a| b.min[a] - TOL <= p[a] && p[a] <= b.max[a] + TOL)
-}
-
-pub(super) fn fmt_box(b: &Aabb, dim: usize) -> String {
-    format!("{:?} to {:?}", &b.min[..dim], &b.max[..dim])
-}
+use super::validate::{Case, Sound, WallSettings};
 
 pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Scenario, CaseError> {
     let solids_alone = case.tank.is_none() && case.obstacles.is_empty() && case.bodies.is_empty();

@@ -5,9 +5,10 @@
 use crate::scenario::Domain;
 use crate::sph::grid::Grid;
 
+use super::check::Aabb;
 use super::error::{num, CaseError};
 use super::locate::Ctx;
-use super::validate::{Aabb, Case};
+use super::validate::Case;
 
 /// Refuse cases with more particles than this.
 pub const MAX_PARTICLES: f64 = 200e6;

@@ -12,7 +12,7 @@ use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
 
-use super::validate::Aabb;
+use super::check::Aabb;
 
 /// How far, relative to the shape's size, the lines that count crossings are moved off the
 /// points they go through (x, y): far below a spacing, off any round number (also a

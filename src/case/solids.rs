@@ -6,11 +6,12 @@ use crate::scenario::{
     SolidFormulation, Solids,
 };
 
+use super::check::{aabb, number, vector, Aabb, Bound};
 use super::error::{num, CaseError};
 use super::lattice::Lattice;
 use super::locate::Ctx;
 use super::schema::{RawSolid, SolidFormulationName, SolidVelocityName};
-use super::validate::{aabb, number, vector, Aabb, Bound, Case};
+use super::validate::Case;
 use crate::layout::MAX_SOLID_MATERIALS;
 
 /// Initial velocity of a cantilever in its first bending mode (Gray, Monaghan & Swift 2001,
