@@ -915,7 +915,27 @@ fn domain(
         min: d.min,
         max: d.max,
     };
-    limits::grid_fits(ctx, case, &domain, &solid)?;
+    // The fluid's parts: blocks and inlets' buffers.
+    let fluid_parts: Vec<(String, Aabb)> = case
+        .blocks
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (format!("fluid_block[{i}]"), b.bx))
+        .chain(
+            case.inlets
+                .iter()
+                .enumerate()
+                .map(|(i, s)| (format!("inlet[{i}]"), s.bx)),
+        )
+        .collect();
+    limits::grid_fits(
+        ctx,
+        (dim, case.h_over_dx * case.dx),
+        &domain,
+        case.domain.is_some(),
+        &fluid_parts,
+        &solid,
+    )?;
     Ok(domain)
 }
 
