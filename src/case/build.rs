@@ -5,12 +5,12 @@
 use std::collections::HashSet;
 
 use crate::scenario::{
-    Body, Domain, Kind, MirrorPlane, Motion, Particle, Physics, ProbeKind, RepulsiveForm, Scenario,
-    Solids, WallParams,
+    Body, Domain, ElasticMaterial, Kind, MirrorPlane, Motion, Particle, Physics, ProbeKind,
+    RepulsiveForm, Scenario, Solids, WallParams,
 };
 
 use super::bodies::Shape;
-use super::check::{fmt_box, inside, point_inside, Aabb, Treatment, AXES, TOL};
+use super::check::{fmt_box, inside, point_in, point_inside, Aabb, Treatment, AXES, TOL};
 use super::error::{num, CaseError};
 use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
 use super::limits;
@@ -20,7 +20,7 @@ use super::validate::{Case, Sound, WallSettings};
 pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Scenario, CaseError> {
     let solids_alone = case.tank.is_none() && case.obstacles.is_empty() && case.bodies.is_empty();
     if !case.solids.is_empty() && case.blocks.is_empty() && case.inlets.is_empty() && solids_alone {
-        return super::solids::build_solid_case(ctx, case, max_particles);
+        return build_solid_case(ctx, case, max_particles);
     }
     let (dim, dx) = (case.dim, case.dx);
     let v = dim - 1;
@@ -698,6 +698,99 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         inlets,
         outlets: case.outlets,
         warnings,
+    })
+}
+
+/// The scenario of a case whose only particles are solids.
+pub(super) fn build_solid_case(
+    ctx: &Ctx<'_>,
+    case: Case,
+    max_particles: f64,
+) -> Result<Scenario, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
+    let first = &case.solids[0];
+    let (materials, particles, body) =
+        super::solids::solid_particles(ctx, &case.solids, dim, dx, max_particles)?;
+    // Default domain: the solids' box, with half its largest extent of room on every side.
+    let mut bb = first.bx;
+    for s in &case.solids {
+        for a in 0..dim {
+            bb.min[a] = bb.min[a].min(s.bx.min[a]);
+            bb.max[a] = bb.max[a].max(s.bx.max[a]);
+        }
+    }
+    let d = match case.domain {
+        Some(d) => d,
+        None => {
+            let room = (0..dim).map(|a| bb.max[a] - bb.min[a]).fold(0.0, f64::max) * 0.5;
+            let mut d = bb;
+            for a in 0..dim {
+                d.min[a] -= room + 2.0 * dx;
+                d.max[a] += room + 2.0 * dx;
+            }
+            d
+        }
+    };
+    for (i, s) in case.solids.iter().enumerate() {
+        if !(point_in(s.bx.min, &d, dim) && point_in(s.bx.max, &d, dim)) {
+            return Err(ctx.err(
+                &format!("solid[{i}]"),
+                None,
+                "leaves the domain; its particles would be dropped",
+                "enlarge [domain] (or remove it to get the default)",
+            ));
+        }
+    }
+    let n = particles.len();
+    let points = super::probes::resolve_points(ctx, &case.points, &particles, &[], dim, dx)?;
+    let physics = Physics {
+        dim: dim as u32,
+        dx,
+        h: case.h_over_dx * dx,
+        kernel: case.kernel,
+        rho0: case.rho0,
+        // Unused without fluid; the solids' sound speeds enter through their materials.
+        c0: materials
+            .iter()
+            .map(ElasticMaterial::sound_speed)
+            .fold(0.0, f64::max),
+        gamma: case.gamma,
+        gravity: case.gravity,
+        viscosity: case.viscosity,
+        delta_sph: case.delta_sph,
+        delta_sph_form: case.delta_sph_form,
+        particle_mass: case.rho0 * dx.powi(dim as i32),
+        density_filter: case.density_filter,
+        energy: false,
+    };
+    let g = case.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
+    // Solids alone touch only one another. H: from the lowest particle to the highest.
+    let (lo, hi) = particles.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+        (lo.min(p.pos[dim - 1]), hi.max(p.pos[dim - 1]))
+    });
+    let walls = wall_params(ctx, &case.walls, dx, hi - lo + dx, g, case.solids.len() > 1)?;
+    Ok(Scenario {
+        name: case.name,
+        physics,
+        time: case.time,
+        domain: Domain {
+            min: d.min,
+            max: d.max,
+        },
+        particles,
+        probes: case.probes,
+        points,
+        walls,
+        periodic: [false; 3],
+        bodies: Vec::new(),
+        solids: Some(Solids {
+            materials,
+            body,
+            tau0: vec![[0.0; 6]; n],
+        }),
+        inlets: Vec::new(),
+        outlets: Vec::new(),
+        warnings: Vec::new(),
     })
 }
 

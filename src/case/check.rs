@@ -212,6 +212,11 @@ pub(super) fn point_inside(p: [f64; 3], b: &Aabb, dim: usize) -> bool {
     (0..dim).all(|a| b.min[a] - TOL <= p[a] && p[a] <= b.max[a] + TOL)
 }
 
+/// Whether `p` lies in `b`, bounds included (no tolerance).
+pub(super) fn point_in(p: [f64; 3], b: &Aabb, dim: usize) -> bool {
+    (0..dim).all(|a| p[a] >= b.min[a] && p[a] <= b.max[a])
+}
+
 /// `b` as messages write it: `[x0, y0] to [x1, y1]`.
 pub(super) fn fmt_box(b: &Aabb, dim: usize) -> String {
     format!("{:?} to {:?}", &b.min[..dim], &b.max[..dim])
