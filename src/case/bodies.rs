@@ -582,7 +582,8 @@ fn series(
                 Some(format!("{file:?}")),
                 format!("{} line {}: {problem}", full.display(), n + 1),
                 format!(
-                    "write rows of {columns} numbers: t_s, dx_m, dy_m{}, angle_deg, with t increasing",
+                    "write rows of {columns} numbers: t_s, dx_m, dy_m{}, angle_deg, with t \
+                     increasing",
                     if dim == 3 { ", dz_m" } else { "" }
                 ),
             )

@@ -70,7 +70,21 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
                 } else {
                     "max_m"
                 };
-                return Err(ctx.err(&format!("{path}.{field}"), Some(format!("{:?}", &(if field == "min_m" { b.bx.min } else { b.bx.max })[..dim])), format!("the block ({}) leaves the tank's inner box ({}) along {}", fmt_box(&b.bx, dim), fmt_box(&t.inner, dim), AXES[a]), "keep fluid blocks inside the tank: min_m >= tank.min_m and max_m <= tank.max_m"));
+                return Err(ctx.err(
+                    &format!("{path}.{field}"),
+                    Some(format!(
+                        "{:?}",
+                        &(if field == "min_m" { b.bx.min } else { b.bx.max })[..dim]
+                    )),
+                    format!(
+                        "the block ({}) leaves the tank's inner box ({}) along {}",
+                        fmt_box(&b.bx, dim),
+                        fmt_box(&t.inner, dim),
+                        AXES[a]
+                    ),
+                    "keep fluid blocks inside the tank: min_m >= tank.min_m and max_m <= \
+                     tank.max_m",
+                ));
             }
         }
         let mut n = [1.0; 3];
@@ -78,7 +92,18 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             let len = b.bx.max[a] - b.bx.min[a];
             *na = cells(len, dx);
             if *na < 1.0 {
-                return Err(ctx.err(&format!("{path}.max_m"), None, format!("the block is {} m thick along {}, too thin to hold one particle at dx = {} m", num(len), AXES[a], num(dx)), "make the block at least dx thick, or decrease particles.dx_m"));
+                return Err(ctx.err(
+                    &format!("{path}.max_m"),
+                    None,
+                    format!(
+                        "the block is {} m thick along {}, too thin to hold one particle at \
+                         dx = {} m",
+                        num(len),
+                        AXES[a],
+                        num(dx)
+                    ),
+                    "make the block at least dx thick, or decrease particles.dx_m",
+                ));
             }
         }
         for (j, other) in case.blocks[..i].iter().enumerate() {
@@ -115,7 +140,17 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     let mut obstacle_ranges = Vec::with_capacity(case.obstacles.len());
     for (i, o) in case.obstacles.iter().enumerate() {
         let Some(r) = lat.range_in(o) else {
-            return Err(ctx.err(&format!("obstacle[{i}].max_m"), None, format!("the obstacle ({}) is too thin to hold one wall particle on the particle lattice (spacing dx = {} m)", fmt_box(o, dim), num(dx)), "make it at least dx thick along every axis, or decrease particles.dx_m"));
+            return Err(ctx.err(
+                &format!("obstacle[{i}].max_m"),
+                None,
+                format!(
+                    "the obstacle ({}) is too thin to hold one wall particle on the particle \
+                     lattice (spacing dx = {} m)",
+                    fmt_box(o, dim),
+                    num(dx)
+                ),
+                "make it at least dx thick along every axis, or decrease particles.dx_m",
+            ));
         };
         obstacle_ranges.push(r);
     }
@@ -127,7 +162,18 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         let path = format!("inlet[{i}]");
         if let Some((t, _)) = &tank {
             if let Some(a) = inside(&s.bx, &t.inner, dim) {
-                return Err(ctx.err(&path, None, format!("the buffer box ({}) leaves the tank's inner box ({}) along {}", fmt_box(&s.bx, dim), fmt_box(&t.inner, dim), AXES[a]), "keep inlets inside the tank: a nozzle through a wall is a gap in an obstacle, with the buffer inside the tank"));
+                return Err(ctx.err(
+                    &path,
+                    None,
+                    format!(
+                        "the buffer box ({}) leaves the tank's inner box ({}) along {}",
+                        fmt_box(&s.bx, dim),
+                        fmt_box(&t.inner, dim),
+                        AXES[a]
+                    ),
+                    "keep inlets inside the tank: a nozzle through a wall is a gap in an \
+                     obstacle, with the buffer inside the tank",
+                ));
             }
         }
         let overlaps = |b: &Aabb| {
@@ -255,7 +301,19 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             let inflow = case.inlets.iter().map(|s| s.speed).fold(0.0, f64::max);
             let c = k * (g * depth).sqrt().max(inflow);
             if !c.is_finite() || c <= 0.0 {
-                return Err(ctx.err("physics.sound_speed_coef", Some(num(k)), format!("gives c0 = coef * max(sqrt(|g| * H), inlet speed) = {} m/s with |g| = {} m/s² (physics.gravity_m_s2) and H = {} m (the deepest fluid block)", num(c), num(g), num(depth)), "give physics.sound_speed_m_s instead"));
+                return Err(ctx.err(
+                    "physics.sound_speed_coef",
+                    Some(num(k)),
+                    format!(
+                        "gives c0 = coef * max(sqrt(|g| * H), inlet speed) = {} m/s with |g| \
+                         = {} m/s² (physics.gravity_m_s2) and H = {} m (the deepest fluid \
+                         block)",
+                        num(c),
+                        num(g),
+                        num(depth)
+                    ),
+                    "give physics.sound_speed_m_s instead",
+                ));
             }
             c
         }
@@ -267,7 +325,20 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     };
     let tait_b = c0 * c0 * case.rho0 / case.gamma;
     if !(tait_b.is_finite() && tait_b > 0.0) {
-        return Err(ctx.err(sound_path, Some(num(sound_value)), format!("gives a Tait stiffness B = c0² rho0 / gamma = {} Pa that cannot be computed with (c0 = {} m/s, physics.rho0_kg_m3 = {}, physics.gamma = {})", num(tait_b), num(c0), num(case.rho0), num(case.gamma)), "use a realistic speed of sound, about 10 times the largest flow speed, and a realistic physics.rho0_kg_m3"));
+        return Err(ctx.err(
+            sound_path,
+            Some(num(sound_value)),
+            format!(
+                "gives a Tait stiffness B = c0² rho0 / gamma = {} Pa that cannot be computed \
+                 with (c0 = {} m/s, physics.rho0_kg_m3 = {}, physics.gamma = {})",
+                num(tait_b),
+                num(c0),
+                num(case.rho0),
+                num(case.gamma)
+            ),
+            "use a realistic speed of sound, about 10 times the largest flow speed, and a \
+             realistic physics.rho0_kg_m3",
+        ));
     }
     if let Some((i, s)) = case.inlets.iter().enumerate().find(|(_, s)| s.speed >= c0) {
         return Err(ctx.err(

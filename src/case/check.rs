@@ -85,7 +85,8 @@ pub(super) fn vector(
             path,
             Some(format!("{v:?}")),
             format!(
-                "has {} components but this {dim}D case (dimension = {dim}) needs {dim}: {axes} ({what})",
+                "has {} components but this {dim}D case (dimension = {dim}) needs {dim}: {axes} \
+                 ({what})",
                 v.len()
             ),
             format!("give {dim} numbers, {axes}"),
@@ -180,7 +181,8 @@ pub(super) fn treatment(
                     &format!("{path}.slip"),
                     Some(written.into()),
                     format!(
-                        "is only used with wall = \"mirror\" or \"fixed_ghost\", but the wall is \"{}\"",
+                        "is only used with wall = \"mirror\" or \"fixed_ghost\", but the wall is \
+                         \"{}\"",
                         wall.as_str()
                     ),
                     "remove slip, or set wall = \"fixed_ghost\"",

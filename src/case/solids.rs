@@ -203,7 +203,8 @@ pub(super) fn validate_solid(
                     &format!("{path}.clamped_max_m"),
                     Some(format!("{hi:?}")),
                     format!(
-                        "clamped_max_m[{a}] = {} is not above clamped_min_m[{a}] = {} (the clamped region would be empty)",
+                        "clamped_max_m[{a}] = {} is not above clamped_min_m[{a}] = {} (the \
+                         clamped region would be empty)",
                         max[a], min[a]
                     ),
                     "make every component of clamped_max_m larger than that of clamped_min_m",
@@ -422,7 +423,8 @@ pub(super) fn solid_particles(
                             &format!("solid[{i}].initial_velocity"),
                             None,
                             format!("gives a non-finite velocity at {pos:?}"),
-                            "give a length_m of the order of the solid's length and a finite tip_velocity_m_s",
+                            "give a length_m of the order of the solid's length and a finite \
+                             tip_velocity_m_s",
                         ));
                     }
                     particles.push(Particle {

@@ -205,15 +205,30 @@ pub(super) fn validate(
                 "keep only one of them",
             ))
         }
-        (Some(c), None) => Sound::Speed(number(ctx, "physics.sound_speed_m_s", c, Bound::Positive, "the numerical speed of sound c0 in m/s", "give a positive speed, about 10 times the largest expected flow speed")?),
-        (None, Some(k)) => Sound::Coef(number(ctx, "physics.sound_speed_coef", k, Bound::Positive, "c0 = coef * sqrt(|g| * H)", "use e.g. 10.0")?),
+        (Some(c), None) => Sound::Speed(number(
+            ctx,
+            "physics.sound_speed_m_s",
+            c,
+            Bound::Positive,
+            "the numerical speed of sound c0 in m/s",
+            "give a positive speed, about 10 times the largest expected flow speed",
+        )?),
+        (None, Some(k)) => Sound::Coef(number(
+            ctx,
+            "physics.sound_speed_coef",
+            k,
+            Bound::Positive,
+            "c0 = coef * sqrt(|g| * H)",
+            "use e.g. 10.0",
+        )?),
         // A solid-only case has no fluid to give a sound speed to (unused; see solids.rs).
         (None, None) if raw.fluid_block.is_empty() && !raw.solid.is_empty() => Sound::Speed(1.0),
         (None, None) => {
             return Err(ctx.err(
                 "physics.sound_speed_coef",
                 None,
-                "the speed of sound is not given: [physics] needs exactly one of sound_speed_m_s (c0 in m/s) or sound_speed_coef (c0 = coef * sqrt(|g| * H))",
+                "the speed of sound is not given: [physics] needs exactly one of sound_speed_m_s \
+                 (c0 in m/s) or sound_speed_coef (c0 = coef * sqrt(|g| * H))",
                 "add sound_speed_coef = 10.0 to [physics]",
             ))
         }
@@ -229,7 +244,13 @@ pub(super) fn validate(
     let viscosity = match ph.viscosity.unwrap_or(ViscosityName::Artificial) {
         ViscosityName::Artificial => {
             if let Some(nu) = ph.nu_m2_s {
-                return Err(ctx.err("physics.nu_m2_s", Some(num(nu)), "is only used with viscosity = \"laminar\", but the viscosity is \"artificial\"", "remove nu_m2_s, or set viscosity = \"laminar\""));
+                return Err(ctx.err(
+                    "physics.nu_m2_s",
+                    Some(num(nu)),
+                    "is only used with viscosity = \"laminar\", but the viscosity is \
+                     \"artificial\"",
+                    "remove nu_m2_s, or set viscosity = \"laminar\"",
+                ));
             }
             let alpha = number(
                 ctx,
@@ -243,7 +264,13 @@ pub(super) fn validate(
         }
         ViscosityName::Laminar => {
             if let Some(a) = ph.alpha {
-                return Err(ctx.err("physics.alpha", Some(num(a)), "is only used with viscosity = \"artificial\", but the viscosity is \"laminar\"", "remove alpha, or set viscosity = \"artificial\""));
+                return Err(ctx.err(
+                    "physics.alpha",
+                    Some(num(a)),
+                    "is only used with viscosity = \"artificial\", but the viscosity is \
+                     \"laminar\"",
+                    "remove alpha, or set viscosity = \"artificial\"",
+                ));
             }
             let Some(nu) = ph.nu_m2_s else {
                 return Err(ctx.err(
@@ -462,7 +489,8 @@ pub(super) fn validate(
                         d,
                         Bound::Positive,
                         "the Lennard-Jones strength D of repulsive walls in m²/s²",
-                        "use about 5 |g| H, e.g. 24.5 for 0.5 m of water, or remove it for that default",
+                        "use about 5 |g| H, e.g. 24.5 for 0.5 m of water, or remove it for that \
+                         default",
                     )
                 })
                 .transpose()?,
@@ -492,7 +520,8 @@ pub(super) fn validate(
                         k,
                         Bound::Positive,
                         "the Monaghan & Kajtar strength K of repulsive walls in m²/s²",
-                        "use about |g| H, e.g. 4.9 for 0.5 m of water, or remove it for that default",
+                        "use about |g| H, e.g. 4.9 for 0.5 m of water, or remove it for that \
+                         default",
                     )
                 })
                 .transpose()?,
@@ -663,7 +692,8 @@ fn density_filter(ctx: &Ctx<'_>, ph: &RawPhysics) -> Result<DensityFilter, CaseE
             return Err(ctx.err(
                 "physics.density_filter_every",
                 Some(n.to_string()),
-                "is only used with density_filter = \"shepard\" or \"mls\", but the filter is \"none\"",
+                "is only used with density_filter = \"shepard\" or \"mls\", but the filter is \
+                 \"none\"",
                 "remove density_filter_every, or set density_filter = \"shepard\" or \"mls\"",
             ));
         }
