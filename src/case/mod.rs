@@ -10,6 +10,7 @@ mod bodies;
 mod build;
 mod check;
 mod diagnose;
+mod domain;
 mod error;
 mod friction;
 mod lattice;
