@@ -1152,39 +1152,9 @@ pub(super) fn build_solid_case(
     max_particles: f64,
 ) -> Result<Scenario, CaseError> {
     let (dim, dx) = (case.dim, case.dx);
-    let first = &case.solids[0];
     let (materials, particles, body) =
         super::solids::solid_particles(ctx, &case.solids, dim, dx, max_particles)?;
-    // Default domain: the solids' box, with half its largest extent of room on every side.
-    let mut bb = first.bx;
-    for s in &case.solids {
-        for a in 0..dim {
-            bb.min[a] = bb.min[a].min(s.bx.min[a]);
-            bb.max[a] = bb.max[a].max(s.bx.max[a]);
-        }
-    }
-    let d = match case.domain {
-        Some(d) => d,
-        None => {
-            let room = (0..dim).map(|a| bb.max[a] - bb.min[a]).fold(0.0, f64::max) * 0.5;
-            let mut d = bb;
-            for a in 0..dim {
-                d.min[a] -= room + 2.0 * dx;
-                d.max[a] += room + 2.0 * dx;
-            }
-            d
-        }
-    };
-    for (i, s) in case.solids.iter().enumerate() {
-        if !(point_in(s.bx.min, &d, dim) && point_in(s.bx.max, &d, dim)) {
-            return Err(ctx.err(
-                &format!("solid[{i}]"),
-                None,
-                "leaves the domain; its particles would be dropped",
-                "enlarge [domain] (or remove it to get the default)",
-            ));
-        }
-    }
+    let d = solid_case_domain(ctx, &case)?;
     let n = particles.len();
     let points = super::probes::resolve_points(ctx, &case.points, &particles, &[], dim, dx)?;
     let physics = Physics {
@@ -1236,6 +1206,44 @@ pub(super) fn build_solid_case(
         outlets: Vec::new(),
         warnings: Vec::new(),
     })
+}
+
+/// The domain of a case of solids alone: the given one, or the solids' box with half its
+/// largest extent of room on every side; every solid inside it.
+fn solid_case_domain(ctx: &Ctx<'_>, case: &Case) -> Result<Aabb, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
+    let first = &case.solids[0];
+    // Default domain: the solids' box, with half its largest extent of room on every side.
+    let mut bb = first.bx;
+    for s in &case.solids {
+        for a in 0..dim {
+            bb.min[a] = bb.min[a].min(s.bx.min[a]);
+            bb.max[a] = bb.max[a].max(s.bx.max[a]);
+        }
+    }
+    let d = match case.domain {
+        Some(d) => d,
+        None => {
+            let room = (0..dim).map(|a| bb.max[a] - bb.min[a]).fold(0.0, f64::max) * 0.5;
+            let mut d = bb;
+            for a in 0..dim {
+                d.min[a] -= room + 2.0 * dx;
+                d.max[a] += room + 2.0 * dx;
+            }
+            d
+        }
+    };
+    for (i, s) in case.solids.iter().enumerate() {
+        if !(point_in(s.bx.min, &d, dim) && point_in(s.bx.max, &d, dim)) {
+            return Err(ctx.err(
+                &format!("solid[{i}]"),
+                None,
+                "leaves the domain; its particles would be dropped",
+                "enlarge [domain] (or remove it to get the default)",
+            ));
+        }
+    }
+    Ok(d)
 }
 
 /// The wall parameters: `[walls]` over the defaults for spacing `dx`, height H = `height` and
