@@ -9,13 +9,12 @@ use std::sync::Arc;
 
 use crate::scenario::{Motion, MotionLaw, Prescribed};
 
+use super::check::{aabb, number, read_bounded, treatment, vector, Aabb, Bound, Treatment};
 use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::mesh::Mesh;
 use super::polygon::Polygon;
 use super::schema::{MotionName, RawBody, RawMotion, ShapeName};
-use super::validate::Treatment;
-use super::validate::{aabb, number, vector, Aabb, Bound};
 
 #[derive(Debug, Clone, PartialEq)]
 pub(super) enum Shape {
@@ -77,7 +76,7 @@ pub(super) fn validate(
                 "give every body a different name",
             ));
         }
-        let wall = super::validate::treatment(ctx, &path, b.wall, b.slip)?;
+        let wall = treatment(ctx, &path, b.wall, b.slip)?;
         if let Treatment::Mirror { .. } = wall {
             return Err(ctx.err(
                 &format!("{path}.wall"),
@@ -560,7 +559,7 @@ fn series(
             ));
         }
     }
-    let text = super::read_bounded(&full, 256 << 20).map_err(|e| {
+    let text = read_bounded(&full, 256 << 20).map_err(|e| {
         ctx.err(
             path,
             Some(format!("{file:?}")),
@@ -583,7 +582,8 @@ fn series(
                 Some(format!("{file:?}")),
                 format!("{} line {}: {problem}", full.display(), n + 1),
                 format!(
-                    "write rows of {columns} numbers: t_s, dx_m, dy_m{}, angle_deg, with t increasing",
+                    "write rows of {columns} numbers: t_s, dx_m, dy_m{}, angle_deg, with t \
+                     increasing",
                     if dim == 3 { ", dz_m" } else { "" }
                 ),
             )

@@ -5,87 +5,208 @@
 use std::collections::HashSet;
 
 use crate::scenario::{
-    Body, Domain, Kind, MirrorPlane, Motion, Particle, Physics, ProbeKind, RepulsiveForm, Scenario,
-    Solids, WallParams,
+    Body, Domain, ElasticMaterial, Inlet, Kind, MirrorPlane, Motion, Particle, Physics, Probe,
+    ProbeKind, RepulsiveForm, Scenario, Solids, WallParams,
 };
 
 use super::bodies::Shape;
+use super::check::{fmt_box, inside, point_in, point_inside, Aabb, Treatment, AXES, TOL};
+use super::domain::domain;
 use super::error::{num, CaseError};
 use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
 use super::limits;
 use super::locate::Ctx;
-use super::validate::{Aabb, Case, Sound, Treatment, WallSettings};
+use super::validate::{Block, Case, Sound, WallSettings};
 
-/// Tolerance for "inside" tests of user boxes [m].
-const TOL: f64 = 1e-9;
-pub(super) const AXES: [&str; 3] = ["x", "y", "z"];
+/// An obstacle's range of lattice indices: the first and the last, as floats.
+type IndexRange = ([f64; 3], [f64; 3]);
 
-fn inside(b: &Aabb, outer: &Aabb, dim: usize) -> Option<usize> {
-    (0..dim).find(|&a| b.min[a] < outer.min[a] - TOL || b.max[a] > outer.max[a] + TOL)
-}
+/// The elastic solids placed: their materials and the solid of each particle.
+type Placed = (Vec<ElasticMaterial>, Vec<u32>);
 
-fn point_inside(p: [f64; 3], b: &Aabb, dim: usize) -> bool {
-    (0..dim).all(|a| b.min[a] - TOL <= p[a] && p[a] <= b.max[a] + TOL)
-}
-
-pub(super) fn fmt_box(b: &Aabb, dim: usize) -> String {
-    format!("{:?} to {:?}", &b.min[..dim], &b.max[..dim])
-}
-
+/// The scenario of `case`, built in stages, each a function below in this order (so an error
+/// is that of the first stage that finds one):
+///
+/// 1. the parts on the particle lattice, checked ([`Geometry::of`]: tank, fluid blocks,
+///    lattice, obstacles, inlets);
+/// 2. the particle budget ([`particle_budget`]), before anything is allocated;
+/// 3. the elastic solids' particles ([`elastic_solids`]);
+/// 4. the domain ([`domain`]);
+/// 5. the speed of sound and the hydrostatic start ([`Start::of`]);
+/// 6. the particles: fluid ([`fluid_particles`]), inlets, walls ([`wall_particles`], and
+///    [`mirror_planes`]), elastic solids ([`place_solids`]), bodies ([`bodies`]), checked
+///    together ([`check_particles`]);
+/// 7. probes, warnings, physics and wall parameters ([`finish`]).
+///
+/// A case of elastic solids alone is built by [`build_solid_case`].
 pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Scenario, CaseError> {
     let solids_alone = case.tank.is_none() && case.obstacles.is_empty() && case.bodies.is_empty();
     if !case.solids.is_empty() && case.blocks.is_empty() && case.inlets.is_empty() && solids_alone {
-        return super::solids::build_solid_case(ctx, case, max_particles);
+        return build_solid_case(ctx, case, max_particles);
     }
-    let (dim, dx) = (case.dim, case.dx);
-    let v = dim - 1;
-    let layers = case.tank.as_ref().map_or(3, |t| t.layers as i64);
-    // Particle layers of the tank wall: `layers` for dynamic and fixed-ghost walls, the one
-    // nearest the fluid for repulsive walls, none for mirror planes.
-    let wall_layers = case.tank.as_ref().map_or(layers, |t| match t.wall {
-        Treatment::Dynamic | Treatment::FixedGhost { .. } => layers,
-        Treatment::Repulsive => 1,
-        Treatment::Mirror { .. } => 0,
-    });
+    let geo = Geometry::of(ctx, &case)?;
+    let total = particle_budget(ctx, &case, &geo, max_particles)?;
+    let wall = geo.tank_cells.map(|n| geo.tank_wall(&case, n));
+    let elastic = elastic_solids(ctx, &case, max_particles - total)?;
+    let domain = domain(ctx, &case, &geo.lat, wall.as_ref())?;
+    let start = Start::of(ctx, &case, elastic.as_ref())?;
 
-    // Tank cells along each axis.
-    let tank = match &case.tank {
-        None => None,
-        Some(t) => {
-            let mut n = [1.0; 3];
-            for (a, na) in n.iter_mut().enumerate().take(dim) {
-                *na = cells(t.inner.max[a] - t.inner.min[a], dx);
-                limits::tank_length(ctx, t.inner.max[a] - t.inner.min[a], *na, AXES[a])?;
-                if *na < 1.0 {
-                    return Err(ctx.err(
-                        "tank.max_m",
-                        None,
-                        format!(
-                            "the tank is {} m along {}, less than one particle spacing dx = {} m",
-                            num(t.inner.max[a] - t.inner.min[a]),
-                            AXES[a],
-                            num(dx)
-                        ),
-                        "make the tank larger or particles.dx_m smaller",
-                    ));
-                }
-            }
-            Some((t, n))
-        }
+    let mut particles = fluid_particles(ctx, &case, &geo, elastic.as_ref(), &start, total)?;
+    // Inlets right after the fluid blocks (their particles become fluid).
+    let inlets: Vec<_> = case
+        .inlets
+        .iter()
+        .zip(geo.inlet_layouts)
+        .map(|(s, l)| {
+            let rho_at = |depth| start.rho_at(depth);
+            super::open_boundaries::build(s, l, &geo.lat, case.gravity, &rho_at, &mut particles)
+        })
+        .collect();
+    let rho = BoundaryRho {
+        blocks: &case.blocks,
+        start: &start,
+        reach: geo.layers as f64 * case.dx + case.dx,
+        v: case.dim - 1,
     };
+    let tank_particles = wall_particles(
+        &case,
+        (&geo.lat, &geo.obstacle_ranges),
+        wall.as_ref(),
+        &rho,
+        &mut particles,
+    );
+    let mirror_planes = mirror_planes(&case, &geo.lat, wall.as_ref());
+    let solids = place_solids(ctx, case.dim, elastic, &domain, &mut particles)?;
+    let bodies = bodies(ctx, &case, &rho, tank_particles, &mut particles)?;
+    check_particles(ctx, &case, &start, &particles, solids.as_ref())?;
 
-    // Fluid blocks: inside the tank, at least one particle thick, not overlapping.
+    let built = Built {
+        domain,
+        particles,
+        bodies,
+        solids,
+        inlets,
+        mirror_planes,
+    };
+    finish(ctx, case, &geo.obstacle_ranges, geo.h, &start, built)
+}
+
+/// The parts of a case on the particle lattice, checked: what [`Geometry::of`] finds.
+struct Geometry {
+    /// Particle layers of the tank (3 without a tank).
+    layers: i64,
+    /// Particle layers of the tank wall: `layers` for dynamic and fixed-ghost walls, the one
+    /// nearest the fluid for repulsive walls, none for mirror planes.
+    wall_layers: i64,
+    /// The tank's cells along each axis (`None`: no tank).
+    tank_cells: Option<[f64; 3]>,
+    /// Each fluid block's cells along each axis.
+    block_cells: Vec<[f64; 3]>,
+    /// The global lattice, continued by walls and obstacles.
+    lat: Lattice,
+    /// Each obstacle's range of lattice indices (first and last, as floats).
+    obstacle_ranges: Vec<IndexRange>,
+    /// The smoothing length.
+    h: f64,
+    /// Each inlet's layout on the lattice.
+    inlet_layouts: Vec<super::open_boundaries::Layout>,
+}
+
+impl Geometry {
+    /// Checks the tank, the fluid blocks, the obstacles and the inlets against each other and
+    /// the lattice, in this order.
+    fn of(ctx: &Ctx<'_>, case: &Case) -> Result<Geometry, CaseError> {
+        let layers = case.tank.as_ref().map_or(3, |t| t.layers as i64);
+        let wall_layers = case.tank.as_ref().map_or(layers, |t| match t.wall {
+            Treatment::Dynamic | Treatment::FixedGhost { .. } => layers,
+            Treatment::Repulsive => 1,
+            Treatment::Mirror { .. } => 0,
+        });
+        let tank_cells = tank_cells(ctx, case)?;
+        let block_cells = block_cells(ctx, case)?;
+        let lat = lattice(case);
+        let obstacle_ranges = obstacle_ranges(ctx, case, &lat)?;
+        let h = case.h_over_dx * case.dx;
+        let inlet_layouts = inlet_layouts(ctx, case, &lat, h)?;
+        Ok(Geometry {
+            layers,
+            wall_layers,
+            tank_cells,
+            block_cells,
+            lat,
+            obstacle_ranges,
+            h,
+            inlet_layouts,
+        })
+    }
+
+    /// The particle layers of a tank of `n` cells along each axis.
+    fn tank_wall(&self, case: &Case, n: [f64; 3]) -> TankWall {
+        TankWall {
+            n: n.map(|c| c.min(1e15) as i64),
+            layers: self.wall_layers,
+            open_top: case.tank.as_ref().is_none_or(|t| t.open_top),
+            dim: case.dim,
+        }
+    }
+}
+
+/// Tank cells along each axis (`None` without a tank): at least one, and not too many.
+fn tank_cells(ctx: &Ctx<'_>, case: &Case) -> Result<Option<[f64; 3]>, CaseError> {
+    let Some(t) = &case.tank else {
+        return Ok(None);
+    };
+    let (dim, dx) = (case.dim, case.dx);
+    let mut n = [1.0; 3];
+    for (a, na) in n.iter_mut().enumerate().take(dim) {
+        *na = cells(t.inner.max[a] - t.inner.min[a], dx);
+        limits::tank_length(ctx, t.inner.max[a] - t.inner.min[a], *na, AXES[a])?;
+        if *na < 1.0 {
+            return Err(ctx.err(
+                "tank.max_m",
+                None,
+                format!(
+                    "the tank is {} m along {}, less than one particle spacing dx = {} m",
+                    num(t.inner.max[a] - t.inner.min[a]),
+                    AXES[a],
+                    num(dx)
+                ),
+                "make the tank larger or particles.dx_m smaller",
+            ));
+        }
+    }
+    Ok(Some(n))
+}
+
+/// Each fluid block's cells along each axis. Fluid blocks: inside the tank, at least one
+/// particle thick, not overlapping.
+fn block_cells(ctx: &Ctx<'_>, case: &Case) -> Result<Vec<[f64; 3]>, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
     let mut block_cells = Vec::with_capacity(case.blocks.len());
     for (i, b) in case.blocks.iter().enumerate() {
         let path = format!("fluid_block[{i}]");
-        if let Some((t, _)) = &tank {
+        if let Some(t) = &case.tank {
             if let Some(a) = inside(&b.bx, &t.inner, dim) {
                 let field = if b.bx.min[a] < t.inner.min[a] - TOL {
                     "min_m"
                 } else {
                     "max_m"
                 };
-                return Err(ctx.err(&format!("{path}.{field}"), Some(format!("{:?}", &(if field == "min_m" { b.bx.min } else { b.bx.max })[..dim])), format!("the block ({}) leaves the tank's inner box ({}) along {}", fmt_box(&b.bx, dim), fmt_box(&t.inner, dim), AXES[a]), "keep fluid blocks inside the tank: min_m >= tank.min_m and max_m <= tank.max_m"));
+                return Err(ctx.err(
+                    &format!("{path}.{field}"),
+                    Some(format!(
+                        "{:?}",
+                        &(if field == "min_m" { b.bx.min } else { b.bx.max })[..dim]
+                    )),
+                    format!(
+                        "the block ({}) leaves the tank's inner box ({}) along {}",
+                        fmt_box(&b.bx, dim),
+                        fmt_box(&t.inner, dim),
+                        AXES[a]
+                    ),
+                    "keep fluid blocks inside the tank: min_m >= tank.min_m and max_m <= \
+                     tank.max_m",
+                ));
             }
         }
         let mut n = [1.0; 3];
@@ -93,7 +214,18 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             let len = b.bx.max[a] - b.bx.min[a];
             *na = cells(len, dx);
             if *na < 1.0 {
-                return Err(ctx.err(&format!("{path}.max_m"), None, format!("the block is {} m thick along {}, too thin to hold one particle at dx = {} m", num(len), AXES[a], num(dx)), "make the block at least dx thick, or decrease particles.dx_m"));
+                return Err(ctx.err(
+                    &format!("{path}.max_m"),
+                    None,
+                    format!(
+                        "the block is {} m thick along {}, too thin to hold one particle at \
+                         dx = {} m",
+                        num(len),
+                        AXES[a],
+                        num(dx)
+                    ),
+                    "make the block at least dx thick, or decrease particles.dx_m",
+                ));
             }
         }
         for (j, other) in case.blocks[..i].iter().enumerate() {
@@ -113,9 +245,12 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         }
         block_cells.push(n);
     }
+    Ok(block_cells)
+}
 
-    // The global lattice, continued by walls and obstacles.
-    let lat = Lattice {
+/// The global lattice, continued by walls and obstacles.
+fn lattice(case: &Case) -> Lattice {
+    Lattice {
         // The tank's inner corner, else the first fluid block's, else the first inlet's, else
         // (solids and walls without fluid) the first solid's.
         origin: match (&case.tank, case.blocks.first(), case.inlets.first()) {
@@ -124,25 +259,63 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             (None, None, Some(i)) => i.bx.min,
             (None, None, None) => case.solids[0].bx.min,
         },
-        dx,
-        dim,
-    };
+        dx: case.dx,
+        dim: case.dim,
+    }
+}
+
+/// Each obstacle's range of lattice indices: at least one point along every axis.
+fn obstacle_ranges(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    lat: &Lattice,
+) -> Result<Vec<IndexRange>, CaseError> {
     let mut obstacle_ranges = Vec::with_capacity(case.obstacles.len());
     for (i, o) in case.obstacles.iter().enumerate() {
         let Some(r) = lat.range_in(o) else {
-            return Err(ctx.err(&format!("obstacle[{i}].max_m"), None, format!("the obstacle ({}) is too thin to hold one wall particle on the particle lattice (spacing dx = {} m)", fmt_box(o, dim), num(dx)), "make it at least dx thick along every axis, or decrease particles.dx_m"));
+            return Err(ctx.err(
+                &format!("obstacle[{i}].max_m"),
+                None,
+                format!(
+                    "the obstacle ({}) is too thin to hold one wall particle on the particle \
+                     lattice (spacing dx = {} m)",
+                    fmt_box(o, case.dim),
+                    num(case.dx)
+                ),
+                "make it at least dx thick along every axis, or decrease particles.dx_m",
+            ));
         };
         obstacle_ranges.push(r);
     }
+    Ok(obstacle_ranges)
+}
 
-    // Inlets: inside the tank, clear of fluid blocks and obstacles, on the lattice.
-    let h = case.h_over_dx * dx;
+/// Each inlet's layout. Inlets: inside the tank, clear of fluid blocks and obstacles, on the
+/// lattice.
+fn inlet_layouts(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    lat: &Lattice,
+    h: f64,
+) -> Result<Vec<super::open_boundaries::Layout>, CaseError> {
+    let dim = case.dim;
     let mut inlet_layouts = Vec::with_capacity(case.inlets.len());
     for (i, s) in case.inlets.iter().enumerate() {
         let path = format!("inlet[{i}]");
-        if let Some((t, _)) = &tank {
+        if let Some(t) = &case.tank {
             if let Some(a) = inside(&s.bx, &t.inner, dim) {
-                return Err(ctx.err(&path, None, format!("the buffer box ({}) leaves the tank's inner box ({}) along {}", fmt_box(&s.bx, dim), fmt_box(&t.inner, dim), AXES[a]), "keep inlets inside the tank: a nozzle through a wall is a gap in an obstacle, with the buffer inside the tank"));
+                return Err(ctx.err(
+                    &path,
+                    None,
+                    format!(
+                        "the buffer box ({}) leaves the tank's inner box ({}) along {}",
+                        fmt_box(&s.bx, dim),
+                        fmt_box(&t.inner, dim),
+                        AXES[a]
+                    ),
+                    "keep inlets inside the tank: a nozzle through a wall is a gap in an \
+                     obstacle, with the buffer inside the tank",
+                ));
             }
         }
         let overlaps = |b: &Aabb| {
@@ -176,29 +349,38 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
                 "make the buffer box touch other parts without overlapping them",
             ));
         }
-        inlet_layouts.push(super::open_boundaries::layout(ctx, i, s, &lat, h)?);
+        inlet_layouts.push(super::open_boundaries::layout(ctx, i, s, lat, h)?);
     }
+    Ok(inlet_layouts)
+}
 
-    // Particle budget, before anything is allocated: every part's count (for a body, the
-    // lattice its particles are picked from, so that a long thin box counts its true length).
-    let wall_of = |n: [f64; 3]| TankWall {
-        n: n.map(|c| c.min(1e15) as i64),
-        layers: wall_layers,
-        open_top: case.tank.as_ref().is_none_or(|t| t.open_top),
-        dim,
-    };
+/// The particle count of the case, checked against `max_particles` before anything is
+/// allocated: every part's count (for a body, the lattice its particles are picked from, so
+/// that a long thin box counts its true length).
+fn particle_budget(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    geo: &Geometry,
+    max_particles: f64,
+) -> Result<f64, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
     let mut parts: Vec<(String, f64)> = Vec::new();
-    for (i, n) in block_cells.iter().enumerate() {
+    for (i, n) in geo.block_cells.iter().enumerate() {
         parts.push((format!("fluid_block[{i}]"), n.iter().product()));
     }
-    for (i, l) in inlet_layouts.iter().enumerate() {
+    for (i, l) in geo.inlet_layouts.iter().enumerate() {
         parts.push((format!("inlet[{i}]"), l.n_columns * l.layers as f64));
     }
     let n_fluid_parts = parts.len();
-    if let Some((_, n)) = tank {
-        parts.push(("tank".into(), wall_of(n).count()));
+    if let Some(n) = geo.tank_cells {
+        parts.push(("tank".into(), geo.tank_wall(case, n).count()));
     }
-    for (i, ((lo, hi), t)) in obstacle_ranges.iter().zip(&case.obstacle_walls).enumerate() {
+    for (i, ((lo, hi), t)) in geo
+        .obstacle_ranges
+        .iter()
+        .zip(&case.obstacle_walls)
+        .enumerate()
+    {
         let n = (0..dim).map(|a| hi[a] - lo[a] + 1.0);
         let all: f64 = n.clone().product();
         let count = if *t == Treatment::Repulsive {
@@ -212,52 +394,165 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     for (i, b) in case.bodies.iter().enumerate() {
         parts.push((format!("body[{i}]"), b.shape.lattice_size(dx, dim)));
     }
-    let total = limits::budget(
+    limits::budget(
         ctx,
         (dx, dim),
         &parts,
         [n_fluid_parts, n_wall_parts],
         max_particles,
-    )?;
-    let wall = tank.map(|(_, n)| wall_of(n));
-    // Elastic solids in the fluid: their particles, bodies and materials, within what is left
-    // of the budget; and the box of each solid's particles.
-    let elastic = if case.solids.is_empty() {
-        None
-    } else {
-        let (materials, parts, body) =
-            super::solids::solid_particles(ctx, &case.solids, dim, dx, max_particles - total)?;
-        let mut extents = vec![
-            Aabb {
-                min: [f64::MAX; 3],
-                max: [f64::MIN; 3],
-            };
-            case.solids.len()
-        ];
-        for (p, &b) in parts.iter().zip(&body) {
-            let e = &mut extents[b as usize];
-            for a in 0..3 {
-                e.min[a] = e.min[a].min(p.pos[a]);
-                e.max[a] = e.max[a].max(p.pos[a]);
-            }
+    )
+}
+
+/// The elastic solids of a case with fluid, as [`elastic_solids`] makes them.
+struct Elastic {
+    materials: Vec<ElasticMaterial>,
+    particles: Vec<Particle>,
+    /// The solid (index) of each particle.
+    body: Vec<u32>,
+    /// The box of each solid's particles.
+    extents: Vec<Aabb>,
+}
+
+/// Elastic solids in the fluid: their particles, bodies and materials, within what is left of
+/// the budget (`budget`); and the box of each solid's particles.
+fn elastic_solids(ctx: &Ctx<'_>, case: &Case, budget: f64) -> Result<Option<Elastic>, CaseError> {
+    if case.solids.is_empty() {
+        return Ok(None);
+    }
+    let (materials, particles, body) =
+        super::solids::solid_particles(ctx, &case.solids, case.dim, case.dx, budget)?;
+    let mut extents = vec![
+        Aabb {
+            min: [f64::MAX; 3],
+            max: [f64::MIN; 3],
+        };
+        case.solids.len()
+    ];
+    for (p, &b) in particles.iter().zip(&body) {
+        let e = &mut extents[b as usize];
+        for a in 0..3 {
+            e.min[a] = e.min[a].min(p.pos[a]);
+            e.max[a] = e.max[a].max(p.pos[a]);
         }
-        Some((materials, parts, body, extents))
-    };
+    }
+    Ok(Some(Elastic {
+        materials,
+        particles,
+        body,
+        extents,
+    }))
+}
 
-    let domain = domain(ctx, &case, &lat, wall.as_ref())?;
+/// The speed of sound and the hydrostatic start, checked: what [`Start::of`] finds.
+struct Start {
+    /// |g| [m/s²].
+    g: f64,
+    c0: f64,
+    /// The field the speed of sound came from, and its value, for errors.
+    sound_path: &'static str,
+    sound_value: f64,
+    /// The Tait stiffness B = c0² ρ0 / γ.
+    tait_b: f64,
+    rho0: f64,
+    gamma: f64,
+    /// The particle mass ρ0 dx^dim.
+    mass: f64,
+}
 
-    // Speed of sound and the hydrostatic start.
-    let g = case.gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
-    let c0 = match case.sound {
+impl Start {
+    /// Speed of sound and the hydrostatic start: c0, the Tait stiffness, inflow below c0, the
+    /// particle mass.
+    fn of(ctx: &Ctx<'_>, case: &Case, elastic: Option<&Elastic>) -> Result<Start, CaseError> {
+        let (dim, dx) = (case.dim, case.dx);
+        let g = case.gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let c0 = sound_speed(ctx, case, g, elastic)?;
+        // The field the speed of sound came from, for the errors below.
+        let (sound_path, sound_value) = match case.sound {
+            Sound::Speed(c) => ("physics.sound_speed_m_s", c),
+            Sound::Coef(k) => ("physics.sound_speed_coef", k),
+        };
+        let tait_b = c0 * c0 * case.rho0 / case.gamma;
+        if !(tait_b.is_finite() && tait_b > 0.0) {
+            return Err(ctx.err(
+                sound_path,
+                Some(num(sound_value)),
+                format!(
+                    "gives a Tait stiffness B = c0² rho0 / gamma = {} Pa that cannot be computed \
+                     with (c0 = {} m/s, physics.rho0_kg_m3 = {}, physics.gamma = {})",
+                    num(tait_b),
+                    num(c0),
+                    num(case.rho0),
+                    num(case.gamma)
+                ),
+                "use a realistic speed of sound, about 10 times the largest flow speed, and a \
+                 realistic physics.rho0_kg_m3",
+            ));
+        }
+        if let Some((i, s)) = case.inlets.iter().enumerate().find(|(_, s)| s.speed >= c0) {
+            return Err(ctx.err(
+                &format!("inlet[{i}].velocity_m_s"),
+                Some(num(s.speed)),
+                format!(
+                    "is not below the speed of sound c0 = {} m/s: weakly compressible SPH needs \
+                     flow speeds of about c0 / 10 or less",
+                    num(c0)
+                ),
+                format!(
+                    "lower the inflow speed, or raise {sound_path} so that c0 is about 10 times it"
+                ),
+            ));
+        }
+        let mass = case.rho0 * dx.powi(dim as i32);
+        if !(mass.is_finite() && mass > 0.0) {
+            return Err(ctx.err(
+                "particles.dx_m",
+                Some(num(dx)),
+                format!(
+                    "gives a particle mass physics.rho0_kg_m3 * dx^{dim} = {} * {}^{dim} = {} kg \
+                     that cannot be computed with",
+                    num(case.rho0),
+                    num(dx),
+                    num(mass)
+                ),
+                "use a spacing and density of realistic size",
+            ));
+        }
+        Ok(Start {
+            g,
+            c0,
+            sound_path,
+            sound_value,
+            tait_b,
+            rho0: case.rho0,
+            gamma: case.gamma,
+            mass,
+        })
+    }
+
+    /// The hydrostatic start density `depth` below a free surface.
+    fn rho_at(&self, depth: f64) -> f64 {
+        self.rho0 * (1.0 + self.rho0 * self.g * depth.max(0.0) / self.tait_b).powf(1.0 / self.gamma)
+    }
+}
+
+/// The speed of sound c0: given, or `coef` times the larger of sqrt(|g| H) (H: the deepest
+/// fluid block) and the fastest inflow. `g`: |g|.
+fn sound_speed(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    g: f64,
+    elastic: Option<&Elastic>,
+) -> Result<f64, CaseError> {
+    let v = case.dim - 1;
+    Ok(match case.sound {
         // Without fluid c0 is unused (the solids have their own sound speed); that one keeps
         // the checks below meaningful.
-        _ if case.blocks.is_empty() && case.inlets.is_empty() => {
-            elastic.as_ref().map_or(1.0, |e| {
-                e.0.iter()
-                    .map(crate::scenario::ElasticMaterial::sound_speed)
-                    .fold(0.0, f64::max)
-            })
-        }
+        _ if case.blocks.is_empty() && case.inlets.is_empty() => elastic.map_or(1.0, |e| {
+            e.materials
+                .iter()
+                .map(ElasticMaterial::sound_speed)
+                .fold(0.0, f64::max)
+        }),
         Sound::Speed(c) => c,
         Sound::Coef(k) => {
             let floor = |b: &Aabb| case.tank.as_ref().map_or(b.min[v], |t| t.inner.min[v]);
@@ -270,72 +565,39 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             let inflow = case.inlets.iter().map(|s| s.speed).fold(0.0, f64::max);
             let c = k * (g * depth).sqrt().max(inflow);
             if !c.is_finite() || c <= 0.0 {
-                return Err(ctx.err("physics.sound_speed_coef", Some(num(k)), format!("gives c0 = coef * max(sqrt(|g| * H), inlet speed) = {} m/s with |g| = {} m/s² (physics.gravity_m_s2) and H = {} m (the deepest fluid block)", num(c), num(g), num(depth)), "give physics.sound_speed_m_s instead"));
+                return Err(ctx.err(
+                    "physics.sound_speed_coef",
+                    Some(num(k)),
+                    format!(
+                        "gives c0 = coef * max(sqrt(|g| * H), inlet speed) = {} m/s with |g| \
+                         = {} m/s² (physics.gravity_m_s2) and H = {} m (the deepest fluid \
+                         block)",
+                        num(c),
+                        num(g),
+                        num(depth)
+                    ),
+                    "give physics.sound_speed_m_s instead",
+                ));
             }
             c
         }
-    };
-    // The field the speed of sound came from, for the errors below.
-    let (sound_path, sound_value) = match case.sound {
-        Sound::Speed(c) => ("physics.sound_speed_m_s", c),
-        Sound::Coef(k) => ("physics.sound_speed_coef", k),
-    };
-    let tait_b = c0 * c0 * case.rho0 / case.gamma;
-    if !(tait_b.is_finite() && tait_b > 0.0) {
-        return Err(ctx.err(sound_path, Some(num(sound_value)), format!("gives a Tait stiffness B = c0² rho0 / gamma = {} Pa that cannot be computed with (c0 = {} m/s, physics.rho0_kg_m3 = {}, physics.gamma = {})", num(tait_b), num(c0), num(case.rho0), num(case.gamma)), "use a realistic speed of sound, about 10 times the largest flow speed, and a realistic physics.rho0_kg_m3"));
-    }
-    if let Some((i, s)) = case.inlets.iter().enumerate().find(|(_, s)| s.speed >= c0) {
-        return Err(ctx.err(
-            &format!("inlet[{i}].velocity_m_s"),
-            Some(num(s.speed)),
-            format!(
-                "is not below the speed of sound c0 = {} m/s: weakly compressible SPH needs \
-                 flow speeds of about c0 / 10 or less",
-                num(c0)
-            ),
-            format!(
-                "lower the inflow speed, or raise {sound_path} so that c0 is about 10 times it"
-            ),
-        ));
-    }
-    let mass = case.rho0 * dx.powi(dim as i32);
-    if !(mass.is_finite() && mass > 0.0) {
-        return Err(ctx.err(
-            "particles.dx_m",
-            Some(num(dx)),
-            format!(
-                "gives a particle mass physics.rho0_kg_m3 * dx^{dim} = {} * {}^{dim} = {} kg \
-                 that cannot be computed with",
-                num(case.rho0),
-                num(dx),
-                num(mass)
-            ),
-            "use a spacing and density of realistic size",
-        ));
-    }
-    let rho_at = |depth: f64| {
-        case.rho0 * (1.0 + case.rho0 * g * depth.max(0.0) / tait_b).powf(1.0 / case.gamma)
-    };
+    })
+}
 
-    // Fluid, minus what lies in (or within half a spacing of) an obstacle's particles.
-    let solids: Vec<(Aabb, Aabb)> = case
-        .obstacles
-        .iter()
-        .zip(&obstacle_ranges)
-        .map(|(o, (lo, hi))| {
-            let first = lat.pos(lo.map(|c| c as i64));
-            let last = lat.pos(hi.map(|c| c as i64));
-            (
-                *o,
-                Aabb {
-                    min: first,
-                    max: last,
-                },
-            )
-        })
-        .collect();
-    // Whether `p` lies in the user's box or within a spacing of the particles' box.
-    let covered = |p: [f64; 3], user: &Aabb, parts: &Aabb| {
+/// What takes the place of fluid: the obstacles (the user's box and that of its particles),
+/// the elastic solids and the bodies.
+struct Blockers<'a> {
+    case: &'a Case,
+    /// Each obstacle's box and the box of its particles.
+    obstacles: Vec<(Aabb, Aabb)>,
+    /// The box of each elastic solid's particles.
+    solids: Option<&'a [Aabb]>,
+}
+
+impl Blockers<'_> {
+    /// Whether `p` lies in the user's box or within a spacing of the particles' box.
+    fn covered(&self, p: [f64; 3], user: &Aabb, parts: &Aabb) -> bool {
+        let (dim, dx) = (self.case.dim, self.case.dx);
         let d2: f64 = (0..dim)
             .map(|a| {
                 (parts.min[a] - p[a])
@@ -345,41 +607,78 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             })
             .sum();
         point_inside(p, user, dim) || d2 < (dx * (1.0 - 1e-6)).powi(2)
-    };
-    // The obstacle, elastic solid or body that takes the place of a fluid particle at `p`.
-    let blocker = |p: [f64; 3]| {
-        let obstacle = solids
+    }
+
+    /// The obstacle, elastic solid or body that takes the place of a fluid particle at `p`.
+    fn at(&self, p: [f64; 3]) -> Option<(&'static str, usize)> {
+        let case = self.case;
+        let obstacle = self
+            .obstacles
             .iter()
-            .position(|(user, parts)| covered(p, user, parts));
+            .position(|(user, parts)| self.covered(p, user, parts));
         let elastic_solid = || {
-            let (_, _, _, extents) = elastic.as_ref()?;
+            let extents = self.solids?;
             case.solids
                 .iter()
                 .zip(extents)
-                .position(|(s, parts)| covered(p, &s.bx, parts))
+                .position(|(s, parts)| self.covered(p, &s.bx, parts))
         };
         let body = || {
             case.bodies
                 .iter()
-                .position(|b| b.shape.near(p, 0.5 * dx * (1.0 - 1e-6), dim))
+                .position(|b| b.shape.near(p, 0.5 * case.dx * (1.0 - 1e-6), case.dim))
         };
         match (obstacle, elastic_solid()) {
             (Some(i), _) => Some(("obstacle", i)),
             (None, Some(i)) => Some(("solid", i)),
             (None, None) => body().map(|i| ("body", i)),
         }
+    }
+}
+
+/// The fluid blocks' particles (room for `total` particles), minus what lies in (or within
+/// half a spacing of) an obstacle's particles, an elastic solid or a body; a block left
+/// without any is an error.
+fn fluid_particles(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    geo: &Geometry,
+    elastic: Option<&Elastic>,
+    start: &Start,
+    total: f64,
+) -> Result<Vec<Particle>, CaseError> {
+    let (dim, dx, v, lat) = (case.dim, case.dx, case.dim - 1, &geo.lat);
+    let blockers = Blockers {
+        case,
+        obstacles: case
+            .obstacles
+            .iter()
+            .zip(&geo.obstacle_ranges)
+            .map(|(o, (lo, hi))| {
+                let first = lat.pos(lo.map(|c| c as i64));
+                let last = lat.pos(hi.map(|c| c as i64));
+                (
+                    *o,
+                    Aabb {
+                        min: first,
+                        max: last,
+                    },
+                )
+            })
+            .collect(),
+        solids: elastic.map(|e| e.extents.as_slice()),
     };
     let mut particles = Vec::with_capacity(total as usize);
-    for (i, (b, n)) in case.blocks.iter().zip(&block_cells).enumerate() {
+    for (i, (b, n)) in case.blocks.iter().zip(&geo.block_cells).enumerate() {
         let top = b.bx.max[v];
-        let start = particles.len();
+        let start_len = particles.len();
         let mut first_blocker = None;
         for pos in block_points(b.bx.min, n.map(|c| c as i64), dx, dim) {
-            match blocker(pos) {
+            match blockers.at(pos) {
                 None => particles.push(Particle {
                     pos,
                     vel: b.vel,
-                    rho: rho_at(top - pos[v]),
+                    rho: start.rho_at(top - pos[v]),
                     kind: Kind::Fluid,
                 }),
                 Some(s) => {
@@ -387,7 +686,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
                 }
             }
         }
-        if particles.len() == start {
+        if particles.len() == start_len {
             // A block wholly inside solids is a mistake, and a case without fluid is empty.
             let solid = first_blocker.map_or(String::new(), |(kind, j)| format!("{kind}[{j}]"));
             return Err(ctx.err(
@@ -406,43 +705,61 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             ));
         }
     }
+    Ok(particles)
+}
 
-    // Inlets right after the fluid blocks (their particles become fluid).
-    let inlets: Vec<_> = case
-        .inlets
-        .iter()
-        .zip(inlet_layouts)
-        .map(|(s, l)| {
-            super::open_boundaries::build(s, l, &lat, case.gravity, &rho_at, &mut particles)
-        })
-        .collect();
+/// The start density of wall and body particles.
+struct BoundaryRho<'a> {
+    blocks: &'a [Block],
+    start: &'a Start,
+    /// How far beside a fluid block a wall particle takes its hydrostatic density.
+    reach: f64,
+    /// The vertical axis.
+    v: usize,
+}
 
-    // Walls: tank, then obstacles (each lattice point once).
-    let reach = layers as f64 * dx + dx;
-    let wall_rho = |p: [f64; 3]| {
-        let over = case
+impl BoundaryRho<'_> {
+    /// Hydrostatic below the highest fluid block over `p` (within `reach`), else ρ0.
+    fn wall(&self, p: [f64; 3]) -> f64 {
+        let (v, reach) = (self.v, self.reach);
+        let over = self
             .blocks
             .iter()
             .filter(|b| (0..v).all(|a| b.bx.min[a] - reach <= p[a] && p[a] <= b.bx.max[a] + reach));
         match over.map(|b| b.bx.max[v]).reduce(f64::max) {
-            Some(top) => rho_at(top - p[v]),
-            None => case.rho0,
+            Some(top) => self.start.rho_at(top - p[v]),
+            None => self.start.rho0,
         }
-    };
-    // Repulsive particles carry no pressure: ρ0.
-    let boundary_rho = |t: Treatment, pos: [f64; 3]| match t {
-        Treatment::Repulsive => case.rho0,
-        _ => wall_rho(pos),
-    };
-    // Mirror walls have no particles (their TankWall has no layers). A moving tank's walls and
-    // obstacles become the body "tank", after every fixed particle.
+    }
+
+    /// The start density of a particle of treatment `t` at `pos`. Repulsive particles carry no
+    /// pressure: ρ0.
+    fn of(&self, t: Treatment, pos: [f64; 3]) -> f64 {
+        match t {
+            Treatment::Repulsive => self.start.rho0,
+            _ => self.wall(pos),
+        }
+    }
+}
+
+/// Walls: tank, then obstacles (each lattice point once), pushed onto `particles`; of a moving
+/// tank, returned instead (its walls and obstacles become the body "tank", after every fixed
+/// particle). Mirror walls have no particles (their TankWall has no layers).
+fn wall_particles(
+    case: &Case,
+    (lat, obstacle_ranges): (&Lattice, &[IndexRange]),
+    wall: Option<&TankWall>,
+    rho: &BoundaryRho<'_>,
+    particles: &mut Vec<Particle>,
+) -> Vec<Particle> {
+    let dim = case.dim;
     let tank_moves = case.tank_moves();
     let mut tank_particles = Vec::new();
     let mut push_wall = |pos: [f64; 3], t: Treatment| {
         let p = Particle {
             pos,
             vel: [0.0; 3],
-            rho: boundary_rho(t, pos),
+            rho: rho.of(t, pos),
             kind: kind_of(t),
         };
         if tank_moves {
@@ -451,7 +768,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             particles.push(p);
         }
     };
-    if let (Some(w), Some(t)) = (&wall, case.tank.as_ref()) {
+    if let (Some(w), Some(t)) = (wall, case.tank.as_ref()) {
         w.indices()
             .into_iter()
             .for_each(|i| push_wall(lat.pos(i), t.wall));
@@ -459,7 +776,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     let mut seen = HashSet::new();
     for ((lo, hi), &t) in obstacle_ranges.iter().zip(&case.obstacle_walls) {
         let (first, last) = (lo.map(|c| c as i64), hi.map(|c| c as i64));
-        for idx in range_points(&lat, *lo, *hi) {
+        for idx in range_points(lat, *lo, *hi) {
             // A repulsive obstacle is only its surface: points with a lattice neighbour outside.
             let surface = (0..dim).any(|a| idx[a] == first[a] || idx[a] == last[a]);
             if t == Treatment::Repulsive && !surface {
@@ -470,11 +787,15 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             }
         }
     }
+    tank_particles
+}
 
-    // Mirror planes on every face of the tank's inner box on the lattice (origin + n dx), the
-    // lid only when the top is closed; normals point into the fluid.
+/// Mirror planes on every face of the tank's inner box on the lattice (origin + n dx), the lid
+/// only when the top is closed; normals point into the fluid.
+fn mirror_planes(case: &Case, lat: &Lattice, wall: Option<&TankWall>) -> Vec<MirrorPlane> {
+    let (dim, dx, v) = (case.dim, case.dx, case.dim - 1);
     let mut mirror_planes = Vec::new();
-    if let (Some(w), Some(t)) = (&wall, case.tank.as_ref()) {
+    if let (Some(w), Some(t)) = (wall, case.tank.as_ref()) {
         if let Treatment::Mirror { no_slip } = t.wall {
             for a in 0..dim {
                 let mut normal = [0.0; 3];
@@ -498,32 +819,61 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             }
         }
     }
+    mirror_planes
+}
 
-    // Elastic solids after the fixed walls (bodies come last), each particle inside the domain.
-    let mut solids_of_particles = None;
-    if let Some((materials, mut parts, body, _)) = elastic {
-        if let Some((p, &b)) = parts.iter().zip(&body).find(|(p, _)| {
-            !(0..dim).all(|a| domain.min[a] <= p.pos[a] && p.pos[a] <= domain.max[a])
-        }) {
-            return Err(ctx.err(
-                &format!("solid[{b}]"),
-                None,
-                format!(
-                    "has a particle at {:?}, outside the domain ({:?} to {:?})",
-                    &p.pos[..dim],
-                    &domain.min[..dim],
-                    &domain.max[..dim]
-                ),
-                "keep the solid inside the tank, or enlarge [domain]",
-            ));
-        }
-        let start = particles.len();
-        let mut of_particle = vec![0; start];
-        of_particle.extend(body);
-        particles.append(&mut parts);
-        solids_of_particles = Some((materials, of_particle));
+/// Elastic solids after the fixed walls (bodies come last), each particle inside the domain:
+/// their materials and the solid of each particle (0 before them).
+fn place_solids(
+    ctx: &Ctx<'_>,
+    dim: usize,
+    elastic: Option<Elastic>,
+    domain: &Domain,
+    particles: &mut Vec<Particle>,
+) -> Result<Option<Placed>, CaseError> {
+    let Some(Elastic {
+        materials,
+        particles: mut parts,
+        body,
+        ..
+    }) = elastic
+    else {
+        return Ok(None);
+    };
+    if let Some((p, &b)) = parts
+        .iter()
+        .zip(&body)
+        .find(|(p, _)| !(0..dim).all(|a| domain.min[a] <= p.pos[a] && p.pos[a] <= domain.max[a]))
+    {
+        return Err(ctx.err(
+            &format!("solid[{b}]"),
+            None,
+            format!(
+                "has a particle at {:?}, outside the domain ({:?} to {:?})",
+                &p.pos[..dim],
+                &domain.min[..dim],
+                &domain.max[..dim]
+            ),
+            "keep the solid inside the tank, or enlarge [domain]",
+        ));
     }
+    let start = particles.len();
+    let mut of_particle = vec![0; start];
+    of_particle.extend(body);
+    particles.append(&mut parts);
+    Ok(Some((materials, of_particle)))
+}
 
+/// The bodies, their particles pushed onto `particles`: a moving tank's (`tank_particles`)
+/// first, then each `[[body]]`'s.
+fn bodies(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    rho: &BoundaryRho<'_>,
+    mut tank_particles: Vec<Particle>,
+    particles: &mut Vec<Particle>,
+) -> Result<Vec<Body>, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
     let mut bodies = Vec::with_capacity(case.bodies.len() + 1);
     if let (Some(t), Some(motion)) = (
         &case.tank,
@@ -550,58 +900,13 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         };
         let points = spec.shape.points(dx, dim, layers);
         if points.is_empty() {
-            // Particles sit inside the surface (a ball's and a polygon's at least dx/2): a ball
-            // smaller than that, a polygon too thin or a mesh around no lattice point has none,
-            // and a body without particles would feel no fluid.
-            return Err(match &spec.shape {
-                Shape::Ball { radius, .. } => ctx.err(
-                    &format!("body[{i}].radius_m"),
-                    Some(num(*radius)),
-                    format!(
-                        "is less than half a particle spacing (dx / 2 = {} m): the body would \
-                         have no particles",
-                        num(0.5 * dx)
-                    ),
-                    "make the radius a few particle spacings, or decrease particles.dx_m",
-                ),
-                shape => ctx.err(
-                    &format!(
-                        "body[{i}].{}",
-                        if let Shape::Polygon(_) = shape {
-                            "vertices_m"
-                        } else {
-                            "file"
-                        }
-                    ),
-                    None,
-                    format!(
-                        "no particle fits in the shape (particles sit at least dx/2 inside \
-                         its surface, dx = {} m): the body would have no particles",
-                        num(dx)
-                    ),
-                    "make the body a few particle spacings thick, or decrease particles.dx_m",
-                ),
-            });
+            return Err(no_particles(ctx, i, &spec.shape, dx));
         }
         for pos in points {
-            let vel = match &spec.motion {
-                Motion::Free {
-                    velocity, omega, ..
-                } => {
-                    let r = [0, 1, 2].map(|a| pos[a] - center[a]);
-                    [
-                        velocity[0] + omega[1] * r[2] - omega[2] * r[1],
-                        velocity[1] + omega[2] * r[0] - omega[0] * r[2],
-                        velocity[2] + omega[0] * r[1] - omega[1] * r[0],
-                    ]
-                }
-                // The prescribed motion sets the velocity from the first step on.
-                Motion::Prescribed(_) => [0.0; 3],
-            };
             particles.push(Particle {
                 pos,
-                vel,
-                rho: boundary_rho(spec.wall, pos),
+                vel: start_velocity(&spec.motion, center, pos),
+                rho: rho.of(spec.wall, pos),
                 kind: kind_of(spec.wall),
             });
         }
@@ -615,15 +920,80 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             motion: spec.motion.clone(),
         });
     }
+    Ok(bodies)
+}
 
-    if let Some((_, solid_of)) = &solids_of_particles {
-        super::solids::check_clearance(ctx, &particles, solid_of, dim, dx)?;
+/// The error of body `i`, whose `shape` holds no particle. Particles sit inside the surface (a
+/// ball's and a polygon's at least dx/2): a ball smaller than that, a polygon too thin or a
+/// mesh around no lattice point has none, and a body without particles would feel no fluid.
+fn no_particles(ctx: &Ctx<'_>, i: usize, shape: &Shape, dx: f64) -> CaseError {
+    match shape {
+        Shape::Ball { radius, .. } => ctx.err(
+            &format!("body[{i}].radius_m"),
+            Some(num(*radius)),
+            format!(
+                "is less than half a particle spacing (dx / 2 = {} m): the body would \
+                 have no particles",
+                num(0.5 * dx)
+            ),
+            "make the radius a few particle spacings, or decrease particles.dx_m",
+        ),
+        shape => ctx.err(
+            &format!(
+                "body[{i}].{}",
+                if let Shape::Polygon(_) = shape {
+                    "vertices_m"
+                } else {
+                    "file"
+                }
+            ),
+            None,
+            format!(
+                "no particle fits in the shape (particles sit at least dx/2 inside \
+                 its surface, dx = {} m): the body would have no particles",
+                num(dx)
+            ),
+            "make the body a few particle spacings thick, or decrease particles.dx_m",
+        ),
     }
+}
 
+/// The start velocity of a body's particle at `pos`: a free body's, rigid about `center`; zero
+/// for a prescribed motion, which sets the velocity from the first step on.
+fn start_velocity(motion: &Motion, center: [f64; 3], pos: [f64; 3]) -> [f64; 3] {
+    match motion {
+        Motion::Free {
+            velocity, omega, ..
+        } => {
+            let r = [0, 1, 2].map(|a| pos[a] - center[a]);
+            [
+                velocity[0] + omega[1] * r[2] - omega[2] * r[1],
+                velocity[1] + omega[2] * r[0] - omega[0] * r[2],
+                velocity[2] + omega[0] * r[1] - omega[1] * r[0],
+            ]
+        }
+        // The prescribed motion sets the velocity from the first step on.
+        Motion::Prescribed(_) => [0.0; 3],
+    }
+}
+
+/// Checks of all particles together: free solid particles clear of the boundary particles
+/// (`solids`: the solid of each particle), and every start density finite.
+fn check_particles(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    start: &Start,
+    particles: &[Particle],
+    solids: Option<&Placed>,
+) -> Result<(), CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
+    if let Some((_, solid_of)) = solids {
+        super::solids::check_clearance(ctx, particles, solid_of, dim, dx)?;
+    }
     if let Some(p) = particles.iter().find(|p| !p.rho.is_finite()) {
         return Err(ctx.err(
-            sound_path,
-            Some(num(sound_value)),
+            start.sound_path,
+            Some(num(start.sound_value)),
             format!(
                 "is so small that the hydrostatic start density at {:?} is {}",
                 &p.pos[..dim],
@@ -632,7 +1002,41 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
             "use a speed of sound about 10 times sqrt(|g| * H) or more",
         ));
     }
+    Ok(())
+}
 
+/// What the stages of [`build`] made, for [`finish`].
+struct Built {
+    domain: Domain,
+    particles: Vec<Particle>,
+    bodies: Vec<Body>,
+    /// The elastic materials and the solid of each particle (for the particles before the
+    /// solids', 0).
+    solids: Option<Placed>,
+    inlets: Vec<Inlet>,
+    mirror_planes: Vec<MirrorPlane>,
+}
+
+/// The scenario: the particles and parts `built`, with the probes and points resolved on them,
+/// the warnings, the physics and the wall parameters. `obstacle_ranges`: each obstacle's
+/// lattice indices; `h`: the smoothing length.
+fn finish(
+    ctx: &Ctx<'_>,
+    case: Case,
+    obstacle_ranges: &[IndexRange],
+    h: f64,
+    start: &Start,
+    built: Built,
+) -> Result<Scenario, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
+    let Built {
+        domain,
+        particles,
+        bodies,
+        solids,
+        inlets,
+        mirror_planes,
+    } = built;
     let points = super::probes::resolve_points(ctx, &case.points, &particles, &bodies, dim, dx)?;
     // Lattice points of each obstacle along each axis.
     let obstacle_points: Vec<[f64; 3]> = obstacle_ranges
@@ -645,48 +1049,22 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         h,
         &obstacle_points,
         super::warnings::Sound {
-            c0,
-            field: sound_path,
+            c0: start.c0,
+            field: start.sound_path,
         },
     );
+    let physics = physics(&case, start, h);
     let mut probes = case.probes;
     super::probes::resolve_wall_patches(ctx, &mut probes, &particles, dim, dx, h)?;
-    let physics = Physics {
-        dim: dim as u32,
-        dx,
-        h,
-        kernel: case.kernel,
-        rho0: case.rho0,
-        c0,
-        gamma: case.gamma,
-        gravity: case.gravity,
-        viscosity: case.viscosity,
-        delta_sph: case.delta_sph,
-        delta_sph_form: case.delta_sph_form,
-        particle_mass: mass,
-        density_filter: case.density_filter,
-        energy: case.energy,
-    };
-    let g = case.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
-    // The repulsive law acts on repulsive walls, on bodies and on solids (contact).
-    let contact = !bodies.is_empty()
-        || particles
-            .iter()
-            .any(|p| matches!(p.kind, Kind::Repulsive | Kind::Solid));
-    let height = highest_column(&particles, dim, dx);
-    let mut walls = wall_params(ctx, &case.walls, dx, height, g, contact)?;
+    let mut walls = walls(
+        ctx,
+        &case.walls,
+        (dim, dx, start.g),
+        &probes,
+        &particles,
+        &bodies,
+    )?;
     walls.mirror_planes = mirror_planes;
-    walls.reactions = probes
-        .iter()
-        .any(|p| matches!(p.kind, ProbeKind::WallPressure(_)));
-    walls.sensors = probes
-        .iter()
-        .filter(|p| p.body.is_none())
-        .filter_map(|p| match p.kind {
-            ProbeKind::WallPressure(patch) => Some(patch),
-            _ => None,
-        })
-        .collect();
     warnings.extend(super::probes::sensors_meeting_at_edges(
         &probes, &walls, &particles, h,
     ));
@@ -702,7 +1080,7 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
         walls,
         periodic: [false; 3],
         bodies,
-        solids: solids_of_particles.map(|(materials, mut body)| {
+        solids: solids.map(|(materials, mut body)| {
             body.resize(n_particles, 0);
             Solids {
                 materials,
@@ -716,257 +1094,156 @@ pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Sce
     })
 }
 
-/// The given domain, or the default one; checks that fluid, walls and probes lie inside it.
-fn domain(
-    ctx: &Ctx<'_>,
-    case: &Case,
-    lat: &Lattice,
-    wall: Option<&TankWall>,
-) -> Result<Domain, CaseError> {
-    let (dim, dx) = (case.dim, case.dx);
-    let v = dim - 1;
-    // The solids with the field that places each: obstacles, the tank's walls, the bodies (a
-    // prescribed motion's whole path).
-    let mut solid: Vec<(String, Aabb)> = case
-        .obstacles
-        .iter()
-        .enumerate()
-        .map(|(i, o)| (format!("obstacle[{i}]"), *o))
-        .collect();
-    if let Some(w) = wall {
-        let (mut min, mut max) = ([0.0; 3], [0.0; 3]);
-        for a in 0..dim {
-            let (lo, hi) = w.outer(a);
-            min[a] = lat.origin[a] + lo as f64 * dx;
-            max[a] = lat.origin[a] + hi as f64 * dx;
-        }
-        let mut b = Aabb { min, max };
-        let mut path = "tank";
-        if let Some(m) = case.tank.as_ref().and_then(|t| t.motion.as_ref()) {
-            b = swept(&b, m, case.time.end_s, dim);
-            path = "tank.motion";
-        }
-        solid.push((path.into(), b));
+/// The physics of the scenario.
+fn physics(case: &Case, start: &Start, h: f64) -> Physics {
+    Physics {
+        dim: case.dim as u32,
+        dx: case.dx,
+        h,
+        kernel: case.kernel,
+        rho0: case.rho0,
+        c0: start.c0,
+        gamma: case.gamma,
+        gravity: case.gravity,
+        viscosity: case.viscosity,
+        delta_sph: case.delta_sph,
+        delta_sph_form: case.delta_sph_form,
+        particle_mass: start.mass,
+        density_filter: case.density_filter,
+        energy: case.energy,
     }
-    // Bodies, each at its start position (a free body's later path is the user's business).
-    for (i, body) in case.bodies.iter().enumerate() {
-        let mut b = body.shape.bounds(dim);
-        let mut path = format!("body[{i}]");
-        if let Motion::Prescribed(_) = body.motion {
-            b = swept(&b, &body.motion, case.time.end_s, dim);
-            path.push_str(".motion");
+}
+
+/// The wall parameters ([`wall_params`], with H the fluid's height and the repulsive law's
+/// strength checked where it acts) and the wall-pressure sensors of `probes`. `g`: |g|.
+fn walls(
+    ctx: &Ctx<'_>,
+    set: &WallSettings,
+    (dim, dx, g): (usize, f64, f64),
+    probes: &[Probe],
+    particles: &[Particle],
+    bodies: &[Body],
+) -> Result<WallParams, CaseError> {
+    // The repulsive law acts on repulsive walls, on bodies and on solids (contact).
+    let contact = !bodies.is_empty()
+        || particles
+            .iter()
+            .any(|p| matches!(p.kind, Kind::Repulsive | Kind::Solid));
+    let height = highest_column(particles, dim, dx);
+    let mut walls = wall_params(ctx, set, dx, height, g, contact)?;
+    walls.reactions = probes
+        .iter()
+        .any(|p| matches!(p.kind, ProbeKind::WallPressure(_)));
+    walls.sensors = probes
+        .iter()
+        .filter(|p| p.body.is_none())
+        .filter_map(|p| match p.kind {
+            ProbeKind::WallPressure(patch) => Some(patch),
+            _ => None,
+        })
+        .collect();
+    Ok(walls)
+}
+
+/// The scenario of a case whose only particles are solids.
+pub(super) fn build_solid_case(
+    ctx: &Ctx<'_>,
+    case: Case,
+    max_particles: f64,
+) -> Result<Scenario, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
+    let (materials, particles, body) =
+        super::solids::solid_particles(ctx, &case.solids, dim, dx, max_particles)?;
+    let d = solid_case_domain(ctx, &case)?;
+    let n = particles.len();
+    let points = super::probes::resolve_points(ctx, &case.points, &particles, &[], dim, dx)?;
+    let physics = Physics {
+        dim: dim as u32,
+        dx,
+        h: case.h_over_dx * dx,
+        kernel: case.kernel,
+        rho0: case.rho0,
+        // Unused without fluid; the solids' sound speeds enter through their materials.
+        c0: materials
+            .iter()
+            .map(ElasticMaterial::sound_speed)
+            .fold(0.0, f64::max),
+        gamma: case.gamma,
+        gravity: case.gravity,
+        viscosity: case.viscosity,
+        delta_sph: case.delta_sph,
+        delta_sph_form: case.delta_sph_form,
+        particle_mass: case.rho0 * dx.powi(dim as i32),
+        density_filter: case.density_filter,
+        energy: false,
+    };
+    let g = case.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
+    // Solids alone touch only one another. H: from the lowest particle to the highest.
+    let (lo, hi) = particles.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+        (lo.min(p.pos[dim - 1]), hi.max(p.pos[dim - 1]))
+    });
+    let walls = wall_params(ctx, &case.walls, dx, hi - lo + dx, g, case.solids.len() > 1)?;
+    Ok(Scenario {
+        name: case.name,
+        physics,
+        time: case.time,
+        domain: Domain {
+            min: d.min,
+            max: d.max,
+        },
+        particles,
+        probes: case.probes,
+        points,
+        walls,
+        periodic: [false; 3],
+        bodies: Vec::new(),
+        solids: Some(Solids {
+            materials,
+            body,
+            tau0: vec![[0.0; 6]; n],
+        }),
+        inlets: Vec::new(),
+        outlets: Vec::new(),
+        warnings: Vec::new(),
+    })
+}
+
+/// The domain of a case of solids alone: the given one, or the solids' box with half its
+/// largest extent of room on every side; every solid inside it.
+fn solid_case_domain(ctx: &Ctx<'_>, case: &Case) -> Result<Aabb, CaseError> {
+    let (dim, dx) = (case.dim, case.dx);
+    let first = &case.solids[0];
+    // Default domain: the solids' box, with half its largest extent of room on every side.
+    let mut bb = first.bx;
+    for s in &case.solids {
+        for a in 0..dim {
+            bb.min[a] = bb.min[a].min(s.bx.min[a]);
+            bb.max[a] = bb.max[a].max(s.bx.max[a]);
         }
-        solid.push((path, b));
     }
     let d = match case.domain {
         Some(d) => d,
         None => {
-            let mut all: Vec<Aabb> = solid.iter().map(|(_, b)| *b).collect();
-            if wall.is_none() {
-                all.extend(case.blocks.iter().map(|b| b.bx));
-                all.extend(case.solids.iter().map(|s| s.bx));
-                all.extend(case.inlets.iter().map(|s| s.bx));
-            }
-            let mut d = all[0];
-            for b in &all[1..] {
-                for a in 0..dim {
-                    d.min[a] = d.min[a].min(b.min[a]);
-                    d.max[a] = d.max[a].max(b.max[a]);
-                }
-            }
-            let open = case.tank.as_ref().is_none_or(|t| t.open_top);
-            if open {
-                // Room above for splashes: the tank's (or the fluid's) height.
-                d.max[v] += match wall {
-                    Some(w) => w.n[v] as f64 * dx,
-                    None => d.max[v] - d.min[v],
-                };
-            }
+            let room = (0..dim).map(|a| bb.max[a] - bb.min[a]).fold(0.0, f64::max) * 0.5;
+            let mut d = bb;
             for a in 0..dim {
-                d.min[a] -= 2.0 * dx;
-                d.max[a] += 2.0 * dx;
+                d.min[a] -= room + 2.0 * dx;
+                d.max[a] += room + 2.0 * dx;
             }
             d
         }
     };
-    // Which bound of [domain] to move, and to where, for a box that leaves it along `a`.
-    let fix = |b: &Aabb, a: usize| {
-        if case.domain.is_none() {
-            return "enlarge [domain] (or remove it to get the default, which encloses the tank)"
-                .to_string();
-        }
-        let (field, side, to) = if b.min[a] < d.min[a] - TOL {
-            ("min_m", "lower", b.min[a])
-        } else {
-            ("max_m", "raise", b.max[a])
-        };
-        format!(
-            "{side} domain.{field}[{a}] to {} or beyond, or remove [domain] to get the \
-             default, which encloses everything",
-            num(to)
-        )
-    };
-    for (i, b) in case.blocks.iter().enumerate() {
-        if let Some(a) = inside(&b.bx, &d, dim) {
+    for (i, s) in case.solids.iter().enumerate() {
+        if !(point_in(s.bx.min, &d, dim) && point_in(s.bx.max, &d, dim)) {
             return Err(ctx.err(
-                &format!("fluid_block[{i}]"),
+                &format!("solid[{i}]"),
                 None,
-                format!(
-                    "the block ({}) leaves the domain ({}) along {}",
-                    fmt_box(&b.bx, dim),
-                    fmt_box(&d, dim),
-                    AXES[a]
-                ),
-                fix(&b.bx, a),
+                "leaves the domain; its particles would be dropped",
+                "enlarge [domain] (or remove it to get the default)",
             ));
         }
     }
-    for (i, s) in case.inlets.iter().enumerate() {
-        if let Some(a) = inside(&s.bx, &d, dim) {
-            return Err(ctx.err(
-                &format!("inlet[{i}]"),
-                None,
-                format!(
-                    "the buffer box ({}) leaves the domain ({}) along {}",
-                    fmt_box(&s.bx, dim),
-                    fmt_box(&d, dim),
-                    AXES[a]
-                ),
-                fix(&s.bx, a),
-            ));
-        }
-    }
-    // Outlets: reaching into the domain, clear of the fluid blocks and the inlets' buffers.
-    let overlap = |a: &Aabb, b: &Aabb| {
-        (0..dim).all(|k| a.max[k].min(b.max[k]) - a.min[k].max(b.min[k]) > TOL)
-    };
-    for (i, o) in case.outlets.iter().enumerate() {
-        let bx = Aabb {
-            min: o.min,
-            max: o.max,
-        };
-        if !overlap(&bx, &d) {
-            return Err(ctx.err(
-                &format!("outlet[{i}]"),
-                None,
-                format!(
-                    "the box ({}) lies outside the domain ({}): no fluid could reach it",
-                    fmt_box(&bx, dim),
-                    fmt_box(&d, dim)
-                ),
-                "place the outlet where the fluid leaves, inside the domain",
-            ));
-        }
-        let other = case
-            .blocks
-            .iter()
-            .position(|b| overlap(&bx, &b.bx))
-            .map(|j| format!("fluid_block[{j}]"))
-            .or_else(|| {
-                case.inlets
-                    .iter()
-                    .position(|s| overlap(&bx, &s.bx))
-                    .map(|j| format!("inlet[{j}]"))
-            });
-        if let Some(other) = other {
-            return Err(ctx.err(
-                &format!("outlet[{i}]"),
-                None,
-                format!(
-                    "the box ({}) overlaps {other}, whose fluid it would remove at once",
-                    fmt_box(&bx, dim)
-                ),
-                "move the outlet downstream, clear of fluid blocks and inlets",
-            ));
-        }
-    }
-    for (path, b) in &solid {
-        if let Some(a) = inside(b, &d, dim) {
-            return Err(ctx.err(
-                path,
-                None,
-                format!(
-                    "its particles ({}) leave the domain ({}) along {} and would be dropped",
-                    fmt_box(b, dim),
-                    fmt_box(&d, dim),
-                    AXES[a]
-                ),
-                fix(b, a),
-            ));
-        }
-    }
-    for (i, p) in case.probes.iter().enumerate() {
-        let (field, point) = match &p.kind {
-            ProbeKind::Pressure { point } => ("point_m", *point),
-            ProbeKind::Height { base } => ("base_m", *base),
-            ProbeKind::Front { origin, .. } => ("origin_m", *origin),
-            ProbeKind::WallPressure(patch) => ("point_m", patch.point),
-        };
-        if !point_inside(point, &d, dim) {
-            // Say what the default domain encloses: removing the tank shrinks it to the fluid.
-            let (which, fix) = match (case.domain, &case.tank) {
-                (Some(_), _) => (
-                    "the domain",
-                    "move the probe inside [domain], or enlarge it",
-                ),
-                (None, Some(_)) => (
-                    "the default domain (around the tank, obstacles and bodies)",
-                    "move the probe inside it, or give a [domain] that encloses it",
-                ),
-                (None, None) => (
-                    "the default domain (around the fluid, obstacles and bodies: there is no tank)",
-                    "move the probe inside it, or give a [domain] that encloses it",
-                ),
-            };
-            return Err(ctx.err(
-                &format!("probe[{i}].{field}"),
-                Some(format!("{:?}", &point[..dim])),
-                format!("lies outside {which} ({})", fmt_box(&d, dim)),
-                fix,
-            ));
-        }
-    }
-    let domain = Domain {
-        min: d.min,
-        max: d.max,
-    };
-    limits::grid_fits(ctx, case, &domain, &solid)?;
-    Ok(domain)
-}
-
-/// The bounding box of `b` moved by a prescribed `motion` over [0, end_s] (sampled finely; a
-/// free motion leaves it as it is).
-fn swept(b: &Aabb, motion: &Motion, end_s: f64, dim: usize) -> Aabb {
-    let Motion::Prescribed(law) = motion else {
-        return *b;
-    };
-    let mut out = *b;
-    let corners: Vec<glam::DVec3> = (0..1 << dim)
-        .map(|k: usize| {
-            glam::DVec3::from_array([0, 1, 2].map(|a| {
-                if a >= dim {
-                    0.0
-                } else if k >> a & 1 == 1 {
-                    b.max[a]
-                } else {
-                    b.min[a]
-                }
-            }))
-        })
-        .collect();
-    const SAMPLES: usize = 2000;
-    for s in 0..=SAMPLES {
-        let t = end_s * s as f64 / SAMPLES as f64;
-        for &c in &corners {
-            // A corner moves as a body whose centre it is.
-            let x = law.pose(c, t).center;
-            for a in 0..dim {
-                out.min[a] = out.min[a].min(x[a]);
-                out.max[a] = out.max[a].max(x[a]);
-            }
-        }
-    }
-    out
+    Ok(d)
 }
 
 /// The wall parameters: `[walls]` over the defaults for spacing `dx`, height H = `height` and

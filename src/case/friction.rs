@@ -2,11 +2,11 @@
 //! solids, the walls), over `[walls] friction_coefficient` for every other pair.
 
 use super::bodies::BodySpec;
+use super::check::{number, Bound};
 use super::error::CaseError;
 use super::locate::Ctx;
 use super::schema::RawFriction;
 use super::solids::SolidSpec;
-use super::validate::{number, Bound};
 use crate::layout::MAX_FRICTION_GROUPS;
 use crate::scenario::{ContactGroup, FrictionPair};
 

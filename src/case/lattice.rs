@@ -2,7 +2,7 @@
 //! at cell centres, `origin + (i + 0.5) dx` for integer i. 2D cases use the x and y axes and
 //! put every particle at z = 0.
 
-use super::validate::Aabb;
+use super::check::Aabb;
 
 /// Largest magnitude an index may take; larger boxes are refused by the particle-count check
 /// before any index is used.

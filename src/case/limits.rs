@@ -5,9 +5,9 @@
 use crate::grid::Grid;
 use crate::scenario::Domain;
 
+use super::check::Aabb;
 use super::error::{num, CaseError};
 use super::locate::Ctx;
-use super::validate::{Aabb, Case};
 
 /// Refuse cases with more particles than this.
 pub const MAX_PARTICLES: f64 = 200e6;
@@ -106,13 +106,18 @@ pub(super) fn budget(
 
 /// The solver's neighbour grid (cells 2h wide) must cover the domain; an error names the
 /// given domain, or the part that stretches the default one farthest from the fluid.
+///
+/// `given`: whether the case gives `[domain]`; `fluid_parts`: the fluid's parts (blocks and
+/// inlets' buffers, a case has one of them at least; the solids-only cases do not come here)
+/// and `solid` the walls', obstacles' and bodies' boxes, each with the field that places it.
 pub(super) fn grid_fits(
     ctx: &Ctx<'_>,
-    case: &Case,
+    (dim, h): (usize, f64),
     domain: &Domain,
+    given: bool,
+    fluid_parts: &[(String, Aabb)],
     solid: &[(String, Aabb)],
 ) -> Result<(), CaseError> {
-    let (dim, h) = (case.dim, case.h_over_dx * case.dx);
     let Err(e) = Grid::new(domain, h, dim as u32, 0, [false; 3]) else {
         return Ok(());
     };
@@ -120,20 +125,6 @@ pub(super) fn grid_fits(
     let a = (0..dim)
         .max_by(|&a, &b| extent(a).total_cmp(&extent(b)))
         .unwrap_or(0);
-    // The fluid's parts: blocks and inlets' buffers (a case has one of them at least; the
-    // solids-only cases do not come here).
-    let fluid_parts: Vec<(String, Aabb)> = case
-        .blocks
-        .iter()
-        .enumerate()
-        .map(|(i, b)| (format!("fluid_block[{i}]"), b.bx))
-        .chain(
-            case.inlets
-                .iter()
-                .enumerate()
-                .map(|(i, s)| (format!("inlet[{i}]"), s.bx)),
-        )
-        .collect();
     let Some((first_path, first)) = fluid_parts.first().cloned() else {
         return Err(ctx.err(
             "domain",
@@ -144,7 +135,7 @@ pub(super) fn grid_fits(
     };
     let fluid = 0.5 * (first.min[a] + first.max[a]);
     let reach = |b: &Aabb| (b.min[a] - fluid).abs().max((b.max[a] - fluid).abs());
-    let (path, fix) = if case.domain.is_some() {
+    let (path, fix) = if given {
         let field = if (domain.min[a] - fluid).abs() > (domain.max[a] - fluid).abs() {
             "domain.min_m"
         } else {

@@ -61,7 +61,8 @@ impl Index {
             .iter()
             .flat_map(|e| e.key.iter().chain(Some(&e.value)).map(move |r| (r, e)))
             .filter(|(r, _)| encloses(r))
-            // The smallest span; on a tie (a `[[list]]` and its entry share the header) the deeper path.
+            // The smallest span; on a tie (a `[[list]]` and its entry share the header) the
+            // deeper path.
             .min_by_key(|(r, e)| (r.len(), std::cmp::Reverse(e.path.len())))
             .map(|(_, e)| e.path.clone())
             .unwrap_or_default()

@@ -12,7 +12,7 @@ use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
 
-use super::validate::Aabb;
+use super::check::Aabb;
 
 /// How far, relative to the shape's size, the lines that count crossings are moved off the
 /// points they go through (x, y): far below a spacing, off any round number (also a
@@ -704,8 +704,8 @@ pub(super) mod tests {
 
     /// The corner tetrahedron of the unit cube, scaled by L and moved: V = L³/6, centroid at
     /// L/4 from the corner, and by direct integration ∫x'² dV = L⁵/160, ∫x'y' dV = −L⁵/480
-    /// about the centroid, so I_xx = (m/V)(2 L⁵/160) and I_xy = (m/V) L⁵/480. Its centroid is not the centre of its bounds, which the mass
-    /// properties are summed about.
+    /// about the centroid, so I_xx = (m/V)(2 L⁵/160) and I_xy = (m/V) L⁵/480. Its centroid is
+    /// not the centre of its bounds, which the mass properties are summed about.
     #[test]
     fn a_tetrahedron_has_its_textbook_mass_properties() {
         let (l, o) = (0.3, [1.0, -2.0, 0.5]);

@@ -8,7 +8,9 @@
 
 mod bodies;
 mod build;
+mod check;
 mod diagnose;
+mod domain;
 mod error;
 mod friction;
 mod lattice;
@@ -29,6 +31,7 @@ mod tests;
 
 use std::path::Path;
 
+pub(crate) use check::read_bounded;
 pub use error::{CaseError, Diagnostic};
 pub use limits::MAX_PARTICLES;
 
@@ -39,22 +42,6 @@ use schema::RawCase;
 /// The largest case file read: case files are a few kilobytes, and without a bound a path such
 /// as /dev/zero would be read forever.
 const MAX_CASE_BYTES: u64 = 16 << 20;
-
-/// The text of the file at `path`, or an error if it is longer than `limit` bytes.
-pub(crate) fn read_bounded(path: &Path, limit: u64) -> std::io::Result<String> {
-    use std::io::Read;
-    let mut text = String::new();
-    std::fs::File::open(path)?
-        .take(limit + 1)
-        .read_to_string(&mut text)?;
-    if text.len() as u64 > limit {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!("longer than {} MiB; is it the right file?", limit >> 20),
-        ));
-    }
-    Ok(text)
-}
 
 /// Reads and builds the case file at `path`, with `--set KEY=VALUE` overrides applied.
 pub fn load(path: &Path, overrides: &[String]) -> Result<Scenario, CaseError> {

@@ -5,14 +5,12 @@
 //! GPU finds a particle's layer and column from its id (shaders/open_boundaries.wgsl). An
 //! outlet is a box that removes the fluid entering it.
 
+use super::check::{aabb, number, vector, Aabb, Bound, AXES};
 use super::error::{num, CaseError};
 use super::lattice::{range_points, Lattice};
 use super::locate::Ctx;
 use super::schema::{InletPressureName, RawInlet, RawOutlet};
-use super::validate::{aabb, number, vector, Aabb, Bound};
 use crate::scenario::{Inlet, InletPressure, Kind, Outlet, Particle};
-
-const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// An `[[inlet]]` as checked against the case, before the lattice is known.
 #[derive(Clone, Debug)]

@@ -181,7 +181,11 @@ pub(super) fn apply(file: &str, doc: &mut Table, ov: &Override) -> Result<(), Ca
                 return Err(fail(
                     file,
                     &ov.arg,
-                    format!("`{path}[{n}]` does not exist: the file has {len} entries (indices 0 to {})", len.saturating_sub(1)),
+                    format!(
+                        "`{path}[{n}]` does not exist: the file has {len} entries (indices 0 \
+                         to {})",
+                        len.saturating_sub(1)
+                    ),
                     "use an existing index, or add the entry to the file",
                 ));
             };

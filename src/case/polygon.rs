@@ -5,7 +5,7 @@
 //! lines going through points shifted by a fixed tiny offset as for meshes (src/case/mesh.rs),
 //! so a line does not run exactly through a vertex drawn on round numbers.
 
-use super::validate::Aabb;
+use super::check::Aabb;
 
 /// What is wrong with an outline: a problem and the index of a vertex or edge to look at.
 #[derive(Debug, PartialEq)]

@@ -6,10 +6,10 @@ use crate::scenario::{
     Body, Particle, Probe, ProbeKind, TrackedPoint, WallParams, WallPatch, FACE_UNBOUNDED,
 };
 
+use super::check::vector;
 use super::error::CaseError;
 use super::locate::Ctx;
 use super::schema::{ProbeName, RawProbe};
-use super::validate::vector;
 
 /// A checked `[[probe]]`: a sampled quantity, or a point of a body to follow.
 pub(super) enum Checked {

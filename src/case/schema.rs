@@ -592,7 +592,8 @@ pub(super) const FIELDS: &[FieldHelp] = &[
     ),
     f(
         "inlet[].pressure",
-        "the buffer's pressure: zero (a free jet) or hydrostatic below the box's top (an open channel's inflow)",
+        "the buffer's pressure: zero (a free jet) or hydrostatic below the box's top (an open \
+         channel's inflow)",
         "pressure = \"hydrostatic\"",
     ),
     f(
@@ -889,7 +890,8 @@ pub(super) const FIELDS: &[FieldHelp] = &[
     ),
     f(
         "motion.file",
-        "the CSV of the motion time series (t_s, dx_m, dy_m[, dz_m], angle_deg), relative to the case file",
+        "the CSV of the motion time series (t_s, dx_m, dy_m[, dz_m], angle_deg), relative to the \
+         case file",
         "file = \"excitation.csv\"",
     ),
     f(

@@ -1,16 +1,14 @@
 //! `[[solid]]`: elastic bodies of hypoelastic solid particles (Gray, Monaghan & Swift 2001):
-//! their particles, and the build of a solid-only case (with fluid, `build.rs` adds them).
+//! their checks and their particles (`build.rs` adds them to a case, or builds a case of solids
+//! alone from them).
 
-use crate::scenario::{
-    distinct_materials, Domain, ElasticMaterial, Kind, Particle, Physics, Scenario,
-    SolidFormulation, Solids,
-};
+use crate::scenario::{distinct_materials, ElasticMaterial, Kind, Particle, SolidFormulation};
 
+use super::check::{aabb, number, point_in, vector, Aabb, Bound};
 use super::error::{num, CaseError};
 use super::lattice::Lattice;
 use super::locate::Ctx;
 use super::schema::{RawSolid, SolidFormulationName, SolidVelocityName};
-use super::validate::{aabb, number, vector, Aabb, Bound, Case};
 use crate::layout::MAX_SOLID_MATERIALS;
 
 /// Initial velocity of a cantilever in its first bending mode (Gray, Monaghan & Swift 2001,
@@ -205,7 +203,8 @@ pub(super) fn validate_solid(
                     &format!("{path}.clamped_max_m"),
                     Some(format!("{hi:?}")),
                     format!(
-                        "clamped_max_m[{a}] = {} is not above clamped_min_m[{a}] = {} (the clamped region would be empty)",
+                        "clamped_max_m[{a}] = {} is not above clamped_min_m[{a}] = {} (the \
+                         clamped region would be empty)",
                         max[a], min[a]
                     ),
                     "make every component of clamped_max_m larger than that of clamped_min_m",
@@ -322,11 +321,6 @@ pub(super) fn validate_solid(
     })
 }
 
-fn point_in(p: [f64; 3], b: &Aabb, dim: usize) -> bool {
-    (0..dim).all(|a| p[a] >= b.min[a] && p[a] <= b.max[a])
-}
-
-/// The scenario of a case whose only particles are solids.
 /// How many particles at the end of `body` belong to solid `i` (they are built solid by solid).
 fn body_len(body: &[u32], i: usize) -> usize {
     body.iter().rev().take_while(|&&b| b == i as u32).count()
@@ -429,7 +423,8 @@ pub(super) fn solid_particles(
                             &format!("solid[{i}].initial_velocity"),
                             None,
                             format!("gives a non-finite velocity at {pos:?}"),
-                            "give a length_m of the order of the solid's length and a finite tip_velocity_m_s",
+                            "give a length_m of the order of the solid's length and a finite \
+                             tip_velocity_m_s",
                         ));
                     }
                     particles.push(Particle {
@@ -460,98 +455,6 @@ pub(super) fn solid_particles(
         }
     }
     Ok((materials, particles, body))
-}
-
-pub(super) fn build_solid_case(
-    ctx: &Ctx<'_>,
-    case: Case,
-    max_particles: f64,
-) -> Result<Scenario, CaseError> {
-    let (dim, dx) = (case.dim, case.dx);
-    let first = &case.solids[0];
-    let (materials, particles, body) = solid_particles(ctx, &case.solids, dim, dx, max_particles)?;
-    // Default domain: the solids' box, with half its largest extent of room on every side.
-    let mut bb = first.bx;
-    for s in &case.solids {
-        for a in 0..dim {
-            bb.min[a] = bb.min[a].min(s.bx.min[a]);
-            bb.max[a] = bb.max[a].max(s.bx.max[a]);
-        }
-    }
-    let d = match case.domain {
-        Some(d) => d,
-        None => {
-            let room = (0..dim).map(|a| bb.max[a] - bb.min[a]).fold(0.0, f64::max) * 0.5;
-            let mut d = bb;
-            for a in 0..dim {
-                d.min[a] -= room + 2.0 * dx;
-                d.max[a] += room + 2.0 * dx;
-            }
-            d
-        }
-    };
-    for (i, s) in case.solids.iter().enumerate() {
-        if !(point_in(s.bx.min, &d, dim) && point_in(s.bx.max, &d, dim)) {
-            return Err(ctx.err(
-                &format!("solid[{i}]"),
-                None,
-                "leaves the domain; its particles would be dropped",
-                "enlarge [domain] (or remove it to get the default)",
-            ));
-        }
-    }
-    let n = particles.len();
-    let points = super::probes::resolve_points(ctx, &case.points, &particles, &[], dim, dx)?;
-    let physics = Physics {
-        dim: dim as u32,
-        dx,
-        h: case.h_over_dx * dx,
-        kernel: case.kernel,
-        rho0: case.rho0,
-        // Unused without fluid; the solids' sound speeds enter through their materials.
-        c0: materials
-            .iter()
-            .map(ElasticMaterial::sound_speed)
-            .fold(0.0, f64::max),
-        gamma: case.gamma,
-        gravity: case.gravity,
-        viscosity: case.viscosity,
-        delta_sph: case.delta_sph,
-        delta_sph_form: case.delta_sph_form,
-        particle_mass: case.rho0 * dx.powi(dim as i32),
-        density_filter: case.density_filter,
-        energy: false,
-    };
-    let g = case.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
-    // Solids alone touch only one another. H: from the lowest particle to the highest.
-    let (lo, hi) = particles.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
-        (lo.min(p.pos[dim - 1]), hi.max(p.pos[dim - 1]))
-    });
-    let walls =
-        super::build::wall_params(ctx, &case.walls, dx, hi - lo + dx, g, case.solids.len() > 1)?;
-    Ok(Scenario {
-        name: case.name,
-        physics,
-        time: case.time,
-        domain: Domain {
-            min: d.min,
-            max: d.max,
-        },
-        particles,
-        probes: case.probes,
-        points,
-        walls,
-        periodic: [false; 3],
-        bodies: Vec::new(),
-        solids: Some(Solids {
-            materials,
-            body,
-            tau0: vec![[0.0; 6]; n],
-        }),
-        inlets: Vec::new(),
-        outlets: Vec::new(),
-        warnings: Vec::new(),
-    })
 }
 
 /// Refuses a free solid particle that starts closer than a particle spacing to a wall, obstacle

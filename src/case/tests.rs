@@ -1057,8 +1057,10 @@ fn geometry_errors() {
 
 #[test]
 fn cases_without_tank_and_with_obstacles() {
-    let text = "dimension = 3\n[particles]\ndx_m = 0.1\n[physics]\nsound_speed_m_s = 20.0\n[time]\nend_s = 1.0\noutput_every_s = 0.1\n\
-                [[fluid_block]]\nmin_m = [0.0, 0.0, 0.0]\nmax_m = [1.0, 0.5, 0.5]\nvelocity_m_s = [1.0, 0.0, 0.0]\n\
+    let text = "dimension = 3\n[particles]\ndx_m = 0.1\n[physics]\nsound_speed_m_s = 20.0\n\
+                [time]\nend_s = 1.0\noutput_every_s = 0.1\n\
+                [[fluid_block]]\nmin_m = [0.0, 0.0, 0.0]\nmax_m = [1.0, 0.5, 0.5]\nvelocity_m_s = \
+                [1.0, 0.0, 0.0]\n\
                 [[obstacle]]\nmin_m = [0.2, 0.0, 0.0]\nmax_m = [0.4, 0.2, 0.2]\n\
                 [[obstacle]]\nmin_m = [0.3, 0.0, 0.0]\nmax_m = [0.5, 0.2, 0.2]\n";
     let s = load_str(text, "x.toml", &[]).unwrap();
@@ -1195,7 +1197,8 @@ fn body_cases_build_with_bodies_last() {
 #[test]
 fn a_moving_tank_becomes_the_last_body_and_widens_the_domain() {
     let text = format!(
-        "{BASE}\n[tank.motion]\nkind = \"sine\"\npivot_m = [0.5, 0.0]\nrotation_deg = 4.0\nperiod_s = 3.14159\n"
+        "{BASE}\n[tank.motion]\nkind = \"sine\"\npivot_m = [0.5, 0.0]\nrotation_deg = 4.0\n\
+         period_s = 3.14159\n"
     );
     let moving = load_str(&text, "c.toml", &[]).unwrap();
     let fixed = load_str(BASE, "c.toml", &[]).unwrap();
@@ -1285,13 +1288,19 @@ fn bad_bodies_and_motions_are_refused() {
         &["body[0]", "mass"],
     );
     assert_err(
-        &with_body("shape = \"circle\"\ncenter_m = [0.5, 0.5]\nradius_m = 0.05\nmass_kg = 1.0\nwall = \"mirror\""),
+        &with_body(
+            "shape = \"circle\"\ncenter_m = [0.5, 0.5]\nradius_m = 0.05\nmass_kg = 1.0\n\
+             wall = \"mirror\"",
+        ),
         &[],
         None,
         &["body[0].wall", "dynamic"],
     );
     assert_err(
-        &with_body("shape = \"circle\"\ncenter_m = [0.5, 0.5]\nradius_m = 0.05\nmass_kg = 1.0\n[body.motion]\nkind = \"series\"\nfile = \"no_such.csv\""),
+        &with_body(
+            "shape = \"circle\"\ncenter_m = [0.5, 0.5]\nradius_m = 0.05\nmass_kg = 1.0\n\
+             [body.motion]\nkind = \"series\"\nfile = \"no_such.csv\"",
+        ),
         &[],
         None,
         &["body[0].motion.file", "no_such.csv"],
@@ -1309,10 +1318,17 @@ fn bad_bodies_and_motions_are_refused() {
         &["tank.motion.kind", "without [tank.motion] is fixed"],
     );
     assert_err(
-        &with_body("shape = \"box\"\nmin_m = [0.4, 0.4]\nmax_m = [0.5, 0.5]\n[body.motion]\nkind = \"fixed\"\nperiod_s = 1.0"),
+        &with_body(
+            "shape = \"box\"\nmin_m = [0.4, 0.4]\nmax_m = [0.5, 0.5]\n[body.motion]\nkind \
+             = \"fixed\"\nperiod_s = 1.0",
+        ),
         &[],
         None,
-        &["body[0].motion.period_s", "not used by a fixed motion", "no other field"],
+        &[
+            "body[0].motion.period_s",
+            "not used by a fixed motion",
+            "no other field",
+        ],
     );
     let held = |more: &str| {
         with_body(&format!(
@@ -1454,7 +1470,8 @@ fn friction_pairs_resolve_names_and_refuse_bad_ones() {
     // A moving tank is a body (index 0) and, for friction, one of the walls.
     let sloshing = format!(
         "{}\n[[body]]\nname = \"float\"\nshape = \"box\"\nmin_m = [0.4, 0.3]\nmax_m = [0.5, 0.4]\n\
-         density_kg_m3 = 500.0\n[[friction]]\nbetween = [\"float\", \"walls\"]\ncoefficient = 0.4\n",
+         density_kg_m3 = 500.0\n[[friction]]\nbetween = [\"float\", \"walls\"]\ncoefficient = \
+         0.4\n",
         include_str!("../../cases/sloshing_2d.toml")
     );
     let sc = load_str(&sloshing, "f.toml", &[]).unwrap();

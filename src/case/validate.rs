@@ -7,20 +7,14 @@ use crate::scenario::{
     RepulsiveForm, TimeControl, Viscosity, DEFAULT_FRICTION_SLIP,
 };
 
+use super::check::{aabb, number, treatment, vector, Aabb, Bound, Treatment};
 use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::probes::Checked;
 use super::schema::{
     DeltaSphFormName, DensityFilterName, GhostCorrectionName, KernelName, OutputBoundaryName,
-    RawCase, RawPhysics, RepulsiveFormName, SlipName, ViscosityName, WallName,
+    RawCase, RawPhysics, RepulsiveFormName, ViscosityName, WallName,
 };
-
-/// An axis-aligned box (3 components; in 2D the third is 0).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Aabb {
-    pub min: [f64; 3],
-    pub max: [f64; 3],
-}
 
 #[derive(Debug, Clone, Copy)]
 pub(super) enum Sound {
@@ -36,19 +30,6 @@ pub(super) struct Tank {
     pub wall: Treatment,
     /// A prescribed motion (the tank and its obstacles move together); `None`: fixed.
     pub motion: Option<crate::scenario::Motion>,
-}
-
-/// The wall treatment of the tank or of an obstacle (`docs/cases.md`, "Wall treatments").
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Treatment {
-    /// Dynamic boundary particles (Crespo et al. 2007), `Kind::Wall`.
-    Dynamic,
-    /// One layer of Lennard-Jones boundary particles (Monaghan 1994), `Kind::Repulsive`.
-    Repulsive,
-    /// Mirror planes on the tank's faces, no particles (tank only).
-    Mirror { no_slip: bool },
-    /// Fixed ghost particles, `Kind::GhostNoSlip` / `Kind::GhostFreeSlip`.
-    FixedGhost { no_slip: bool },
 }
 
 /// `[walls]`, with the defaults that need the built particles left as `None`, and the
@@ -117,130 +98,6 @@ impl Case {
     pub fn tank_moves(&self) -> bool {
         self.tank.as_ref().is_some_and(|t| t.motion.is_some())
     }
-}
-
-/// Allowed range of a number.
-#[derive(Clone, Copy)]
-pub(super) enum Bound {
-    /// > 0
-    Positive,
-    /// [lo, hi]
-    Closed(f64, f64),
-    /// (lo, hi]
-    OpenClosed(f64, f64),
-}
-
-pub(super) fn number(
-    ctx: &Ctx<'_>,
-    path: &str,
-    v: f64,
-    bound: Bound,
-    what: &str,
-    fix: &str,
-) -> Result<f64, CaseError> {
-    if !v.is_finite() {
-        return Err(ctx.err(
-            path,
-            Some(num(v)),
-            format!("must be a finite number ({what})"),
-            fix,
-        ));
-    }
-    let (ok, rule) = match bound {
-        Bound::Positive => (v > 0.0, "must be > 0".to_string()),
-        Bound::Closed(lo, hi) => (
-            lo <= v && v <= hi,
-            format!("must be in [{}, {}]", num(lo), num(hi)),
-        ),
-        Bound::OpenClosed(lo, hi) => (
-            lo < v && v <= hi,
-            format!("must be in ({}, {}]", num(lo), num(hi)),
-        ),
-    };
-    if ok {
-        Ok(v)
-    } else {
-        Err(ctx.err(path, Some(num(v)), format!("{rule} ({what})"), fix))
-    }
-}
-
-/// A `dim`-component vector of finite numbers, padded to 3 components.
-pub(super) fn vector(
-    ctx: &Ctx<'_>,
-    path: &str,
-    v: &[f64],
-    dim: usize,
-    what: &str,
-) -> Result<[f64; 3], CaseError> {
-    let axes = if dim == 2 {
-        "[x, y] with y up"
-    } else {
-        "[x, y, z] with z up"
-    };
-    if v.len() != dim {
-        return Err(ctx.err(
-            path,
-            Some(format!("{v:?}")),
-            format!(
-                "has {} components but this {dim}D case (dimension = {dim}) needs {dim}: {axes} ({what})",
-                v.len()
-            ),
-            format!("give {dim} numbers, {axes}"),
-        ));
-    }
-    let mut out = [0.0; 3];
-    for (i, &c) in v.iter().enumerate() {
-        if !c.is_finite() {
-            return Err(ctx.err(
-                &format!("{path}[{i}]"),
-                Some(num(c)),
-                format!("must be a finite number ({what})"),
-                "give a finite number",
-            ));
-        }
-        out[i] = c;
-    }
-    Ok(out)
-}
-
-/// A box from `{path}.min_m` / `{path}.max_m` with min < max on every axis.
-pub(super) fn aabb(
-    ctx: &Ctx<'_>,
-    path: &str,
-    min: &[f64],
-    max: &[f64],
-    dim: usize,
-    what: &str,
-) -> Result<Aabb, CaseError> {
-    let lo = vector(
-        ctx,
-        &format!("{path}.min_m"),
-        min,
-        dim,
-        &format!("the lower corner of {what}"),
-    )?;
-    let hi = vector(
-        ctx,
-        &format!("{path}.max_m"),
-        max,
-        dim,
-        &format!("the upper corner of {what}"),
-    )?;
-    for a in 0..dim {
-        if hi[a] <= lo[a] {
-            return Err(ctx.err(
-                &format!("{path}.max_m"),
-                Some(format!("{max:?}")),
-                format!(
-                    "max_m[{a}] = {} is not above min_m[{a}] = {} ({what} would be empty)",
-                    num(hi[a]),
-                    num(lo[a])
-                ),
-                "make every component of max_m larger than that of min_m",
-            ));
-        }
-    }
-    Ok(Aabb { min: lo, max: hi })
 }
 
 pub(super) fn validate(
@@ -348,15 +205,30 @@ pub(super) fn validate(
                 "keep only one of them",
             ))
         }
-        (Some(c), None) => Sound::Speed(number(ctx, "physics.sound_speed_m_s", c, Bound::Positive, "the numerical speed of sound c0 in m/s", "give a positive speed, about 10 times the largest expected flow speed")?),
-        (None, Some(k)) => Sound::Coef(number(ctx, "physics.sound_speed_coef", k, Bound::Positive, "c0 = coef * sqrt(|g| * H)", "use e.g. 10.0")?),
+        (Some(c), None) => Sound::Speed(number(
+            ctx,
+            "physics.sound_speed_m_s",
+            c,
+            Bound::Positive,
+            "the numerical speed of sound c0 in m/s",
+            "give a positive speed, about 10 times the largest expected flow speed",
+        )?),
+        (None, Some(k)) => Sound::Coef(number(
+            ctx,
+            "physics.sound_speed_coef",
+            k,
+            Bound::Positive,
+            "c0 = coef * sqrt(|g| * H)",
+            "use e.g. 10.0",
+        )?),
         // A solid-only case has no fluid to give a sound speed to (unused; see solids.rs).
         (None, None) if raw.fluid_block.is_empty() && !raw.solid.is_empty() => Sound::Speed(1.0),
         (None, None) => {
             return Err(ctx.err(
                 "physics.sound_speed_coef",
                 None,
-                "the speed of sound is not given: [physics] needs exactly one of sound_speed_m_s (c0 in m/s) or sound_speed_coef (c0 = coef * sqrt(|g| * H))",
+                "the speed of sound is not given: [physics] needs exactly one of sound_speed_m_s \
+                 (c0 in m/s) or sound_speed_coef (c0 = coef * sqrt(|g| * H))",
                 "add sound_speed_coef = 10.0 to [physics]",
             ))
         }
@@ -372,7 +244,13 @@ pub(super) fn validate(
     let viscosity = match ph.viscosity.unwrap_or(ViscosityName::Artificial) {
         ViscosityName::Artificial => {
             if let Some(nu) = ph.nu_m2_s {
-                return Err(ctx.err("physics.nu_m2_s", Some(num(nu)), "is only used with viscosity = \"laminar\", but the viscosity is \"artificial\"", "remove nu_m2_s, or set viscosity = \"laminar\""));
+                return Err(ctx.err(
+                    "physics.nu_m2_s",
+                    Some(num(nu)),
+                    "is only used with viscosity = \"laminar\", but the viscosity is \
+                     \"artificial\"",
+                    "remove nu_m2_s, or set viscosity = \"laminar\"",
+                ));
             }
             let alpha = number(
                 ctx,
@@ -386,7 +264,13 @@ pub(super) fn validate(
         }
         ViscosityName::Laminar => {
             if let Some(a) = ph.alpha {
-                return Err(ctx.err("physics.alpha", Some(num(a)), "is only used with viscosity = \"artificial\", but the viscosity is \"laminar\"", "remove alpha, or set viscosity = \"artificial\""));
+                return Err(ctx.err(
+                    "physics.alpha",
+                    Some(num(a)),
+                    "is only used with viscosity = \"artificial\", but the viscosity is \
+                     \"laminar\"",
+                    "remove alpha, or set viscosity = \"artificial\"",
+                ));
             }
             let Some(nu) = ph.nu_m2_s else {
                 return Err(ctx.err(
@@ -605,7 +489,8 @@ pub(super) fn validate(
                         d,
                         Bound::Positive,
                         "the Lennard-Jones strength D of repulsive walls in m²/s²",
-                        "use about 5 |g| H, e.g. 24.5 for 0.5 m of water, or remove it for that default",
+                        "use about 5 |g| H, e.g. 24.5 for 0.5 m of water, or remove it for that \
+                         default",
                     )
                 })
                 .transpose()?,
@@ -635,7 +520,8 @@ pub(super) fn validate(
                         k,
                         Bound::Positive,
                         "the Monaghan & Kajtar strength K of repulsive walls in m²/s²",
-                        "use about |g| H, e.g. 4.9 for 0.5 m of water, or remove it for that default",
+                        "use about |g| H, e.g. 4.9 for 0.5 m of water, or remove it for that \
+                         default",
                     )
                 })
                 .transpose()?,
@@ -806,7 +692,8 @@ fn density_filter(ctx: &Ctx<'_>, ph: &RawPhysics) -> Result<DensityFilter, CaseE
             return Err(ctx.err(
                 "physics.density_filter_every",
                 Some(n.to_string()),
-                "is only used with density_filter = \"shepard\" or \"mls\", but the filter is \"none\"",
+                "is only used with density_filter = \"shepard\" or \"mls\", but the filter is \
+                 \"none\"",
                 "remove density_filter_every, or set density_filter = \"shepard\" or \"mls\"",
             ));
         }
@@ -825,43 +712,5 @@ fn density_filter(ctx: &Ctx<'_>, ph: &RawPhysics) -> Result<DensityFilter, CaseE
     Ok(match name {
         DensityFilterName::Shepard => DensityFilter::Shepard { every },
         _ => DensityFilter::Mls { every },
-    })
-}
-
-/// The treatment of `{path}.wall` with `{path}.slip` (only for mirror and fixed_ghost walls).
-pub(super) fn treatment(
-    ctx: &Ctx<'_>,
-    path: &str,
-    wall: Option<WallName>,
-    slip: Option<SlipName>,
-) -> Result<Treatment, CaseError> {
-    let wall = wall.unwrap_or(WallName::Dynamic);
-    let no_slip = slip.unwrap_or(SlipName::NoSlip) == SlipName::NoSlip;
-    Ok(match wall {
-        WallName::Dynamic | WallName::Repulsive => {
-            if let Some(s) = slip {
-                let written = if s == SlipName::NoSlip {
-                    "\"no_slip\""
-                } else {
-                    "\"free_slip\""
-                };
-                return Err(ctx.err(
-                    &format!("{path}.slip"),
-                    Some(written.into()),
-                    format!(
-                        "is only used with wall = \"mirror\" or \"fixed_ghost\", but the wall is \"{}\"",
-                        wall.as_str()
-                    ),
-                    "remove slip, or set wall = \"fixed_ghost\"",
-                ));
-            }
-            if wall == WallName::Dynamic {
-                Treatment::Dynamic
-            } else {
-                Treatment::Repulsive
-            }
-        }
-        WallName::Mirror => Treatment::Mirror { no_slip },
-        WallName::FixedGhost => Treatment::FixedGhost { no_slip },
     })
 }

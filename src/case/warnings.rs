@@ -3,9 +3,9 @@
 //! gives a fix; `wgsph run` logs them and run.json lists them.
 
 use super::bodies::Shape;
-use super::build::{fmt_box, AXES};
+use super::check::{fmt_box, Treatment, AXES};
 use super::error::num;
-use super::validate::{Case, Treatment};
+use super::validate::Case;
 use crate::scenario::{ContactGroup, Motion, MotionLaw};
 
 /// The speed of sound `c0` and the field it came from (`physics.sound_speed_m_s` or

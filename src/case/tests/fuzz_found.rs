@@ -18,7 +18,8 @@ fn an_index_after_an_index_in_a_set_is_refused() {
 #[test]
 fn a_body_too_small_for_one_particle_is_refused() {
     let text = format!(
-        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"circle\"\ncenter_m = [0.5, 0.7]\nradius_m = 0.04\nmass_kg = 1.0\n"
+        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"circle\"\ncenter_m = [0.5, 0.7]\nradius_m = \
+         0.04\nmass_kg = 1.0\n"
     );
     assert_err(
         &text,
@@ -40,7 +41,8 @@ fn a_body_too_small_for_one_particle_is_refused() {
 #[test]
 fn a_block_wholly_inside_a_solid_is_refused() {
     let body = format!(
-        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"circle\"\ncenter_m = [0.25, 0.25]\nradius_m = 1.0\nmass_kg = 1.0\n"
+        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"circle\"\ncenter_m = [0.25, 0.25]\nradius_m = \
+         1.0\nmass_kg = 1.0\n"
     );
     assert_err(
         &body,
@@ -83,7 +85,8 @@ fn a_set_key_with_thousands_of_parts_is_refused() {
 #[test]
 fn a_series_file_must_be_a_regular_file() {
     let text = format!(
-        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"circle\"\ncenter_m = [0.5, 0.7]\nradius_m = 0.1\nmass_kg = 1.0\n[body.motion]\nkind = \"series\"\nfile = \"/dev/zero\"\n"
+        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"circle\"\ncenter_m = [0.5, 0.7]\nradius_m = \
+         0.1\nmass_kg = 1.0\n[body.motion]\nkind = \"series\"\nfile = \"/dev/zero\"\n"
     );
     assert_err(
         &text,
@@ -137,7 +140,8 @@ fn the_particle_budget_names_the_largest_part() {
         &["particles.dx_m", "in tank", "shrink tank"],
     );
     let thin = format!(
-        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.0, 0.8]\nmax_m = [1e10, 0.8000001]\nmass_kg = 1.0\n"
+        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.0, 0.8]\nmax_m = [1e10, \
+         0.8000001]\nmass_kg = 1.0\n"
     );
     assert_err(
         &thin,
@@ -193,7 +197,8 @@ fn fluid_outside_a_given_domain_names_the_bound() {
 #[test]
 fn errors_after_a_deleted_table_say_what_it_changed() {
     let body = format!(
-        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"circle\"\ncenter_m = [0.5, 0.7]\nradius_m = 0.1\n"
+        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"circle\"\ncenter_m = [0.5, 0.7]\nradius_m = \
+         0.1\n"
     );
     assert_err(
         &body,
@@ -217,7 +222,8 @@ fn errors_after_a_deleted_table_say_what_it_changed() {
 #[test]
 fn a_nan_rate_of_turn_names_its_component() {
     let text = format!(
-        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"circle\"\ncenter_m = [0.5, 0.7]\nradius_m = 0.1\nmass_kg = 1.0\n[body.motion]\nkind = \"free\"\nangular_velocity_rad_s = [nan]\n"
+        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"circle\"\ncenter_m = [0.5, 0.7]\nradius_m = \
+         0.1\nmass_kg = 1.0\n[body.motion]\nkind = \"free\"\nangular_velocity_rad_s = [nan]\n"
     );
     assert_err(
         &text,
@@ -240,7 +246,10 @@ fn a_nan_rate_of_turn_names_its_component() {
 #[test]
 fn a_body_mass_or_inertia_out_of_range_is_refused() {
     let body = |fields: &str| {
-        format!("{BASE}\n[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.2, 0.6]\nmax_m = [0.8, 0.9]\n{fields}\n")
+        format!(
+            "{BASE}\n[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.2, 0.6]\nmax_m = \
+             [0.8, 0.9]\n{fields}\n"
+        )
     };
     // A 2 m by 0.3 m box of 1.5e308 kg/m³ has 9e307 kg, finite, but an infinite inertia
     // m (w² + h²) / 12; a 2 m by 3.3 m box an infinite mass.

@@ -255,7 +255,10 @@ fn case_2d(body: &str) -> String {
 #[test]
 fn a_rectangle_polygon_is_the_box_body() {
     let poly = load_str(
-        &case_2d("shape = \"polygon\"\nvertices_m = [[0.5, 0.625], [0.75, 0.625], [0.75, 0.8125], [0.5, 0.8125]]"),
+        &case_2d(
+            "shape = \"polygon\"\nvertices_m = [[0.5, 0.625], [0.75, 0.625], [0.75, 0.8125], \
+             [0.5, 0.8125]]",
+        ),
         "c.toml",
         &[],
     )
@@ -420,8 +423,10 @@ fn wall_layers_short_of_the_kernel_support_load_with_a_warning() {
     let w = warnings(&case_2d(body), &["particles.h_over_dx=2"]);
     assert_eq!(w.len(), 1, "{w:?}");
     assert!(
-        w[0].starts_with("tank.layers = 3: 3 particle layers (0.1875 m) are less than the kernel support 2h = 0.25 m deep, so fluid beside the tank wall")
-            && w[0].ends_with("fix: set tank.layers to 4 or more"),
+        w[0].starts_with(
+            "tank.layers = 3: 3 particle layers (0.1875 m) are less than the kernel \
+             support 2h = 0.25 m deep, so fluid beside the tank wall"
+        ) && w[0].ends_with("fix: set tank.layers to 4 or more"),
         "{w:?}"
     );
     assert!(warnings(
@@ -434,7 +439,13 @@ fn wall_layers_short_of_the_kernel_support_load_with_a_warning() {
         &[],
     );
     assert_eq!(w.len(), 1, "{w:?}");
-    assert!(w[0].starts_with("body[0].layers = 2: 2 particle layers (0.125 m) are less than the kernel support 2h = 0.1625 m deep, so fluid beside the body 'b' misses"), "{w:?}");
+    assert!(
+        w[0].starts_with(
+            "body[0].layers = 2: 2 particle layers (0.125 m) are less than the kernel support \
+             2h = 0.1625 m deep, so fluid beside the body 'b' misses"
+        ),
+        "{w:?}"
+    );
     assert!(warnings(&case_2d(&format!("{body}\nlayers = 3")), &[]).is_empty());
     assert!(warnings(
         &case_2d(&format!("{body}\nlayers = 1\nwall = \"repulsive\"")),
@@ -460,7 +471,10 @@ fn speeds_above_a_tenth_of_the_sound_speed_load_with_a_warning() {
         w[0].starts_with(
             "body[0].motion sets a speed of 3 m/s, more than c0/10 = 2.21 m/s (c0 from \
              physics.sound_speed_coef): the water is compressed by about (u/c0)² = 1.83 %"
-        ) && w[0].ends_with("fix: raise physics.sound_speed_coef so that c0 is at least 30 m/s (the time step shrinks with it)"),
+        ) && w[0].ends_with(
+            "fix: raise physics.sound_speed_coef so that c0 is at least 30 m/s (the time \
+             step shrinks with it)"
+        ),
         "{w:?}"
     );
     assert!(warnings(&body("kind = \"free\"\nvelocity_m_s = [0.0, -2.0]"), &[]).is_empty());

@@ -96,7 +96,10 @@ fn solid_errors_name_the_field() {
         &["solid[0].clamped_max_m", "empty"],
     );
     assert_err(
-        &format!("{SOLID}\n[solid.initial_velocity]\nkind = \"cantilever_mode\"\nroot_m = [0.05, 0.02]\naxis = [1.0, 0.0]\ndirection = [0.0, 1.0]\ntip_velocity_m_s = 0.5\n"),
+        &format!(
+            "{SOLID}\n[solid.initial_velocity]\nkind = \"cantilever_mode\"\nroot_m = [0.05, \
+             0.02]\naxis = [1.0, 0.0]\ndirection = [0.0, 1.0]\ntip_velocity_m_s = 0.5\n"
+        ),
         &[],
         None,
         &["solid[0].initial_velocity.length_m", "required"],
@@ -393,7 +396,8 @@ fn fluid_and_solids_build_together() {
     );
 
     let with_body = format!(
-        "{case}[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.5, 0.25]\nmax_m = [0.55, 0.3]\ndensity_kg_m3 = 500.0\n"
+        "{case}[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.5, 0.25]\nmax_m = [0.55, 0.3]\n\
+         density_kg_m3 = 500.0\n"
     );
     let b = load_str(&with_body, "cases/t.toml", &[]).unwrap();
     let solids = b.solids.as_ref().expect("solids");

@@ -192,7 +192,8 @@ fn walls_table_defaults_and_overrides() {
     assert!((s.walls.repulsive_d - 5.0 * 9.81 * 0.5).abs() < 1e-9);
     assert!((s.walls.repulsive_r0 - 0.02).abs() < 1e-15);
     let text = format!(
-        "{HYDROSTATIC}\n[walls]\nghost_correction = \"shepard\"\nrepulsive_d_m2_s2 = 30.0\nrepulsive_r0_m = 0.015\n"
+        "{HYDROSTATIC}\n[walls]\nghost_correction = \"shepard\"\nrepulsive_d_m2_s2 = 30.0\n\
+         repulsive_r0_m = 0.015\n"
     );
     let s = load_str(&text, "w.toml", &[]).unwrap();
     assert_eq!(s.walls.ghost_correction, GhostCorrection::Shepard);
