@@ -8,6 +8,7 @@
 
 mod bodies;
 mod build;
+mod built_in;
 mod check;
 mod diagnose;
 mod domain;
@@ -31,6 +32,7 @@ mod tests;
 
 use std::path::Path;
 
+pub use built_in::{built_in, BuiltIn, BUILT_IN};
 pub(crate) use check::read_bounded;
 pub use error::{CaseError, Diagnostic};
 pub use limits::MAX_PARTICLES;

@@ -1545,3 +1545,16 @@ fn friction_pairs_resolve_names_and_refuse_bad_ones() {
         assert!(e.contains("fix:"), "{e}");
     }
 }
+
+/// A built-in case is found by its name and its file together, as a run records them.
+#[test]
+fn built_in_cases_are_found_by_name_and_file() {
+    for b in BUILT_IN {
+        let found = built_in(b.name, Path::new(b.file)).unwrap();
+        assert_eq!((found.name, found.file), (b.name, b.file));
+        assert_eq!(found.text, std::fs::read_to_string(b.file).unwrap());
+    }
+    let first = &BUILT_IN[0];
+    assert!(built_in(first.name, Path::new("cases/elsewhere.toml")).is_none());
+    assert!(built_in("another_name", Path::new(first.file)).is_none());
+}
