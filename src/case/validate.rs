@@ -1,6 +1,6 @@
 //! Field-by-field checks of the deserialised case: finite numbers, ranges, vector lengths,
 //! options that go together, defaults. Produces a [`Case`] in SI with 3-component vectors.
-//! Geometric checks that need several fields at once live in `build.rs`.
+//! Geometric checks that need several fields at once live in `build.rs` and `domain.rs`.
 
 use crate::scenario::{
     DeltaSphForm, DensityFilter, FrictionPair, GhostCorrection, KernelKind, OutputBoundary, Probe,
@@ -357,7 +357,8 @@ fn sound(ctx: &Ctx<'_>, raw: &RawCase) -> Result<Sound, CaseError> {
             "c0 = coef * sqrt(|g| * H)",
             "use e.g. 10.0",
         )?),
-        // A solid-only case has no fluid to give a sound speed to (unused; see solids.rs).
+        // A solid-only case has no fluid to give a sound speed to (unused; see
+        // build_solid_case in build.rs).
         (None, None) if raw.fluid_block.is_empty() && !raw.solid.is_empty() => Sound::Speed(1.0),
         (None, None) => {
             return Err(ctx.err(
