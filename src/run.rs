@@ -112,10 +112,10 @@ pub fn particle_counts(sc: &Scenario) -> [u64; 4] {
 }
 
 /// The scenario of the run in `dir`, loaded again as its run.json records it: its case file
-/// (or `case` in its place) with its overrides. A validation case whose file is not on disk
-/// here is loaded from the copy built into the binary. Errors when run.json lacks what is
-/// needed, or when the case as loaded now has other particle counts than the run had (the
-/// file changed since): the drawings would not be of that run.
+/// (or `case` in its place) with its overrides. A built-in case ([`crate::case::BUILT_IN`])
+/// whose file is not on disk here is loaded from the copy built into the binary. Errors when
+/// run.json lacks what is needed, or when the case as loaded now has other particle counts
+/// than the run had (the file changed since): the drawings would not be of that run.
 pub fn scenario_of_run(dir: &Path, case: Option<&Path>) -> Result<Scenario> {
     let s = RunSummary::read(dir)?;
     let overrides = s.overrides.clone().unwrap_or_default();
@@ -128,11 +128,8 @@ pub fn scenario_of_run(dir: &Path, case: Option<&Path>) -> Result<Scenario> {
             dir.join(crate::output::RUN_SUMMARY_FILE).display()
         ),
     };
-    let built_in = crate::validation::CASES
-        .iter()
-        .find(|c| c.name == s.case && Path::new(c.file) == file);
-    let sc = match built_in {
-        Some(c) if case.is_none() && !file.is_file() => c.scenario(&overrides)?,
+    let sc = match crate::case::built_in(&s.case, &file) {
+        Some(b) if case.is_none() && !file.is_file() => b.load(&overrides)?,
         _ => crate::case::load(&file, &overrides)?,
     };
     let (had, has) = (

@@ -50,6 +50,7 @@ fn file_safe(name: &str) -> bool {
             .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
 }
 
+/// `[[body]]`: every body checked, in order.
 pub(super) fn validate(
     ctx: &Ctx<'_>,
     raw: &[RawBody],
@@ -58,127 +59,152 @@ pub(super) fn validate(
 ) -> Result<Vec<BodySpec>, CaseError> {
     let mut out: Vec<BodySpec> = Vec::with_capacity(raw.len());
     for (i, b) in raw.iter().enumerate() {
-        let path = format!("body[{i}]");
-        if !file_safe(&b.name) || b.name == "tank" {
-            return Err(ctx.err(
-                &format!("{path}.name"),
-                Some(format!("{:?}", b.name)),
-                "must be made of letters, digits, `_` and `-` (it becomes the file name \
-                 probes/body_<name>.csv) and must not be \"tank\" (the moving tank's name)",
-                "use a name like \"box\" or \"cylinder\"",
-            ));
-        }
-        if let Some(j) = out.iter().position(|o| o.name == b.name) {
-            return Err(ctx.err(
-                &format!("{path}.name"),
-                Some(format!("{:?}", b.name)),
-                format!("body[{j}] already has this name"),
-                "give every body a different name",
-            ));
-        }
-        let wall = treatment(ctx, &path, b.wall, b.slip)?;
-        if let Treatment::Mirror { .. } = wall {
-            return Err(ctx.err(
-                &format!("{path}.wall"),
-                Some("\"mirror\"".into()),
-                "mirror ghosts are for the tank's straight faces",
-                "use wall = \"fixed_ghost\" (or \"dynamic\", \"repulsive\")",
-            ));
-        }
-        let shape = shape(ctx, &path, b, dim, case_dir)?;
-        let mass = match (b.density_kg_m3, b.mass_kg) {
-            (Some(_), Some(_)) => {
-                return Err(ctx.err(
-                    &format!("{path}.mass_kg"),
-                    None,
-                    "density_kg_m3 and mass_kg are both given",
-                    "keep only one of them",
-                ))
-            }
-            (Some(d), None) => Some(
-                number(
-                    ctx,
-                    &format!("{path}.density_kg_m3"),
-                    d,
-                    Bound::Positive,
-                    "the body density in kg/m³",
-                    "give a positive density, e.g. 500.0",
-                )? * shape.measure(dim),
-            ),
-            (None, Some(m)) => Some(number(
-                ctx,
-                &format!("{path}.mass_kg"),
-                m,
-                Bound::Positive,
-                "the body mass in kg (per metre of depth in 2D)",
-                "give a positive mass",
-            )?),
-            (None, None) => None,
-        };
-        if let Some(m) = mass {
-            // Density times a large area, or a large mass times a large size, can overflow (or
-            // a tiny density underflow to 0); the rigid-body equations divide by both.
-            let inertia = shape.inertia(dim, m);
-            let used: &[usize] = if dim == 2 { &[2] } else { &[0, 1, 2] };
-            let fine = |x: f64| x.is_finite() && x > 0.0;
-            if !(fine(m) && used.iter().all(|&a| fine(inertia[a][a]))) {
-                let (field, value) = match (b.density_kg_m3, b.mass_kg) {
-                    (Some(d), _) => ("density_kg_m3", d),
-                    (_, m) => ("mass_kg", m.unwrap_or(0.0)),
-                };
-                return Err(ctx.err(
-                    &format!("{path}.{field}"),
-                    Some(num(value)),
-                    format!(
-                        "gives the body a mass of {} kg and moments of inertia {:?} kg m² that \
-                         cannot be computed with",
-                        num(m),
-                        used.iter().map(|&a| num(inertia[a][a])).collect::<Vec<_>>()
-                    ),
-                    "give a realistic density or mass",
-                ));
-            }
-        }
-        let layers = match b.layers {
-            None => None,
-            Some(l) if (1..=64).contains(&l) => Some(l as u32),
-            Some(l) => {
-                return Err(ctx.err(
-                    &format!("{path}.layers"),
-                    Some(l.to_string()),
-                    "must be between 1 and 64 (particle layers under the surface)",
-                    "use 3 or more (the kernel support is 2h), or remove it to fill the body",
-                ))
-            }
-        };
-        let motion_path = format!("{path}.motion");
-        let motion = match &b.motion {
-            None => Motion::Free {
-                velocity: [0.0; 3],
-                omega: [0.0; 3],
-                release_s: 0.0,
-            },
-            Some(m) => motion(ctx, &motion_path, m, dim, true, case_dir)?,
-        };
-        if matches!(motion, Motion::Free { .. }) && mass.is_none() {
-            return Err(ctx.err(
-                &path,
-                None,
-                "a free body (one without [body.motion], or with kind = \"free\") needs its \
-                 mass: give density_kg_m3 or mass_kg",
-                "add density_kg_m3 = 500.0 (or mass_kg)",
-            ));
-        }
-        out.push(BodySpec {
-            name: b.name.clone(),
-            shape,
-            mass,
-            layers,
-            wall,
-            motion,
-        });
+        let spec = body(ctx, (i, b), &out, dim, case_dir)?;
+        out.push(spec);
     }
     Ok(out)
+}
+
+/// `body[i]`, `b`; `earlier`: the bodies before it, whose names it must not repeat.
+fn body(
+    ctx: &Ctx<'_>,
+    (i, b): (usize, &RawBody),
+    earlier: &[BodySpec],
+    dim: usize,
+    case_dir: &Path,
+) -> Result<BodySpec, CaseError> {
+    let path = format!("body[{i}]");
+    if !file_safe(&b.name) || b.name == "tank" {
+        return Err(ctx.err(
+            &format!("{path}.name"),
+            Some(format!("{:?}", b.name)),
+            "must be made of letters, digits, `_` and `-` (it becomes the file name \
+             probes/body_<name>.csv) and must not be \"tank\" (the moving tank's name)",
+            "use a name like \"box\" or \"cylinder\"",
+        ));
+    }
+    if let Some(j) = earlier.iter().position(|o| o.name == b.name) {
+        return Err(ctx.err(
+            &format!("{path}.name"),
+            Some(format!("{:?}", b.name)),
+            format!("body[{j}] already has this name"),
+            "give every body a different name",
+        ));
+    }
+    let wall = treatment(ctx, &path, b.wall, b.slip)?;
+    if let Treatment::Mirror { .. } = wall {
+        return Err(ctx.err(
+            &format!("{path}.wall"),
+            Some("\"mirror\"".into()),
+            "mirror ghosts are for the tank's straight faces",
+            "use wall = \"fixed_ghost\" (or \"dynamic\", \"repulsive\")",
+        ));
+    }
+    let shape = shape(ctx, &path, b, dim, case_dir)?;
+    let mass = mass(ctx, &path, b, &shape, dim)?;
+    let layers = match b.layers {
+        None => None,
+        Some(l) if (1..=64).contains(&l) => Some(l as u32),
+        Some(l) => {
+            return Err(ctx.err(
+                &format!("{path}.layers"),
+                Some(l.to_string()),
+                "must be between 1 and 64 (particle layers under the surface)",
+                "use 3 or more (the kernel support is 2h), or remove it to fill the body",
+            ))
+        }
+    };
+    let motion_path = format!("{path}.motion");
+    let motion = match &b.motion {
+        None => Motion::Free {
+            velocity: [0.0; 3],
+            omega: [0.0; 3],
+            release_s: 0.0,
+        },
+        Some(m) => motion(ctx, &motion_path, m, dim, true, case_dir)?,
+    };
+    if matches!(motion, Motion::Free { .. }) && mass.is_none() {
+        return Err(ctx.err(
+            &path,
+            None,
+            "a free body (one without [body.motion], or with kind = \"free\") needs its \
+             mass: give density_kg_m3 or mass_kg",
+            "add density_kg_m3 = 500.0 (or mass_kg)",
+        ));
+    }
+    Ok(BodySpec {
+        name: b.name.clone(),
+        shape,
+        mass,
+        layers,
+        wall,
+        motion,
+    })
+}
+
+/// The mass of body `b` at `path` (of `shape`): from `density_kg_m3` or `mass_kg` (not both;
+/// neither: `None`), with a mass and moments of inertia that can be computed with.
+fn mass(
+    ctx: &Ctx<'_>,
+    path: &str,
+    b: &RawBody,
+    shape: &Shape,
+    dim: usize,
+) -> Result<Option<f64>, CaseError> {
+    let mass = match (b.density_kg_m3, b.mass_kg) {
+        (Some(_), Some(_)) => {
+            return Err(ctx.err(
+                &format!("{path}.mass_kg"),
+                None,
+                "density_kg_m3 and mass_kg are both given",
+                "keep only one of them",
+            ))
+        }
+        (Some(d), None) => Some(
+            number(
+                ctx,
+                &format!("{path}.density_kg_m3"),
+                d,
+                Bound::Positive,
+                "the body density in kg/m³",
+                "give a positive density, e.g. 500.0",
+            )? * shape.measure(dim),
+        ),
+        (None, Some(m)) => Some(number(
+            ctx,
+            &format!("{path}.mass_kg"),
+            m,
+            Bound::Positive,
+            "the body mass in kg (per metre of depth in 2D)",
+            "give a positive mass",
+        )?),
+        (None, None) => None,
+    };
+    if let Some(m) = mass {
+        // Density times a large area, or a large mass times a large size, can overflow (or
+        // a tiny density underflow to 0); the rigid-body equations divide by both.
+        let inertia = shape.inertia(dim, m);
+        let used: &[usize] = if dim == 2 { &[2] } else { &[0, 1, 2] };
+        let fine = |x: f64| x.is_finite() && x > 0.0;
+        if !(fine(m) && used.iter().all(|&a| fine(inertia[a][a]))) {
+            let (field, value) = match (b.density_kg_m3, b.mass_kg) {
+                (Some(d), _) => ("density_kg_m3", d),
+                (_, m) => ("mass_kg", m.unwrap_or(0.0)),
+            };
+            return Err(ctx.err(
+                &format!("{path}.{field}"),
+                Some(num(value)),
+                format!(
+                    "gives the body a mass of {} kg and moments of inertia {:?} kg m² that \
+                     cannot be computed with",
+                    num(m),
+                    used.iter().map(|&a| num(inertia[a][a])).collect::<Vec<_>>()
+                ),
+                "give a realistic density or mass",
+            ));
+        }
+    }
+    Ok(mass)
 }
 
 fn shape(
@@ -294,6 +320,86 @@ pub(super) fn motion(
     for_body: bool,
     case_dir: &Path,
 ) -> Result<Motion, CaseError> {
+    let kind = check_motion_fields(ctx, path, m)?;
+    if !for_body && matches!(m.kind, MotionName::Free | MotionName::Fixed) {
+        return Err(ctx.err(
+            &format!("{path}.kind"),
+            Some(format!("\"{kind}\"")),
+            if m.kind == MotionName::Free {
+                "the tank cannot move freely"
+            } else {
+                "a tank without [tank.motion] is fixed"
+            },
+            "use kind = \"sine\" or \"series\" (or remove [tank.motion])",
+        ));
+    }
+    if m.kind == MotionName::Fixed {
+        return Ok(Motion::Prescribed(Prescribed {
+            pivot: [0.0; 3],
+            axis: [0.0, 0.0, 1.0],
+            law: MotionLaw::Fixed,
+        }));
+    }
+    if m.kind == MotionName::Free {
+        return free_motion(ctx, path, m, dim);
+    }
+    let pivot = match &m.pivot_m {
+        Some(p) => vector(
+            ctx,
+            &format!("{path}.pivot_m"),
+            p,
+            dim,
+            "the rotation pivot in metres",
+        )?,
+        None => [0.0; 3],
+    };
+    let axis = match &m.axis {
+        Some(_) if dim == 2 => {
+            return Err(ctx.err(
+                &format!("{path}.axis"),
+                None,
+                "is only used in 3D (2D motions turn about z)",
+                "remove axis",
+            ))
+        }
+        None => [0.0, 0.0, 1.0],
+        Some(a) => {
+            let a = vector(ctx, &format!("{path}.axis"), a, 3, "the rotation axis")?;
+            let len = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+            if len == 0.0 {
+                return Err(ctx.err(
+                    &format!("{path}.axis"),
+                    None,
+                    "is the zero vector",
+                    "give the rotation axis, e.g. [0.0, 1.0, 0.0]",
+                ));
+            }
+            a.map(|c| c / len)
+        }
+    };
+    let law = if m.kind == MotionName::Sine {
+        sine_law(ctx, path, m, dim)?
+    } else {
+        let Some(file) = &m.file else {
+            return Err(ctx.err(
+                &format!("{path}.file"),
+                None,
+                "is required for a series motion",
+                "add file = \"excitation.csv\" (t_s, dx_m, dy_m[, dz_m], angle_deg)",
+            ));
+        };
+        series(ctx, &format!("{path}.file"), file, dim, case_dir)?
+    };
+    Ok(Motion::Prescribed(Prescribed { pivot, axis, law }))
+}
+
+/// The motion's kind as the file writes it; an error names the first field given that the
+/// kind does not use.
+fn check_motion_fields(
+    ctx: &Ctx<'_>,
+    path: &str,
+    m: &RawMotion,
+) -> Result<&'static str, CaseError> {
     let needs: &[&str] = match m.kind {
         MotionName::Free => &["velocity_m_s", "angular_velocity_rad_s", "release_s"],
         MotionName::Fixed => &[],
@@ -339,190 +445,131 @@ pub(super) fn motion(
             ));
         }
     }
-    if !for_body && matches!(m.kind, MotionName::Free | MotionName::Fixed) {
-        return Err(ctx.err(
-            &format!("{path}.kind"),
-            Some(format!("\"{kind}\"")),
-            if m.kind == MotionName::Free {
-                "the tank cannot move freely"
-            } else {
-                "a tank without [tank.motion] is fixed"
-            },
-            "use kind = \"sine\" or \"series\" (or remove [tank.motion])",
-        ));
-    }
-    if m.kind == MotionName::Fixed {
-        return Ok(Motion::Prescribed(Prescribed {
-            pivot: [0.0; 3],
-            axis: [0.0, 0.0, 1.0],
-            law: MotionLaw::Fixed,
-        }));
-    }
-    if m.kind == MotionName::Free {
-        let velocity = match &m.velocity_m_s {
-            Some(v) => vector(
-                ctx,
-                &format!("{path}.velocity_m_s"),
-                v,
-                dim,
-                "the initial velocity in m/s",
-            )?,
-            None => [0.0; 3],
-        };
-        let omega = match &m.angular_velocity_rad_s {
-            None => [0.0; 3],
-            // One component (the length is right): `vector` only checks that it is finite,
-            // naming `angular_velocity_rad_s[0]`.
-            Some(w) if dim == 2 && w.len() == 1 => {
-                let w = vector(
-                    ctx,
-                    &format!("{path}.angular_velocity_rad_s"),
-                    w,
-                    1,
-                    "the initial rate of turn about z in rad/s",
-                )?;
-                [0.0, 0.0, w[0]]
-            }
-            Some(w) if dim == 3 => vector(
-                ctx,
-                &format!("{path}.angular_velocity_rad_s"),
-                w,
-                3,
-                "the initial angular velocity in rad/s",
-            )?,
-            Some(w) => {
-                return Err(ctx.err(
-                    &format!("{path}.angular_velocity_rad_s"),
-                    Some(format!("{w:?}")),
-                    "in 2D (dimension = 2) is one number in a list, the rate about z",
-                    "write angular_velocity_rad_s = [0.0]",
-                ))
-            }
-        };
-        let release_s = match m.release_s {
-            None => 0.0,
-            Some(r) if r.is_finite() && r >= 0.0 => r,
-            Some(r) => {
-                return Err(ctx.err(
-                    &format!("{path}.release_s"),
-                    Some(r.to_string()),
-                    "must be a time of at least 0 s (how long the body is held at rest before \
-                     it is released)",
-                    "write e.g. release_s = 1.0, or remove it to release the body at once",
-                ))
-            }
-        };
-        if release_s > 0.0 && (velocity != [0.0; 3] || omega != [0.0; 3]) {
-            return Err(ctx.err(
-                &format!("{path}.release_s"),
-                Some(release_s.to_string()),
-                "holds the body at rest until it is released, so it cannot also have an \
-                 initial velocity_m_s or angular_velocity_rad_s",
-                "remove velocity_m_s and angular_velocity_rad_s (a held body is released from \
-                 rest), or remove release_s",
-            ));
-        }
-        return Ok(Motion::Free {
-            velocity,
-            omega,
-            release_s,
-        });
-    }
-    let pivot = match &m.pivot_m {
-        Some(p) => vector(
+    Ok(kind)
+}
+
+/// A free motion: the initial velocity and angular velocity, or a release time.
+fn free_motion(ctx: &Ctx<'_>, path: &str, m: &RawMotion, dim: usize) -> Result<Motion, CaseError> {
+    let velocity = match &m.velocity_m_s {
+        Some(v) => vector(
             ctx,
-            &format!("{path}.pivot_m"),
-            p,
+            &format!("{path}.velocity_m_s"),
+            v,
             dim,
-            "the rotation pivot in metres",
+            "the initial velocity in m/s",
         )?,
         None => [0.0; 3],
     };
-    let axis = match &m.axis {
-        Some(_) if dim == 2 => {
+    let omega = match &m.angular_velocity_rad_s {
+        None => [0.0; 3],
+        // One component (the length is right): `vector` only checks that it is finite,
+        // naming `angular_velocity_rad_s[0]`.
+        Some(w) if dim == 2 && w.len() == 1 => {
+            let w = vector(
+                ctx,
+                &format!("{path}.angular_velocity_rad_s"),
+                w,
+                1,
+                "the initial rate of turn about z in rad/s",
+            )?;
+            [0.0, 0.0, w[0]]
+        }
+        Some(w) if dim == 3 => vector(
+            ctx,
+            &format!("{path}.angular_velocity_rad_s"),
+            w,
+            3,
+            "the initial angular velocity in rad/s",
+        )?,
+        Some(w) => {
             return Err(ctx.err(
-                &format!("{path}.axis"),
-                None,
-                "is only used in 3D (2D motions turn about z)",
-                "remove axis",
+                &format!("{path}.angular_velocity_rad_s"),
+                Some(format!("{w:?}")),
+                "in 2D (dimension = 2) is one number in a list, the rate about z",
+                "write angular_velocity_rad_s = [0.0]",
             ))
         }
-        None => [0.0, 0.0, 1.0],
-        Some(a) => {
-            let a = vector(ctx, &format!("{path}.axis"), a, 3, "the rotation axis")?;
-            let len = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-            if len == 0.0 {
-                return Err(ctx.err(
-                    &format!("{path}.axis"),
-                    None,
-                    "is the zero vector",
-                    "give the rotation axis, e.g. [0.0, 1.0, 0.0]",
-                ));
-            }
-            a.map(|c| c / len)
+    };
+    let release_s = match m.release_s {
+        None => 0.0,
+        Some(r) if r.is_finite() && r >= 0.0 => r,
+        Some(r) => {
+            return Err(ctx.err(
+                &format!("{path}.release_s"),
+                Some(r.to_string()),
+                "must be a time of at least 0 s (how long the body is held at rest before \
+                 it is released)",
+                "write e.g. release_s = 1.0, or remove it to release the body at once",
+            ))
         }
     };
-    let law = if m.kind == MotionName::Sine {
-        let Some(period) = m.period_s else {
-            return Err(ctx.err(
-                &format!("{path}.period_s"),
-                None,
-                "is required for a sine motion",
-                "add period_s = 3.14159 (for example)",
-            ));
-        };
-        let period = number(
-            ctx,
+    if release_s > 0.0 && (velocity != [0.0; 3] || omega != [0.0; 3]) {
+        return Err(ctx.err(
+            &format!("{path}.release_s"),
+            Some(release_s.to_string()),
+            "holds the body at rest until it is released, so it cannot also have an \
+             initial velocity_m_s or angular_velocity_rad_s",
+            "remove velocity_m_s and angular_velocity_rad_s (a held body is released from \
+             rest), or remove release_s",
+        ));
+    }
+    Ok(Motion::Free {
+        velocity,
+        omega,
+        release_s,
+    })
+}
+
+/// The law of a sine motion: its period, amplitudes and phase.
+fn sine_law(ctx: &Ctx<'_>, path: &str, m: &RawMotion, dim: usize) -> Result<MotionLaw, CaseError> {
+    let Some(period) = m.period_s else {
+        return Err(ctx.err(
             &format!("{path}.period_s"),
-            period,
-            Bound::Positive,
-            "the period in seconds",
-            "give a positive period",
-        )?;
-        let translation = match &m.translation_m {
-            Some(t) => vector(
-                ctx,
-                &format!("{path}.translation_m"),
-                t,
-                dim,
-                "the displacement amplitude in metres",
-            )?,
-            None => [0.0; 3],
-        };
-        let angle = number(
-            ctx,
-            &format!("{path}.rotation_deg"),
-            m.rotation_deg.unwrap_or(0.0),
-            Bound::Closed(-180.0, 180.0),
-            "the rotation amplitude in degrees",
-            "give an amplitude between -180 and 180 degrees",
-        )?;
-        let phase = number(
-            ctx,
-            &format!("{path}.phase_deg"),
-            m.phase_deg.unwrap_or(0.0),
-            Bound::Closed(-360.0, 360.0),
-            "the phase in degrees",
-            "give a phase between -360 and 360 degrees",
-        )?;
-        MotionLaw::Sine {
-            translation,
-            angle: angle.to_radians(),
-            omega: 2.0 * PI / period,
-            phase: phase.to_radians(),
-        }
-    } else {
-        let Some(file) = &m.file else {
-            return Err(ctx.err(
-                &format!("{path}.file"),
-                None,
-                "is required for a series motion",
-                "add file = \"excitation.csv\" (t_s, dx_m, dy_m[, dz_m], angle_deg)",
-            ));
-        };
-        series(ctx, &format!("{path}.file"), file, dim, case_dir)?
+            None,
+            "is required for a sine motion",
+            "add period_s = 3.14159 (for example)",
+        ));
     };
-    Ok(Motion::Prescribed(Prescribed { pivot, axis, law }))
+    let period = number(
+        ctx,
+        &format!("{path}.period_s"),
+        period,
+        Bound::Positive,
+        "the period in seconds",
+        "give a positive period",
+    )?;
+    let translation = match &m.translation_m {
+        Some(t) => vector(
+            ctx,
+            &format!("{path}.translation_m"),
+            t,
+            dim,
+            "the displacement amplitude in metres",
+        )?,
+        None => [0.0; 3],
+    };
+    let angle = number(
+        ctx,
+        &format!("{path}.rotation_deg"),
+        m.rotation_deg.unwrap_or(0.0),
+        Bound::Closed(-180.0, 180.0),
+        "the rotation amplitude in degrees",
+        "give an amplitude between -180 and 180 degrees",
+    )?;
+    let phase = number(
+        ctx,
+        &format!("{path}.phase_deg"),
+        m.phase_deg.unwrap_or(0.0),
+        Bound::Closed(-360.0, 360.0),
+        "the phase in degrees",
+        "give a phase between -360 and 360 degrees",
+    )?;
+    Ok(MotionLaw::Sine {
+        translation,
+        angle: angle.to_radians(),
+        omega: 2.0 * PI / period,
+        phase: phase.to_radians(),
+    })
 }
 
 /// A motion time series: a CSV with `#` comments, an optional header line, and rows

@@ -1,6 +1,7 @@
-//! From a validated [`Case`] to the [`Scenario`]: geometric checks (blocks inside the tank and
-//! the domain, nothing too thin, probes inside the domain; the size limits are in `limits.rs`),
-//! the particle lattices, the hydrostatic initial density and the default domain.
+//! From a validated [`Case`] to the [`Scenario`]: geometric checks (blocks inside the tank,
+//! nothing too thin; the size limits are in `limits.rs`, the domain and what must lie in it in
+//! `domain.rs`), the particle lattices and the hydrostatic initial density, in the stages that
+//! [`build`] lists.
 
 use std::collections::HashSet;
 

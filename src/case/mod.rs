@@ -5,9 +5,28 @@
 //! the document → deserialise into the schema (unknown, missing and mistyped fields) → check every
 //! field (`validate.rs`) → check the geometry and build the particles (`build.rs`). Every error
 //! names the file, the line, the field's dotted path, what is wrong and a fix.
+//!
+//! The files form layers; each imports only from the layers below it (no file imports one of
+//! its own layer or above, but where noted), so there are no import circles:
+//!
+//! 1. the foundation: `error.rs` ([`CaseError`], [`Diagnostic`], how numbers are written),
+//!    `locate.rs` (field paths, lines and the context every check reports through) and
+//!    `schema.rs` (the deserialised TOML); `diagnose.rs` (parse and schema errors) and
+//!    `overrides.rs` (`--set`) use only these;
+//! 2. `check.rs`: the checking primitives: boxes, the checks of one number, vector or box,
+//!    wall treatments, inside tests, how a box is written in a message, bounded file reads;
+//! 3. geometry and size limits: `lattice.rs`, `mesh.rs`, `polygon.rs` (which uses `mesh.rs`)
+//!    and `limits.rs`;
+//! 4. the checks and particles of one kind of table each: `probes.rs`, `open_boundaries.rs`,
+//!    `solids.rs`, `bodies.rs`, and `friction.rs` (which names bodies and solids);
+//! 5. `validate.rs`: the whole checked case (`Case`);
+//! 6. the build: `warnings.rs` and `domain.rs`, used by `build.rs`;
+//! 7. this file (the loader) with `built_in.rs` ([`BUILT_IN`], the case files built into the
+//!    binary, loaded through this file) and the tests.
 
 mod bodies;
 mod build;
+mod built_in;
 mod check;
 mod diagnose;
 mod domain;
@@ -31,6 +50,7 @@ mod tests;
 
 use std::path::Path;
 
+pub use built_in::{built_in, BuiltIn, BUILT_IN};
 pub(crate) use check::read_bounded;
 pub use error::{CaseError, Diagnostic};
 pub use limits::MAX_PARTICLES;

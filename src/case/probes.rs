@@ -27,6 +27,7 @@ pub(super) struct PointSpec {
     pub point: [f64; 3],
 }
 
+/// `probe[i]`, `p`: its name, its fields, and the probe or point it describes.
 pub(super) fn probe(
     ctx: &Ctx<'_>,
     i: usize,
@@ -47,6 +48,63 @@ pub(super) fn probe(
             "use a name like \"P1\" or \"front\"",
         ));
     }
+    check_probe_fields(ctx, &path, p, dim)?;
+    let get = |field: &str, v: &Option<Vec<f64>>, what: &str| {
+        field_vector(ctx, &path, field, v, dim, what)
+    };
+    let kind = match p.kind {
+        ProbeName::Point => {
+            return Ok(Checked::Point(PointSpec {
+                index: i,
+                name: p.name.clone(),
+                point: get("point_m", &p.point_m, "the point to follow in metres")?,
+            }))
+        }
+        ProbeName::Pressure => ProbeKind::Pressure {
+            point: get("point_m", &p.point_m, "the sampling point in metres")?,
+        },
+        ProbeName::Height => ProbeKind::Height {
+            base: get("base_m", &p.base_m, "the foot of the gauge line in metres")?,
+        },
+        ProbeName::Front => {
+            let origin = get(
+                "origin_m",
+                &p.origin_m,
+                "the front probe's origin in metres",
+            )?;
+            let axis = get(
+                "axis",
+                &p.axis,
+                "the direction along which the front is measured",
+            )?;
+            ProbeKind::Front {
+                origin,
+                axis: unit(
+                    ctx,
+                    &format!("{path}.axis"),
+                    axis,
+                    &p.axis,
+                    "the direction of the surge, e.g. [1.0, 0.0]",
+                )?,
+            }
+        }
+        ProbeName::WallPressure => wall_pressure(ctx, &path, p, dim)?,
+    };
+    Ok(Checked::Sampled(Probe {
+        name: p.name.clone(),
+        kind,
+        // Resolved against the bodies once they are known (validate.rs).
+        body: None,
+    }))
+}
+
+/// The fields of `p` at `path`: exactly those of its kind (a point probe attached to no body).
+fn check_probe_fields(
+    ctx: &Ctx<'_>,
+    path: &str,
+    p: &RawProbe,
+    dim: usize,
+) -> Result<(), CaseError> {
     let (kind_name, needs): (&str, &[&str]) = match p.kind {
         ProbeName::Pressure => ("pressure", &["point_m"]),
         ProbeName::Height => ("height", &["base_m"]),
@@ -104,90 +162,68 @@ pub(super) fn probe(
             _ => {}
         }
     }
+    Ok(())
+}
+
+/// `{path}.{field}`, `v`: a vector of `dim` finite numbers (`what` it is); a missing one is
+/// read as empty.
+fn field_vector(
+    ctx: &Ctx<'_>,
+    path: &str,
+    field: &str,
+    v: &Option<Vec<f64>>,
+    dim: usize,
+    what: &str,
+) -> Result<[f64; 3], CaseError> {
+    vector(
+        ctx,
+        &format!("{path}.{field}"),
+        v.as_deref().unwrap_or(&[]),
+        dim,
+        what,
+    )
+}
+
+/// A `"wall_pressure"` probe: the sensor's face (point, unit normal into the fluid, radius).
+fn wall_pressure(
+    ctx: &Ctx<'_>,
+    path: &str,
+    p: &RawProbe,
+    dim: usize,
+) -> Result<ProbeKind, CaseError> {
     let get = |field: &str, v: &Option<Vec<f64>>, what: &str| {
-        vector(
+        field_vector(ctx, path, field, v, dim, what)
+    };
+    let point = get(
+        "point_m",
+        &p.point_m,
+        "the centre of the sensor's face in metres",
+    )?;
+    let normal = get("normal", &p.normal, "the face's normal, into the fluid")?;
+    let radius = p.radius_m.unwrap_or(f64::NAN);
+    if !(radius.is_finite() && radius > 0.0) {
+        return Err(ctx.err(
+            &format!("{path}.radius_m"),
+            Some(format!("{radius}")),
+            "must be a positive number of metres",
+            "give the sensor's radius, e.g. radius_m = 0.005",
+        ));
+    }
+    Ok(ProbeKind::WallPressure(WallPatch {
+        point,
+        normal: unit(
             ctx,
-            &format!("{path}.{field}"),
-            v.as_deref().unwrap_or(&[]),
-            dim,
-            what,
-        )
-    };
-    let kind = match p.kind {
-        ProbeName::Point => {
-            return Ok(Checked::Point(PointSpec {
-                index: i,
-                name: p.name.clone(),
-                point: get("point_m", &p.point_m, "the point to follow in metres")?,
-            }))
-        }
-        ProbeName::Pressure => ProbeKind::Pressure {
-            point: get("point_m", &p.point_m, "the sampling point in metres")?,
-        },
-        ProbeName::Height => ProbeKind::Height {
-            base: get("base_m", &p.base_m, "the foot of the gauge line in metres")?,
-        },
-        ProbeName::Front => {
-            let origin = get(
-                "origin_m",
-                &p.origin_m,
-                "the front probe's origin in metres",
-            )?;
-            let axis = get(
-                "axis",
-                &p.axis,
-                "the direction along which the front is measured",
-            )?;
-            ProbeKind::Front {
-                origin,
-                axis: unit(
-                    ctx,
-                    &format!("{path}.axis"),
-                    axis,
-                    &p.axis,
-                    "the direction of the surge, e.g. [1.0, 0.0]",
-                )?,
-            }
-        }
-        ProbeName::WallPressure => {
-            let point = get(
-                "point_m",
-                &p.point_m,
-                "the centre of the sensor's face in metres",
-            )?;
-            let normal = get("normal", &p.normal, "the face's normal, into the fluid")?;
-            let radius = p.radius_m.unwrap_or(f64::NAN);
-            if !(radius.is_finite() && radius > 0.0) {
-                return Err(ctx.err(
-                    &format!("{path}.radius_m"),
-                    Some(format!("{radius}")),
-                    "must be a positive number of metres",
-                    "give the sensor's radius, e.g. radius_m = 0.005",
-                ));
-            }
-            ProbeKind::WallPressure(WallPatch {
-                point,
-                normal: unit(
-                    ctx,
-                    &format!("{path}.normal"),
-                    normal,
-                    &p.normal,
-                    "the normal of a right-hand wall, e.g. [-1.0, 0.0]",
-                )?,
-                radius,
-                // Resolved against the particles (`resolve_wall_patches`).
-                area: 0.0,
-                face: 0.0,
-                over_lo: [-FACE_UNBOUNDED; 3],
-                over_hi: [FACE_UNBOUNDED; 3],
-            })
-        }
-    };
-    Ok(Checked::Sampled(Probe {
-        name: p.name.clone(),
-        kind,
-        // Resolved against the bodies once they are known (validate.rs).
-        body: None,
+            &format!("{path}.normal"),
+            normal,
+            &p.normal,
+            "the normal of a right-hand wall, e.g. [-1.0, 0.0]",
+        )?,
+        radius,
+        // Resolved against the particles (`resolve_wall_patches`).
+        area: 0.0,
+        face: 0.0,
+        over_lo: [-FACE_UNBOUNDED; 3],
+        over_hi: [FACE_UNBOUNDED; 3],
     }))
 }
 

@@ -94,6 +94,21 @@ pub(super) fn validate_solid(
         ));
     }
     let bx = aabb(ctx, &path, &s.min_m, &s.max_m, dim, "the solid")?;
+    let material = material(ctx, &path, s)?;
+    let clamped = clamped(ctx, &path, s, dim)?;
+    let velocity = cantilever_mode(ctx, &path, s, dim)?;
+    Ok(SolidSpec {
+        name: s.name.clone(),
+        bx,
+        material,
+        clamped,
+        velocity,
+    })
+}
+
+/// The material of `solid[i]` (`path`): density, Young's modulus and Poisson ratio giving a
+/// sound speed the solver computes with, the formulation and its stabilisers.
+fn material(ctx: &Ctx<'_>, path: &str, s: &RawSolid) -> Result<ElasticMaterial, CaseError> {
     let density = number(
         ctx,
         &format!("{path}.density_kg_m3"),
@@ -137,6 +152,36 @@ pub(super) fn validate_solid(
              density_kg_m3 = 1000.0",
         ));
     }
+    let formulation = formulation(ctx, path, s)?;
+    let tl = formulation == SolidFormulation::TotalLagrangian;
+    let alpha = number(
+        ctx,
+        &format!("{path}.alpha"),
+        s.alpha.unwrap_or(if tl { 0.0 } else { 0.1 }),
+        Bound::Closed(0.0, 2.0),
+        "the Monaghan artificial viscosity between solid particles",
+        "use 0.1 (the default) or up to 1",
+    )?;
+    let artificial_stress = number(
+        ctx,
+        &format!("{path}.artificial_stress"),
+        s.artificial_stress.unwrap_or(if tl { 0.0 } else { 0.3 }),
+        Bound::Closed(0.0, 1.0),
+        "the artificial stress coefficient ε (Monaghan 2000); 0 disables it",
+        "use 0.3 (Gray, Monaghan & Swift 2001), or 0",
+    )?;
+    Ok(ElasticMaterial {
+        density,
+        youngs_modulus,
+        poisson_ratio,
+        alpha,
+        artificial_stress,
+        formulation,
+    })
+}
+
+/// `{path}.formulation`; a total-Lagrangian solid takes no artificial viscosity or stress.
+fn formulation(ctx: &Ctx<'_>, path: &str, s: &RawSolid) -> Result<SolidFormulation, CaseError> {
     let formulation = match s.formulation {
         None | Some(SolidFormulationName::UpdatedLagrangian) => SolidFormulation::UpdatedLagrangian,
         Some(SolidFormulationName::TotalLagrangian) => SolidFormulation::TotalLagrangian,
@@ -164,24 +209,12 @@ pub(super) fn validate_solid(
             }
         }
     }
-    let tl = formulation == SolidFormulation::TotalLagrangian;
-    let alpha = number(
-        ctx,
-        &format!("{path}.alpha"),
-        s.alpha.unwrap_or(if tl { 0.0 } else { 0.1 }),
-        Bound::Closed(0.0, 2.0),
-        "the Monaghan artificial viscosity between solid particles",
-        "use 0.1 (the default) or up to 1",
-    )?;
-    let artificial_stress = number(
-        ctx,
-        &format!("{path}.artificial_stress"),
-        s.artificial_stress.unwrap_or(if tl { 0.0 } else { 0.3 }),
-        Bound::Closed(0.0, 1.0),
-        "the artificial stress coefficient ε (Monaghan 2000); 0 disables it",
-        "use 0.3 (Gray, Monaghan & Swift 2001), or 0",
-    )?;
-    let clamped = match (&s.clamped_min_m, &s.clamped_max_m) {
+    Ok(formulation)
+}
+
+/// The clamped region `{path}.clamped_min_m` to `{path}.clamped_max_m` (both or neither).
+fn clamped(ctx: &Ctx<'_>, path: &str, s: &RawSolid, dim: usize) -> Result<Option<Aabb>, CaseError> {
+    Ok(match (&s.clamped_min_m, &s.clamped_max_m) {
         (None, None) => None,
         (Some(lo), Some(hi)) => {
             let min = vector(
@@ -204,7 +237,7 @@ pub(super) fn validate_solid(
                     Some(format!("{hi:?}")),
                     format!(
                         "clamped_max_m[{a}] = {} is not above clamped_min_m[{a}] = {} (the \
-                         clamped region would be empty)",
+                     clamped region would be empty)",
                         max[a], min[a]
                     ),
                     "make every component of clamped_max_m larger than that of clamped_min_m",
@@ -225,8 +258,17 @@ pub(super) fn validate_solid(
                 format!("add {missing}, or remove the other"),
             ));
         }
-    };
-    let velocity = match &s.initial_velocity {
+    })
+}
+
+/// `{path}.initial_velocity`: a cantilever's first bending mode, with every field it needs.
+fn cantilever_mode(
+    ctx: &Ctx<'_>,
+    path: &str,
+    s: &RawSolid,
+    dim: usize,
+) -> Result<Option<CantileverMode>, CaseError> {
+    Ok(match &s.initial_velocity {
         None => None,
         Some(v) => {
             let vp = format!("{path}.initial_velocity");
@@ -304,20 +346,6 @@ pub(super) fn validate_solid(
                 tip_velocity: tip,
             })
         }
-    };
-    Ok(SolidSpec {
-        name: s.name.clone(),
-        bx,
-        material: ElasticMaterial {
-            density,
-            youngs_modulus,
-            poisson_ratio,
-            alpha,
-            artificial_stress,
-            formulation,
-        },
-        clamped,
-        velocity,
     })
 }
 
@@ -339,34 +367,7 @@ pub(super) fn solid_particles(
     max_particles: f64,
 ) -> Result<SolidParticles, CaseError> {
     let first = &solids[0];
-    for (i, s) in solids.iter().enumerate().skip(1) {
-        if let Some(j) = solids[..i].iter().position(|o| o.name == s.name) {
-            return Err(ctx.err(
-                &format!("solid[{i}].name"),
-                Some(format!("{:?}", s.name)),
-                format!("is also the name of solid[{j}]"),
-                "give every solid its own name",
-            ));
-        }
-    }
-    let materials: Vec<ElasticMaterial> = solids.iter().map(|s| s.material).collect();
-    let (_, index) = distinct_materials(&materials);
-    if let Some(i) = index
-        .iter()
-        .position(|&k| k as usize >= MAX_SOLID_MATERIALS)
-    {
-        return Err(ctx.err(
-            &format!("solid[{i}]"),
-            None,
-            format!(
-                "is of a {}th material: a case holds at most {MAX_SOLID_MATERIALS} different \
-                 solid materials (density, Young's modulus, Poisson ratio, alpha and \
-                 artificial_stress)",
-                index[i] + 1
-            ),
-            "give solids of nearly equal materials the same values",
-        ));
-    }
+    let materials = materials(ctx, solids)?;
     let lat = Lattice {
         origin: first.bx.min,
         dx,
@@ -401,46 +402,7 @@ pub(super) fn solid_particles(
                 "increase particles.dx_m",
             ));
         }
-        let n = [0, 1, 2].map(|a| {
-            if a < dim {
-                (hi[a] - lo[a]) as i64 + 1
-            } else {
-                1
-            }
-        });
-        for k in 0..n[2] {
-            for j in 0..n[1] {
-                for l in 0..n[0] {
-                    let idx = [lo[0] as i64 + l, lo[1] as i64 + j, lo[2] as i64 + k];
-                    let pos = lat.pos(idx);
-                    let clamped = s.clamped.as_ref().is_some_and(|c| point_in(pos, c, dim));
-                    let vel = match (&s.velocity, clamped) {
-                        (Some(m), false) => m.velocity(pos),
-                        _ => [0.0; 3],
-                    };
-                    if !vel.iter().all(|v| v.is_finite()) {
-                        return Err(ctx.err(
-                            &format!("solid[{i}].initial_velocity"),
-                            None,
-                            format!("gives a non-finite velocity at {pos:?}"),
-                            "give a length_m of the order of the solid's length and a finite \
-                             tip_velocity_m_s",
-                        ));
-                    }
-                    particles.push(Particle {
-                        pos,
-                        vel,
-                        rho: s.material.density,
-                        kind: if clamped {
-                            Kind::SolidClamped
-                        } else {
-                            Kind::Solid
-                        },
-                    });
-                    body.push(i as u32);
-                }
-            }
-        }
+        push_solid(ctx, (i, s), &lat, (lo, hi), &mut particles, &mut body)?;
         // A solid clamped everywhere has nothing to simulate.
         if !particles[particles.len() - body_len(&body, i)..]
             .iter()
@@ -455,6 +417,94 @@ pub(super) fn solid_particles(
         }
     }
     Ok((materials, particles, body))
+}
+
+/// The material of each solid; names unique, and at most [`MAX_SOLID_MATERIALS`] materials.
+fn materials(ctx: &Ctx<'_>, solids: &[SolidSpec]) -> Result<Vec<ElasticMaterial>, CaseError> {
+    for (i, s) in solids.iter().enumerate().skip(1) {
+        if let Some(j) = solids[..i].iter().position(|o| o.name == s.name) {
+            return Err(ctx.err(
+                &format!("solid[{i}].name"),
+                Some(format!("{:?}", s.name)),
+                format!("is also the name of solid[{j}]"),
+                "give every solid its own name",
+            ));
+        }
+    }
+    let materials: Vec<ElasticMaterial> = solids.iter().map(|s| s.material).collect();
+    let (_, index) = distinct_materials(&materials);
+    if let Some(i) = index
+        .iter()
+        .position(|&k| k as usize >= MAX_SOLID_MATERIALS)
+    {
+        return Err(ctx.err(
+            &format!("solid[{i}]"),
+            None,
+            format!(
+                "is of a {}th material: a case holds at most {MAX_SOLID_MATERIALS} different \
+                 solid materials (density, Young's modulus, Poisson ratio, alpha and \
+                 artificial_stress)",
+                index[i] + 1
+            ),
+            "give solids of nearly equal materials the same values",
+        ));
+    }
+    Ok(materials)
+}
+
+/// The particles of solid `i`, `s` (lattice indices `lo` to `hi` of `lat`), pushed onto
+/// `particles` with their `body` (`i`); clamped where inside the clamped region, else moving
+/// with the initial velocity, which must be finite.
+fn push_solid(
+    ctx: &Ctx<'_>,
+    (i, s): (usize, &SolidSpec),
+    lat: &Lattice,
+    (lo, hi): ([f64; 3], [f64; 3]),
+    particles: &mut Vec<Particle>,
+    body: &mut Vec<u32>,
+) -> Result<(), CaseError> {
+    let dim = lat.dim;
+    let n = [0, 1, 2].map(|a| {
+        if a < dim {
+            (hi[a] - lo[a]) as i64 + 1
+        } else {
+            1
+        }
+    });
+    for k in 0..n[2] {
+        for j in 0..n[1] {
+            for l in 0..n[0] {
+                let idx = [lo[0] as i64 + l, lo[1] as i64 + j, lo[2] as i64 + k];
+                let pos = lat.pos(idx);
+                let clamped = s.clamped.as_ref().is_some_and(|c| point_in(pos, c, dim));
+                let vel = match (&s.velocity, clamped) {
+                    (Some(m), false) => m.velocity(pos),
+                    _ => [0.0; 3],
+                };
+                if !vel.iter().all(|v| v.is_finite()) {
+                    return Err(ctx.err(
+                        &format!("solid[{i}].initial_velocity"),
+                        None,
+                        format!("gives a non-finite velocity at {pos:?}"),
+                        "give a length_m of the order of the solid's length and a finite \
+                         tip_velocity_m_s",
+                    ));
+                }
+                particles.push(Particle {
+                    pos,
+                    vel,
+                    rho: s.material.density,
+                    kind: if clamped {
+                        Kind::SolidClamped
+                    } else {
+                        Kind::Solid
+                    },
+                });
+                body.push(i as u32);
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Refuses a free solid particle that starts closer than a particle spacing to a wall, obstacle

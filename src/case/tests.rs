@@ -670,152 +670,155 @@ fn wrong_types_are_named() {
     );
 }
 
+/// Out-of-range numbers: (the line of [`BASE`] to replace, its replacement, the line the error
+/// names, words the message contains).
+const BAD_NUMBERS: &[(&str, &str, usize, &[&str])] = &[
+    (
+        "dx_m = 0.1",
+        "dx_m = -0.01",
+        4,
+        &["particles.dx_m = -0.01", "must be > 0", "spacing"],
+    ),
+    (
+        "dx_m = 0.1",
+        "dx_m = 0.0",
+        4,
+        &["particles.dx_m = 0", "> 0"],
+    ),
+    (
+        "dx_m = 0.1",
+        "dx_m = nan",
+        4,
+        &["particles.dx_m = NaN", "finite"],
+    ),
+    (
+        "dx_m = 0.1",
+        "dx_m = inf",
+        4,
+        &["particles.dx_m = inf", "finite"],
+    ),
+    (
+        "dx_m = 0.1",
+        "dx_m = 0.1\nh_over_dx = 3.5",
+        5,
+        &["particles.h_over_dx = 3.5", "[1, 3]"],
+    ),
+    (
+        "dx_m = 0.1",
+        "dx_m = 0.1\nh_over_dx = 0.5",
+        5,
+        &["particles.h_over_dx", "[1, 3]"],
+    ),
+    ("end_s = 1.0", "end_s = 0.0", 10, &["time.end_s", "> 0"]),
+    ("end_s = 1.0", "end_s = -inf", 10, &["time.end_s", "finite"]),
+    (
+        "output_every_s = 0.1",
+        "output_every_s = 0",
+        11,
+        &["time.output_every_s", "> 0"],
+    ),
+    (
+        "output_every_s = 0.1",
+        "output_every_s = 0.1\nprobe_every_s = 0.2",
+        12,
+        &["time.probe_every_s", "(0, 0.1]"],
+    ),
+    (
+        "output_every_s = 0.1",
+        "output_every_s = 0.1\ncfl = 1.5",
+        12,
+        &["time.cfl", "(0, 1]"],
+    ),
+    (
+        "output_every_s = 0.1",
+        "output_every_s = 0.1\ncfl = 0",
+        12,
+        &["time.cfl", "(0, 1]"],
+    ),
+    (
+        "output_every_s = 0.1",
+        "output_every_s = 0.1\noutput_boundary = \"firs\"",
+        12,
+        &["time.output_boundary = \"firs\"", "\"every\", \"first\""],
+    ),
+    (
+        "sound_speed_coef = 10.0",
+        "sound_speed_coef = 10.0\nrho0_kg_m3 = 0",
+        8,
+        &["physics.rho0_kg_m3", "> 0"],
+    ),
+    (
+        "sound_speed_coef = 10.0",
+        "sound_speed_coef = -1.0",
+        7,
+        &["physics.sound_speed_coef", "> 0"],
+    ),
+    (
+        "sound_speed_coef = 10.0",
+        "sound_speed_coef = 10.0\ndelta_sph = 2",
+        8,
+        &["physics.delta_sph", "[0, 1]"],
+    ),
+    (
+        "sound_speed_coef = 10.0",
+        "sound_speed_coef = 10.0\ndelta_sph = 0\ndelta_sph_form = \"fourtakas\"",
+        9,
+        &[
+            "physics.delta_sph_form",
+            "delta_sph = 0",
+            "remove delta_sph_form",
+        ],
+    ),
+    (
+        "sound_speed_coef = 10.0",
+        "sound_speed_coef = 10.0\ndelta_sph_form = \"antuono\"",
+        8,
+        &[
+            "physics.delta_sph_form = \"antuono\"",
+            "\"fourtakas\", \"molteni_colagrossi\"",
+        ],
+    ),
+    (
+        "sound_speed_coef = 10.0",
+        "sound_speed_coef = 10.0\ngamma = 0.5",
+        8,
+        &["physics.gamma", "[1, 10]"],
+    ),
+    (
+        "sound_speed_coef = 10.0",
+        "sound_speed_coef = 10.0\nalpha = -0.1",
+        8,
+        &["physics.alpha", "[0, 1]"],
+    ),
+    (
+        "max_m = [1.0, 1.0]",
+        "max_m = [1.0, 1.0]\nlayers = 0",
+        16,
+        &["tank.layers = 0", "between 1 and 8"],
+    ),
+    (
+        "max_m = [1.0, 1.0]",
+        "max_m = [1.0, 1.0]\nlayers = 99999999999",
+        16,
+        &["tank.layers", "between 1 and 8"],
+    ),
+    (
+        "dimension = 2",
+        "dimension = 4",
+        1,
+        &["dimension = 4", "2 or 3"],
+    ),
+    (
+        "point_m = [0.5, 0.05]",
+        "point_m = [0.5, nan]",
+        24,
+        &["probe[0].point_m[1] = NaN", "finite"],
+    ),
+];
+
 #[test]
 fn bad_numbers_are_refused() {
-    let cases: &[(&str, &str, usize, &[&str])] = &[
-        (
-            "dx_m = 0.1",
-            "dx_m = -0.01",
-            4,
-            &["particles.dx_m = -0.01", "must be > 0", "spacing"],
-        ),
-        (
-            "dx_m = 0.1",
-            "dx_m = 0.0",
-            4,
-            &["particles.dx_m = 0", "> 0"],
-        ),
-        (
-            "dx_m = 0.1",
-            "dx_m = nan",
-            4,
-            &["particles.dx_m = NaN", "finite"],
-        ),
-        (
-            "dx_m = 0.1",
-            "dx_m = inf",
-            4,
-            &["particles.dx_m = inf", "finite"],
-        ),
-        (
-            "dx_m = 0.1",
-            "dx_m = 0.1\nh_over_dx = 3.5",
-            5,
-            &["particles.h_over_dx = 3.5", "[1, 3]"],
-        ),
-        (
-            "dx_m = 0.1",
-            "dx_m = 0.1\nh_over_dx = 0.5",
-            5,
-            &["particles.h_over_dx", "[1, 3]"],
-        ),
-        ("end_s = 1.0", "end_s = 0.0", 10, &["time.end_s", "> 0"]),
-        ("end_s = 1.0", "end_s = -inf", 10, &["time.end_s", "finite"]),
-        (
-            "output_every_s = 0.1",
-            "output_every_s = 0",
-            11,
-            &["time.output_every_s", "> 0"],
-        ),
-        (
-            "output_every_s = 0.1",
-            "output_every_s = 0.1\nprobe_every_s = 0.2",
-            12,
-            &["time.probe_every_s", "(0, 0.1]"],
-        ),
-        (
-            "output_every_s = 0.1",
-            "output_every_s = 0.1\ncfl = 1.5",
-            12,
-            &["time.cfl", "(0, 1]"],
-        ),
-        (
-            "output_every_s = 0.1",
-            "output_every_s = 0.1\ncfl = 0",
-            12,
-            &["time.cfl", "(0, 1]"],
-        ),
-        (
-            "output_every_s = 0.1",
-            "output_every_s = 0.1\noutput_boundary = \"firs\"",
-            12,
-            &["time.output_boundary = \"firs\"", "\"every\", \"first\""],
-        ),
-        (
-            "sound_speed_coef = 10.0",
-            "sound_speed_coef = 10.0\nrho0_kg_m3 = 0",
-            8,
-            &["physics.rho0_kg_m3", "> 0"],
-        ),
-        (
-            "sound_speed_coef = 10.0",
-            "sound_speed_coef = -1.0",
-            7,
-            &["physics.sound_speed_coef", "> 0"],
-        ),
-        (
-            "sound_speed_coef = 10.0",
-            "sound_speed_coef = 10.0\ndelta_sph = 2",
-            8,
-            &["physics.delta_sph", "[0, 1]"],
-        ),
-        (
-            "sound_speed_coef = 10.0",
-            "sound_speed_coef = 10.0\ndelta_sph = 0\ndelta_sph_form = \"fourtakas\"",
-            9,
-            &[
-                "physics.delta_sph_form",
-                "delta_sph = 0",
-                "remove delta_sph_form",
-            ],
-        ),
-        (
-            "sound_speed_coef = 10.0",
-            "sound_speed_coef = 10.0\ndelta_sph_form = \"antuono\"",
-            8,
-            &[
-                "physics.delta_sph_form = \"antuono\"",
-                "\"fourtakas\", \"molteni_colagrossi\"",
-            ],
-        ),
-        (
-            "sound_speed_coef = 10.0",
-            "sound_speed_coef = 10.0\ngamma = 0.5",
-            8,
-            &["physics.gamma", "[1, 10]"],
-        ),
-        (
-            "sound_speed_coef = 10.0",
-            "sound_speed_coef = 10.0\nalpha = -0.1",
-            8,
-            &["physics.alpha", "[0, 1]"],
-        ),
-        (
-            "max_m = [1.0, 1.0]",
-            "max_m = [1.0, 1.0]\nlayers = 0",
-            16,
-            &["tank.layers = 0", "between 1 and 8"],
-        ),
-        (
-            "max_m = [1.0, 1.0]",
-            "max_m = [1.0, 1.0]\nlayers = 99999999999",
-            16,
-            &["tank.layers", "between 1 and 8"],
-        ),
-        (
-            "dimension = 2",
-            "dimension = 4",
-            1,
-            &["dimension = 4", "2 or 3"],
-        ),
-        (
-            "point_m = [0.5, 0.05]",
-            "point_m = [0.5, nan]",
-            24,
-            &["probe[0].point_m[1] = NaN", "finite"],
-        ),
-    ];
-    for (from, to, line, words) in cases {
+    for (from, to, line, words) in BAD_NUMBERS {
         assert_err(&base_with(from, to), &[], Some(*line), words);
     }
 }
@@ -1541,4 +1544,17 @@ fn friction_pairs_resolve_names_and_refuse_bad_ones() {
         }
         assert!(e.contains("fix:"), "{e}");
     }
+}
+
+/// A built-in case is found by its name and its file together, as a run records them.
+#[test]
+fn built_in_cases_are_found_by_name_and_file() {
+    for b in BUILT_IN {
+        let found = built_in(b.name, Path::new(b.file)).unwrap();
+        assert_eq!((found.name, found.file), (b.name, b.file));
+        assert_eq!(found.text, std::fs::read_to_string(b.file).unwrap());
+    }
+    let first = &BUILT_IN[0];
+    assert!(built_in(first.name, Path::new("cases/elsewhere.toml")).is_none());
+    assert!(built_in("another_name", Path::new(first.file)).is_none());
 }

@@ -1,6 +1,6 @@
 //! Field-by-field checks of the deserialised case: finite numbers, ranges, vector lengths,
 //! options that go together, defaults. Produces a [`Case`] in SI with 3-component vectors.
-//! Geometric checks that need several fields at once live in `build.rs`.
+//! Geometric checks that need several fields at once live in `build.rs` and `domain.rs`.
 
 use crate::scenario::{
     DeltaSphForm, DensityFilter, FrictionPair, GhostCorrection, KernelKind, OutputBoundary, Probe,
@@ -100,13 +100,95 @@ impl Case {
     }
 }
 
+/// The checked case, from the deserialised one: field by field, in the order of the file's
+/// tables (an error is that of the first field found wrong): dimension, name, `[particles]`,
+/// `[physics]`, `[time]`, the geometry (`[tank]`, `[[solid]]`, `[[fluid_block]]`,
+/// `[[obstacle]]`, `[walls]`, `[domain]`), then bodies, inlets, outlets, friction pairs and
+/// probes.
 pub(super) fn validate(
     ctx: &Ctx<'_>,
     raw: &RawCase,
     default_name: &str,
     case_dir: &std::path::Path,
 ) -> Result<Case, CaseError> {
-    let dim = match raw.dimension {
+    let dim = dimension(ctx, raw)?;
+    // Before the physics: without fluid or solids nothing else of the case matters.
+    if raw.fluid_block.is_empty() && raw.solid.is_empty() && raw.inlet.is_empty() {
+        return Err(ctx.err(
+            "fluid_block",
+            None,
+            "no fluid: at least one [[fluid_block]] (or [[inlet]] or [[solid]]) is required",
+            "add a [[fluid_block]] table with min_m and max_m",
+        ));
+    }
+    let name = case_name(ctx, raw, default_name)?;
+    let (dx, h_over_dx, kernel) = particles(ctx, raw)?;
+    let physics = physics(ctx, raw, dim)?;
+    let time = time(ctx, raw)?;
+
+    // Geometry.
+    let tank = tank(ctx, raw, dim, case_dir)?;
+    let solids = solids(ctx, raw, dim)?;
+    let blocks = blocks(ctx, raw, dim)?;
+    let (obstacles, obstacle_walls) = obstacles(ctx, raw, dim)?;
+    let mut walls = wall_settings(ctx, raw)?;
+    let domain = match &raw.domain {
+        Some(d) => Some(aabb(ctx, "domain", &d.min_m, &d.max_m, dim, "the domain")?),
+        None => None,
+    };
+    check_probe_names(ctx, raw)?;
+    let bodies = super::bodies::validate(ctx, &raw.body, dim, case_dir)?;
+    let inlets = super::open_boundaries::validate(ctx, &raw.inlet, dim, time.end_s)?;
+    let outlets = super::open_boundaries::validate_outlets(ctx, &raw.outlet, dim)?;
+    let tank_moves = tank.as_ref().is_some_and(|t| t.motion.is_some());
+    walls.friction_pairs =
+        super::friction::pairs(ctx, &raw.friction, &bodies, &solids, tank_moves)?;
+    let (probes, points) = probes(ctx, raw, dim, tank_moves, &bodies)?;
+    let CheckedPhysics {
+        rho0,
+        gravity,
+        sound,
+        gamma,
+        viscosity,
+        delta_sph,
+        delta_sph_form,
+        density_filter,
+        energy,
+    } = physics;
+    Ok(Case {
+        name,
+        dim,
+        dx,
+        h_over_dx,
+        kernel,
+        rho0,
+        gravity,
+        sound,
+        gamma,
+        viscosity,
+        delta_sph,
+        delta_sph_form,
+        density_filter,
+        energy,
+        time,
+        tank,
+        blocks,
+        obstacles,
+        obstacle_walls,
+        domain,
+        walls,
+        probes,
+        points,
+        bodies,
+        solids,
+        inlets,
+        outlets,
+    })
+}
+
+/// `dimension`: 2 or 3.
+fn dimension(ctx: &Ctx<'_>, raw: &RawCase) -> Result<usize, CaseError> {
+    Ok(match raw.dimension {
         2 => 2,
         3 => 3,
         d => {
@@ -117,17 +199,12 @@ pub(super) fn validate(
                 "write dimension = 2 (vectors [x, y], y up) or dimension = 3 ([x, y, z], z up)",
             ))
         }
-    };
-    // Before the physics: without fluid or solids nothing else of the case matters.
-    if raw.fluid_block.is_empty() && raw.solid.is_empty() && raw.inlet.is_empty() {
-        return Err(ctx.err(
-            "fluid_block",
-            None,
-            "no fluid: at least one [[fluid_block]] (or [[inlet]] or [[solid]]) is required",
-            "add a [[fluid_block]] table with min_m and max_m",
-        ));
-    }
-    let name = match &raw.name {
+    })
+}
+
+/// `name`, or `default_name` without one.
+fn case_name(ctx: &Ctx<'_>, raw: &RawCase, default_name: &str) -> Result<String, CaseError> {
+    Ok(match &raw.name {
         Some(n)
             if n.trim().is_empty()
                 || n.chars().any(|c| c.is_control() || c == '/' || c == '\\') =>
@@ -141,9 +218,11 @@ pub(super) fn validate(
         }
         Some(n) => n.clone(),
         None => default_name.to_string(),
-    };
+    })
+}
 
-    // [particles]
+/// `[particles]`: the spacing dx, h / dx and the kernel.
+fn particles(ctx: &Ctx<'_>, raw: &RawCase) -> Result<(f64, f64, KernelKind), CaseError> {
     let p = &raw.particles;
     let dx = number(
         ctx,
@@ -165,8 +244,24 @@ pub(super) fn validate(
         KernelName::CubicSpline => KernelKind::CubicSpline,
         KernelName::WendlandC2 => KernelKind::WendlandC2,
     };
+    Ok((dx, h_over_dx, kernel))
+}
 
-    // [physics]
+/// The checked `[physics]` table.
+struct CheckedPhysics {
+    rho0: f64,
+    gravity: [f64; 3],
+    sound: Sound,
+    gamma: f64,
+    viscosity: Viscosity,
+    delta_sph: f64,
+    delta_sph_form: DeltaSphForm,
+    density_filter: DensityFilter,
+    energy: bool,
+}
+
+/// `[physics]`.
+fn physics(ctx: &Ctx<'_>, raw: &RawCase, dim: usize) -> Result<CheckedPhysics, CaseError> {
     let ph = &raw.physics;
     let rho0 = number(
         ctx,
@@ -176,7 +271,43 @@ pub(super) fn validate(
         "the reference density in kg/m³",
         "use e.g. 1000.0 for water",
     )?;
-    let gravity = match &ph.gravity_m_s2 {
+    let gravity = gravity(ctx, ph, dim)?;
+    let sound = sound(ctx, raw)?;
+    let gamma = number(
+        ctx,
+        "physics.gamma",
+        ph.gamma.unwrap_or(7.0),
+        Bound::Closed(1.0, 10.0),
+        "the Tait exponent",
+        "use 7.0 for water",
+    )?;
+    let viscosity = viscosity(ctx, ph)?;
+    let delta_sph = number(
+        ctx,
+        "physics.delta_sph",
+        ph.delta_sph.unwrap_or(0.1),
+        Bound::Closed(0.0, 1.0),
+        "the delta-SPH density diffusion coefficient; 0 disables it",
+        "use 0.1, or 0 to disable",
+    )?;
+    let delta_sph_form = delta_sph_form(ctx, ph, delta_sph)?;
+    let density_filter = density_filter(ctx, ph)?;
+    Ok(CheckedPhysics {
+        rho0,
+        gravity,
+        sound,
+        gamma,
+        viscosity,
+        delta_sph,
+        delta_sph_form,
+        density_filter,
+        energy: ph.energy.unwrap_or(false),
+    })
+}
+
+/// `physics.gravity_m_s2` (default 9.81 m/s² down).
+fn gravity(ctx: &Ctx<'_>, ph: &RawPhysics, dim: usize) -> Result<[f64; 3], CaseError> {
+    Ok(match &ph.gravity_m_s2 {
         Some(g) => {
             let v = vector(ctx, "physics.gravity_m_s2", g, dim, "gravity in m/s²")?;
             // Finite components can still have an infinite magnitude |g|.
@@ -195,8 +326,13 @@ pub(super) fn validate(
             g[dim - 1] = -9.81;
             g
         }
-    };
-    let sound = match (ph.sound_speed_m_s, ph.sound_speed_coef) {
+    })
+}
+
+/// The speed of sound: `physics.sound_speed_m_s` or `physics.sound_speed_coef`, exactly one.
+fn sound(ctx: &Ctx<'_>, raw: &RawCase) -> Result<Sound, CaseError> {
+    let ph = &raw.physics;
+    Ok(match (ph.sound_speed_m_s, ph.sound_speed_coef) {
         (Some(_), Some(_)) => {
             return Err(ctx.err(
                 "physics.sound_speed_coef",
@@ -221,34 +357,31 @@ pub(super) fn validate(
             "c0 = coef * sqrt(|g| * H)",
             "use e.g. 10.0",
         )?),
-        // A solid-only case has no fluid to give a sound speed to (unused; see solids.rs).
+        // A solid-only case has no fluid to give a sound speed to (unused; see
+        // build_solid_case in build.rs).
         (None, None) if raw.fluid_block.is_empty() && !raw.solid.is_empty() => Sound::Speed(1.0),
         (None, None) => {
             return Err(ctx.err(
                 "physics.sound_speed_coef",
                 None,
                 "the speed of sound is not given: [physics] needs exactly one of sound_speed_m_s \
-                 (c0 in m/s) or sound_speed_coef (c0 = coef * sqrt(|g| * H))",
+             (c0 in m/s) or sound_speed_coef (c0 = coef * sqrt(|g| * H))",
                 "add sound_speed_coef = 10.0 to [physics]",
             ))
         }
-    };
-    let gamma = number(
-        ctx,
-        "physics.gamma",
-        ph.gamma.unwrap_or(7.0),
-        Bound::Closed(1.0, 10.0),
-        "the Tait exponent",
-        "use 7.0 for water",
-    )?;
-    let viscosity = match ph.viscosity.unwrap_or(ViscosityName::Artificial) {
+    })
+}
+
+/// `physics.viscosity` with its coefficient (`alpha` or `nu_m2_s`, not the other's).
+fn viscosity(ctx: &Ctx<'_>, ph: &RawPhysics) -> Result<Viscosity, CaseError> {
+    Ok(match ph.viscosity.unwrap_or(ViscosityName::Artificial) {
         ViscosityName::Artificial => {
             if let Some(nu) = ph.nu_m2_s {
                 return Err(ctx.err(
                     "physics.nu_m2_s",
                     Some(num(nu)),
                     "is only used with viscosity = \"laminar\", but the viscosity is \
-                     \"artificial\"",
+                 \"artificial\"",
                     "remove nu_m2_s, or set viscosity = \"laminar\"",
                 ));
             }
@@ -268,7 +401,7 @@ pub(super) fn validate(
                     "physics.alpha",
                     Some(num(a)),
                     "is only used with viscosity = \"artificial\", but the viscosity is \
-                     \"laminar\"",
+                 \"laminar\"",
                     "remove alpha, or set viscosity = \"artificial\"",
                 ));
             }
@@ -290,19 +423,11 @@ pub(super) fn validate(
             )?;
             Viscosity::Laminar { nu }
         }
-    };
-    let delta_sph = number(
-        ctx,
-        "physics.delta_sph",
-        ph.delta_sph.unwrap_or(0.1),
-        Bound::Closed(0.0, 1.0),
-        "the delta-SPH density diffusion coefficient; 0 disables it",
-        "use 0.1, or 0 to disable",
-    )?;
-    let delta_sph_form = delta_sph_form(ctx, ph, delta_sph)?;
-    let density_filter = density_filter(ctx, ph)?;
+    })
+}
 
-    // [time]
+/// `[time]`.
+fn time(ctx: &Ctx<'_>, raw: &RawCase) -> Result<TimeControl, CaseError> {
     let t = &raw.time;
     let end_s = number(
         ctx,
@@ -336,7 +461,7 @@ pub(super) fn validate(
         "the Courant number",
         "use e.g. 0.2",
     )?;
-    let time = TimeControl {
+    Ok(TimeControl {
         end_s,
         output_every_s,
         probe_every_s,
@@ -345,10 +470,17 @@ pub(super) fn validate(
             None | Some(OutputBoundaryName::Every) => OutputBoundary::Every,
             Some(OutputBoundaryName::First) => OutputBoundary::First,
         },
-    };
+    })
+}
 
-    // Geometry.
-    let tank = match &raw.tank {
+/// `[tank]` with its motion.
+fn tank(
+    ctx: &Ctx<'_>,
+    raw: &RawCase,
+    dim: usize,
+    case_dir: &std::path::Path,
+) -> Result<Option<Tank>, CaseError> {
+    Ok(match &raw.tank {
         None => None,
         Some(tk) => {
             let inner = aabb(ctx, "tank", &tk.min_m, &tk.max_m, dim, "the tank")?;
@@ -370,9 +502,9 @@ pub(super) fn validate(
                             "tank.motion",
                             None,
                             "a moving tank needs wall particles that move with it; mirror \
-                             walls are fixed planes",
+                         walls are fixed planes",
                             "set tank.wall = \"fixed_ghost\" (or \"dynamic\", \"repulsive\"), \
-                             or remove [tank.motion]",
+                         or remove [tank.motion]",
                         ));
                     }
                     Some(super::bodies::motion(
@@ -393,7 +525,15 @@ pub(super) fn validate(
                 motion,
             })
         }
-    };
+    })
+}
+
+/// `[[solid]]`, and what a case with solids cannot have.
+fn solids(
+    ctx: &Ctx<'_>,
+    raw: &RawCase,
+    dim: usize,
+) -> Result<Vec<super::solids::SolidSpec>, CaseError> {
     let solids = raw
         .solid
         .iter()
@@ -432,6 +572,11 @@ pub(super) fn validate(
             ));
         }
     }
+    Ok(solids)
+}
+
+/// `[[fluid_block]]`.
+fn blocks(ctx: &Ctx<'_>, raw: &RawCase, dim: usize) -> Result<Vec<Block>, CaseError> {
     let mut blocks = Vec::with_capacity(raw.fluid_block.len());
     for (i, b) in raw.fluid_block.iter().enumerate() {
         let path = format!("fluid_block[{i}]");
@@ -448,6 +593,15 @@ pub(super) fn validate(
         };
         blocks.push(Block { bx, vel });
     }
+    Ok(blocks)
+}
+
+/// `[[obstacle]]`: each box and its wall treatment (not mirror).
+fn obstacles(
+    ctx: &Ctx<'_>,
+    raw: &RawCase,
+    dim: usize,
+) -> Result<(Vec<Aabb>, Vec<Treatment>), CaseError> {
     let mut obstacles = Vec::with_capacity(raw.obstacle.len());
     let mut obstacle_walls = Vec::with_capacity(raw.obstacle.len());
     for (i, o) in raw.obstacle.iter().enumerate() {
@@ -463,7 +617,12 @@ pub(super) fn validate(
         }
         obstacle_walls.push(treatment(ctx, &path, o.wall, o.slip)?);
     }
-    let walls = match &raw.walls {
+    Ok((obstacles, obstacle_walls))
+}
+
+/// `[walls]` (the friction pairs are added later, once the bodies are known).
+fn wall_settings(ctx: &Ctx<'_>, raw: &RawCase) -> Result<WallSettings, CaseError> {
+    Ok(match &raw.walls {
         None => WallSettings {
             ghost_correction: GhostCorrection::Mls,
             repulsive_d: None,
@@ -490,7 +649,7 @@ pub(super) fn validate(
                         Bound::Positive,
                         "the Lennard-Jones strength D of repulsive walls in m²/s²",
                         "use about 5 |g| H, e.g. 24.5 for 0.5 m of water, or remove it for that \
-                         default",
+                     default",
                     )
                 })
                 .transpose()?,
@@ -521,7 +680,7 @@ pub(super) fn validate(
                         Bound::Positive,
                         "the Monaghan & Kajtar strength K of repulsive walls in m²/s²",
                         "use about |g| H, e.g. 4.9 for 0.5 m of water, or remove it for that \
-                         default",
+                     default",
                     )
                 })
                 .transpose()?,
@@ -551,11 +710,11 @@ pub(super) fn validate(
             )?,
             friction_pairs: Vec::new(),
         },
-    };
-    let domain = match &raw.domain {
-        Some(d) => Some(aabb(ctx, "domain", &d.min_m, &d.max_m, dim, "the domain")?),
-        None => None,
-    };
+    })
+}
+
+/// Every probe's name differs from the others' (names become file names).
+fn check_probe_names(ctx: &Ctx<'_>, raw: &RawCase) -> Result<(), CaseError> {
     if let Some((i, j)) = (0..raw.probe.len())
         .flat_map(|i| (0..i).map(move |j| (i, j)))
         .find(|&(i, j)| raw.probe[i].name == raw.probe[j].name)
@@ -567,13 +726,17 @@ pub(super) fn validate(
             "give every probe a different name",
         ));
     }
-    let bodies = super::bodies::validate(ctx, &raw.body, dim, case_dir)?;
-    let inlets = super::open_boundaries::validate(ctx, &raw.inlet, dim, time.end_s)?;
-    let outlets = super::open_boundaries::validate_outlets(ctx, &raw.outlet, dim)?;
-    let tank_moves = tank.as_ref().is_some_and(|t| t.motion.is_some());
-    let mut walls = walls;
-    walls.friction_pairs =
-        super::friction::pairs(ctx, &raw.friction, &bodies, &solids, tank_moves)?;
+    Ok(())
+}
+
+/// `[[probe]]`: the sampled probes (with the body each is attached to) and the points.
+fn probes(
+    ctx: &Ctx<'_>,
+    raw: &RawCase,
+    dim: usize,
+    tank_moves: bool,
+    bodies: &[super::bodies::BodySpec],
+) -> Result<(Vec<Probe>, Vec<super::probes::PointSpec>), CaseError> {
     let mut probes: Vec<Probe> = Vec::with_capacity(raw.probe.len());
     let mut points = Vec::new();
     for (i, p) in raw.probe.iter().enumerate() {
@@ -581,43 +744,14 @@ pub(super) fn validate(
             Checked::Sampled(mut probe) => {
                 probe.body = match &p.body {
                     None => None,
-                    Some(name) => Some(attached_body(ctx, i, name, tank_moves, &bodies)?),
+                    Some(name) => Some(attached_body(ctx, i, name, tank_moves, bodies)?),
                 };
                 probes.push(probe);
             }
             Checked::Point(spec) => points.push(spec),
         }
     }
-
-    Ok(Case {
-        name,
-        dim,
-        dx,
-        h_over_dx,
-        kernel,
-        rho0,
-        gravity,
-        sound,
-        gamma,
-        viscosity,
-        delta_sph,
-        delta_sph_form,
-        density_filter,
-        energy: ph.energy.unwrap_or(false),
-        time,
-        tank,
-        blocks,
-        obstacles,
-        obstacle_walls,
-        domain,
-        walls,
-        probes,
-        points,
-        bodies,
-        solids,
-        inlets,
-        outlets,
-    })
+    Ok((probes, points))
 }
 
 /// The index in the scenario's bodies (a moving tank first, then `[[body]]` in order) of the

@@ -143,9 +143,9 @@ pub struct Evaluation {
 pub struct Case {
     /// Also the folder of its outputs, `DIR/<name>`.
     pub name: &'static str,
-    /// The case file, relative to the repository root.
+    /// The case file, relative to the repository root; its text is built in
+    /// ([`crate::case::BUILT_IN`], under this case's name).
     pub file: &'static str,
-    text: &'static str,
     /// The reference: a data file (relative to the repository root) or an analytic solution.
     pub reference: &'static str,
     /// Where the reference data comes from (empty for an analytic reference).
@@ -171,7 +171,9 @@ impl Case {
 
     /// The case with `overrides` applied.
     pub fn scenario(&self, overrides: &[String]) -> Result<Scenario> {
-        Ok(crate::case::load_str(self.text, self.file, overrides)?)
+        let built_in = crate::case::built_in(self.name, Path::new(self.file))
+            .with_context(|| format!("{} ({}) is not a built-in case", self.name, self.file))?;
+        Ok(built_in.load(overrides)?)
     }
 
     /// Metrics and figures of the finished run of `sc` in `dir`, judged with the bounds of
@@ -186,7 +188,6 @@ pub static CASES: &[Case] = &[
     Case {
         name: "hydrostatic_2d",
         file: "cases/hydrostatic_2d.toml",
-        text: include_str!("../../cases/hydrostatic_2d.toml"),
         reference: "analytic: p = ρ0 g (H − z)",
         citation: "",
         overrides: hydrostatic::overrides,
@@ -195,7 +196,6 @@ pub static CASES: &[Case] = &[
     Case {
         name: "dam_break_2d",
         file: "cases/dam_break_2d.toml",
-        text: include_str!("../../cases/dam_break_2d.toml"),
         reference: dam_break::REFERENCE,
         citation: dam_break::CITATION,
         overrides: dam_break::overrides,
@@ -204,7 +204,6 @@ pub static CASES: &[Case] = &[
     Case {
         name: "dam_break_lobovsky_2d",
         file: "cases/dam_break_lobovsky_2d.toml",
-        text: include_str!("../../cases/dam_break_lobovsky_2d.toml"),
         reference: lobovsky::REFERENCE,
         citation: lobovsky::CITATION,
         overrides: lobovsky::overrides,
@@ -213,7 +212,6 @@ pub static CASES: &[Case] = &[
     Case {
         name: "floating_box_2d",
         file: "cases/floating_box_2d.toml",
-        text: include_str!("../../cases/floating_box_2d.toml"),
         reference: "analytic: Archimedes' draft ρ_b/ρ0 · h",
         citation: "",
         overrides: bodies::floating_box_overrides,
@@ -222,7 +220,6 @@ pub static CASES: &[Case] = &[
     Case {
         name: "water_entry_cylinder_2d",
         file: "cases/water_entry_cylinder_2d.toml",
-        text: include_str!("../../cases/water_entry_cylinder_2d.toml"),
         reference: bodies::ENTRY_500.file,
         citation: bodies::ENTRY_CITATION,
         overrides: bodies::water_entry_500_overrides,
@@ -231,7 +228,6 @@ pub static CASES: &[Case] = &[
     Case {
         name: "water_entry_cylinder_2d_rho1000",
         file: "cases/water_entry_cylinder_2d.toml",
-        text: include_str!("../../cases/water_entry_cylinder_2d.toml"),
         reference: bodies::ENTRY_1000.file,
         citation: bodies::ENTRY_CITATION,
         overrides: bodies::water_entry_1000_overrides,
@@ -240,7 +236,6 @@ pub static CASES: &[Case] = &[
     Case {
         name: "sloshing_2d",
         file: "cases/sloshing_2d.toml",
-        text: include_str!("../../cases/sloshing_2d.toml"),
         reference: "tests/data/sloshing_akyildiz_unal_2006_pitch_probe{2,8}.csv",
         citation: sloshing::CITATION,
         overrides: sloshing::overrides,
@@ -249,7 +244,6 @@ pub static CASES: &[Case] = &[
     Case {
         name: "oscillating_plate_2d",
         file: "cases/oscillating_plate_2d.toml",
-        text: include_str!("../../cases/oscillating_plate_2d.toml"),
         reference: "analytic: Euler–Bernoulli first-mode period (shared/validation/analytic_oscillating_plate_frequency.csv)",
         citation: "",
         overrides: plate::overrides,
@@ -258,7 +252,6 @@ pub static CASES: &[Case] = &[
     Case {
         name: "oscillating_plate_tl_2d",
         file: "cases/oscillating_plate_tl_2d.toml",
-        text: include_str!("../../cases/oscillating_plate_tl_2d.toml"),
         reference: "analytic: Euler–Bernoulli first-mode period (shared/validation/analytic_oscillating_plate_frequency.csv)",
         citation: "",
         overrides: plate::overrides,
@@ -267,7 +260,6 @@ pub static CASES: &[Case] = &[
     Case {
         name: "elastic_gate_2d",
         file: "cases/elastic_gate_2d.toml",
-        text: include_str!("../../cases/elastic_gate_2d.toml"),
         reference: gate::X_DISPLACEMENT.file,
         citation: gate::CITATION,
         overrides: gate::overrides,
@@ -276,7 +268,6 @@ pub static CASES: &[Case] = &[
     Case {
         name: "dam_break_3d",
         file: "cases/dam_break_3d.toml",
-        text: include_str!("../../cases/dam_break_3d.toml"),
         reference: spheric::REFERENCE,
         citation: spheric::CITATION,
         overrides: spheric::overrides,

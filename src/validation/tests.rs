@@ -710,3 +710,15 @@ fn a_report_of_reused_runs_opens_no_adapter() {
     assert!(!report.passed());
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// The case module's built-in cases are exactly this table's cases, in its order (so a run of
+/// any of them can be loaded again where its file is not on disk).
+#[test]
+fn every_case_is_built_in() {
+    let built: Vec<(&str, &str)> = crate::case::BUILT_IN
+        .iter()
+        .map(|b| (b.name, b.file))
+        .collect();
+    let cases: Vec<(&str, &str)> = CASES.iter().map(|c| (c.name, c.file)).collect();
+    assert_eq!(built, cases);
+}

@@ -243,12 +243,25 @@ fn monaghan_kajtar_repulsion_settings() {
 
 #[test]
 fn wall_errors_name_line_and_field() {
-    let tank_with = |extra: &str| {
-        base_with(
-            "max_m = [1.0, 1.0]",
-            &format!("max_m = [1.0, 1.0]\n{extra}"),
-        )
-    };
+    slip_and_mirror_errors();
+    unknown_names_and_bad_strengths();
+}
+
+/// [`BASE`] with `extra` lines in its `[tank]`.
+fn tank_with(extra: &str) -> String {
+    base_with(
+        "max_m = [1.0, 1.0]",
+        &format!("max_m = [1.0, 1.0]\n{extra}"),
+    )
+}
+
+/// [`BASE`] with an obstacle of `extra` lines.
+fn obstacle(extra: &str) -> String {
+    format!("{BASE}[[obstacle]]\nmin_m = [0.6, 0.0]\nmax_m = [0.7, 0.1]\n{extra}")
+}
+
+/// Slip with a dynamic or repulsive wall, mirror on an obstacle.
+fn slip_and_mirror_errors() {
     // slip with a dynamic or repulsive wall.
     assert_err(
         &tank_with("slip = \"free_slip\""),
@@ -277,9 +290,6 @@ fn wall_errors_name_line_and_field() {
         ],
     );
     // Mirror on an obstacle; slip on a dynamic obstacle.
-    let obstacle = |extra: &str| {
-        format!("{BASE}[[obstacle]]\nmin_m = [0.6, 0.0]\nmax_m = [0.7, 0.1]\n{extra}")
-    };
     assert_err(
         &obstacle("wall = \"mirror\"\n"),
         &[],
@@ -305,6 +315,10 @@ fn wall_errors_name_line_and_field() {
         Some(28),
         &["obstacle[0].slip", "\"dynamic\""],
     );
+}
+
+/// Unknown enum strings and fields of `[walls]`, non-positive repulsion settings.
+fn unknown_names_and_bad_strengths() {
     // Unknown enum strings list the allowed values.
     assert_err(
         &tank_with("wall = \"mdbc\""),
