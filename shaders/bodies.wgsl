@@ -15,8 +15,6 @@
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> code: array<u32>;
 @group(0) @binding(4) var<storage, read> rate: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read> body_particles: array<BodyParticle>;
-@group(0) @binding(6) var<storage, read> bodies: array<BodyMotion>;
 // Index in the particle arrays of body particle k, as of the last sort.
 @group(0) @binding(7) var<storage, read_write> body_slot: array<u32>;
 // Per workgroup of body_force: (force, 0) then (torque, 0).
@@ -37,8 +35,8 @@ fn body_move(
     if (k < params.n_body_particles) {
         let i = body_slot[k];
         if (code_kind(code[i]) != KIND_EXCLUDED) {
-            let bp = body_particles[k];
-            let m = bodies[bp.body];
+            let bp = tables.body_particles[k];
+            let m = tables.bodies[bp.body];
             let arm = m.rotation * bp.r;
             let moved = move_by(Pos(m.center_off, m.center_block), arm);
             let vr = vec4<f32>(body_wall_motion(m, bp.r).velocity, velrho[i].w);
@@ -80,12 +78,12 @@ fn body_force(
     let group = wid.x + wid.y * nwg.x;
     // The body this workgroup belongs to: the last whose first group is not after it.
     var b = 0u;
-    for (var c = 1u; c < arrayLength(&bodies); c++) {
-        if (bodies[c].first_group <= group) {
+    for (var c = 1u; c < N_BODIES; c++) {
+        if (tables.bodies[c].first_group <= group) {
             b = c;
         }
     }
-    let m = bodies[b];
+    let m = tables.bodies[b];
     let local = (group - m.first_group) * WG + li;
     var force = vec3<f32>(0.0);
     var torque = vec3<f32>(0.0);
@@ -94,7 +92,7 @@ fn body_force(
         let i = body_slot[k];
         if (code_kind(code[i]) != KIND_EXCLUDED) {
             force = params.mass * rate[i].xyz;
-            torque = cross(m.rotation * body_particles[k].r, force);
+            torque = cross(m.rotation * tables.body_particles[k].r, force);
         }
     }
     // Tree reduction in a fixed order: the same input gives the same sums.

@@ -72,7 +72,9 @@ fn rank_in_cell(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     perm[start + rank] = i;
 }
 
-// Gathers every per-particle array into cell order.
+// Gathers the positions and code words into cell order. The per-particle arrays go in two
+// dispatches (this and `reorder_motion`) so that neither binds more than WebGPU's 8 storage
+// buffers.
 @compute @workgroup_size(WG)
 fn reorder(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let p = linear_index(gid, nwg);
@@ -81,9 +83,19 @@ fn reorder(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     }
     let i = perm[p];
     pos_out[p] = pos_in[i];
+    code_out[p] = code_in[i];
+}
+
+// Gathers (v, ρ) and the last rates into cell order.
+@compute @workgroup_size(WG)
+fn reorder_motion(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let p = linear_index(gid, nwg);
+    if (p >= params.n_particles) {
+        return;
+    }
+    let i = perm[p];
     velrho_out[p] = velrho_in[i];
     rate_out[p] = rate_in[i];
-    code_out[p] = code_in[i];
 }
 
 // Gathers (e, de/dt) into cell order; a separate dispatch, only when the energy equation is on.

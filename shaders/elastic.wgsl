@@ -225,15 +225,20 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
         }
     }
     rate[i] += vec4<f32>(acc + params.gravity, drho);
-
-    let eps = 0.5 * (grad_v + transpose(grad_v));
-    let omega = 0.5 * (grad_v - transpose(grad_v));
-    let tau = tau_of(solid[slot_i]);
-    let tr3 = (eps[0].x + eps[1].y + eps[2].z) / 3.0;
-    let iso = mat3x3<f32>(vec3<f32>(tr3, 0.0, 0.0), vec3<f32>(0.0, tr3, 0.0), vec3<f32>(0.0, 0.0, tr3));
-    let d = 2.0 * mat.mu * (eps - iso) + tau * transpose(omega) + omega * tau;
+    let d = jaumann_stress_rate(grad_v, tau_of(solid[slot_i]), mat.mu);
     stress_rate[slot_i] = SymRate(vec4<f32>(d[0].x, d[1].y, d[2].z, 0.5 * (d[1].x + d[0].y)),
                              vec4<f32>(0.5 * (d[2].x + d[0].z), 0.5 * (d[2].y + d[1].z), 0.0, 0.0));
+}
+
+// The Jaumann rate of the deviatoric stress, eq. 7 (Gray, Monaghan & Swift 2001): dτ/dt =
+// 2μ (ε̇ − tr ε̇/3 I) + τ Ωᵀ + Ω τ, with the strain and rotation rates ε̇, Ω of eq. 8 from
+// the velocity gradient `grad_v`.
+fn jaumann_stress_rate(grad_v: mat3x3<f32>, tau: mat3x3<f32>, mu: f32) -> mat3x3<f32> {
+    let eps = 0.5 * (grad_v + transpose(grad_v));
+    let omega = 0.5 * (grad_v - transpose(grad_v));
+    let tr3 = (eps[0].x + eps[1].y + eps[2].z) / 3.0;
+    let iso = mat3x3<f32>(vec3<f32>(tr3, 0.0, 0.0), vec3<f32>(0.0, tr3, 0.0), vec3<f32>(0.0, 0.0, tr3));
+    return 2.0 * mu * (eps - iso) + tau * transpose(omega) + omega * tau;
 }
 
 // Predictor for τ (see integrate.wgsl): τ* = τ_n + dt (dτ/dt)_n.

@@ -14,8 +14,6 @@
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read> code: array<u32>;
 @group(0) @binding(4) var<storage, read> cell_start: array<u32>;
-@group(0) @binding(6) var<storage, read> body_particles: array<BodyParticle>;
-@group(0) @binding(7) var<storage, read> bodies: array<BodyMotion>;
 
 @compute @workgroup_size(WG)
 fn ghost_interpolate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -26,8 +24,8 @@ fn ghost_interpolate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     var g_eff = params.gravity;
     let id = code[g] & ID_MASK;
     if (is_body_particle(id)) {
-        let bp = body_particles[id - params.body_id_base];
-        g_eff -= body_wall_motion(bodies[bp.body], bp.r).accel;
+        let bp = tables.body_particles[id - params.body_id_base];
+        g_eff -= body_wall_motion(tables.bodies[bp.body], bp.r).accel;
     }
     let f = fluid_at(pos[g], g_eff);
     // The interpolated fluid velocity is stored; the interaction makes the no-slip ghost

@@ -17,7 +17,6 @@
 // (e, de/dt of the last evaluation) and the new de/dt, when ENERGY.
 @group(0) @binding(8) var<storage, read_write> energy: array<vec2<f32>>;
 @group(0) @binding(9) var<storage, read> energy_rate: array<f32>;
-@group(0) @binding(10) var<storage, read> mirror_planes: array<MirrorPlane>;
 
 fn all_finite(v: vec4<f32>) -> bool {
     // NaN fails every comparison; |inf| fails the bound.
@@ -50,7 +49,7 @@ fn predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         // near a thin, fast layer is ~0 the images do not push back) is reflected specularly,
         // position and normal velocity, which is what the image method models.
         for (var k = 0u; k < params.n_mirror_planes; k++) {
-            let plane = mirror_planes[k];
+            let plane = tables.mirror_planes[k];
             let d = dot(domain_pos(moved.pos) - plane.point, plane.normal);
             if (d < 0.0) {
                 moved = move_by(moved.pos, -2.0 * d * plane.normal);

@@ -17,12 +17,8 @@
 @group(0) @binding(3) var<storage, read> code: array<u32>;
 @group(0) @binding(4) var<storage, read> cell_start: array<u32>;
 @group(0) @binding(5) var<storage, read_write> rate: array<vec4<f32>>;
-@group(0) @binding(6) var<storage, read> mirror_planes: array<MirrorPlane>;
 @group(0) @binding(7) var<storage, read_write> energy_rate: array<f32>;
-@group(0) @binding(8) var<storage, read> body_particles: array<BodyParticle>;
 @group(0) @binding(9) var<storage, read> solid: array<SolidState>;
-@group(0) @binding(10) var<storage, read> bodies: array<BodyMotion>;
-@group(0) @binding(11) var<storage, read> wall_sensors: array<WallSensor>;
 
 // The state of particle i that every pair term needs.
 struct Particle {
@@ -64,6 +60,48 @@ fn diffused_density(rho_i: f32, rho_j: f32, x_ij: vec3<f32>) -> f32 {
     return rho_i - rho_j - rho_h_ij;
 }
 
+// The terms of a pair, each one equation (docs/equations.md); `pair_rates` adds them up in the
+// order that fixes their f32 rounding, shared by the f64 twin (src/reference/interaction.rs).
+
+// Continuity, eq. 1: m_j v_ij·∇_i W_ij, times ρ_i/ρ_j across materials (eq. 14).
+fn continuity_rate(v_ij: vec3<f32>, dw_ij: vec3<f32>, rho_ratio: f32) -> f32 {
+    return params.mass * dot(v_ij, dw_ij) * rho_ratio;
+}
+
+// δ-SPH density diffusion, eq. 20 (Molteni & Colagrossi 2009): 2 δ h c0 ψ_ij F_ij r²/(r² + η²)
+// m_j/ρ_j, ψ the density difference `diffused_density` gives (Fourtakas et al. 2019's without
+// its hydrostatic part).
+fn delta_sph_molteni2009(psi: f32, f_ij: f32, r2: f32, rho_j: f32) -> f32 {
+    return params.delta_coef * 2.0 * psi * f_ij * r2 / (r2 + params.eta2) * params.mass / rho_j;
+}
+
+// Monaghan's artificial viscosity Π_ij, eq. 18 (Monaghan 1992), of an approaching pair.
+fn artificial_viscosity_monaghan1992(w_ij: vec3<f32>, x_ij: vec3<f32>, r2: f32, rho_i: f32, rho_j: f32) -> f32 {
+    let vx = dot(w_ij, x_ij);
+    if (vx < 0.0) {
+        let mu = params.h * vx / (r2 + params.eta2);
+        return -params.alpha * params.c0 * mu / (0.5 * (rho_i + rho_j));
+    }
+    return 0.0;
+}
+
+// Laminar viscosity, eq. 19 (Morris et al. 1997, in Lo & Shao 2002's form).
+fn laminar_viscosity_morris1997(w_ij: vec3<f32>, r2: f32, f_ij: f32, rho_i: f32, rho_j: f32) -> vec3<f32> {
+    return params.mass * 4.0 * params.nu * r2 * f_ij / ((rho_i + rho_j) * (r2 + params.eta2)) * w_ij;
+}
+
+// Momentum, eq. 2 with σ = −P I: −m_j (P_i/ρ_i² + P_j/ρ_j² + Π_ij) ∇_i W_ij; `b_ij` is the
+// bracket.
+fn pressure_acceleration(b_ij: f32, dw_ij: vec3<f32>) -> vec3<f32> {
+    return -(params.mass * b_ij * dw_ij);
+}
+
+// Energy, eq. 3: ½ m_j ((P_i/ρ_i² + P_j/ρ_j²) v_ij + Π_ij w_ij)·∇_i W_ij, the specific internal
+// energy's rate.
+fn specific_energy_rate(pressure_term: f32, pi_ij: f32, v_ij: vec3<f32>, w_ij: vec3<f32>, dw_ij: vec3<f32>) -> f32 {
+    return 0.5 * params.mass * (pressure_term * dot(v_ij, dw_ij) + pi_ij * dot(w_ij, dw_ij));
+}
+
 // Contribution to fluid particle i of a pressure-carrying neighbour j (fluid, dynamic wall,
 // ghost or mirror image) at x_ij = x_i − x_j, diffusing the density difference `psi`
 // (`diffused_density`, 0 for pairs without δ-SPH). A wall neighbour has two velocities: `v_cont`
@@ -76,25 +114,19 @@ fn pair_rates(pi: Particle, x_ij: vec3<f32>, r2: f32, v_cont: vec3<f32>, v_visc:
     let w_ij = pi.v - v_visc;
     let f_ij = kernel_f(sqrt(r2) / params.h);
     let dw_ij = x_ij * f_ij;
-    let drho = params.mass * dot(v_ij, dw_ij) * rho_ratio
-        + params.delta_coef * 2.0 * psi * f_ij * r2 / (r2 + params.eta2) * params.mass / rho_j;
+    let drho = continuity_rate(v_ij, dw_ij, rho_ratio) + delta_sph_molteni2009(psi, f_ij, r2, rho_j);
     var acc = vec3<f32>(0.0);
     var pi_ij = 0.0;
     if (VISCOSITY == VISCOSITY_ARTIFICIAL) {
-        let vx = dot(w_ij, x_ij);
-        if (vx < 0.0) {
-            let mu = params.h * vx / (r2 + params.eta2);
-            pi_ij = -params.alpha * params.c0 * mu / (0.5 * (pi.rho + rho_j));
-        }
+        pi_ij = artificial_viscosity_monaghan1992(w_ij, x_ij, r2, pi.rho, rho_j);
     } else {
-        acc += params.mass * 4.0 * params.nu * r2 * f_ij / ((pi.rho + rho_j) * (r2 + params.eta2)) * w_ij;
+        acc += laminar_viscosity_morris1997(w_ij, r2, f_ij, pi.rho, rho_j);
     }
-    let p_over_rho2_j = pressure_of(rho_j) / (rho_j * rho_j);
-    let pressure_term = pi.p_over_rho2 + p_over_rho2_j;
-    acc -= params.mass * (pressure_term + pi_ij) * dw_ij;
+    let pressure_term = pi.p_over_rho2 + pressure_of(rho_j) / (rho_j * rho_j);
+    acc += pressure_acceleration(pressure_term + pi_ij, dw_ij);
     var de = 0.0;
     if (ENERGY) {
-        de = 0.5 * params.mass * (pressure_term * dot(v_ij, dw_ij) + pi_ij * dot(w_ij, dw_ij));
+        de = specific_energy_rate(pressure_term, pi_ij, v_ij, w_ij, dw_ij);
     }
     return PairRates(vec4<f32>(acc, drho), de);
 }
@@ -213,7 +245,7 @@ fn friction_between(a: u32, b: u32) -> f32 {
 // The contact group of the boundary particle with id `id`: its body's, or the fixed walls'.
 fn boundary_group(id: u32) -> u32 {
     if (is_body_particle(id)) {
-        return 1u + body_particles[id - params.body_id_base].body;
+        return 1u + tables.body_particles[id - params.body_id_base].body;
     }
     return 0u;
 }
@@ -226,8 +258,8 @@ fn contact_velocity(j: u32) -> vec3<f32> {
     }
     let id = code[j] & ID_MASK;
     if (is_body_particle(id)) {
-        let bp = body_particles[id - params.body_id_base];
-        return body_wall_motion(bodies[bp.body], bp.r).velocity;
+        let bp = tables.body_particles[id - params.body_id_base];
+        return body_wall_motion(tables.bodies[bp.body], bp.r).velocity;
     }
     return vec3<f32>(0.0);
 }
@@ -268,8 +300,8 @@ struct GhostVelocity {
 fn fixed_ghost_velocity(kind: u32, id: u32, v_f: vec3<f32>) -> GhostVelocity {
     var v_wall = vec3<f32>(0.0);
     if (is_body_particle(id)) {
-        let bp = body_particles[id - params.body_id_base];
-        v_wall = body_wall_motion(bodies[bp.body], bp.r).velocity;
+        let bp = tables.body_particles[id - params.body_id_base];
+        v_wall = body_wall_motion(tables.bodies[bp.body], bp.r).velocity;
     }
     return GhostVelocity(v_wall, select(v_f, 2.0 * v_wall - v_f, kind == KIND_GHOST_NO_SLIP));
 }
@@ -280,13 +312,13 @@ const NO_BODY: u32 = 0xFFFFFFFFu;
 // Whether boundary particle `id_j` belongs to a fixed wall or to a body other than `body_i`
 // (contact between a body and itself is not a thing).
 fn other_solid(body_i: u32, id_j: u32) -> bool {
-    return !is_body_particle(id_j) || body_particles[id_j - params.body_id_base].body != body_i;
+    return !is_body_particle(id_j) || tables.body_particles[id_j - params.body_id_base].body != body_i;
 }
 
 // Whether body `b` moves as the case prescribes whatever its load (`kind = "fixed"`, `"sine"`
 // or `"series"`, the moving tank too).
 fn body_kinematic(b: u32) -> bool {
-    return (bodies[b].flags & BODY_KINEMATIC) != 0u;
+    return (tables.bodies[b].flags & BODY_KINEMATIC) != 0u;
 }
 
 // Whether the contact of a body particle (of a kinematic body: `kinematic_i`) with the wall or
@@ -294,7 +326,7 @@ fn body_kinematic(b: u32) -> bool {
 // fixed building on the street, a paddle sliding on the floor, another prescribed body), where
 // it would only add their standing contact to the load written for the body.
 fn contact_counts(kinematic_i: bool, id_j: u32) -> bool {
-    return !kinematic_i || (is_body_particle(id_j) && !body_kinematic(body_particles[id_j - params.body_id_base].body));
+    return !kinematic_i || (is_body_particle(id_j) && !body_kinematic(tables.body_particles[id_j - params.body_id_base].body));
 }
 
 // Velocity of a ghost across `plane`: normal part reversed (free-slip) or all (no-slip).
@@ -329,7 +361,7 @@ fn image_rates(pi: Particle, p_i: Pos, image: vec3<f32>, chain: vec3<u32>, n: u3
             var v_cont = velrho[j].xyz;
             var v_visc = v_cont;
             for (var c = n; c > 0u; c--) {
-                let plane = mirror_planes[chain[c - 1u]];
+                let plane = tables.mirror_planes[chain[c - 1u]];
                 x_ig = reflect_vec(x_ig, plane.normal);
                 v_cont = reflect_vec(v_cont, plane.normal);
                 v_visc = ghost_velocity(v_visc, plane);
@@ -354,21 +386,21 @@ fn mirror_rates(i: u32, pi: Particle) -> PairRates {
     let xi = domain_pos(pos[i]);
     let reach = 2.0 * params.h;
     for (var k1 = 0u; k1 < params.n_mirror_planes; k1++) {
-        let p1 = mirror_planes[k1];
+        let p1 = tables.mirror_planes[k1];
         if (dot(xi - p1.point, p1.normal) >= reach) {
             continue;
         }
         let once = reflect_point(xi, p1);
         out = add_rates(out, image_rates(pi, pos[i], once, vec3<u32>(k1, 0u, 0u), 1u));
         for (var k2 = k1 + 1u; k2 < params.n_mirror_planes; k2++) {
-            let p2 = mirror_planes[k2];
+            let p2 = tables.mirror_planes[k2];
             if (dot(xi - p2.point, p2.normal) >= reach) {
                 continue;
             }
             let twice = reflect_point(once, p2);
             out = add_rates(out, image_rates(pi, pos[i], twice, vec3<u32>(k1, k2, 0u), 2u));
             for (var k3 = k2 + 1u; k3 < params.n_mirror_planes; k3++) {
-                let p3 = mirror_planes[k3];
+                let p3 = tables.mirror_planes[k3];
                 if (dot(xi - p3.point, p3.normal) < reach) {
                     out = add_rates(out, image_rates(pi, pos[i], reflect_point(twice, p3), vec3<u32>(k1, k2, k3), 3u));
                 }
@@ -378,41 +410,16 @@ fn mirror_rates(i: u32, pi: Particle) -> PairRates {
     return out;
 }
 
-@compute @workgroup_size(WG)
-fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = linear_index(gid, nwg);
-    if (i >= params.n_particles) {
-        return;
-    }
-    let kind_i = code_kind(code[i]);
-    if (ENERGY) {
-        energy_rate[i] = 0.0;
-    }
-    if (HYDROSTATIC_DIFFUSION) {
-        set_hydrostatic_coefficients();
-    }
-    if (is_solid(kind_i)) {
-        // A lone elastic body (shader::Present) has nothing outside it to load it.
-        var loads = vec3<f32>(0.0);
-        if (!LONE_SOLID) {
-            loads = solid_loads(i);
-        }
-        rate[i] = vec4<f32>(loads, 0.0);
-        return;
-    }
-    let fluid_i = kind_i == KIND_FLUID;
+// The rates of a boundary particle i (dynamic wall, or one that takes the fluid's force: a
+// body's particle of any wall treatment, a fixed wall's with WALL_REACTIONS): a dynamic wall's
+// dρ/dt from the fluid (eq. 22), the reaction to the fluid's force (for bodies.wgsl's load and
+// the wall sensors) and a body particle's contact with walls, other bodies and solids (eq. 24).
+fn boundary_rates(i: u32, kind_i: u32, reacts: bool, on_body: bool) -> vec4<f32> {
     let id_i = code[i] & ID_MASK;
-    let on_body = !fluid_i && kind_i != KIND_EXCLUDED && is_body_particle(id_i);
-    // Boundary particles that take the fluid's force: bodies', and fixed walls' for probes.
-    let reacts = on_body || (WALL_REACTIONS && !fluid_i && kind_i != KIND_EXCLUDED && kind_i != KIND_INLET);
-    if (!fluid_i && kind_i != KIND_WALL && !reacts) {
-        rate[i] = vec4<f32>(0.0);
-        return;
-    }
     var body_i = NO_BODY;
     var kinematic_i = false;
     if (on_body) {
-        body_i = body_particles[id_i - params.body_id_base].body;
+        body_i = tables.body_particles[id_i - params.body_id_base].body;
         kinematic_i = body_kinematic(body_i);
     }
     let p_i = pos[i];
@@ -436,7 +443,58 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     if (on_body && (params.friction != 0.0 || params.friction_groups != 0u)) {
         v_contact_i = contact_velocity(i);
     }
+    var r = vec4<f32>(0.0);
+    var ranges: array<vec2<u32>, 27>;
+    let n_ranges = neighbour_ranges(cell_of(p_i), &ranges);
+    for (var s = 0u; s < n_ranges; s++) {
+        for (var j = ranges[s].x; j < ranges[s].y; j++) {
+            let x_ij = rel_pos(p_i, pos[j]);
+            let r2 = dot(x_ij, x_ij);
+            if (r2 >= support2 || j == i) {
+                continue;
+            }
+            let kind_j = code_kind(code[j]);
+            if (kind_j == KIND_FLUID) {
+                let vr_j = velrho[j];
+                let loads = sensor == NO_SENSOR || faces_sensor(tables.wall_sensors[sensor], x_i - x_ij);
+                if (!reacts) {
+                    // Fixed dynamic wall particle: continuity only.
+                    r.w += params.mass * dot(pi.v - vr_j.xyz, x_ij * kernel_f(sqrt(r2) / params.h));
+                } else if (is_repulsive(kind_i)) {
+                    // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
+                    if (loads) {
+                        r += vec4<f32>(repulsion(x_ij, r2), 0.0);
+                    }
+                } else {
+                    // The reaction to the fluid's pressure and viscous force; a dynamic body
+                    // particle also its dρ/dt (ghosts have none).
+                    let pr = pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, 0.0, 1.0).rate;
+                    let force = select(vec3<f32>(0.0), pr.xyz, loads);
+                    r += vec4<f32>(force, select(0.0, pr.w, kind_i == KIND_WALL));
+                }
+            } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
+                // Contact with an elastic solid.
+                let s_j = solid[solid_slot(code[j])];
+                let mu = friction_between(1u + body_i, params.friction_first_solid + s_j.body);
+                r += vec4<f32>(contact_weight(params.mass, material_of(s_j).mass) * contact(x_ij, r2, v_contact_i - velrho[j].xyz, mu), 0.0);
+            } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, code[j] & ID_MASK) && contact_counts(kinematic_i, code[j] & ID_MASK)) {
+                // Contact with a fixed wall or another body.
+                let mu = friction_between(1u + body_i, boundary_group(code[j] & ID_MASK));
+                r += vec4<f32>(contact(x_ij, r2, v_contact_i - contact_velocity(j), mu), 0.0);
+            }
+        }
+    }
+    return r;
+}
 
+// The rates of fluid particle i: continuity and momentum from every pressure-carrying neighbour
+// (`pair_rates`), repulsive walls (eq. 23), elastic solids (eq. 28) and mirror images (eq. 12),
+// gravity, and with ENERGY de/dt (written here).
+fn fluid_rates(i: u32) -> vec4<f32> {
+    let p_i = pos[i];
+    let vr_i = velrho[i];
+    let pi = Particle(vr_i.xyz, vr_i.w, pressure_of(vr_i.w) / (vr_i.w * vr_i.w));
+    let support2 = 4.0 * params.h * params.h;
     var r = vec4<f32>(0.0);
     var de = 0.0;
     var ranges: array<vec2<u32>, 27>;
@@ -449,37 +507,6 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                 continue;
             }
             let kind_j = code_kind(code[j]);
-            if (!fluid_i) {
-                if (kind_j == KIND_FLUID) {
-                    let vr_j = velrho[j];
-                    let loads = sensor == NO_SENSOR || faces_sensor(wall_sensors[sensor], x_i - x_ij);
-                    if (!reacts) {
-                        // Fixed dynamic wall particle: continuity only.
-                        r.w += params.mass * dot(pi.v - vr_j.xyz, x_ij * kernel_f(sqrt(r2) / params.h));
-                    } else if (is_repulsive(kind_i)) {
-                        // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
-                        if (loads) {
-                            r += vec4<f32>(repulsion(x_ij, r2), 0.0);
-                        }
-                    } else {
-                        // The reaction to the fluid's pressure and viscous force; a dynamic
-                        // body particle also its dρ/dt (ghosts have none).
-                        let pr = pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, 0.0, 1.0).rate;
-                        let force = select(vec3<f32>(0.0), pr.xyz, loads);
-                        r += vec4<f32>(force, select(0.0, pr.w, kind_i == KIND_WALL));
-                    }
-                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
-                    // Contact with an elastic solid.
-                    let s_j = solid[solid_slot(code[j])];
-                    let mu = friction_between(1u + body_i, params.friction_first_solid + s_j.body);
-                    r += vec4<f32>(contact_weight(params.mass, material_of(s_j).mass) * contact(x_ij, r2, v_contact_i - velrho[j].xyz, mu), 0.0);
-                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, code[j] & ID_MASK) && contact_counts(kinematic_i, code[j] & ID_MASK)) {
-                    // Contact with a fixed wall or another body.
-                    let mu = friction_between(1u + body_i, boundary_group(code[j] & ID_MASK));
-                    r += vec4<f32>(contact(x_ij, r2, v_contact_i - contact_velocity(j), mu), 0.0);
-                }
-                continue;
-            }
             if (is_repulsive(kind_j)) {
                 r += vec4<f32>(repulsion(x_ij, r2), 0.0);
                 continue;
@@ -511,16 +538,53 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
             de += pr.de;
         }
     }
-    if (fluid_i) {
-        if (MIRRORS && params.n_mirror_planes > 0u) {
-            let m = mirror_rates(i, pi);
-            r += m.rate;
-            de += m.de;
-        }
-        r += vec4<f32>(params.gravity, 0.0);
-        if (ENERGY) {
-            energy_rate[i] = de;
-        }
+    if (MIRRORS && params.n_mirror_planes > 0u) {
+        let m = mirror_rates(i, pi);
+        r += m.rate;
+        de += m.de;
     }
-    rate[i] = r;
+    r += vec4<f32>(params.gravity, 0.0);
+    if (ENERGY) {
+        energy_rate[i] = de;
+    }
+    return r;
+}
+
+// One invocation per particle, by the kind of i: solids (their loads from outside their body;
+// their own stress in elastic.wgsl), fluid, and boundary particles that take rates; every other
+// particle gets zero.
+@compute @workgroup_size(WG)
+fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles) {
+        return;
+    }
+    let kind_i = code_kind(code[i]);
+    if (ENERGY) {
+        energy_rate[i] = 0.0;
+    }
+    if (HYDROSTATIC_DIFFUSION) {
+        set_hydrostatic_coefficients();
+    }
+    if (is_solid(kind_i)) {
+        // A lone elastic body (sph::initial::Present) has nothing outside it to load it.
+        var loads = vec3<f32>(0.0);
+        if (!LONE_SOLID) {
+            loads = solid_loads(i);
+        }
+        rate[i] = vec4<f32>(loads, 0.0);
+        return;
+    }
+    if (kind_i == KIND_FLUID) {
+        rate[i] = fluid_rates(i);
+        return;
+    }
+    let on_body = kind_i != KIND_EXCLUDED && is_body_particle(code[i] & ID_MASK);
+    // Boundary particles that take the fluid's force: bodies', and fixed walls' for probes.
+    let reacts = on_body || (WALL_REACTIONS && kind_i != KIND_EXCLUDED && kind_i != KIND_INLET);
+    if (kind_i != KIND_WALL && !reacts) {
+        rate[i] = vec4<f32>(0.0);
+        return;
+    }
+    rate[i] = boundary_rates(i, kind_i, reacts, on_body);
 }

@@ -25,7 +25,6 @@ const PROBE_WALL_PRESSURE: u32 = 3u;
 @group(0) @binding(5) var<storage, read> probes: array<ProbeDef>;
 @group(0) @binding(6) var<storage, read_write> probe_out: array<atomic<u32>>;
 @group(0) @binding(9) var<storage, read> rate: array<vec4<f32>>;
-@group(0) @binding(10) var<storage, read> wall_sensors: array<WallSensor>;
 
 struct KernelSums {
     volume: f32,        // Σ_j W V_j over fluid (the Shepard denominator)
@@ -137,7 +136,7 @@ fn probe_wall_force(def: ProbeDef) -> f32 {
                     // A fixed wall's particle that belongs to another face's sensor is its.
                     if (def.face != NO_FACE && !is_body_particle(code[j] & ID_MASK)) {
                         let owner = owning_sensor(x);
-                        if (owner != NO_SENSOR && wall_sensors[owner].face_id != def.face) {
+                        if (owner != NO_SENSOR && tables.wall_sensors[owner].face_id != def.face) {
                             continue;
                         }
                     }

@@ -15,8 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::layout::{Pos, SimState, SolidState, ID_MASK, KIND_SHIFT};
 use crate::output::write_atomic;
-use crate::reference::elastic::is_solid;
-use crate::scenario::Scenario;
+use crate::scenario::{Kind, Scenario};
 use crate::sph::state::SolverState;
 
 /// Name of the checkpoint file inside the output directory.
@@ -343,7 +342,7 @@ fn solid_by_id(per_particle: &[SolidState], code: &[u32]) -> Result<Vec<SolidSta
     let mut by_id: Vec<(u32, SolidState)> = code
         .iter()
         .zip(per_particle)
-        .filter(|(c, _)| is_solid(*c >> KIND_SHIFT))
+        .filter(|(c, _)| Kind::code_is_solid(*c >> KIND_SHIFT))
         .map(|(c, s)| (c & ID_MASK, *s))
         .collect();
     by_id.sort_unstable_by_key(|(id, _)| *id);

@@ -498,6 +498,49 @@ mod tests {
         }
     }
 
+    /// The case tables' parts start where `TableSizes` puts them, for any table sizes.
+    #[test]
+    fn case_tables_match_wgsl() {
+        use crate::sph::buffers::TableSizes;
+        let sizes = TableSizes {
+            bodies: 2,
+            mirror_planes: 3,
+            wall_sensors: 5,
+        };
+        let cfg = ShaderConfig {
+            tables: sizes,
+            ..ShaderConfig::default()
+        };
+        let (module, _) = parse(&compose(&interaction::SHADER, cfg), "interaction").unwrap();
+        let (_, ty) = (module.types.iter())
+            .find(|(_, t)| t.name.as_deref() == Some("CaseTables"))
+            .unwrap();
+        let naga::TypeInner::Struct { members, .. } = &ty.inner else {
+            panic!("CaseTables is not a struct");
+        };
+        let at = |name: &str| {
+            members
+                .iter()
+                .find(|m| m.name.as_deref() == Some(name))
+                .unwrap()
+        };
+        assert_eq!(at("bodies").offset, 0);
+        assert_eq!(
+            at("mirror_planes").offset as usize,
+            sizes.mirror_planes_offset()
+        );
+        assert_eq!(
+            at("wall_sensors").offset as usize,
+            sizes.wall_sensors_offset()
+        );
+        assert_eq!(
+            at("body_particles").offset as usize,
+            sizes.body_particles_offset()
+        );
+        let bytes = sizes.pack(&[], &[], &[], &[BodyParticle::default(); 7]);
+        assert_eq!(bytes.len(), sizes.body_particles_offset() + 7 * 16);
+    }
+
     /// Every particle kind has the same code in Rust (`scenario::Kind`), in the WGSL `KIND_*`
     /// constants and in the f64 reference.
     #[test]
@@ -655,6 +698,7 @@ mod tests {
                                     hydrostatic_diffusion,
                                     wall_reactions,
                                     present,
+                                    ..ShaderConfig::default()
                                 };
                                 parse(&compose(pass, cfg), pass.name).unwrap();
                             }

@@ -17,4 +17,6 @@ pub mod reference;
 pub mod run;
 pub mod scenario;
 pub mod sph;
+#[cfg(test)]
+mod twins;
 pub mod validation;

@@ -55,6 +55,11 @@ impl Kind {
         !self.is_fluid() && !self.is_solid() && self != Kind::Inlet
     }
 
+    /// Whether a code word's kind field is an elastic solid's (free or clamped).
+    pub fn code_is_solid(kind: u32) -> bool {
+        Kind::from_code(kind).is_some_and(Kind::is_solid)
+    }
+
     /// The kind of a code word's kind field (None: excluded, or not a kind).
     pub fn from_code(kind: u32) -> Option<Kind> {
         Kind::ALL.into_iter().find(|k| *k as u32 == kind)

@@ -6,7 +6,7 @@ mod common;
 use bytemuck::Zeroable;
 use wgsph::gpu::kernel::Resolve;
 use wgsph::layout::{Params, Pos};
-use wgsph::sph::buffers::{CaseTables, InitialParticles, ParticleBuffers};
+use wgsph::sph::buffers::{CaseTables, InitialParticles, ParticleBuffers, TableSizes};
 
 fn buffers() -> ParticleBuffers {
     let ctx = common::gpu();
@@ -27,6 +27,11 @@ fn buffers() -> ParticleBuffers {
             probes: &[],
             mirror_planes: &[],
             wall_sensors: &[],
+        },
+        TableSizes {
+            bodies: 1,
+            mirror_planes: 1,
+            wall_sensors: 1,
         },
         true,
     )
@@ -56,7 +61,7 @@ fn particle_arrays_resolve_to_their_parity_and_the_sort_writes_the_other() {
             ("rate_old", &b.rate_sorted),
             ("rate_out", &b.rate_sorted),
             ("counts", &b.cell_start),
-            ("bodies", &b.body_motions),
+            ("tables", &b.tables),
         ] {
             assert!(
                 same(at.resolve(name).unwrap(), want),

@@ -268,7 +268,7 @@ fn body_particles_follow_their_pose() {
         let (mut worst_x, mut worst_v) = (0.0f64, 0.0f64);
         for id in body.particles.clone() {
             let r = [0, 1, 2].map(|a| sc.particles[id].pos[a] - body.center[a]);
-            let (x, v) = reference::bodies::place(&pose, r);
+            let (x, v) = reference::bodies::body_move(&pose, r);
             let g = &parts[id];
             let dx = DVec3::from_array(g.pos) - DVec3::from_array(x);
             let dv = DVec3::from_array(g.vel) - DVec3::from_array(v);
@@ -326,7 +326,7 @@ fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind, pair: bool) {
     let space = reference::Space::of(&sc);
     if matches!(kind, Kind::GhostNoSlip | Kind::GhostFreeSlip) {
         // The ghosts of moving bodies interpolate the fluid like those of fixed walls.
-        let cpu_parts = reference::ghost::interpolate(&sc.physics, &sc.walls, &space, &parts);
+        let cpu_parts = reference::ghost::ghost_interpolate(&sc.physics, &sc.walls, &space, &parts);
         let (mut ev, mut er, mut ghosts) = (0.0f64, 0.0f64, 0);
         for (g, c) in parts.iter().zip(&cpu_parts) {
             if g.body.is_none()
@@ -405,7 +405,7 @@ fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind, pair: bool) {
         .map(|k| solver.bodies().unwrap().pose(k).center)
         .collect();
     let cpu_rates: Vec<[f64; 4]> = gpu_rates.iter().map(|g| g.map(|x| x as f64)).collect();
-    let want = reference::bodies::loads(&sc.physics, &parts, &cpu_rates, &centers);
+    let want = reference::bodies::body_force(&sc.physics, &parts, &cpu_rates, &centers);
     let got = solver.rerun_body_loads().unwrap();
     for (k, (w, g)) in want.iter().zip(&got).enumerate() {
         // Scale: the sum of the magnitudes (the force is a sum with cancellation).
@@ -504,7 +504,7 @@ fn a_body_in_free_flight_follows_the_exact_trajectory() {
     let gpu_parts = by_id(&solver);
     for id in sc.bodies[0].particles.clone() {
         let r = [0, 1, 2].map(|a| sc.particles[id].pos[a] - sc.bodies[0].center[a]);
-        let (x, _) = reference::bodies::place(&pose, r);
+        let (x, _) = reference::bodies::body_move(&pose, r);
         let e = (DVec3::from_array(gpu_parts[id].pos) - DVec3::from_array(x)).length();
         assert!(e < 2e-6, "particle {id} is {e} m off its rigid position");
     }
@@ -536,7 +536,7 @@ fn a_flying_body_sets_the_time_step_with_its_rigid_speed() {
             for (id, p) in before.iter().enumerate() {
                 let u = if sc.bodies[0].particles.contains(&id) {
                     let r = [0, 1, 2].map(|a| sc.particles[id].pos[a] - sc.bodies[0].center[a]);
-                    DVec3::from_array(reference::bodies::place(&pose, r).1).length()
+                    DVec3::from_array(reference::bodies::body_move(&pose, r).1).length()
                 } else if p.kind == reference::FLUID {
                     DVec3::from_array(p.vel).length()
                 } else {
@@ -860,7 +860,7 @@ angular_velocity_rad_s = {:?}
     let gpu_parts = by_id(&solver);
     for id in b.particles.clone() {
         let r = [0, 1, 2].map(|a| sc.particles[id].pos[a] - b.center[a]);
-        let (x, _) = reference::bodies::place(&pose, r);
+        let (x, _) = reference::bodies::body_move(&pose, r);
         let e = (DVec3::from_array(gpu_parts[id].pos) - DVec3::from_array(x)).length();
         assert!(e < 2e-6, "particle {id} is {e} m off its rigid position");
     }

@@ -161,8 +161,14 @@ fn gpu_filters_match_reference() {
                 let mls_used = (0..parts.len())
                     .filter(|&i| parts[i].kind == reference::FLUID)
                     .filter(|&i| {
-                        reference::density_filter::density_of(&sc.physics, &space, &parts, i, true)
-                            .1
+                        reference::density_filter::filter_density(
+                            &sc.physics,
+                            &space,
+                            &parts,
+                            i,
+                            true,
+                        )
+                        .1
                     })
                     .count();
                 let change = parts
@@ -293,8 +299,14 @@ fn mls_reproduces_a_linear_density_and_shepard_does_not_near_the_surface() {
                     // Every particle of the block (corners too) is MLS-corrected...
                     let space = reference::Space::OPEN;
                     assert!(
-                        reference::density_filter::density_of(&sc.physics, &space, &parts, i, true)
-                            .1
+                        reference::density_filter::filter_density(
+                            &sc.physics,
+                            &space,
+                            &parts,
+                            i,
+                            true
+                        )
+                        .1
                     );
                     // ...so every one gets its own linear value.
                     assert!(e < 1e-5, "MLS error {e:.2e} at {:?}", p.pos);

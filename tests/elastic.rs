@@ -319,7 +319,7 @@ fn elastic_rates_match_reference() {
         let (solver, parts, solid, gpu_rate) = rerun(&sc);
         let gpu_dtau = stress_rates(&solver);
         let mats = &sc.solids.as_ref().unwrap().materials;
-        let cpu = elastic::rates(&sc.physics, mats, &Space::of(&sc), &parts, &solid);
+        let cpu = elastic::elastic_rates(&sc.physics, mats, &Space::of(&sc), &parts, &solid);
         let all: Vec<_> = cpu.iter().map(|c| c.as_ref().expect("all solid")).collect();
         let acc_rms = rms(all.iter().flat_map(|c| c.rate[..3].to_vec()));
         // The artificial stress (ε = 0.3) must be a visible part of what is compared: the
@@ -328,7 +328,7 @@ fn elastic_rates_match_reference() {
         for m in &mut without {
             m.artificial_stress = 0.0;
         }
-        let cpu0 = elastic::rates(&sc.physics, &without, &Space::of(&sc), &parts, &solid);
+        let cpu0 = elastic::elastic_rates(&sc.physics, &without, &Space::of(&sc), &parts, &solid);
         let as_rms = rms(all.iter().zip(&cpu0).flat_map(|(c, c0)| {
             let c0 = c0.expect("all solid");
             (0..3).map(move |a| c.rate[a] - c0.rate[a])
@@ -493,7 +493,7 @@ fn solid_contact_matches_reference() {
         let mats = &sc.solids.as_ref().unwrap().materials;
         let (_solver, parts, solid, gpu_rate) = rerun(&sc);
         let space = Space::of(&sc);
-        let solids = elastic::rates(ph, mats, &space, &parts, &solid);
+        let solids = elastic::elastic_rates(ph, mats, &space, &parts, &solid);
         let contact = elastic::contact_rates(ph, mats, &sc.walls, &space, &parts, &solid);
         let frictionless = WallParams {
             friction: 0.0,
@@ -648,7 +648,7 @@ fn fluid_solid_interface_matches_reference() {
         let (_solver, parts, solid, gpu_rate) = rerun(&sc);
         let space = Space::of(&sc);
         let fluid = wgsph::reference::interaction::rates(ph, &sc.walls, &space, &parts);
-        let p_g = wgsph::reference::ghost::interface_pressure(ph, &sc.walls, &space, &parts);
+        let p_g = wgsph::reference::ghost::solid_interface_pressure(ph, &sc.walls, &space, &parts);
         let on_solid: Vec<f64> = (0..parts.len())
             .filter(|&i| elastic::is_solid(parts[i].kind))
             .map(|i| p_g[i])
@@ -658,7 +658,7 @@ fn fluid_solid_interface_matches_reference() {
             "the interface pressures are all small: {on_solid:?}"
         );
         let interface = elastic::interface_rates(ph, mats, &space, &parts, &solid, &p_g);
-        let solids = elastic::rates(ph, mats, &space, &parts, &solid);
+        let solids = elastic::elastic_rates(ph, mats, &space, &parts, &solid);
         let cpu: Vec<[f64; 4]> = (0..parts.len())
             .map(|i| {
                 let s = solids[i].map_or([0.0; 4], |s| s.rate);
@@ -823,7 +823,7 @@ fn solids_of_both_formulations_match_their_references() {
         let mats = &sc.solids.as_ref().unwrap().materials;
 
         // The updated-Lagrangian body.
-        let cpu = elastic::rates(&sc.physics, mats, &Space::of(&sc), &parts, &solid);
+        let cpu = elastic::elastic_rates(&sc.physics, mats, &Space::of(&sc), &parts, &solid);
         let ul: Vec<usize> = (0..parts.len()).filter(|&i| cpu[i].is_some()).collect();
         let n_tl = parts
             .iter()

@@ -59,7 +59,7 @@ fn energy_rate_matches_reference() {
         let parts = gpu_particles(&solver);
         solver.rerun_interaction(false).unwrap();
         let gpu_de = solver.read_energy_rates().unwrap();
-        let cpu = reference::interaction::rates_and_energy(
+        let cpu = reference::interaction::interaction(
             &sc.physics,
             &sc.walls,
             &reference::Space::of(&sc),

@@ -152,7 +152,7 @@ fn cell_list_sort_matches_reference_exactly() {
         let grid = &solver.grid;
         let init: Vec<([f32; 3], [u32; 3])> =
             sc.particles.iter().map(|p| grid.to_block(p.pos)).collect();
-        let keys = reference::cell_list::keys(grid, &init, &vec![false; init.len()]);
+        let keys = reference::cell_list::cell_key(grid, &init, &vec![false; init.len()]);
         let (order, start) = reference::cell_list::sorted_order(grid, &keys);
         let (_, _, code) = solver.read_raw().unwrap();
         let ids: Vec<usize> = code.iter().map(|c| (c & ID_MASK) as usize).collect();
@@ -610,9 +610,9 @@ fn probes_match_reference() {
         let ph = &sc.physics;
         let top = s.domain;
         let cpu = [
-            reference::probes::pressure_at(ph, &parts, centre),
-            reference::probes::height_at(ph, &parts, base, top),
-            reference::probes::front(&parts, [0.01, 0.02, 0.0], axis),
+            reference::probes::probe_pressure(ph, &parts, centre),
+            reference::probes::probe_height(ph, &parts, base, top),
+            reference::probes::probe_front(&parts, [0.01, 0.02, 0.0], axis),
         ];
         println!("dim {}: GPU {gpu_values:?} CPU {cpu:?}", s.dim);
         assert!(
@@ -703,7 +703,7 @@ max_m = {}
     wgsph::case::load_str(&text, "unit_box.toml", &[]).unwrap()
 }
 
-/// The inlet pass against `reference::open_boundaries::place` over steps of random size: every inlet
+/// The inlet pass against `reference::open_boundaries::inlet_flow` over steps of random size: every inlet
 /// particle's kind, place, velocity and density after the pass, and the count of particles that
 /// joined a buffer. A particle that became fluid in the step is compared by place only (the
 /// corrector then moves its velocity and density on). (An extrapolated buffer's density, which
@@ -738,7 +738,14 @@ fn inlet_flow_matches_reference() {
                     let (g_pos, g_vel, g_rho, g_kind) =
                         (after.pos[id], after.vel[id], after.rho[id], after.kind[id]);
                     let rho0 = before.rho[id] as f64;
-                    match reference::open_boundaries::place(inlet, k, kind0, rho0, t, &sc.physics) {
+                    match reference::open_boundaries::inlet_flow(
+                        inlet,
+                        k,
+                        kind0,
+                        rho0,
+                        t,
+                        &sc.physics,
+                    ) {
                         None => {
                             if kind0 != reference::FLUID {
                                 assert_eq!(g_kind, kind0, "step {step} {} {k}", inlet.name);

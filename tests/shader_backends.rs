@@ -85,3 +85,52 @@ fn every_shipped_variant_translates_to_every_backend() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// WebGPU's default `max_storage_buffers_per_shader_stage`.
+const WEBGPU_STORAGE_BUFFERS: usize = 8;
+
+/// Every entry point of every variant the shipped cases use (and the all-kinds one) binds at
+/// most WebGPU's default of 8 storage buffers, so the engine runs on every adapter wgpu
+/// supports, browsers included.
+#[test]
+fn every_entry_point_binds_at_most_8_storage_buffers() {
+    let mut configs = vec![("all kinds".to_string(), ShaderConfig::default())];
+    for file in cases() {
+        let sc = wgsph::case::load(&file, &[]).unwrap();
+        let cfg = ShaderConfig::of(&sc).unwrap();
+        if !configs.iter().any(|(_, c)| *c == cfg) {
+            configs.push((file.display().to_string(), cfg));
+        }
+    }
+    let mut over = Vec::new();
+    for (what, cfg) in &configs {
+        for shader in SHADERS {
+            let module = naga::front::wgsl::parse_str(&compose(shader, *cfg)).unwrap();
+            let info = Validator::new(ValidationFlags::all(), Capabilities::empty())
+                .validate(&module)
+                .unwrap();
+            for (k, entry) in module.entry_points.iter().enumerate() {
+                let uses = info.get_entry_point(k);
+                let storage: Vec<&str> = (module.global_variables.iter())
+                    .filter(|(h, g)| {
+                        !uses[*h].is_empty()
+                            && matches!(g.space, naga::AddressSpace::Storage { .. })
+                    })
+                    .filter_map(|(_, g)| g.name.as_deref())
+                    .collect();
+                if storage.len() > WEBGPU_STORAGE_BUFFERS {
+                    over.push(format!(
+                        "{}::{} for {what}: {} ({})",
+                        shader.name,
+                        entry.name,
+                        storage.len(),
+                        storage.join(", ")
+                    ));
+                }
+            }
+        }
+    }
+    over.sort();
+    over.dedup();
+    assert!(over.is_empty(), "{}", over.join("\n"));
+}

@@ -108,7 +108,7 @@ fn ghosts_repulsion_and_mirrors_match_reference() {
             let solver = Solver::new(gpu(), &sc).unwrap();
             let gpu_parts = gpu_particles(&solver);
             // Ghost values: the reference interpolates from the GPU's fluid.
-            let cpu_parts = reference::ghost::interpolate(
+            let cpu_parts = reference::ghost::ghost_interpolate(
                 &sc.physics,
                 &sc.walls,
                 &reference::Space::of(&sc),
@@ -189,8 +189,8 @@ fn mls_ghosts_extrapolate_a_linear_pressure_exactly() {
             for g in parts.iter().filter(|p| p.kind == reference::GHOST_NO_SLIP) {
                 let a =
                     reference::ghost::moment_matrix(&ph, &reference::Space::OPEN, &parts, g.pos);
-                if reference::ghost::min_pivot_ratio(dim as usize, a)
-                    < 1.2 * reference::ghost::MLS_MIN_PIVOT
+                if reference::mls::min_pivot_ratio(dim as usize, a)
+                    < 1.2 * reference::mls::MLS_MIN_PIVOT
                 {
                     continue;
                 }

@@ -320,6 +320,32 @@ struct MirrorPlane {
     pad: u32,
 }
 
+// A wall-pressure probe's patch on a fixed wall, in domain coordinates.
+struct WallSensor {
+    point: vec3<f32>,   // on the wall's face
+    radius: f32,        // across the normal
+    normal: vec3<f32>,  // unit, into the fluid
+    face: f32,          // (x − point)·normal of the wall's face
+    over_lo: vec3<f32>, // the face's extent where an edge is near (WallPatch::over_lo)
+    face_id: u32,       // the first sensor on the same face (WallParams::sensor_faces)
+    over_hi: vec3<f32>,
+}
+
+// The case's small read-only tables in one binding (so that no pass binds more than WebGPU's 8
+// storage buffers): the bodies' motions of the step (the host writes them at offset 0 every
+// step), the mirror planes, the fixed walls' wall-pressure sensors, and the body particles
+// (indexed by id − params.body_id_base). The counts are the case's (at least one each, unused
+// stand-ins where it has none), composed in front as N_BODIES, N_MIRROR_PLANES,
+// N_WALL_SENSORS. Mirrored by `sph::buffers::CaseTables`.
+struct CaseTables {
+    bodies: array<BodyMotion, N_BODIES>,
+    mirror_planes: array<MirrorPlane, N_MIRROR_PLANES>,
+    wall_sensors: array<WallSensor, N_WALL_SENSORS>,
+    body_particles: array<BodyParticle>,
+}
+
+@group(0) @binding(30) var<storage, read> tables: CaseTables;
+
 fn reflect_vec(v: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return v - 2.0 * dot(v, n) * n;
 }

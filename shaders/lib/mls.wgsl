@@ -79,8 +79,3 @@ fn mls_solve(a_in: mat4x4<f32>) -> MlsBeta {
     let finite = all(abs(beta) < vec4<f32>(1e30));
     return MlsBeta(beta, finite);
 }
-
-// The MLS correction factor β0 + β·x_ij/h of a pair.
-fn mls_weight(b: vec4<f32>, x_ij: vec3<f32>) -> f32 {
-    return dot(b, mls_basis(x_ij));
-}

@@ -1,19 +1,8 @@
 // The boundary particles a wall-pressure sensor sums over (WallPatch in scenario.rs): the
 // probe's column test (probes.wgsl) and, on fixed walls, the sensor each particle belongs to
-// and the fluid that loads it (interaction.wgsl). The pass declares `wall_sensors`.
+// and the fluid that loads it (interaction.wgsl). The sensors are `tables.wall_sensors` (common.wgsl).
 
 const NO_SENSOR: u32 = 0xFFFFFFFFu;
-
-// A wall-pressure probe's patch on a fixed wall, in domain coordinates.
-struct WallSensor {
-    point: vec3<f32>,   // on the wall's face
-    radius: f32,        // across the normal
-    normal: vec3<f32>,  // unit, into the fluid
-    face: f32,          // (x − point)·normal of the wall's face
-    over_lo: vec3<f32>, // the face's extent where an edge is near (WallPatch::over_lo)
-    face_id: u32,       // the first sensor on the same face (WallParams::sensor_faces)
-    over_hi: vec3<f32>,
-}
 
 // Whether fluid at x loads the sensor's particles: in front of its face and over it, not
 // beyond an edge.
@@ -37,8 +26,8 @@ fn in_wall_patch(point: vec3<f32>, normal: vec3<f32>, radius: f32, x: vec3<f32>)
 fn owning_sensor(x: vec3<f32>) -> u32 {
     var best = NO_SENSOR;
     var best_depth = 0.0;
-    for (var k = 0u; k < arrayLength(&wall_sensors); k++) {
-        let s = wall_sensors[k];
+    for (var k = 0u; k < N_WALL_SENSORS; k++) {
+        let s = tables.wall_sensors[k];
         let depth = s.face - dot(x - s.point, s.normal);
         let nearer = depth < best_depth - 0.01 * params.h;
         if (in_wall_patch(s.point, s.normal, s.radius, x) && (best == NO_SENSOR || nearer)) {

@@ -9,7 +9,7 @@ use crate::scenario::Physics;
 
 /// Position and velocity of the body particle whose offset from the centre of mass at t = 0
 /// is `r`: x = x_c + R r, u = u_c + ω × (R r).
-pub fn place(pose: &Pose, r: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+pub fn body_move(pose: &Pose, r: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     let arm = pose.rotation * DVec3::from_array(r);
     (
         (pose.center + arm).to_array(),
@@ -19,7 +19,7 @@ pub fn place(pose: &Pose, r: [f64; 3]) -> ([f64; 3], [f64; 3]) {
 
 /// Force Σ m a_a and torque Σ (x_a − x_c) × m a_a on each body from the rates of its particles
 /// (excluded particles left out); `centers` are the bodies' centres of mass.
-pub fn loads(
+pub fn body_force(
     ph: &Physics,
     parts: &[RefParticle],
     rates: &[[f64; 4]],

@@ -3,7 +3,7 @@
 use crate::grid::Grid;
 
 /// Slot of each particle (given as GPU block + offset), `slots` for excluded ones.
-pub fn keys(grid: &Grid, pos: &[([f32; 3], [u32; 3])], excluded: &[bool]) -> Vec<u32> {
+pub fn cell_key(grid: &Grid, pos: &[([f32; 3], [u32; 3])], excluded: &[bool]) -> Vec<u32> {
     pos.iter()
         .zip(excluded)
         .map(|((off, b), &ex)| {

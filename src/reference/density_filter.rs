@@ -3,12 +3,12 @@
 //!
 //! Shepard: ρ_i = Σ_j m_j W_ij / Σ_j W_ij V_j, V_j = m_j/ρ_j.
 //! MLS:     ρ_i = Σ_j m_j W^MLS_ij, W^MLS_ij = (β0 + β·x_ij/h) W_ij, β = A⁻¹ e1,
-//!          A = Σ_j W_ij V_j b_ij b_ijᵀ, b_ij = [1, x_ij/h] (the matrix of `ghost::moment_matrix`).
+//!          A = Σ_j W_ij V_j b_ij b_ijᵀ, b_ij = [1, x_ij/h] (`mls::mls_add`, as for the ghosts' `ghost::moment_matrix`).
 //! j runs over i itself and every fluid, dynamic-wall and ghost particle within 2h; repulsive
 //! and excluded particles carry no density and do not count. MLS falls back to Shepard when a
 //! pivot of A is below `MLS_MIN_PIVOT`·A00 or when the MLS density is not positive and finite.
 
-use super::ghost::{basis, mls_beta};
+use super::mls::{mls_add, mls_solve, mls_weight};
 use super::{dot, kernel, RefParticle, Space, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP, INLET, WALL};
 use crate::scenario::Physics;
 
@@ -46,23 +46,13 @@ fn neighbours(
 
 /// The MLS correction β of particle `i` (in the basis [1, x/h]), None where the moment matrix is
 /// ill-conditioned (the Shepard fallback).
-pub fn mls_beta_of(
-    ph: &Physics,
-    space: &Space,
-    parts: &[RefParticle],
-    i: usize,
-) -> Option<[f64; 4]> {
+pub fn mls_beta(ph: &Physics, space: &Space, parts: &[RefParticle], i: usize) -> Option<[f64; 4]> {
     let dim = ph.dim as usize;
     let mut a = [[0.0; 4]; 4];
     for (_, x, wv) in neighbours(ph, space, parts, i) {
-        let b = basis(dim, ph.h, x);
-        for r in 0..4 {
-            for c in 0..4 {
-                a[r][c] += wv * b[r] * b[c];
-            }
-        }
+        mls_add(&mut a, dim, ph.h, x, wv);
     }
-    mls_beta(dim, a)
+    mls_solve(dim, a)
 }
 
 /// W^MLS_ij V_j for every neighbour j of `i` (None where MLS falls back to Shepard): the weights
@@ -73,21 +63,18 @@ pub fn mls_weights(
     parts: &[RefParticle],
     i: usize,
 ) -> Option<Vec<(usize, f64)>> {
-    let beta = mls_beta_of(ph, space, parts, i)?;
+    let beta = mls_beta(ph, space, parts, i)?;
     let dim = ph.dim as usize;
     Some(
         neighbours(ph, space, parts, i)
             .into_iter()
-            .map(|(j, x, wv)| {
-                let b = basis(dim, ph.h, x);
-                (j, (0..4).map(|k| beta[k] * b[k]).sum::<f64>() * wv)
-            })
+            .map(|(j, x, wv)| (j, mls_weight(beta, dim, ph.h, x) * wv))
             .collect(),
     )
 }
 
 /// The filtered density of particle `i` and whether MLS was used (false: Shepard).
-pub fn density_of(
+pub fn filter_density(
     ph: &Physics,
     space: &Space,
     parts: &[RefParticle],
@@ -121,7 +108,7 @@ pub fn filter(ph: &Physics, space: &Space, parts: &[RefParticle], mls: bool) -> 
     (0..parts.len())
         .map(|i| {
             if parts[i].kind == FLUID {
-                density_of(ph, space, parts, i, mls).0
+                filter_density(ph, space, parts, i, mls).0
             } else {
                 parts[i].rho
             }
@@ -270,8 +257,8 @@ mod tests {
             for p in parts.iter_mut() {
                 p.rho = lin(p.pos);
             }
-            let (rho, used_mls) = density_of(&ph, &Space::OPEN, &parts, i, true);
-            let (shepard, _) = density_of(&ph, &Space::OPEN, &parts, i, false);
+            let (rho, used_mls) = filter_density(&ph, &Space::OPEN, &parts, i, true);
+            let (shepard, _) = filter_density(&ph, &Space::OPEN, &parts, i, false);
             println!(
                 "{dim}D surface particle: exact {:.6}, MLS {rho:.6}, Shepard {shepard:.6}",
                 lin(parts[i].pos)
@@ -309,9 +296,9 @@ mod tests {
             let mut pair = vec![far, far];
             pair[1].pos[0] += 0.5 * ph.h;
             pair[1].rho = 990.0;
-            let (rho, used_mls) = density_of(&ph, &Space::OPEN, &pair[..1], 0, true);
+            let (rho, used_mls) = filter_density(&ph, &Space::OPEN, &pair[..1], 0, true);
             assert!(!used_mls && (rho - 1010.0).abs() < 1e-9, "{rho}");
-            let (rho, used_mls) = density_of(&ph, &Space::OPEN, &pair, 0, true);
+            let (rho, used_mls) = filter_density(&ph, &Space::OPEN, &pair, 0, true);
             assert!(!used_mls && rho.is_finite() && rho > 990.0 && rho < 1010.0);
         }
     }

@@ -128,7 +128,7 @@ fn stress_terms(mat: &ElasticMaterial, p: &RefParticle, s: &SolidRef) -> (M3, M3
 /// solids' included): continuity, momentum with σ = −pI + τ, artificial viscosity and
 /// artificial stress, and the Jaumann rate of τ, over the solid particles of the same body, of
 /// the body's material (`mats` indexed by body).
-pub fn rates(
+pub fn elastic_rates(
     ph: &Physics,
     mats: &[ElasticMaterial],
     space: &Space,
@@ -190,26 +190,7 @@ pub fn rates(
                     }
                 }
             }
-            let g = transpose(&grad_v);
-            let mut eps = [[0.0; 3]; 3];
-            let mut omega = [[0.0; 3]; 3];
-            for a in 0..3 {
-                for b in 0..3 {
-                    eps[a][b] = 0.5 * (grad_v[a][b] + g[a][b]);
-                    omega[a][b] = 0.5 * (grad_v[a][b] - g[a][b]);
-                }
-            }
-            let tr3 = (eps[0][0] + eps[1][1] + eps[2][2]) / 3.0;
-            let tau = tensor(&solid[i].tau);
-            let t1 = mul(&tau, &transpose(&omega));
-            let t2 = mul(&omega, &tau);
-            let mut d = [[0.0; 3]; 3];
-            for a in 0..3 {
-                for b in 0..3 {
-                    let iso = if a == b { tr3 } else { 0.0 };
-                    d[a][b] = 2.0 * mu_shear * (eps[a][b] - iso) + t1[a][b] + t2[a][b];
-                }
-            }
+            let d = jaumann_stress_rate(&grad_v, &tensor(&solid[i].tau), mu_shear);
             Some(ElasticRates {
                 rate: [
                     acc[0] + ph.gravity[0],
@@ -223,10 +204,36 @@ pub fn rates(
         .collect()
 }
 
+/// The Jaumann rate of the deviatoric stress, eq. 7 (Gray, Monaghan & Swift 2001;
+/// `jaumann_stress_rate`): 2μ (ε̇ − tr ε̇/3 I) + τ Ωᵀ + Ω τ, ε̇ and Ω the symmetric and
+/// antisymmetric parts of the velocity gradient (eq. 8).
+pub fn jaumann_stress_rate(grad_v: &M3, tau: &M3, mu: f64) -> M3 {
+    let g = transpose(grad_v);
+    let mut eps = [[0.0; 3]; 3];
+    let mut omega = [[0.0; 3]; 3];
+    for a in 0..3 {
+        for b in 0..3 {
+            eps[a][b] = 0.5 * (grad_v[a][b] + g[a][b]);
+            omega[a][b] = 0.5 * (grad_v[a][b] - g[a][b]);
+        }
+    }
+    let tr3 = (eps[0][0] + eps[1][1] + eps[2][2]) / 3.0;
+    let t1 = mul(tau, &transpose(&omega));
+    let t2 = mul(&omega, tau);
+    let mut d = [[0.0; 3]; 3];
+    for a in 0..3 {
+        for b in 0..3 {
+            let iso = if a == b { tr3 } else { 0.0 };
+            d[a][b] = 2.0 * mu * (eps[a][b] - iso) + t1[a][b] + t2[a][b];
+        }
+    }
+    d
+}
+
 /// The fluid–solid pair terms of interaction.wgsl (see its header): for every particle, the
 /// (dv/dt, dρ/dt) it gets from neighbours of the other material (fluid from solid particles,
 /// solid from fluid ones). A solid particle enters with its interface pressure `p_g`
-/// (`ghost::interface_pressure`), its own mass (its body's material, `mats` indexed by
+/// (`ghost::solid_interface_pressure`), its own mass (its body's material, `mats` indexed by
 /// `solid[k].body`), density and velocity; with the fluid's viscosity, and on the fluid side
 /// the seed's density-rate correction ρ_i/ρ_j (a solid's density follows its own body only);
 /// zero for the others.

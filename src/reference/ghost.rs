@@ -1,34 +1,8 @@
 //! Twin of shaders/ghost.wgsl: ghost pressure (as ρ) and velocity interpolated from the fluid.
 
+use super::mls::{mls_add, mls_basis, mls_solve};
 use super::{dot, kernel, pressure, RefParticle, Space, FLUID, GHOST_FREE_SLIP, GHOST_NO_SLIP};
 use crate::scenario::{GhostCorrection, Physics, WallParams};
-
-/// Smallest accepted MLS pivot relative to A00 = Σ W V (as `MLS_MIN_PIVOT` in mls.wgsl).
-pub const MLS_MIN_PIVOT: f64 = 0.03;
-
-/// The smallest pivot of the elimination relative to A00 (the conditioning the GPU tests).
-pub fn min_pivot_ratio(dim: usize, a: [[f64; 4]; 4]) -> f64 {
-    let n = dim + 1;
-    let mut m = a;
-    let mut worst = f64::MAX;
-    for k in 0..n {
-        let piv = (k..n)
-            .max_by(|&x, &y| m[x][k].abs().total_cmp(&m[y][k].abs()))
-            .unwrap();
-        m.swap(k, piv);
-        worst = worst.min(m[k][k].abs() / a[0][0]);
-        if m[k][k] == 0.0 {
-            return 0.0;
-        }
-        for r in k + 1..n {
-            let f = m[r][k] / m[k][k];
-            for c in 0..n {
-                m[r][c] -= f * m[k][c];
-            }
-        }
-    }
-    worst
-}
 
 /// The MLS moment matrix Σ_j W_gj V_j b bᵀ, b = [1, x_gj/h], over fluid particles.
 pub fn moment_matrix(
@@ -43,61 +17,10 @@ pub fn moment_matrix(
         let r = dot(d, d).sqrt();
         if r < 2.0 * ph.h {
             let wv = kernel::w(ph.kernel, ph.dim, ph.h, r) * ph.particle_mass / j.rho;
-            let b = basis(ph.dim as usize, ph.h, d);
-            for r in 0..4 {
-                for c in 0..4 {
-                    a[r][c] += wv * b[r] * b[c];
-                }
-            }
+            mls_add(&mut a, ph.dim as usize, ph.h, d, wv);
         }
     }
     a
-}
-
-/// β = A⁻¹ e1 of the (d+1)×(d+1) MLS system, None when a pivot is below MLS_MIN_PIVOT·A00
-/// (as the GPU).
-pub fn mls_beta(dim: usize, a: [[f64; 4]; 4]) -> Option<[f64; 4]> {
-    let n = dim + 1;
-    let mut m = a;
-    let mut rhs = [1.0, 0.0, 0.0, 0.0];
-    let tiny = MLS_MIN_PIVOT * a[0][0];
-    if a[0][0] <= 0.0 {
-        return None;
-    }
-    for k in 0..n {
-        let piv = (k..n)
-            .max_by(|&x, &y| m[x][k].abs().total_cmp(&m[y][k].abs()))
-            .unwrap();
-        if m[piv][k].abs() <= tiny {
-            return None;
-        }
-        m.swap(k, piv);
-        rhs.swap(k, piv);
-        for r in 0..n {
-            if r != k {
-                let f = m[r][k] / m[k][k];
-                for c in 0..n {
-                    m[r][c] -= f * m[k][c];
-                }
-                rhs[r] -= f * rhs[k];
-            }
-        }
-    }
-    let mut beta = [0.0; 4];
-    for k in 0..n {
-        beta[k] = rhs[k] / m[k][k];
-    }
-    Some(beta)
-}
-
-/// [1, x/h] with the unused z left 0 in 2D.
-pub fn basis(dim: usize, h: f64, x: [f64; 3]) -> [f64; 4] {
-    [
-        1.0,
-        x[0] / h,
-        x[1] / h,
-        if dim == 3 { x[2] / h } else { 0.0 },
-    ]
 }
 
 /// The fluid's pressure (with the hydrostatic correction along `g_eff` = g − a_wall) and
@@ -123,12 +46,10 @@ pub fn fluid_at(
             continue;
         }
         let wv = kernel::w(ph.kernel, ph.dim, h, r2.sqrt()) * ph.particle_mass / j.rho;
-        let b = basis(dim, h, d);
+        let b = mls_basis(dim, h, d);
         let p = pressure(ph, j.rho) + j.rho * dot(g_eff, d);
+        mls_add(&mut a, dim, h, d, wv);
         for r in 0..4 {
-            for c in 0..4 {
-                a[r][c] += wv * b[r] * b[c];
-            }
             m_p[r] += p * wv * b[r];
             for k in 0..3 {
                 m_v[k][r] += j.vel[k] * wv * b[r];
@@ -140,7 +61,7 @@ pub fn fluid_at(
     }
     let mut beta = [1.0 / a[0][0], 0.0, 0.0, 0.0];
     if walls.ghost_correction == GhostCorrection::Mls {
-        if let Some(b) = mls_beta(dim, a) {
+        if let Some(b) = mls_solve(dim, a) {
             beta = b;
         }
     }
@@ -149,7 +70,7 @@ pub fn fluid_at(
 }
 
 /// Sets (v, ρ) of every ghost from the fluid; other particles are returned unchanged.
-pub fn interpolate(
+pub fn ghost_interpolate(
     ph: &Physics,
     walls: &WallParams,
     space: &Space,
@@ -175,7 +96,7 @@ pub fn interpolate(
 
 /// The interface pressure P_g of every elastic solid particle (the fluid pressure
 /// interpolated at it, as for a ghost), 0 for the others.
-pub fn interface_pressure(
+pub fn solid_interface_pressure(
     ph: &Physics,
     walls: &WallParams,
     space: &Space,

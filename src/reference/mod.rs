@@ -11,6 +11,7 @@ pub mod elastic;
 pub mod ghost;
 pub mod integrate;
 pub mod interaction;
+pub mod mls;
 pub mod open_boundaries;
 pub mod probes;
 pub mod total_lagrangian;

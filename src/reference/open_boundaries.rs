@@ -18,7 +18,14 @@ pub struct Placed {
 /// What the pass makes at time `t` of particle `k` of `inlet`, whose kind is `kind` and density
 /// `rho`: `None` where it leaves the particle alone (fluid already, or excluded and not due:
 /// still dormant, or past the plane, i.e. fluid that left the domain).
-pub fn place(inlet: &Inlet, k: usize, kind: u32, rho: f64, t: f64, ph: &Physics) -> Option<Placed> {
+pub fn inlet_flow(
+    inlet: &Inlet,
+    k: usize,
+    kind: u32,
+    rho: f64,
+    t: f64,
+    ph: &Physics,
+) -> Option<Placed> {
     let s = inlet.distance(k, t);
     let joined = match kind {
         INLET => false,
@@ -91,18 +98,18 @@ mod tests {
         // At t = 0.003 s every particle has moved 6 mm: layer 0 (s = 1 mm) is fluid, layer 4
         // (s = −39 mm) has joined.
         let t = 0.003;
-        let first = place(&inlet, 1, INLET, ph.rho0, t, ph).unwrap();
+        let first = inlet_flow(&inlet, 1, INLET, ph.rho0, t, ph).unwrap();
         assert_eq!(first.kind, FLUID);
         assert!((first.pos[0] - 0.101).abs() < 1e-12 && (first.pos[1] - 0.21).abs() < 1e-12);
         assert_eq!(first.vel, [2.0, 0.0, 0.0]);
-        let joined = place(&inlet, 8, EXCLUDED, ph.rho0, t, ph).unwrap();
+        let joined = inlet_flow(&inlet, 8, EXCLUDED, ph.rho0, t, ph).unwrap();
         assert!(joined.joined && joined.kind == INLET);
         assert!((joined.pos[0] - (0.1 - 0.039)).abs() < 1e-12);
         // Layer 5 still waits; a fluid particle is left alone, and so is an excluded one past
         // the plane (it was fluid and left the domain).
-        assert_eq!(place(&inlet, 10, EXCLUDED, ph.rho0, t, ph), None);
-        assert_eq!(place(&inlet, 3, FLUID, ph.rho0, t, ph), None);
-        assert_eq!(place(&inlet, 0, EXCLUDED, ph.rho0, t, ph), None);
+        assert_eq!(inlet_flow(&inlet, 10, EXCLUDED, ph.rho0, t, ph), None);
+        assert_eq!(inlet_flow(&inlet, 3, FLUID, ph.rho0, t, ph), None);
+        assert_eq!(inlet_flow(&inlet, 0, EXCLUDED, ph.rho0, t, ph), None);
         assert_eq!(first.rho, ph.rho0);
     }
 
@@ -116,9 +123,9 @@ mod tests {
             ..inlet()
         };
         let t = 0.003;
-        let crossing = place(&inlet, 1, INLET, 1003.5, t, ph).unwrap();
+        let crossing = inlet_flow(&inlet, 1, INLET, 1003.5, t, ph).unwrap();
         assert_eq!((crossing.kind, crossing.rho), (FLUID, 1003.5));
-        let joined = place(&inlet, 8, EXCLUDED, 1003.5, t, ph).unwrap();
+        let joined = inlet_flow(&inlet, 8, EXCLUDED, 1003.5, t, ph).unwrap();
         assert_eq!((joined.kind, joined.rho), (INLET, ph.rho0));
     }
 
@@ -133,7 +140,7 @@ mod tests {
             },
             ..inlet()
         };
-        let p = place(&inlet, 0, INLET, ph.rho0, 0.0, ph).unwrap();
+        let p = inlet_flow(&inlet, 0, INLET, ph.rho0, 0.0, ph).unwrap();
         let expected = ph.rho0 * (1.0 + ph.rho0 * 9.81 * 0.015 / ph.tait_b()).powf(1.0 / ph.gamma);
         assert!(
             (p.rho - expected).abs() < 1e-9 * expected,

@@ -20,7 +20,7 @@ fn sums(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> (f64, f64) {
 }
 
 /// Shepard-interpolated pressure; 0 where Σ W V < 0.1.
-pub fn pressure_at(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> f64 {
+pub fn probe_pressure(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> f64 {
     let (vol, pw) = sums(ph, parts, x);
     if vol < 0.1 {
         0.0
@@ -31,7 +31,7 @@ pub fn pressure_at(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> f64 {
 
 /// Height above `base` of the highest point of the vertical line where Σ W V reaches ½,
 /// stepping down by h/4 from `top` (the domain top) and interpolating linearly.
-pub fn height_at(ph: &Physics, parts: &[RefParticle], base: [f64; 3], top: f64) -> f64 {
+pub fn probe_height(ph: &Physics, parts: &[RefParticle], base: [f64; 3], top: f64) -> f64 {
     let up = ph.dim as usize - 1;
     let step = 0.25 * ph.h;
     let mut x = base;
@@ -55,7 +55,7 @@ pub fn height_at(ph: &Physics, parts: &[RefParticle], base: [f64; 3], top: f64) 
 }
 
 /// max over fluid of (x − origin)·axis (axis normalised).
-pub fn front(parts: &[RefParticle], origin: [f64; 3], axis: [f64; 3]) -> f64 {
+pub fn probe_front(parts: &[RefParticle], origin: [f64; 3], axis: [f64; 3]) -> f64 {
     let n = dot(axis, axis).sqrt();
     parts
         .iter()

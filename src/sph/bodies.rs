@@ -61,7 +61,7 @@ pub fn initial_motions(sc: &Scenario, first_id: u32) -> Vec<BodyMotion> {
 }
 
 pub struct Bodies {
-    /// The per-body table (`ParticleBuffers::body_motions`); `first`, `count` and
+    /// The per-body table (at the start of `ParticleBuffers::tables`); `first`, `count` and
     /// `first_group` never change.
     motions: Vec<BodyMotion>,
     motion_buf: wgpu::Buffer,
@@ -110,7 +110,7 @@ impl Bodies {
             poses: vec![Pose::default(); motions.len()],
             accels: vec![[DVec3::ZERO; 2]; motions.len()],
             motions,
-            motion_buf: b.body_motions.clone(),
+            motion_buf: b.tables.clone(),
             partials,
             groups,
             n_body,

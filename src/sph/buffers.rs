@@ -34,20 +34,16 @@ pub struct ParticleBuffers {
     pub scan_sizes: Vec<u32>,
     pub probes: wgpu::Buffer,
     pub probe_out: wgpu::Buffer,
-    pub mirror_planes: wgpu::Buffer,
-    /// The wall-pressure probes' patches on fixed walls (`WallParams::sensors`); one that
-    /// holds no particle when there are none.
-    pub wall_sensors: wgpu::Buffer,
     /// (e, de/dt) per particle, 2 parities, and the new de/dt: one element each when the
     /// energy equation is off.
     pub energy: [wgpu::Buffer; 2],
     pub energy_rate: wgpu::Buffer,
-    /// Body-frame offset and body of every body particle (by id − body_id_base); one dummy
-    /// element without bodies.
-    pub body_particles: wgpu::Buffer,
-    /// Each body's rigid motion for the step (uploaded by the host every step); one dummy
-    /// element without bodies.
-    pub body_motions: wgpu::Buffer,
+    /// The case's small read-only tables in one binding (`CaseTables` in common.wgsl, laid
+    /// out by [`TableSizes`]): each body's rigid motion for the step (the host uploads it at
+    /// offset 0 every step), the mirror planes, the wall-pressure probes' patches on fixed
+    /// walls (`WallParams::sensors`), and the body-frame offset and body of every body particle
+    /// (by id − body_id_base); a stand-in of each where the case has none.
+    pub tables: wgpu::Buffer,
     /// Deviatoric stress, body, last dτ/dt, interface pressure and material of the solid
     /// particles, indexed by id − `Params::solid_id_base`: the sort leaves them in place, and
     /// fluid and wall particles take no room in it (one element when there are no solids).
@@ -64,6 +60,77 @@ const EMPTY_PROBES: [ProbeDef; 1] = [ProbeDef {
     face: crate::layout::NO_FACE,
     pad: [0; 3],
 }];
+
+/// How many entries each fixed table of `CaseTables` (shaders/lib/common.wgsl) has: the case's
+/// count, at least one (a stand-in where it has none). Composed into the shaders as N_BODIES,
+/// N_MIRROR_PLANES and N_WALL_SENSORS; the body particles follow, as many as the case has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TableSizes {
+    pub bodies: u32,
+    pub mirror_planes: u32,
+    pub wall_sensors: u32,
+}
+
+impl TableSizes {
+    /// The sizes of `sc`'s tables.
+    pub fn of(sc: &crate::scenario::Scenario) -> TableSizes {
+        let at_least_one = |n: usize| n.max(1) as u32;
+        TableSizes {
+            bodies: at_least_one(sc.bodies.len()),
+            mirror_planes: at_least_one(sc.walls.mirror_planes.len()),
+            wall_sensors: at_least_one(sc.walls.sensors.len()),
+        }
+    }
+
+    /// Byte offset of the mirror planes (the bodies' motions start at 0).
+    pub fn mirror_planes_offset(&self) -> usize {
+        self.bodies as usize * std::mem::size_of::<BodyMotion>()
+    }
+
+    pub fn wall_sensors_offset(&self) -> usize {
+        self.mirror_planes_offset()
+            + self.mirror_planes as usize * std::mem::size_of::<MirrorPlane>()
+    }
+
+    pub fn body_particles_offset(&self) -> usize {
+        self.wall_sensors_offset() + self.wall_sensors as usize * std::mem::size_of::<WallSensor>()
+    }
+
+    /// The tables' bytes; an empty table takes its stand-in (zeros; a sensor of radius 0).
+    pub fn pack(
+        &self,
+        motions: &[BodyMotion],
+        planes: &[MirrorPlane],
+        sensors: &[WallSensor],
+        body_particles: &[BodyParticle],
+    ) -> Vec<u8> {
+        assert!(
+            motions.len() <= self.bodies as usize
+                && planes.len() <= self.mirror_planes as usize
+                && sensors.len() <= self.wall_sensors as usize,
+            "tables larger than their sizes"
+        );
+        let sensors: &[WallSensor] = if sensors.is_empty() {
+            &[NO_SENSOR]
+        } else {
+            sensors
+        };
+        let n_body = body_particles.len().max(1);
+        let mut out =
+            vec![0u8; self.body_particles_offset() + n_body * std::mem::size_of::<BodyParticle>()];
+        let mut put = |offset: usize, bytes: &[u8]| {
+            out[offset..offset + bytes.len()].copy_from_slice(bytes);
+        };
+        put(0, bytemuck::cast_slice(motions));
+        put(self.mirror_planes_offset(), bytemuck::cast_slice(planes));
+        put(self.wall_sensors_offset(), bytemuck::cast_slice(sensors));
+        put(
+            self.body_particles_offset(),
+            bytemuck::cast_slice(body_particles),
+        );
+        out
+    }
+}
 
 /// Stand-in for a run without wall sensors: a patch of radius 0 holds no particle.
 const NO_SENSOR: WallSensor = WallSensor {
@@ -103,6 +170,7 @@ impl ParticleBuffers {
         slots: u32,
         init: &InitialParticles,
         tables: &CaseTables,
+        sizes: TableSizes,
         energy: bool,
     ) -> Self {
         let CaseTables {
@@ -173,41 +241,10 @@ impl ParticleBuffers {
             } else {
                 storage_init(device, "solid", init.solid)
             },
-            body_particles: if init.body_particles.is_empty() {
-                storage(
-                    device,
-                    "body particles",
-                    std::mem::size_of::<BodyParticle>() as u64,
-                )
-            } else {
-                storage_init(device, "body particles", init.body_particles)
-            },
-            body_motions: if init.body_motions.is_empty() {
-                storage(
-                    device,
-                    "body motions",
-                    std::mem::size_of::<BodyMotion>() as u64,
-                )
-            } else {
-                storage_init(device, "body motions", init.body_motions)
-            },
-            mirror_planes: if planes.is_empty() {
-                storage(
-                    device,
-                    "mirror planes",
-                    std::mem::size_of::<MirrorPlane>() as u64,
-                )
-            } else {
-                storage_init(device, "mirror planes", planes)
-            },
-            wall_sensors: storage_init(
+            tables: storage_init(
                 device,
-                "wall sensors",
-                if sensors.is_empty() {
-                    &[NO_SENSOR]
-                } else {
-                    sensors
-                },
+                "case tables",
+                &sizes.pack(init.body_motions, planes, sensors, init.body_particles),
             ),
         }
     }
@@ -248,11 +285,8 @@ impl ParticleBuffers {
             "rate_out" | "rate_old" => Some(&self.rate_sorted),
             "probes" => Some(&self.probes),
             "probe_out" => Some(&self.probe_out),
-            "mirror_planes" => Some(&self.mirror_planes),
-            "wall_sensors" => Some(&self.wall_sensors),
+            "tables" => Some(&self.tables),
             "energy_rate" => Some(&self.energy_rate),
-            "body_particles" => Some(&self.body_particles),
-            "bodies" => Some(&self.body_motions),
             "solid" => Some(&self.solid),
             _ => None,
         };
@@ -289,11 +323,8 @@ impl ParticleBuffers {
             &self.cell_start,
             &self.probes,
             &self.probe_out,
-            &self.mirror_planes,
-            &self.wall_sensors,
+            &self.tables,
             &self.energy_rate,
-            &self.body_particles,
-            &self.body_motions,
             &self.solid,
         ];
         all.extend(self.energy.iter());

@@ -42,6 +42,7 @@ pub struct CellList {
     scatter: Kernel,
     rank_in_cell: Kernel,
     reorder: ParityKernel,
+    reorder_motion: ParityKernel,
     reorder_energy: Option<ParityKernel>,
     scan_blocks: Kernel,
     scan_add: Kernel,
@@ -89,6 +90,7 @@ impl CellList {
             scatter,
             rank_in_cell,
             reorder: parity("reorder")?,
+            reorder_motion: parity("reorder_motion")?,
             reorder_energy,
             scan_blocks,
             scan_add,
@@ -127,6 +129,7 @@ impl CellList {
     /// The particle arrays of parity `p` copied into the other parity in sorted order.
     pub fn encode_reorder(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.reorder.dispatch(pass, p, self.n);
+        self.reorder_motion.dispatch(pass, p, self.n);
         if let Some(k) = &self.reorder_energy {
             k.dispatch(pass, p, self.n);
         }

@@ -120,7 +120,7 @@ impl Solver {
         let grid = Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic)?;
         let params = Params::from_scenario(sc, &grid)?;
         let cfg = ShaderConfig::of(sc)?;
-        check_wall_pressure_probes(sc)?;
+        probes::check_wall_pressure(sc)?;
         let device = ctx.device.clone();
         // Allocation failures are caught here to name what was being allocated; later ones
         // reach `faults`.
@@ -147,6 +147,7 @@ impl Solver {
                 mirror_planes: &params::mirror_planes(sc, grid.origin),
                 wall_sensors: &params::wall_sensors(sc, grid.origin),
             },
+            cfg.tables,
             ph.energy,
         );
         let passes = Passes::new(&device, sc, cfg, &grid, &buffers, &defs, body_motions)?;
@@ -589,22 +590,6 @@ impl Solver {
             _ => [[0.0; 3]; 2],
         }
     }
-}
-
-/// A wall-pressure probe needs the walls' reactions and a resolved patch.
-fn check_wall_pressure_probes(sc: &Scenario) -> Result<()> {
-    for p in &sc.probes {
-        if let crate::scenario::ProbeKind::WallPressure(patch) = &p.kind {
-            if !sc.walls.reactions || patch.area.is_nan() || patch.area <= 0.0 {
-                bail!(
-                    "wall-pressure probe {:?} needs walls.reactions and a patch resolved \
-                     by WallPatch::resolve",
-                    p.name
-                );
-            }
-        }
-    }
-    Ok(())
 }
 
 /// Kind word of an excluded particle, for callers filtering outputs.

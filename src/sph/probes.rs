@@ -39,6 +39,22 @@ pub fn probe_faces(probes: &[Probe], walls: &WallParams) -> Vec<u32> {
         .collect()
 }
 
+/// A wall-pressure probe needs the walls' reactions and a resolved patch.
+pub fn check_wall_pressure(sc: &crate::scenario::Scenario) -> Result<()> {
+    for p in &sc.probes {
+        if let ProbeKind::WallPressure(patch) = &p.kind {
+            if !sc.walls.reactions || patch.area.is_nan() || patch.area <= 0.0 {
+                anyhow::bail!(
+                    "wall-pressure probe {:?} needs walls.reactions and a patch resolved \
+                     by WallPatch::resolve",
+                    p.name
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
 /// GPU definitions of the probes, in domain coordinates (from the domain's min corner);
 /// `faces` from [`probe_faces`].
 pub fn probe_defs(probes: &[Probe], origin: [f64; 3], faces: &[u32]) -> Vec<ProbeDef> {

@@ -9,11 +9,6 @@ use crate::gpu::buffers::read;
 use crate::layout::{unpack_block, SolidState, ID_MASK, KIND_SHIFT};
 use crate::scenario::Kind;
 
-/// Whether the kind word `kind` is an elastic solid's (free or clamped).
-fn is_solid_kind(kind: u32) -> bool {
-    kind == Kind::Solid as u32 || kind == Kind::SolidClamped as u32
-}
-
 impl Solver {
     /// Raw arrays of the current parity, in GPU (cell) order.
     pub fn read_raw(&self) -> Result<RawParticles> {
@@ -102,7 +97,7 @@ impl Solver {
             out.rho.push(v[3]);
             let kind = code[i] >> KIND_SHIFT;
             let id = code[i] & ID_MASK;
-            let solid_kind = is_solid_kind(kind);
+            let solid_kind = Kind::code_is_solid(kind);
             // τ and material of the particle (zeros for the others), when the case has solids.
             let state = solid.as_ref().map(|s| {
                 if !solid_kind {

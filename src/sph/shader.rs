@@ -8,6 +8,7 @@
 
 use anyhow::Result;
 
+use super::buffers::TableSizes;
 use super::initial::Present;
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::shader::{compose as compose_shader, Shader, WORKGROUP_SIZE};
@@ -121,6 +122,8 @@ pub struct ShaderConfig {
     pub wall_reactions: bool,
     /// Which particles and walls the case has: a pass compiles out the pair terms of the others.
     pub present: Present,
+    /// The sizes of the case's tables (`CaseTables` in common.wgsl).
+    pub tables: TableSizes,
 }
 
 impl Default for ShaderConfig {
@@ -133,6 +136,11 @@ impl Default for ShaderConfig {
             hydrostatic_diffusion: false,
             wall_reactions: false,
             present: Present::ALL,
+            tables: TableSizes {
+                bodies: 1,
+                mirror_planes: 1,
+                wall_sensors: 1,
+            },
         }
     }
 }
@@ -153,6 +161,7 @@ impl ShaderConfig {
                 && ph.delta_sph_form == DeltaSphForm::Fourtakas,
             wall_reactions: sc.walls.reactions,
             present: Present::of(sc)?,
+            tables: TableSizes::of(sc),
         })
     }
 
@@ -171,7 +180,9 @@ impl ShaderConfig {
              const SOLIDS: bool = {solids};\nconst FIXED_GHOSTS: bool = {ghosts};\n\
              const REPULSIVE: bool = {repulsive};\nconst BODIES: bool = {bodies};\n\
              const MIRRORS: bool = {mirrors};\nconst LONE_SOLID: bool = {lone_solid};\n\
-             const WG: u32 = {wg}u;\n",
+             const WG: u32 = {wg}u;\n\
+             const N_BODIES: u32 = {bodies_n}u;\nconst N_MIRROR_PLANES: u32 = {planes_n}u;\n\
+             const N_WALL_SENSORS: u32 = {sensors_n}u;\n",
             dim = self.dim,
             kernel = self.kernel.name(),
             visc = self.viscosity.name(),
@@ -185,6 +196,9 @@ impl ShaderConfig {
             mirrors = p.mirrors,
             lone_solid = p.lone_solid,
             wg = WORKGROUP_SIZE,
+            bodies_n = self.tables.bodies,
+            planes_n = self.tables.mirror_planes,
+            sensors_n = self.tables.wall_sensors,
         );
         out
     }

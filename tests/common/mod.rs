@@ -264,7 +264,8 @@ pub fn rows(o: &wgsph::validation::CaseOutcome) -> String {
 /// matrix's conditioning is within 10 % of the threshold. Such ghosts are left out of
 /// comparisons with the reference.
 pub fn mls_borderline(sc: &Scenario, parts: &[RefParticle], x: [f64; 3]) -> bool {
-    use wgsph::reference::ghost::{min_pivot_ratio, moment_matrix, MLS_MIN_PIVOT};
+    use wgsph::reference::ghost::moment_matrix;
+    use wgsph::reference::mls::{min_pivot_ratio, MLS_MIN_PIVOT};
     let a = moment_matrix(&sc.physics, &wgsph::reference::Space::of(sc), parts, x);
     sc.walls.ghost_correction == GhostCorrection::Mls
         && (min_pivot_ratio(sc.physics.dim as usize, a) / MLS_MIN_PIVOT - 1.0).abs() < 0.1
