@@ -414,7 +414,7 @@ fn mirror_rates(i: u32, pi: Particle) -> PairRates {
 // body's particle of any wall treatment, a fixed wall's with WALL_REACTIONS): a dynamic wall's
 // dρ/dt from the fluid (eq. 22), the reaction to the fluid's force (for bodies.wgsl's load and
 // the wall sensors) and a body particle's contact with walls, other bodies and solids (eq. 24).
-fn boundary_rates(i: u32, kind_i: u32, reacts: bool, on_body: bool) -> vec4<f32> {
+fn boundary_rates(i: u32, kind_i: u32, reacts: bool, on_body: bool, ranges: ptr<function, array<vec2<u32>, 27>>, n_ranges: u32) -> vec4<f32> {
     let id_i = code[i] & ID_MASK;
     var body_i = NO_BODY;
     var kinematic_i = false;
@@ -444,10 +444,8 @@ fn boundary_rates(i: u32, kind_i: u32, reacts: bool, on_body: bool) -> vec4<f32>
         v_contact_i = contact_velocity(i);
     }
     var r = vec4<f32>(0.0);
-    var ranges: array<vec2<u32>, 27>;
-    let n_ranges = neighbour_ranges(cell_of(p_i), &ranges);
     for (var s = 0u; s < n_ranges; s++) {
-        for (var j = ranges[s].x; j < ranges[s].y; j++) {
+        for (var j = (*ranges)[s].x; j < (*ranges)[s].y; j++) {
             let x_ij = rel_pos(p_i, pos[j]);
             let r2 = dot(x_ij, x_ij);
             if (r2 >= support2 || j == i) {
@@ -490,17 +488,15 @@ fn boundary_rates(i: u32, kind_i: u32, reacts: bool, on_body: bool) -> vec4<f32>
 // The rates of fluid particle i: continuity and momentum from every pressure-carrying neighbour
 // (`pair_rates`), repulsive walls (eq. 23), elastic solids (eq. 28) and mirror images (eq. 12),
 // gravity, and with ENERGY de/dt (written here).
-fn fluid_rates(i: u32) -> vec4<f32> {
+fn fluid_rates(i: u32, ranges: ptr<function, array<vec2<u32>, 27>>, n_ranges: u32) -> vec4<f32> {
     let p_i = pos[i];
     let vr_i = velrho[i];
     let pi = Particle(vr_i.xyz, vr_i.w, pressure_of(vr_i.w) / (vr_i.w * vr_i.w));
     let support2 = 4.0 * params.h * params.h;
     var r = vec4<f32>(0.0);
     var de = 0.0;
-    var ranges: array<vec2<u32>, 27>;
-    let n_ranges = neighbour_ranges(cell_of(p_i), &ranges);
     for (var s = 0u; s < n_ranges; s++) {
-        for (var j = ranges[s].x; j < ranges[s].y; j++) {
+        for (var j = (*ranges)[s].x; j < (*ranges)[s].y; j++) {
             let x_ij = rel_pos(p_i, pos[j]);
             let r2 = dot(x_ij, x_ij);
             if (r2 >= support2 || j == i) {
@@ -575,8 +571,11 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         rate[i] = vec4<f32>(loads, 0.0);
         return;
     }
+    // One neighbour list, for fluid and boundary particles alike.
+    var ranges: array<vec2<u32>, 27>;
     if (kind_i == KIND_FLUID) {
-        rate[i] = fluid_rates(i);
+        let n_ranges = neighbour_ranges(cell_of(pos[i]), &ranges);
+        rate[i] = fluid_rates(i, &ranges, n_ranges);
         return;
     }
     let on_body = kind_i != KIND_EXCLUDED && is_body_particle(code[i] & ID_MASK);
@@ -586,5 +585,6 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         rate[i] = vec4<f32>(0.0);
         return;
     }
-    rate[i] = boundary_rates(i, kind_i, reacts, on_body);
+    let n_ranges = neighbour_ranges(cell_of(pos[i]), &ranges);
+    rate[i] = boundary_rates(i, kind_i, reacts, on_body, &ranges, n_ranges);
 }
