@@ -4,6 +4,7 @@
 
 use naga::back::{glsl, hlsl, msl, spv};
 use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
+use wgsph::gpu::shader::Shader;
 use wgsph::sph::passes::SHADERS;
 use wgsph::sph::shader::{compose, ShaderConfig};
 
@@ -15,6 +16,29 @@ fn cases() -> Vec<std::path::PathBuf> {
         .collect();
     files.sort();
     files
+}
+
+/// The distinct shader configurations of the shipped cases, after the all-kinds one, each with
+/// the first case that uses it.
+fn variants() -> Vec<(String, ShaderConfig)> {
+    let mut configs = vec![("all kinds".to_string(), ShaderConfig::default())];
+    for file in cases() {
+        let sc = wgsph::case::load(&file, &[]).unwrap();
+        let cfg = ShaderConfig::of(&sc).unwrap();
+        if !configs.iter().any(|(_, c)| *c == cfg) {
+            configs.push((file.display().to_string(), cfg));
+        }
+    }
+    configs
+}
+
+/// `shader` composed for `cfg`, parsed and validated.
+fn validated(shader: &Shader, cfg: ShaderConfig) -> (naga::Module, ModuleInfo) {
+    let module = naga::front::wgsl::parse_str(&compose(shader, cfg)).unwrap();
+    let info = Validator::new(ValidationFlags::all(), Capabilities::empty())
+        .validate(&module)
+        .unwrap();
+    (module, info)
 }
 
 /// Every backend's translation of `module`, or the first error with the backend's name.
@@ -61,23 +85,12 @@ fn translate(module: &naga::Module, info: &ModuleInfo) -> Result<(), String> {
 
 #[test]
 fn every_shipped_variant_translates_to_every_backend() {
-    let mut configs = vec![("all kinds".to_string(), ShaderConfig::default())];
-    for file in cases() {
-        let sc = wgsph::case::load(&file, &[]).unwrap();
-        let cfg = ShaderConfig::of(&sc).unwrap();
-        if !configs.iter().any(|(_, c)| *c == cfg) {
-            configs.push((file.display().to_string(), cfg));
-        }
-    }
+    let configs = variants();
     assert!(configs.len() > 5, "{} variants", configs.len());
     let mut failures = Vec::new();
     for (what, cfg) in &configs {
         for shader in SHADERS {
-            let source = compose(shader, *cfg);
-            let module = naga::front::wgsl::parse_str(&source).unwrap();
-            let info = Validator::new(ValidationFlags::all(), Capabilities::empty())
-                .validate(&module)
-                .unwrap();
+            let (module, info) = validated(shader, *cfg);
             if let Err(e) = translate(&module, &info) {
                 failures.push(format!("{}.wgsl for {what}: {e}", shader.name));
             }
@@ -94,21 +107,11 @@ const WEBGPU_STORAGE_BUFFERS: usize = 8;
 /// supports, browsers included.
 #[test]
 fn every_entry_point_binds_at_most_8_storage_buffers() {
-    let mut configs = vec![("all kinds".to_string(), ShaderConfig::default())];
-    for file in cases() {
-        let sc = wgsph::case::load(&file, &[]).unwrap();
-        let cfg = ShaderConfig::of(&sc).unwrap();
-        if !configs.iter().any(|(_, c)| *c == cfg) {
-            configs.push((file.display().to_string(), cfg));
-        }
-    }
+    let configs = variants();
     let mut over = Vec::new();
     for (what, cfg) in &configs {
         for shader in SHADERS {
-            let module = naga::front::wgsl::parse_str(&compose(shader, *cfg)).unwrap();
-            let info = Validator::new(ValidationFlags::all(), Capabilities::empty())
-                .validate(&module)
-                .unwrap();
+            let (module, info) = validated(shader, *cfg);
             for (k, entry) in module.entry_points.iter().enumerate() {
                 let uses = info.get_entry_point(k);
                 let storage: Vec<&str> = (module.global_variables.iter())

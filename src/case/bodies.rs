@@ -9,7 +9,9 @@ use std::sync::Arc;
 
 use crate::scenario::{Motion, MotionLaw, Prescribed};
 
-use super::check::{aabb, number, read_bounded, treatment, vector, Aabb, Bound, Treatment};
+use super::check::{
+    aabb, initial_velocity, number, read_bounded, treatment, vector, Aabb, Bound, Treatment,
+};
 use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::mesh::Mesh;
@@ -450,16 +452,7 @@ fn check_motion_fields(
 
 /// A free motion: the initial velocity and angular velocity, or a release time.
 fn free_motion(ctx: &Ctx<'_>, path: &str, m: &RawMotion, dim: usize) -> Result<Motion, CaseError> {
-    let velocity = match &m.velocity_m_s {
-        Some(v) => vector(
-            ctx,
-            &format!("{path}.velocity_m_s"),
-            v,
-            dim,
-            "the initial velocity in m/s",
-        )?,
-        None => [0.0; 3],
-    };
+    let velocity = initial_velocity(ctx, path, &m.velocity_m_s, dim)?;
     let omega = match &m.angular_velocity_rad_s {
         None => [0.0; 3],
         // One component (the length is right): `vector` only checks that it is finite,

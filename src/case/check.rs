@@ -67,6 +67,25 @@ pub(super) fn number(
     }
 }
 
+/// `path.velocity_m_s`, an optional initial velocity (zero when absent).
+pub(super) fn initial_velocity(
+    ctx: &Ctx<'_>,
+    path: &str,
+    v: &Option<Vec<f64>>,
+    dim: usize,
+) -> Result<[f64; 3], CaseError> {
+    match v {
+        Some(v) => vector(
+            ctx,
+            &format!("{path}.velocity_m_s"),
+            v,
+            dim,
+            "the initial velocity in m/s",
+        ),
+        None => Ok([0.0; 3]),
+    }
+}
+
 /// A `dim`-component vector of finite numbers, padded to 3 components.
 pub(super) fn vector(
     ctx: &Ctx<'_>,

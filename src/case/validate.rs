@@ -7,7 +7,7 @@ use crate::scenario::{
     RepulsiveForm, TimeControl, Viscosity, DEFAULT_FRICTION_SLIP,
 };
 
-use super::check::{aabb, number, treatment, vector, Aabb, Bound, Treatment};
+use super::check::{aabb, initial_velocity, number, treatment, vector, Aabb, Bound, Treatment};
 use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::probes::Checked;
@@ -581,16 +581,7 @@ fn blocks(ctx: &Ctx<'_>, raw: &RawCase, dim: usize) -> Result<Vec<Block>, CaseEr
     for (i, b) in raw.fluid_block.iter().enumerate() {
         let path = format!("fluid_block[{i}]");
         let bx = aabb(ctx, &path, &b.min_m, &b.max_m, dim, "the fluid block")?;
-        let vel = match &b.velocity_m_s {
-            Some(v) => vector(
-                ctx,
-                &format!("{path}.velocity_m_s"),
-                v,
-                dim,
-                "the initial velocity in m/s",
-            )?,
-            None => [0.0; 3],
-        };
+        let vel = initial_velocity(ctx, &path, &b.velocity_m_s, dim)?;
         blocks.push(Block { bx, vel });
     }
     Ok(blocks)

@@ -21,37 +21,24 @@ impl Solver {
     /// NaN so an entry the kernel skips cannot pass.
     pub fn rerun_interaction(&self, poison: bool) -> Result<Vec<[f32; 4]>> {
         if poison {
-            let nan = vec![f32::NAN; 4 * self.buffers.n as usize];
-            self.queue
-                .write_buffer(&self.buffers.rate, 0, bytemuck::cast_slice(&nan));
+            self.fill_nan(&self.buffers.rate, 4 * self.buffers.n as usize);
             if let Some(e) = &self.passes.elastic {
-                let nan = vec![f32::NAN; 8 * self.n_solid as usize];
-                self.queue
-                    .write_buffer(&e.stress_rate, 0, bytemuck::cast_slice(&nan));
+                self.fill_nan(&e.stress_rate, 8 * self.n_solid as usize);
             }
         }
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("interaction"),
-            });
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("interaction"),
-            timestamp_writes: None,
+        self.submit_pass("interaction", |pass| {
+            self.passes.ghost.encode(pass, self.parity);
+            if let Some(o) = &self.passes.open_boundaries {
+                o.encode_pressure(pass, self.parity);
+            }
+            self.passes.interaction.encode(pass, self.parity);
+            if let Some(e) = &self.passes.elastic {
+                e.encode_rates(pass, self.parity);
+            }
+            if let Some(t) = &self.passes.total_lagrangian {
+                t.encode_rates(pass, self.parity);
+            }
         });
-        self.passes.ghost.encode(&mut pass, self.parity);
-        if let Some(o) = &self.passes.open_boundaries {
-            o.encode_pressure(&mut pass, self.parity);
-        }
-        self.passes.interaction.encode(&mut pass, self.parity);
-        if let Some(e) = &self.passes.elastic {
-            e.encode_rates(&mut pass, self.parity);
-        }
-        if let Some(t) = &self.passes.total_lagrangian {
-            t.encode_rates(&mut pass, self.parity);
-        }
-        drop(pass);
-        self.queue.submit([encoder.finish()]);
         self.read_rates()
     }
 
@@ -74,19 +61,10 @@ impl Solver {
         let Some(gpu) = &self.passes.bodies else {
             bail!("the case has no bodies");
         };
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("body loads"),
-            });
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("body loads"),
-            timestamp_writes: None,
+        self.submit_pass("body loads", |pass| {
+            self.passes.interaction.encode(pass, self.parity);
+            gpu.encode_force(pass, self.parity);
         });
-        self.passes.interaction.encode(&mut pass, self.parity);
-        gpu.encode_force(&mut pass, self.parity);
-        drop(pass);
-        self.queue.submit([encoder.finish()]);
         let partials: Vec<[f32; 4]> = read(
             &self.device,
             &self.queue,
@@ -104,22 +82,11 @@ impl Solver {
             bail!("the case has no density filter");
         };
         if poison {
-            let nan = vec![f32::NAN; 4 * self.buffers.n as usize];
-            self.queue
-                .write_buffer(&self.buffers.rate_sorted, 0, bytemuck::cast_slice(&nan));
+            self.fill_nan(&self.buffers.rate_sorted, 4 * self.buffers.n as usize);
         }
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("density filter"),
-            });
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("density filter"),
-            timestamp_writes: None,
+        self.submit_pass("density filter", |pass| {
+            f.encode_now(pass, self.parity);
         });
-        f.encode_now(&mut pass, self.parity);
-        drop(pass);
-        self.queue.submit([encoder.finish()]);
         Ok(())
     }
 
@@ -143,5 +110,27 @@ impl Solver {
             &self.buffers.energy_rate,
             self.buffers.n as usize,
         )
+    }
+
+    /// Writes NaN into the first `floats` f32 of `buffer`, so that an entry a kernel skips
+    /// cannot pass a comparison.
+    fn fill_nan(&self, buffer: &wgpu::Buffer, floats: usize) {
+        let nan = vec![f32::NAN; floats];
+        self.queue
+            .write_buffer(buffer, 0, bytemuck::cast_slice(&nan));
+    }
+
+    /// Records one compute pass with `record` and submits it.
+    fn submit_pass(&self, label: &str, record: impl FnOnce(&mut wgpu::ComputePass<'_>)) {
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        record(
+            &mut encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(label),
+                timestamp_writes: None,
+            }),
+        );
+        self.queue.submit([encoder.finish()]);
     }
 }

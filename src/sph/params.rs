@@ -5,7 +5,7 @@ use anyhow::{bail, Result};
 use bytemuck::Zeroable;
 
 use super::initial::{body_id_base, solid_range};
-use super::shader::{ghost_correction_code, repulsive_form_code};
+use super::shader::WgslEnum;
 use crate::grid::Grid;
 use crate::kernel::{kernel_norm, w};
 use crate::layout::{MirrorPlane, Params, SolidMaterial, WallSensor, MAX_SOLID_MATERIALS};
@@ -51,10 +51,10 @@ impl Params {
             cfl: sc.time.cfl as f32,
             n_probes: sc.probes.len() as u32,
             n_mirror_planes: sc.walls.mirror_planes.len() as u32,
-            ghost_mls: ghost_correction_code(sc.walls.ghost_correction),
+            ghost_mls: sc.walls.ghost_correction.code(),
             repulsive_d: sc.walls.repulsive_d as f32,
             repulsive_r0: sc.walls.repulsive_r0 as f32,
-            repulsive_form: repulsive_form_code(sc.walls.repulsive_form),
+            repulsive_form: sc.walls.repulsive_form.code(),
             repulsive_k_over_beta: (sc.walls.repulsive_k / sc.walls.repulsive_beta) as f32,
             friction: sc.walls.friction as f32,
             friction_slip: sc.walls.friction_slip as f32,

@@ -38,8 +38,9 @@ pub enum ViscosityForm {
     Laminar,
 }
 
-/// A Rust enum's variants as WGSL constants: `(prefix)_(VARIANT)` = its index.
-trait WgslEnum: Copy + PartialEq + 'static {
+/// A Rust enum's variants as WGSL constants: `(prefix)_(VARIANT)` = its index; `code` is the
+/// value a run-time choice takes in `Params` (the same number as its WGSL constant).
+pub trait WgslEnum: Copy + PartialEq + 'static {
     const PREFIX: &'static str;
     const VARIANTS: &'static [(Self, &'static str)];
 
@@ -95,16 +96,6 @@ impl WgslEnum for GhostCorrection {
         (GhostCorrection::Shepard, "SHEPARD"),
         (GhostCorrection::Mls, "MLS"),
     ];
-}
-
-/// The code of a run-time method choice in `Params` (the same numbers the WGSL constants have).
-pub fn repulsive_form_code(f: RepulsiveForm) -> u32 {
-    f.code()
-}
-
-/// The code of `Params::ghost_mls`.
-pub fn ghost_correction_code(c: GhostCorrection) -> u32 {
-    c.code()
 }
 
 /// Compile-time choices of a run, emitted as WGSL constants.
@@ -227,14 +218,14 @@ mod tests {
             (RepulsiveForm::LennardJones, "REPULSIVE_LENNARD_JONES"),
             (RepulsiveForm::MonaghanKajtar, "REPULSIVE_MONAGHAN_KAJTAR"),
         ] {
-            let decl = format!("const {name}: u32 = {}u;", repulsive_form_code(form));
+            let decl = format!("const {name}: u32 = {}u;", form.code());
             assert!(src.contains(&decl), "{decl}");
         }
         for (c, name) in [
             (GhostCorrection::Shepard, "GHOST_SHEPARD"),
             (GhostCorrection::Mls, "GHOST_MLS"),
         ] {
-            let decl = format!("const {name}: u32 = {}u;", ghost_correction_code(c));
+            let decl = format!("const {name}: u32 = {}u;", c.code());
             assert!(src.contains(&decl), "{decl}");
         }
         assert!(src.contains("const KERNEL: u32 = KERNEL_WENDLAND_C2;"));
