@@ -154,7 +154,7 @@ impl TlSetup {
                 format!(
                     "the quadratic least-squares fit of the total-Lagrangian solid is singular at \
                      the particle at {:?} ({} neighbours): the solid must be at least about three \
-                     particles thick everywhere",
+                     particles thick everywhere (or use formulation = \"updated_lagrangian\")",
                     x0[i],
                     list.len()
                 )

@@ -75,6 +75,11 @@ pub static BUILT_IN: &[BuiltIn] = &[
         text: include_str!("../../cases/oscillating_plate_tl_2d.toml"),
     },
     BuiltIn {
+        name: "oscillating_plate_thin_2d",
+        file: "cases/oscillating_plate_thin_2d.toml",
+        text: include_str!("../../cases/oscillating_plate_thin_2d.toml"),
+    },
+    BuiltIn {
         name: "elastic_gate_2d",
         file: "cases/elastic_gate_2d.toml",
         text: include_str!("../../cases/elastic_gate_2d.toml"),

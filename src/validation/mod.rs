@@ -258,6 +258,14 @@ pub static CASES: &[Case] = &[
         evaluate: plate::evaluate_tl,
     },
     Case {
+        name: "oscillating_plate_thin_2d",
+        file: "cases/oscillating_plate_thin_2d.toml",
+        reference: "analytic: Euler–Bernoulli first-mode period",
+        citation: "",
+        overrides: plate::overrides_thin,
+        evaluate: plate::evaluate_tl,
+    },
+    Case {
         name: "elastic_gate_2d",
         file: "cases/elastic_gate_2d.toml",
         reference: gate::X_DISPLACEMENT.file,

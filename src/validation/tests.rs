@@ -235,6 +235,7 @@ fn cases_are_selected_by_mode_and_name() {
             "sloshing_2d",
             "oscillating_plate_2d",
             "oscillating_plate_tl_2d",
+            "oscillating_plate_thin_2d",
             "elastic_gate_2d"
         ]
     );

@@ -409,8 +409,8 @@ fn a_pair_with_its_own_friction_coefficient_slides_by_it() {
     assert!(error.abs() < 0.03, "pair μ = 0.2: {error:+.3}");
 }
 
-/// An elastic block (0.2 × 0.06 m, ρ = 1000, E = 0.25 MPa) on the slope (measured: +0.01 %,
-/// −0.9 %, held at 7e-3 m/s² and 1.7 mm/s).
+/// An elastic block (0.2 × 0.06 m, ρ = 1000, E = 0.25 MPa; total Lagrangian, the default) on
+/// the slope (measured: +0.01 %, −0.9 %, held at 4.9e-3 m/s² and 1.8 mm/s).
 #[test]
 fn an_elastic_block_slides_down_a_slope_as_coulomb_friction_says() {
     let body = r#"[[solid]]

@@ -6,8 +6,8 @@ use crate::common::*;
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
 use wgsph::validation::plate::{
-    theory_period, zero_crossings, Oscillation, AMPLITUDE_BOUND, H, HALF_PERIOD_BOUND, L,
-    PERIOD_BOUND,
+    zero_crossings, Cantilever, Oscillation, AMPLITUDE_BOUND, HALF_PERIOD_BOUND, PERIOD_BOUND,
+    SHIPPED,
 };
 
 use std::path::Path;
@@ -18,6 +18,8 @@ const UL: &str = "cases/oscillating_plate_2d.toml";
 const TL: &str = "cases/oscillating_plate_tl_2d.toml";
 /// A 3D beam of the plate's length and thickness, square cross-section, total-Lagrangian.
 const BEAM_3D: &str = "cases/oscillating_beam_tl_3d.toml";
+/// A plate half as thick (L/H = 20), of the default formulation (total Lagrangian).
+const THIN: &str = "cases/oscillating_plate_thin_2d.toml";
 
 /// The plate case `file` with `--set` overrides.
 fn plate(file: &str, set: &[&str]) -> Scenario {
@@ -38,10 +40,16 @@ fn tip_of(sc: &Scenario, mid: f64) -> usize {
         .0
 }
 
+/// Euler–Bernoulli's first-mode period of the plate of `sc` [s].
+fn theory_period(sc: &Scenario) -> f64 {
+    let m = &sc.solids.as_ref().unwrap().materials[0];
+    Cantilever::of(sc).unwrap().period(m, sc.physics.dim)
+}
+
 /// Runs the plate to `end` and returns the tip's (t, y-displacement) every `every` seconds;
 /// the tip is the free-end particle nearest the mid-plane.
 fn tip_history(sc: &Scenario, end: f64, every: f64) -> Vec<(f64, f64)> {
-    let tip = tip_of(sc, 0.5 * H);
+    let tip = tip_of(sc, 0.5 * Cantilever::of(sc).unwrap().thickness);
     histories(sc, &[tip], end, every).remove(0)
 }
 
@@ -74,7 +82,7 @@ impl PlateRun {
 
     fn of(file: &str, set: &[&str]) -> Self {
         let sc = plate(file, set);
-        let t_theory = theory_period(&sc.solids.as_ref().unwrap().materials[0], sc.physics.dim);
+        let t_theory = theory_period(&sc);
         let history = tip_history(&sc, 1.65 * t_theory, t_theory / 200.0);
         Self(Oscillation::new(t_theory, history).unwrap())
     }
@@ -177,6 +185,57 @@ fn tl_plate_of(file: &str, label: &str, overrides: &[&str]) {
     run.assert_steady(AMPLITUDE_BOUND);
 }
 
+/// The tip's first zero crossing of the plate `file` (with `set`), run to 0.6 of its theory
+/// period, against T/2: (crossing, error relative to T/2).
+fn first_crossing(file: &str, set: &[&str]) -> (f64, f64) {
+    let sc = plate(file, set);
+    let t_theory = theory_period(&sc);
+    let history = tip_history(&sc, 0.6 * t_theory, t_theory / 200.0);
+    let first = *zero_crossings(&history)
+        .first()
+        .expect("the tip crossed its rest position");
+    (first, 2.0 * first / t_theory - 1.0)
+}
+
+/// The thin plate (cases/oscillating_plate_thin_2d.toml, L = 0.2 m, H = 0.01 m, H/dx = 5, T =
+/// 0.5081 s), of the default formulation, through half a period: the first zero crossing within
+/// 5 % of T/2 (measured: 0.2591 s, +2.0 %; the full cycle is the next test).
+#[test]
+fn thin_plate_half_period_within_5_percent() {
+    let (first, error) = first_crossing(THIN, &[]);
+    println!(
+        "thin plate: first crossing {first:.4} s, {:+.1} % of T/2",
+        100.0 * error
+    );
+    assert!(
+        error.abs() < PERIOD_BOUND,
+        "half-period error {:.1} %",
+        100.0 * error
+    );
+}
+
+/// The thin plate through a cycle and a half: period within 5 %, half periods within 3 % and
+/// the amplitude within 5 % (measured: +2.0 %, half periods 0.2589 / 0.2592 s, peaks 0.02313 / 0.02315 /
+/// 0.02311 m).
+#[test]
+#[ignore = "met but slow for CI: period +2.0 % at constant amplitude, 105 288 steps in 163 s on lavapipe; its first half period runs in CI"]
+fn thin_plate_period_within_5_percent() {
+    tl_plate_of(THIN, "thin plate, TL, H/dx = 5", &[]);
+}
+
+/// The thin plate with the seed's updated-Lagrangian solid (its default α = 0.1, ε = 0.3).
+#[test]
+#[ignore = "fails: period −18 % (crossings 0.154 / 0.418 / 0.570 s against T = 0.5081 s), the tip drifting off zero (peaks +12.4 / −25.8 mm); 225 s on lavapipe; docs/validation.md"]
+fn ul_thin_plate_period_within_5_percent() {
+    let run = PlateRun::of(THIN, &["solid[0].formulation=updated_lagrangian"]);
+    run.report("thin plate, UL, H/dx = 5");
+    assert!(
+        run.error().abs() < PERIOD_BOUND,
+        "period error {:.1} %",
+        100.0 * run.error()
+    );
+}
+
 /// The 3D beam (cases/oscillating_beam_tl_3d.toml, H/dx = 5, 1 625 particles) through half a
 /// period: the tip's first zero crossing, T/2, within 5 % of Euler–Bernoulli beam theory's
 /// (T = 0.2769 s). Half a period includes the start-up from the approximate mode shape; the
@@ -185,14 +244,9 @@ fn tl_plate_of(file: &str, label: &str, overrides: &[&str]) {
 #[test]
 #[ignore = "met but slow for CI: first crossing +3.7 %, about 7 min on lavapipe beside another test (1 625 particles, the TL passes cost 13 us per particle-step); the 2D TL plate's period runs in CI"]
 fn tl_beam_3d_half_period_within_5_percent() {
-    let sc = plate(BEAM_3D, &[]);
-    let t_theory = theory_period(&sc.solids.as_ref().unwrap().materials[0], 3);
-    let history = tip_history(&sc, 0.6 * t_theory, t_theory / 200.0);
-    let first = zero_crossings(&history)[0];
-    let error = 2.0 * first / t_theory - 1.0;
+    let (first, error) = first_crossing(BEAM_3D, &[]);
     println!(
-        "TL 3D beam: first crossing {first:.4} s, T/2 of theory {:.4} s, error {:+.1} %",
-        0.5 * t_theory,
+        "TL 3D beam: first crossing {first:.4} s, error {:+.1} %",
         100.0 * error
     );
     assert!(
@@ -250,8 +304,8 @@ direction = [0.0, 1.0]
 length_m = 0.06
 tip_velocity_m_s = {tip}
 "#,
-            y1 = y0 + H,
-            mid = y0 + 0.5 * H
+            y1 = y0 + SHIPPED.thickness,
+            mid = y0 + 0.5 * SHIPPED.thickness
         )
     };
     let case = r#"name = "two_plates_2d"
@@ -278,8 +332,9 @@ repulsive_d_m2_s2 = 1.0
     let (c_a, c_b) = (mats[0].sound_speed(), mats[1].sound_speed());
     assert!((c_b / c_a - 2.0).abs() < 1e-12, "{c_a} {c_b}");
     // Euler–Bernoulli for the free length, as a time scale.
-    let t_a = theory_period(&mats[0], 2) * (0.06f64 / L).powi(2);
-    let tips = [tip_of(&sc, 0.5 * H), tip_of(&sc, 0.06 + 0.5 * H)];
+    let t_a = SHIPPED.period(&mats[0], 2) * (0.06f64 / SHIPPED.length).powi(2);
+    let h = SHIPPED.thickness;
+    let tips = [tip_of(&sc, 0.5 * h), tip_of(&sc, 0.06 + 0.5 * h)];
     assert!(sc.particles[tips[1]].pos[1] > 0.06);
     let h = histories(&sc, &tips, 1.35 * t_a, t_a / 400.0);
     // Half periods after the start-up: A between its first two crossings, B over three.

@@ -39,6 +39,7 @@ max_m = [0.21, 0.12]
 density_kg_m3 = 1100.0
 youngs_modulus_pa = 1.0e6
 poisson_ratio = 0.3
+formulation = "updated_lagrangian"
 artificial_stress = 0.0
 clamped_min_m = [0.19, 0.0]
 clamped_max_m = [0.21, 0.02]
@@ -80,7 +81,7 @@ fn a_total_lagrangian_column_takes_the_water_pressure() {
 
 fn tl_case() -> String {
     CASE.replace(
-        "artificial_stress = 0.0",
+        "formulation = \"updated_lagrangian\"",
         "formulation = \"total_lagrangian\"",
     )
 }

@@ -187,7 +187,8 @@ fn solids_keep_their_own_materials() {
     );
 }
 
-/// A gate of solid particles (2 particles thick) clamped at its top in a tank of water.
+/// A gate of solid particles (2 particles thick: updated Lagrangian, too thin for the
+/// total-Lagrangian fit) clamped at its top in a tank of water.
 const GATE_IN_WATER: &str = r#"dimension = 2
 [particles]
 dx_m = 0.01
@@ -209,18 +210,25 @@ max_m = [0.22, 0.3]
 density_kg_m3 = 1100.0
 youngs_modulus_pa = 1.2e7
 poisson_ratio = 0.4
+formulation = "updated_lagrangian"
 clamped_min_m = [0.2, 0.25]
 clamped_max_m = [0.22, 0.3]
 "#;
 
-/// `formulation`: the default is the updated-Lagrangian solid; the total-Lagrangian plate reads
-/// without α and ε (also in 3D), its refusals (α or ε given) name the field, and it takes
-/// fluid like the updated-Lagrangian solid.
+/// `formulation`: the default is the total-Lagrangian solid (SOLID gives none); the
+/// updated-Lagrangian plate says so; the total-Lagrangian plate reads without α and ε (also in
+/// 3D), its refusals (α or ε given, with the formulation given or defaulted) name the field,
+/// and it takes fluid like the updated-Lagrangian solid.
 #[test]
 fn total_lagrangian_formulation_and_its_refusals() {
+    let default = load_str(SOLID, "cases/t.toml", &[]).unwrap();
+    let md = default.solids.unwrap().materials[0];
+    assert_eq!(md.formulation, SolidFormulation::TotalLagrangian);
+    assert_eq!((md.alpha, md.artificial_stress), (0.0, 0.0));
     let ul = load_str(PLATE, "cases/oscillating_plate_2d.toml", &[]).unwrap();
     let m = ul.solids.unwrap().materials[0];
     assert_eq!(m.formulation, SolidFormulation::UpdatedLagrangian);
+    assert_eq!((m.alpha, m.artificial_stress), (0.1, 0.3));
     let tl = load_str(PLATE_TL, "cases/oscillating_plate_tl_2d.toml", &[]).unwrap();
     let mt = tl.solids.unwrap().materials[0];
     assert_eq!(mt.formulation, SolidFormulation::TotalLagrangian);
@@ -251,6 +259,21 @@ fn total_lagrangian_formulation_and_its_refusals() {
         None,
         &["solid[0].artificial_stress", "remove artificial_stress"],
     );
+    // A stabiliser given without a formulation (a case written for the old default) names the
+    // default and the way back to the updated-Lagrangian solid.
+    assert_err(
+        &solid_with(
+            "poisson_ratio = 0.3975\n",
+            "poisson_ratio = 0.3975\nalpha = 0.1\n",
+        ),
+        &[],
+        None,
+        &[
+            "solid[0].alpha",
+            "\"total_lagrangian\", the default",
+            "formulation = \"updated_lagrangian\"",
+        ],
+    );
     let three_d = r#"dimension = 3
 [particles]
 dx_m = 0.01
@@ -275,10 +298,21 @@ formulation = "total_lagrangian"
     assert!(
         s3.has(SolidFormulation::TotalLagrangian) && !s3.has(SolidFormulation::UpdatedLagrangian)
     );
-    let fluid = GATE_IN_WATER.replace(
-        "poisson_ratio = 0.4\n",
-        "poisson_ratio = 0.4\nformulation = \"total_lagrangian\"\n",
+    // Two particles thick, the gate is too thin for the total-Lagrangian fit: refused when
+    // the case loads, naming the solid, the axis and the way out; three thick it builds.
+    let thin = GATE_IN_WATER.replace("\"updated_lagrangian\"", "\"total_lagrangian\"");
+    assert_err(
+        &thin,
+        &[],
+        None,
+        &[
+            "solid[0].max_m",
+            "2 particle(s) thick along x",
+            "at least 3",
+            "formulation = \"updated_lagrangian\"",
+        ],
     );
+    let fluid = thin.replace("0.22, 0.3]", "0.23, 0.3]");
     let sc = load_str(&fluid, "c.toml", &[]).unwrap();
     assert!(sc.count(Kind::Fluid) > 0 && sc.count(Kind::Solid) > 0);
     let solids = sc.solids.unwrap();
@@ -293,8 +327,12 @@ formulation = "total_lagrangian"
 /// lists index them so), whatever the order of the `[[solid]]` tables.
 #[test]
 fn solids_of_both_formulations_share_a_case() {
+    let ul = solid_with(
+        "poisson_ratio = 0.3975\n",
+        "poisson_ratio = 0.3975\nformulation = \"updated_lagrangian\"\n",
+    );
     let text = format!(
-        "{SOLID}\n[[solid]]\nname = \"b\"\nmin_m = [0.3, 0.0]\nmax_m = [0.4, 0.04]\n\
+        "{ul}\n[[solid]]\nname = \"b\"\nmin_m = [0.3, 0.0]\nmax_m = [0.4, 0.04]\n\
          density_kg_m3 = 1000.0\nyoungs_modulus_pa = 3.0e6\npoisson_ratio = 0.3975\n\
          formulation = \"total_lagrangian\"\n[walls]\nrepulsive_d_m2_s2 = 1.0\n"
     );
