@@ -51,7 +51,7 @@ fn body_move(
     }
     // Workgroup max, then one atomic per workgroup, as in integrate.wgsl's `correct` (which
     // runs later in the step, before the time step is chosen from the maximum).
-    let largest = workgroup_max(li, vec2<f32>(speed, 0.0));
+    let largest = workgroup_max(li, vec3<f32>(speed, 0.0, 0.0));
     if (li == 0u) {
         atomicMax(&state.max_speed_bits, bitcast<u32>(largest.x));
     }

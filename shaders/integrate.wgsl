@@ -89,6 +89,7 @@ fn correct(
     let i = linear_index(gid, nwg);
     var speed = 0.0;
     var accel = 0.0;
+    var density_variation = 0.0;
     if (i < params.n_particles) {
         let half_dt = 0.5 * state.dt;
         let kind = code_kind(code[i]);
@@ -104,6 +105,14 @@ fn correct(
             if (all_finite(v) && all_finite(r) && v.w > 0.0) {
                 speed = sound_speed_of(v.w) + length(v.xyz);
                 accel = length(r.xyz);
+                density_variation = abs(v.w / params.rho0 - 1.0);
+                // Counted one by one: rare while the flow is weakly compressible.
+                if (density_variation > params.density_warn) {
+                    atomicAdd(&state.beyond_warn, 1u);
+                    if (density_variation > params.density_stop) {
+                        atomicAdd(&state.beyond_stop, 1u);
+                    }
+                }
             } else {
                 atomicAdd(&state.nan_count, 1u);
                 exclude(i);
@@ -138,11 +147,12 @@ fn correct(
         }
     }
     // Workgroup max, then one atomic per workgroup.
-    let largest = workgroup_max(li, vec2<f32>(speed, accel));
+    let largest = workgroup_max(li, vec3<f32>(speed, accel, density_variation));
     if (li == 0u) {
         // Non-negative f32 order like their bit patterns.
         atomicMax(&state.max_speed_bits, bitcast<u32>(largest.x));
         atomicMax(&state.max_accel_bits, bitcast<u32>(largest.y));
+        atomicMax(&state.density_variation_bits, bitcast<u32>(largest.z));
     }
 }
 
@@ -169,6 +179,12 @@ fn timestep() {
     state.dt = select(min(dt, remaining), 0.0, remaining <= 1e-4 * dt);
     atomicStore(&state.max_speed_bits, 0u);
     atomicStore(&state.max_accel_bits, 0u);
+    // For the host's weakly-compressible check (src/sph/mod.rs): the largest of the steps since
+    // the host last cleared them.
+    let variation = bitcast<f32>(atomicExchange(&state.density_variation_bits, 0u));
+    state.density_variation_peak = max(state.density_variation_peak, variation);
+    state.beyond_warn_peak = max(state.beyond_warn_peak, atomicExchange(&state.beyond_warn, 0u));
+    state.beyond_stop_peak = max(state.beyond_stop_peak, atomicExchange(&state.beyond_stop, 0u));
     let excluded_slot = params.hash_mask + 1u;
     state.excluded = cell_start[excluded_slot + 1u] - cell_start[excluded_slot];
 }

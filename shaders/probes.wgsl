@@ -191,7 +191,7 @@ fn probe_front(
             continue;
         }
         let reach = select(-3.0e38, dot(x - def.point, def.axis), fluid);
-        let largest = workgroup_max(li, vec2<f32>(reach, 0.0));
+        let largest = workgroup_max(li, vec3<f32>(reach, 0.0, 0.0));
         if (li == 0u) {
             atomicMax(&probe_out[k], ordered_bits(largest.x));
         }

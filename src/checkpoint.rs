@@ -23,7 +23,64 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"WGSPHCKP";
 /// 2: the solid section holds the solid particles only, in id order. Format 1 (every particle,
 /// in the saved GPU order) is still read.
-const FORMAT: u32 = 2;
+/// 3: `SimState` ends with the density-variation monitor (24 bytes); the shorter state of
+/// formats 1 and 2 is read with the monitor cleared (it changes no dynamics).
+const FORMAT: u32 = 3;
+/// `SimState`'s size before format 3.
+const SIM_STATE_BYTES_V2: usize = 48;
+
+/// When a run writes its checkpoint (`DIR/checkpoint.bin`, the last one replacing the one
+/// before). Checkpoints are taken at probe times, the first one at or after each due time; an
+/// interrupt (Ctrl-C, SIGTERM) always writes one.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CheckpointPolicy {
+    /// Every so many simulated seconds.
+    pub every_sim_s: Option<f64>,
+    /// Every so many wall-clock seconds.
+    pub every_wall_s: Option<f64>,
+}
+
+impl CheckpointPolicy {
+    /// What `wgsph run` does without `--checkpoint-every`: every 30 wall minutes.
+    pub fn default_for_runs() -> Self {
+        Self {
+            every_sim_s: None,
+            every_wall_s: Some(30.0 * 60.0),
+        }
+    }
+}
+
+impl std::str::FromStr for CheckpointPolicy {
+    type Err = anyhow::Error;
+
+    /// `0.5` or `0.5s`: every 0.5 simulated seconds; `10min`: every 10 wall minutes;
+    /// `never`: only on interrupts.
+    fn from_str(text: &str) -> Result<Self> {
+        let t = text.trim();
+        let number = |s: &str| -> Result<f64> {
+            match s.trim().parse::<f64>() {
+                Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+                _ => anyhow::bail!(
+                    "--checkpoint-every '{text}': give a positive number of simulated seconds \
+                     (0.5 or 0.5s), of wall minutes (10min), or 'never'"
+                ),
+            }
+        };
+        Ok(if t == "never" {
+            Self::default()
+        } else if let Some(m) = t.strip_suffix("min") {
+            Self {
+                every_sim_s: None,
+                every_wall_s: Some(60.0 * number(m)?),
+            }
+        } else {
+            Self {
+                every_sim_s: Some(number(t.strip_suffix('s').unwrap_or(t))?),
+                every_wall_s: None,
+            }
+        })
+    }
+}
 
 /// The case file and `--set` overrides a run was started with, so `wgsph resume` can rebuild
 /// the scenario.
@@ -45,6 +102,8 @@ pub struct OutputState {
     pub body_tables: Vec<String>,
     /// Wall time spent so far [s].
     pub wall_s: f64,
+    /// The fluid's largest density variation so far and when it was seen [s].
+    pub max_density_variation: (f64, f64),
 }
 
 /// Everything needed to continue a run.
@@ -58,6 +117,9 @@ pub struct Checkpoint {
     pub snapshot_field: Option<String>,
     /// The adapter the state was computed on (bit-identity holds on the same adapter only).
     pub adapter: String,
+    /// When the run checkpoints (`--checkpoint-every`), which `wgsph resume` keeps; None in a
+    /// file written before it was recorded.
+    pub policy: Option<CheckpointPolicy>,
     pub time_s: f64,
     pub outputs: OutputState,
     pub solver: SolverState,
@@ -71,6 +133,10 @@ struct Header {
     source: Option<CaseSource>,
     snapshot_field: Option<String>,
     adapter: String,
+    #[serde(default)]
+    policy: Option<CheckpointPolicy>,
+    #[serde(default)]
+    max_density_variation: (f64, f64),
     /// For people reading the header; `time_bits` is what resumes.
     time_s: f64,
     time_bits: u64,
@@ -189,6 +255,8 @@ impl Checkpoint {
             source: self.source.clone(),
             snapshot_field: self.snapshot_field.clone(),
             adapter: self.adapter.clone(),
+            policy: self.policy,
+            max_density_variation: o.max_density_variation,
             time_s: self.time_s,
             time_bits: self.time_s.to_bits(),
             wall_s: o.wall_s,
@@ -271,7 +339,7 @@ impl Checkpoint {
             rest = more;
             Ok(mine)
         };
-        let sim: SimState = pod_one(section("sim")?, "sim")?;
+        let sim = sim_state(section("sim")?, format)?;
         let pos: Vec<Pos> = pod_vec(section("pos")?, "pos")?;
         let velrho: Vec<[f32; 4]> = pod_vec(section("velrho")?, "velrho")?;
         let code: Vec<u32> = pod_vec(section("code")?, "code")?;
@@ -298,6 +366,7 @@ impl Checkpoint {
             source: h.source,
             snapshot_field: h.snapshot_field,
             adapter: h.adapter,
+            policy: h.policy,
             time_s: f64::from_bits(h.time_bits),
             outputs: OutputState {
                 next_output_s: f64::from_bits(h.next_output_bits),
@@ -309,6 +378,7 @@ impl Checkpoint {
                 probe_tables: h.probe_tables,
                 body_tables: h.body_tables,
                 wall_s: h.wall_s,
+                max_density_variation: h.max_density_variation,
             },
             solver: SolverState {
                 parity: h.parity,
@@ -359,6 +429,16 @@ fn pod_vec<T: bytemuck::Pod>(bytes: &[u8], name: &str) -> Result<Vec<T>> {
     Ok(bytemuck::pod_collect_to_vec(bytes))
 }
 
+/// The time-step state of a checkpoint of `format`.
+fn sim_state(bytes: &[u8], format: u32) -> Result<SimState> {
+    if format < 3 && bytes.len() == SIM_STATE_BYTES_V2 {
+        let mut full = [0u8; std::mem::size_of::<SimState>()];
+        full[..bytes.len()].copy_from_slice(bytes);
+        return pod_one(&full, "sim");
+    }
+    pod_one(bytes, "sim")
+}
+
 fn pod_one<T: bytemuck::Pod>(bytes: &[u8], name: &str) -> Result<T> {
     if bytes.len() != std::mem::size_of::<T>() {
         bail!("section '{name}' has {} bytes", bytes.len());
@@ -382,12 +462,17 @@ mod tests {
             }),
             snapshot_field: Some("speed".into()),
             adapter: "llvmpipe".into(),
+            policy: Some(CheckpointPolicy {
+                every_sim_s: Some(0.25),
+                every_wall_s: None,
+            }),
             time_s: 0.1 + 0.2,
             outputs: OutputState {
                 next_output_s: 1.0 / 3.0,
                 snapshots: vec![(0.0, "particles/particles_000000.vtu".into())],
                 probe_tables: vec!["t_s,pressure_pa\n0,1.5\n".into()],
                 body_tables: vec![],
+                max_density_variation: (0.021, 0.15),
                 wall_s: 12.5,
             },
             solver: SolverState {
@@ -523,6 +608,42 @@ mod tests {
         std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 
+    /// A format-2 file (the time-step state 48 bytes long, before the density monitor) reads
+    /// with the monitor cleared and everything else as written.
+    #[test]
+    fn format_2_time_step_states_are_read_with_the_monitor_cleared() {
+        let path = temp("format2");
+        let mut c = sample();
+        c.solver.sim.density_variation_peak = 0.5;
+        c.write(&path).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let json_len = u64::from_le_bytes(bytes[12..20].try_into().unwrap()) as usize;
+        let mut header: serde_json::Value =
+            serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+        header["format"] = 2.into();
+        let sim = header["sections"][0].as_array_mut().unwrap();
+        assert_eq!(sim[0], "sim");
+        sim[1] = SIM_STATE_BYTES_V2.into();
+        let json = serde_json::to_vec(&header).unwrap();
+        let sections = &bytes[20 + json_len..bytes.len() - 8];
+        let cut = std::mem::size_of::<SimState>() - SIM_STATE_BYTES_V2;
+        let mut old = Vec::new();
+        old.extend_from_slice(MAGIC);
+        old.extend_from_slice(&2u32.to_le_bytes());
+        old.extend_from_slice(&(json.len() as u64).to_le_bytes());
+        old.extend_from_slice(&json);
+        old.extend_from_slice(&sections[..SIM_STATE_BYTES_V2]);
+        old.extend_from_slice(&sections[SIM_STATE_BYTES_V2 + cut..]);
+        let mut sum = Fnv::default();
+        sum.update(&old);
+        old.extend_from_slice(&sum.finish().to_le_bytes());
+        std::fs::write(&path, &old).unwrap();
+        let read = Checkpoint::read(&path).unwrap();
+        c.solver.sim.density_variation_peak = 0.0;
+        assert_eq!(read, c);
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+    }
+
     #[test]
     fn truncated_or_damaged_files_are_refused() {
         let path = temp("damaged");
@@ -540,5 +661,19 @@ mod tests {
         let e = format!("{:#}", Checkpoint::read(&path).unwrap_err());
         assert!(e.contains("checksum"), "{e}");
         std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+    }
+
+    #[test]
+    fn checkpoint_policy_parses_simulated_and_wall_intervals() {
+        let p = |s: &str| s.parse::<CheckpointPolicy>();
+        assert_eq!(p("0.5").unwrap().every_sim_s, Some(0.5));
+        assert_eq!(p("0.25s").unwrap().every_sim_s, Some(0.25));
+        let wall = p("10min").unwrap();
+        assert_eq!((wall.every_sim_s, wall.every_wall_s), (None, Some(600.0)));
+        assert_eq!(p("never").unwrap(), CheckpointPolicy::default());
+        for bad in ["", "0", "-1s", "nan", "tenmin", "1h"] {
+            let e = p(bad).unwrap_err().to_string();
+            assert!(e.contains("--checkpoint-every"), "{bad}: {e}");
+        }
     }
 }

@@ -58,6 +58,12 @@ pub struct Params {
     /// then the solids; 0 without pairs: every pair has `friction`), and the first solid's.
     pub friction_groups: u32,
     pub friction_first_solid: u32,
+    /// `time.density_variation_warn` and `_stop`: the density variations |ρ/ρ0 − 1| beyond
+    /// which `correct` counts a fluid particle.
+    pub density_warn: f32,
+    pub density_stop: f32,
+    /// To `solid_materials`' 16-byte alignment in WGSL.
+    pub pad: [u32; 2],
     /// The distinct materials of the elastic solids; a solid particle's is
     /// `SolidState::material`.
     pub solid_materials: [SolidMaterial; MAX_SOLID_MATERIALS],
@@ -140,6 +146,16 @@ pub struct SimState {
     pub inlet_joined: u32,
     /// Fluid particles removed by outlets since t = 0.
     pub drained: u32,
+    /// The largest |ρ/ρ0 − 1| over the fluid in the step being taken (f32 bits), and its
+    /// fluid particles beyond `Params::density_warn` and `density_stop` (cleared when the step
+    /// closes).
+    pub density_variation_bits: u32,
+    pub beyond_warn: u32,
+    pub beyond_stop: u32,
+    /// The largest of each over the steps since the host last cleared them.
+    pub density_variation_peak: f32,
+    pub beyond_warn_peak: u32,
+    pub beyond_stop_peak: u32,
 }
 
 /// Mirrors `Pos`: offset from the block's lower corner + packed block coordinates.
@@ -409,6 +425,9 @@ mod tests {
                 friction_slip,
                 friction_groups,
                 friction_first_solid,
+                density_warn,
+                density_stop,
+                pad,
                 solid_materials,
                 friction_table
             ]
@@ -479,7 +498,13 @@ mod tests {
                 steps,
                 t_base,
                 inlet_joined,
-                drained
+                drained,
+                density_variation_bits,
+                beyond_warn,
+                beyond_stop,
+                density_variation_peak,
+                beyond_warn_peak,
+                beyond_stop_peak
             ]
         );
     }

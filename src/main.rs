@@ -11,12 +11,12 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::MultiProgress;
 
-use wgsph::checkpoint::{CaseSource, Checkpoint, CHECKPOINT_FILE};
+use wgsph::checkpoint::{CaseSource, Checkpoint, CheckpointPolicy, CHECKPOINT_FILE};
 use wgsph::gpu::context::list_adapters;
 use wgsph::gpu::{AdapterChoice, GpuContext};
 use wgsph::plot::snapshot::SnapshotField;
 use wgsph::progress::{LogLines, Progress, ProgressBarView};
-use wgsph::run::{CheckpointPolicy, RunOptions, RunReport};
+use wgsph::run::{RunOptions, RunReport};
 
 #[derive(Parser)]
 #[command(
@@ -226,7 +226,14 @@ fn finish(report: &RunReport, dir: &std::path::Path, quiet: bool) -> ExitCode {
     } else {
         ExitCode::SUCCESS
     };
-    if !quiet {
+    if !quiet && report.already_complete {
+        println!(
+            "already complete: t = {:.4} s reached before; nothing computed (outputs in {}); \
+             give a later --set time.end_s=... to continue it",
+            report.summary.simulated_time_s,
+            dir.display()
+        );
+    } else if !quiet {
         let s = &report.summary;
         println!(
             "{}: {} steps to t = {:.4} s in {:.1} s wall ({:.3e} particle-steps/s); outputs in {}",
@@ -429,7 +436,29 @@ fn resume(
     quiet: bool,
     bars: &MultiProgress,
 ) -> Result<ExitCode> {
-    let ck = Checkpoint::read(&dir.join(CHECKPOINT_FILE))?;
+    let ck_path = dir.join(CHECKPOINT_FILE);
+    if !ck_path.is_file() {
+        // A short run completes before its first checkpoint: say so rather than that the
+        // checkpoint is missing.
+        if let Ok(done) = wgsph::output::RunSummary::read(dir) {
+            if done.status == "completed" {
+                let what = format!(
+                    "{}: the run is already complete (t = {:.4} s) and left no checkpoint",
+                    dir.display(),
+                    done.simulated_time_s
+                );
+                if set.is_empty() {
+                    println!("already complete: {what}; nothing computed");
+                    return Ok(ExitCode::SUCCESS);
+                }
+                anyhow::bail!(
+                    "{what} to continue from with {set:?}: run the case again with the later \
+                     time.end_s (and --checkpoint-every to extend it later)"
+                );
+            }
+        }
+    }
+    let ck = Checkpoint::read(&ck_path)?;
     let Some(source) = ck.source.clone() else {
         anyhow::bail!(
             "{} does not record its case file (it was written through the library): \
@@ -446,7 +475,11 @@ fn resume(
             .as_deref()
             .map(|f| f.parse().map_err(anyhow::Error::msg))
             .transpose()?,
-        checkpoint: checkpoint_every.unwrap_or_else(CheckpointPolicy::default_for_runs),
+        // The run's own policy unless given anew (a checkpoint written before the policy was
+        // recorded: the default).
+        checkpoint: checkpoint_every
+            .or(ck.policy)
+            .unwrap_or_else(CheckpointPolicy::default_for_runs),
         source: Some(CaseSource {
             path: source.path,
             overrides,

@@ -10,13 +10,15 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 
 use crate::body;
-use crate::checkpoint::{fingerprint, CaseSource, Checkpoint, OutputState, CHECKPOINT_FILE};
+use crate::checkpoint::{
+    fingerprint, CaseSource, Checkpoint, CheckpointPolicy, OutputState, CHECKPOINT_FILE,
+};
 use crate::gpu::GpuContext;
 use crate::output::{OutputDir, ParticleFile, ProbeWriter, RunSummary, SNAPSHOTS_DIR};
 use crate::plot::snapshot::{SnapshotField, SnapshotView};
 use crate::progress::{Progress, RunStatus};
 use crate::scenario::{Kind, OutputBoundary, ProbeKind, Scenario};
-use crate::sph::{check_capacity, Solver};
+use crate::sph::{check_capacity, DensityVariation, Solver, Unstable};
 
 /// Column name of a probe's CSV.
 pub fn probe_column(kind: &ProbeKind) -> &'static str {
@@ -24,59 +26,6 @@ pub fn probe_column(kind: &ProbeKind) -> &'static str {
         ProbeKind::Pressure { .. } | ProbeKind::WallPressure(_) => "pressure_pa",
         ProbeKind::Height { .. } => "height_m",
         ProbeKind::Front { .. } => "front_m",
-    }
-}
-
-/// When a run writes its checkpoint (`DIR/checkpoint.bin`, the last one replacing the one
-/// before). Checkpoints are taken at probe times, the first one at or after each due time; an
-/// interrupt (Ctrl-C, SIGTERM) always writes one.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct CheckpointPolicy {
-    /// Every so many simulated seconds.
-    pub every_sim_s: Option<f64>,
-    /// Every so many wall-clock seconds.
-    pub every_wall_s: Option<f64>,
-}
-
-impl CheckpointPolicy {
-    /// What `wgsph run` does without `--checkpoint-every`: every 30 wall minutes.
-    pub fn default_for_runs() -> Self {
-        Self {
-            every_sim_s: None,
-            every_wall_s: Some(30.0 * 60.0),
-        }
-    }
-}
-
-impl std::str::FromStr for CheckpointPolicy {
-    type Err = anyhow::Error;
-
-    /// `0.5` or `0.5s`: every 0.5 simulated seconds; `10min`: every 10 wall minutes;
-    /// `never`: only on interrupts.
-    fn from_str(text: &str) -> Result<Self> {
-        let t = text.trim();
-        let number = |s: &str| -> Result<f64> {
-            match s.trim().parse::<f64>() {
-                Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
-                _ => anyhow::bail!(
-                    "--checkpoint-every '{text}': give a positive number of simulated seconds \
-                     (0.5 or 0.5s), of wall minutes (10min), or 'never'"
-                ),
-            }
-        };
-        Ok(if t == "never" {
-            Self::default()
-        } else if let Some(m) = t.strip_suffix("min") {
-            Self {
-                every_sim_s: None,
-                every_wall_s: Some(60.0 * number(m)?),
-            }
-        } else {
-            Self {
-                every_sim_s: Some(number(t.strip_suffix('s').unwrap_or(t))?),
-                every_wall_s: None,
-            }
-        })
     }
 }
 
@@ -167,6 +116,20 @@ pub struct RunReport {
     /// Set when the run stopped on request (interrupt, `halt_at_s`) with a checkpoint at this
     /// simulated time; `wgsph resume` continues it.
     pub interrupted_at_s: Option<f64>,
+    /// Set by [`resume`] when the run had already completed to the case's end: nothing was
+    /// computed, `summary` is its run.json.
+    pub already_complete: bool,
+}
+
+/// The summary of the run in `dir` if it completed to `sc`'s end time, from `sc` (the same
+/// fingerprint): a resume has nothing to compute.
+fn completed_run(dir: &Path, sc: &Scenario) -> Option<RunSummary> {
+    let done = RunSummary::read(dir).ok()?;
+    let end = sc.time.end_s;
+    (done.status == "completed"
+        && done.fingerprint.as_deref() == Some(&fingerprint_hex(sc))
+        && done.simulated_time_s >= end - 1e-9 * end)
+        .then_some(done)
 }
 
 /// Particle outputs at an output time: the VTU snapshot and, when asked for, its PNG (drawn
@@ -350,6 +313,22 @@ pub fn resume(
     options: &RunOptions,
     progress: &mut dyn Progress,
 ) -> Result<RunReport> {
+    if let Some(summary) = completed_run(dir, sc) {
+        log::info!(
+            "{}: the run in {} is already complete (t = {:.6} s, time.end_s = {} s): nothing to \
+             compute; give a later time.end_s (--set time.end_s=...) to continue it",
+            sc.name,
+            dir.display(),
+            summary.simulated_time_s,
+            sc.time.end_s
+        );
+        return Ok(RunReport {
+            summary,
+            stopped: None,
+            interrupted_at_s: None,
+            already_complete: true,
+        });
+    }
     let path = dir.join(CHECKPOINT_FILE);
     let ck = Checkpoint::read(&path)?;
     if ck.fingerprint != fingerprint(sc) {
@@ -385,6 +364,8 @@ pub fn resume(
     runner.next_output = o.next_output_s;
     runner.wall_before = o.wall_s;
     runner.last_checkpoint = Some(ck.time_s);
+    runner.density = DensityWatch::new(sc, ck.time_s);
+    runner.density.max = o.max_density_variation;
     runner.next_checkpoint_sim = options
         .checkpoint
         .every_sim_s
@@ -416,6 +397,108 @@ struct Runner<'a> {
     last_checkpoint_wall: Instant,
     /// Simulated time of the last checkpoint written (or resumed from).
     last_checkpoint: Option<f64>,
+    density: DensityWatch,
+}
+
+/// The weakly-compressible check of a run ([`DensityVariation`]) over each probe interval
+/// against `time.density_variation_warn`.
+#[derive(Clone, Copy, Debug)]
+struct DensityWatch {
+    warn: f64,
+    /// The largest variation so far and the end of the probe interval it was seen in.
+    max: (f64, f64),
+    /// When the fluid last went beyond `warn` (None while within it), and the largest share
+    /// of it beyond since.
+    beyond: Option<(f64, f64)>,
+    /// The end of the last probe interval within `warn`: a run stopped unstable keeps its
+    /// outputs up to here.
+    last_sound_s: f64,
+    /// How many times the fluid went beyond `warn`.
+    episodes: u32,
+}
+
+impl DensityWatch {
+    fn new(sc: &Scenario, t0: f64) -> Self {
+        Self {
+            warn: sc.time.density_variation_warn,
+            max: (0.0, t0),
+            beyond: None,
+            last_sound_s: t0,
+            episodes: 0,
+        }
+    }
+
+    /// The largest variation `d` shows, seen at `t`.
+    fn record_max(&mut self, d: DensityVariation, t: f64) {
+        if d.max > self.max.0 {
+            self.max = (d.max, t);
+        }
+    }
+
+    /// Takes the check `d` of the interval ending at `t`, warning when the fluid first goes
+    /// beyond the limit and saying when it comes back (later episodes at debug level: an
+    /// impact can take a run across the limit and back several times; the summary counts).
+    fn observe(&mut self, name: &str, d: DensityVariation, t: f64) {
+        self.record_max(d, t);
+        let first = self.episodes <= 1;
+        match (d.beyond_warn(), self.beyond) {
+            (true, None) => {
+                log::log!(
+                    if self.episodes == 0 {
+                        log::Level::Warn
+                    } else {
+                        log::Level::Debug
+                    },
+                    "{name}: at t = {t:.4} s {:.1} % of the fluid's particles are more than \
+                     time.density_variation_warn = {:.1} % from ρ0 (up to {:.1} %), beyond the \
+                     weakly-compressible limit: raise physics.sound_speed_coef (c0 at least 10 \
+                     times the fastest flow) or lower time.cfl",
+                    100.0 * d.share_beyond_warn,
+                    100.0 * self.warn,
+                    100.0 * d.max
+                );
+                self.beyond = Some((t, d.share_beyond_warn));
+                self.episodes += 1;
+            }
+            (true, Some((since, share))) => {
+                self.beyond = Some((since, share.max(d.share_beyond_warn)));
+            }
+            (false, Some((since, share))) => {
+                log::log!(
+                    if first {
+                        log::Level::Info
+                    } else {
+                        log::Level::Debug
+                    },
+                    "{name}: at t = {t:.4} s the fluid is back within ±{:.1} % of ρ0 (beyond it \
+                     since t = {since:.4} s, with up to {:.1} % of its particles)",
+                    100.0 * self.warn,
+                    100.0 * share
+                );
+                self.beyond = None;
+            }
+            (false, None) => {}
+        }
+        if !d.beyond_warn() {
+            self.last_sound_s = t;
+        }
+    }
+
+    /// The run summary's warning, if the fluid ever went beyond the limit.
+    fn warning(&self) -> Option<String> {
+        (self.episodes > 0).then(|| {
+            format!(
+                "more than {:.0} % of the fluid's particles were beyond \
+                 time.density_variation_warn = {:.1} % from ρ0 (the weakly-compressible limit) \
+                 {} time(s) during the run; the largest variation was {:.1} % at t ≈ {:.4} s",
+                100.0 * DensityVariation::SHARE,
+                100.0 * self.warn,
+                self.episodes,
+                100.0 * self.max.0,
+                self.max.1
+            )
+        })
+    }
 }
 
 impl<'a> Runner<'a> {
@@ -482,6 +565,7 @@ impl<'a> Runner<'a> {
             started: Instant::now(),
             last_checkpoint_wall: Instant::now(),
             last_checkpoint: None,
+            density: DensityWatch::new(sc, 0.0),
         })
     }
 
@@ -522,6 +606,15 @@ impl<'a> Runner<'a> {
                 }
             }
         }
+        if stopped.is_some() {
+            // The interval the run stopped in, unobserved.
+            let t = self.solver.time();
+            self.density.record_max(self.solver.density_variation(), t);
+        }
+        let trimmed = match &stopped {
+            Some(e) if e.downcast_ref::<Unstable>().is_some() => self.keep_sound_outputs()?,
+            _ => None,
+        };
         self.probes.flush()?;
         self.bodies.csv.flush()?;
         let end = self.status();
@@ -535,10 +628,13 @@ impl<'a> Runner<'a> {
         };
         if let Some(e) = &stopped {
             log::error!(
-                "stopped: {e:#}; outputs up to t = {:.6} s are kept{resume_hint}",
-                self.outputs.out.snapshots().last().map_or(0.0, |(t, _)| *t)
+                "stopped: {e:#}; outputs up to t = {:.6} s are kept{}{resume_hint}",
+                self.outputs.out.snapshots().last().map_or(0.0, |(t, _)| *t),
+                trimmed.as_deref().unwrap_or_default()
             );
         }
+        let mut warnings = sc.warnings.clone();
+        warnings.extend(self.density.warning());
         if let Some(t) = interrupted_at_s {
             log::warn!("interrupted at t = {t:.6} s{resume_hint}");
         }
@@ -566,7 +662,8 @@ impl<'a> Runner<'a> {
                 (None, Some(_)) => format!("interrupted{resume_hint}"),
                 (None, None) => "completed".into(),
             },
-            warnings: sc.warnings.clone(),
+            warnings,
+            max_density_variation: Some(self.density.max.0),
             overrides: self.options.source.as_ref().map(|s| s.overrides.clone()),
             fingerprint: Some(fingerprint_hex(sc)),
             case_file: self
@@ -580,7 +677,36 @@ impl<'a> Runner<'a> {
             summary,
             stopped,
             interrupted_at_s,
+            already_complete: false,
         })
+    }
+
+    /// A run stopped unstable: drops the outputs after the last probe interval whose density
+    /// stayed within `time.density_variation_warn` (particle files, PNGs, probe and body rows),
+    /// which already show the instability. Says what it dropped.
+    fn keep_sound_outputs(&mut self) -> Result<Option<String>> {
+        let t = self.density.last_sound_s;
+        let dropped = self.outputs.out.truncate_after(t)?;
+        for index in dropped.clone() {
+            let png = self
+                .outputs
+                .out
+                .path()
+                .join(SNAPSHOTS_DIR)
+                .join(format!("{index:06}.png"));
+            // Absent when the run draws no pictures.
+            let _ = std::fs::remove_file(png);
+        }
+        self.probes.truncate_after(t);
+        self.bodies.csv.truncate_after(t);
+        Ok(self.density.beyond.map(|(since, _)| {
+            format!(
+                " (the density went beyond ±{:.1} % at t = {since:.4} s: {} particle output(s) \
+                 and the probe rows after t = {t:.6} s, the last state within it, were removed)",
+                100.0 * self.density.warn,
+                dropped.len()
+            )
+        }))
     }
 
     /// Advances to the probe time `t` and writes what is due there: probe rows, particle
@@ -597,6 +723,11 @@ impl<'a> Runner<'a> {
             self.solver.lose_device();
         }
         self.solver.advance_to(t)?;
+        self.density.observe(
+            &sc.name,
+            self.solver.density_variation(),
+            self.solver.time(),
+        );
         if !sc.probes.is_empty() {
             self.probes
                 .record(self.solver.time(), &self.solver.sample_probes()?)?;
@@ -660,6 +791,7 @@ impl<'a> Runner<'a> {
             source: self.options.source.clone(),
             snapshot_field: self.options.snapshot_png.map(|f| f.to_string()),
             adapter: self.ctx.info.name.clone(),
+            policy: Some(self.options.checkpoint),
             time_s: self.solver.time(),
             outputs: OutputState {
                 next_output_s: self.next_output,
@@ -667,6 +799,7 @@ impl<'a> Runner<'a> {
                 probe_tables: self.probes.texts(),
                 body_tables: self.bodies.csv.texts(),
                 wall_s: self.wall_before + self.started.elapsed().as_secs_f64(),
+                max_density_variation: self.density.max,
             },
             solver: self.solver.save_state()?,
         };
@@ -681,7 +814,7 @@ impl<'a> Runner<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::{remove_previous_outputs, schedule, CheckpointPolicy};
+    use super::{remove_previous_outputs, schedule};
 
     /// A new run into an old run's folder removes the old run's outputs (a longer run's last
     /// VTU files, a removed probe's table, its plots, summary and checkpoint) and nothing else.
@@ -720,20 +853,6 @@ mod tests {
         // A folder that does not exist yet is fine.
         remove_previous_outputs(&d.join("new")).unwrap();
         std::fs::remove_dir_all(&d).unwrap();
-    }
-
-    #[test]
-    fn checkpoint_policy_parses_simulated_and_wall_intervals() {
-        let p = |s: &str| s.parse::<CheckpointPolicy>();
-        assert_eq!(p("0.5").unwrap().every_sim_s, Some(0.5));
-        assert_eq!(p("0.25s").unwrap().every_sim_s, Some(0.25));
-        let wall = p("10min").unwrap();
-        assert_eq!((wall.every_sim_s, wall.every_wall_s), (None, Some(600.0)));
-        assert_eq!(p("never").unwrap(), CheckpointPolicy::default());
-        for bad in ["", "0", "-1s", "nan", "tenmin", "1h"] {
-            let e = p(bad).unwrap_err().to_string();
-            assert!(e.contains("--checkpoint-every"), "{bad}: {e}");
-        }
     }
 
     #[test]

@@ -163,6 +163,20 @@ pub struct TimeControl {
     pub cfl: f64,
     /// Which particle outputs hold the boundary particles that have not moved.
     pub output_boundary: OutputBoundary,
+    /// The run warns when the fluid's density varies from ρ0 by more than this fraction (the
+    /// weakly-compressible limit), and keeps only outputs within it when it stops unstable.
+    pub density_variation_warn: f64,
+    /// The run stops when the fluid's density varies from ρ0 by more than this fraction.
+    pub density_variation_stop: f64,
+}
+
+impl TimeControl {
+    /// `time.density_variation_warn`'s default: ±3 %, WCSPH's usual bound on |ρ/ρ0 − 1| (the
+    /// sound speed is chosen ≥ 10 times the largest flow speed so that it holds, Monaghan 1994).
+    pub const DENSITY_VARIATION_WARN: f64 = 0.03;
+    /// `time.density_variation_stop`'s default (or twice `density_variation_warn` when that is
+    /// above 5 %).
+    pub const DENSITY_VARIATION_STOP: f64 = 0.1;
 }
 
 /// Which particle outputs hold the boundary particles still where they started (fixed walls,

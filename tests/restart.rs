@@ -287,17 +287,15 @@ fn assert_consistent_prefix(dir: &Path, reference: &Path) {
     }
 }
 
-fn resume_cli(dir: &Path) {
-    let o = wgsph()
-        .args(["resume", "--quiet"])
-        .arg(dir)
-        .output()
-        .unwrap();
+/// `wgsph resume DIR`; its standard output.
+fn resume_cli(dir: &Path) -> String {
+    let o = wgsph().arg("resume").arg(dir).output().unwrap();
     assert!(
         o.status.success(),
         "resume failed: {}",
         String::from_utf8_lossy(&o.stderr)
     );
+    String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
 #[test]
@@ -315,6 +313,15 @@ fn a_run_killed_with_sigkill_leaves_complete_files_and_resumes_to_the_same_resul
         // result_files() lists every file: no temporary file is left after the resume.
         assert_same_results(reference, &dir);
         assert_eq!(steps(reference), steps(&dir));
+        // The resumed run kept checkpointing every 0.02 s, as the run was told (the default,
+        // every 30 wall minutes, would have left the killed run's early checkpoint).
+        let ck = wgsph::checkpoint::Checkpoint::read(&dir.join("checkpoint.bin")).unwrap();
+        assert_eq!(ck.policy.and_then(|p| p.every_sim_s), Some(0.02));
+        assert!(
+            ck.time_s > 0.35,
+            "the last checkpoint is at t = {} s",
+            ck.time_s
+        );
     }
 }
 
@@ -345,6 +352,16 @@ fn ctrl_c_writes_a_checkpoint_and_stops_then_resume_completes() {
     assert_consistent_prefix(&dir, reference);
     resume_cli(&dir);
     assert_same_results(reference, &dir);
+    // Resuming the completed run says so and computes nothing: every file stays as it is
+    // (run.json's wall time included), with or without a checkpoint left.
+    let before = result_files(&dir);
+    let summary = std::fs::read(dir.join("run.json")).unwrap();
+    for done in [&dir as &Path, reference] {
+        let out = resume_cli(done);
+        assert!(out.contains("already complete"), "{out}");
+    }
+    assert!(result_files(&dir) == before);
+    assert_eq!(std::fs::read(dir.join("run.json")).unwrap(), summary);
 }
 
 #[test]
@@ -437,7 +454,7 @@ fn a_device_lost_mid_run_keeps_the_last_checkpoint_and_resumes() {
         wgsph::gpu::GpuContext::new(wgsph::gpu::AdapterChoice::resolve(None).unwrap()).unwrap();
     let dir = temp_dir("lost");
     let opts = RunOptions {
-        checkpoint: wgsph::run::CheckpointPolicy {
+        checkpoint: wgsph::checkpoint::CheckpointPolicy {
             every_sim_s: Some(0.04),
             every_wall_s: None,
         },

@@ -59,6 +59,11 @@ struct Params {
     // `friction`) and the first solid's (interaction.wgsl `friction_between`).
     friction_groups: u32,
     friction_first_solid: u32,
+    // The weakly-compressible check (integrate.wgsl `correct`): fluid particles whose
+    // |ρ/ρ0 − 1| is beyond each limit are counted (`time.density_variation_warn`, `_stop`).
+    density_warn: f32,
+    density_stop: f32,
+    pad: vec2<u32>,             // to the 16-byte alignment of the array below
     // The distinct materials of the solids; a solid particle's is SolidState.material.
     solid_materials: array<SolidMaterial, MAX_SOLID_MATERIALS>,
     // μ between contact groups a and b at a·G + b, four to a vector.
@@ -98,6 +103,15 @@ struct SimState {
     t_base: f32,                // the host's base time (f32): t = t_base + t_rel, for inlets
     inlet_joined: atomic<u32>,  // dormant inlet particles that joined a buffer (cumulative)
     drained: atomic<u32>,       // fluid particles removed by outlets (cumulative)
+    // The weakly-compressible check: this step's largest |ρ/ρ0 − 1| over the fluid (f32 bits)
+    // and its fluid particles beyond params.density_warn and params.density_stop; then the
+    // largest of each over the steps since the host cleared them.
+    density_variation_bits: atomic<u32>,
+    beyond_warn: atomic<u32>,
+    beyond_stop: atomic<u32>,
+    density_variation_peak: f32,
+    beyond_warn_peak: u32,
+    beyond_stop_peak: u32,
 }
 
 // Particle position: `off` is the offset from the lower corner of block `block`

@@ -1,13 +1,14 @@
 // The largest values over a workgroup, returned to each of its invocations: a tree reduction in
 // workgroup memory before one atomicMax per workgroup (max is order-independent, so the result
-// is deterministic). Two maxima at once: the corrector reduces speed and acceleration together.
+// is deterministic). Three maxima at once: the corrector reduces speed, acceleration and density
+// variation together.
 // It has barriers: call it in uniform control flow. No bindings: composed after common.wgsl by
 // the passes that reduce a maximum (integrate, bodies, probes).
 
-var<workgroup> wg_max: array<vec2<f32>, WG>;
+var<workgroup> wg_max: array<vec3<f32>, WG>;
 
 // Component-wise maximum of `v` over the workgroup; `li` is the local invocation index.
-fn workgroup_max(li: u32, v: vec2<f32>) -> vec2<f32> {
+fn workgroup_max(li: u32, v: vec3<f32>) -> vec3<f32> {
     wg_max[li] = v;
     workgroupBarrier();
     for (var s = WG / 2u; s > 0u; s >>= 1u) {

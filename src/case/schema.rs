@@ -179,6 +179,8 @@ pub(super) struct RawTime {
     pub probe_every_s: Option<f64>,
     pub cfl: Option<f64>,
     pub output_boundary: Option<OutputBoundaryName>,
+    pub density_variation_warn: Option<f64>,
+    pub density_variation_stop: Option<f64>,
 }
 
 /// Which particle outputs hold the boundary particles that have not moved.
@@ -498,6 +500,16 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "time.output_boundary",
         "which particle outputs hold the boundary particles that have not moved: every or first",
         "output_boundary = \"first\"",
+    ),
+    f(
+        "time.density_variation_warn",
+        "the fluid's density variation |ρ/ρ0 − 1| beyond which the run warns",
+        "density_variation_warn = 0.03",
+    ),
+    f(
+        "time.density_variation_stop",
+        "the fluid's density variation |ρ/ρ0 − 1| beyond which the run stops",
+        "density_variation_stop = 0.1",
     ),
     f("tank", "the [tank] table", "[tank] with min_m and max_m"),
     f(

@@ -737,6 +737,22 @@ const BAD_NUMBERS: &[(&str, &str, usize, &[&str])] = &[
     ),
     (
         "output_every_s = 0.1",
+        "output_every_s = 0.1\ndensity_variation_warn = 0",
+        12,
+        &["time.density_variation_warn", "(0, 1]"],
+    ),
+    (
+        "output_every_s = 0.1",
+        "output_every_s = 0.1\ndensity_variation_warn = 0.05\ndensity_variation_stop = 0.05",
+        13,
+        &[
+            "time.density_variation_stop",
+            "(0.05, 10]",
+            "above density_variation_warn = 0.05",
+        ],
+    ),
+    (
+        "output_every_s = 0.1",
         "output_every_s = 0.1\noutput_boundary = \"firs\"",
         12,
         &["time.output_boundary = \"firs\"", "\"every\", \"first\""],
@@ -815,6 +831,28 @@ const BAD_NUMBERS: &[(&str, &str, usize, &[&str])] = &[
         &["probe[0].point_m[1] = NaN", "finite"],
     ),
 ];
+
+/// The weakly-compressible limits: ±3 % warns and ±10 % stops by default; a warning limit of
+/// its own moves the stop to twice it when that is higher.
+#[test]
+fn density_variation_limits_default_and_follow_the_warning() {
+    let t = |set: &[&str]| load_str(BASE, "cases/t.toml", &sets(set)).unwrap().time;
+    let d = t(&[]);
+    assert_eq!(
+        (d.density_variation_warn, d.density_variation_stop),
+        (0.03, 0.1)
+    );
+    let w = t(&["time.density_variation_warn=0.2"]);
+    assert_eq!(
+        (w.density_variation_warn, w.density_variation_stop),
+        (0.2, 0.4)
+    );
+    let s = t(&["time.density_variation_stop=0.5"]);
+    assert_eq!(
+        (s.density_variation_warn, s.density_variation_stop),
+        (0.03, 0.5)
+    );
+}
 
 #[test]
 fn bad_numbers_are_refused() {

@@ -461,11 +461,35 @@ fn time(ctx: &Ctx<'_>, raw: &RawCase) -> Result<TimeControl, CaseError> {
         "the Courant number",
         "use e.g. 0.2",
     )?;
+    let density_variation_warn = number(
+        ctx,
+        "time.density_variation_warn",
+        t.density_variation_warn
+            .unwrap_or(TimeControl::DENSITY_VARIATION_WARN),
+        Bound::OpenClosed(0.0, 1.0),
+        "the fluid's density variation |ρ/ρ0 − 1| beyond which the run warns",
+        "use e.g. 0.03 (3 %)",
+    )?;
+    let density_variation_stop = number(
+        ctx,
+        "time.density_variation_stop",
+        t.density_variation_stop
+            .unwrap_or(TimeControl::DENSITY_VARIATION_STOP.max(2.0 * density_variation_warn)),
+        Bound::OpenClosed(density_variation_warn, 10.0),
+        "the fluid's density variation |ρ/ρ0 − 1| beyond which the run stops, above \
+         time.density_variation_warn",
+        &format!(
+            "give a value above density_variation_warn = {density_variation_warn}, e.g. {}",
+            2.0 * density_variation_warn
+        ),
+    )?;
     Ok(TimeControl {
         end_s,
         output_every_s,
         probe_every_s,
         cfl,
+        density_variation_warn,
+        density_variation_stop,
         output_boundary: match t.output_boundary {
             None | Some(OutputBoundaryName::Every) => OutputBoundary::Every,
             Some(OutputBoundaryName::First) => OutputBoundary::First,

@@ -234,6 +234,26 @@ impl OutputDir {
         Ok(vtu_path)
     }
 
+    /// Drops the snapshots after `t_s` from the series: their files are removed and the `.pvd`
+    /// rewritten (a run stopped unstable keeps what was still sound). Returns the indices of
+    /// the snapshots dropped.
+    pub fn truncate_after(&mut self, t_s: f64) -> Result<std::ops::Range<usize>, OutputError> {
+        let keep = self.snapshots.partition_point(|(t, _)| *t <= t_s);
+        for (_, rel) in &self.snapshots[keep..] {
+            let file = self.dir.join(rel);
+            match std::fs::remove_file(&file) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(OutputError::io("remove", &file, e))
+                }
+                _ => {}
+            }
+        }
+        let dropped = keep..self.snapshots.len();
+        self.snapshots.truncate(keep);
+        write_atomic(&self.pvd_path(), |w| pvd::write_pvd(w, &self.snapshots))?;
+        Ok(dropped)
+    }
+
     /// The (time, relative path) of every snapshot written so far.
     pub fn snapshots(&self) -> &[(f64, String)] {
         &self.snapshots
@@ -487,6 +507,13 @@ mod tests {
                 "probes"
             ]
         );
+        // A stopped run's series cut after t = 0.01: the last file gone, the .pvd lists two.
+        assert_eq!(out.truncate_after(0.01).unwrap(), 2..3);
+        assert!(!base.join("particles/particles_000002.vtu").exists());
+        let pvd_text = std::fs::read_to_string(base.join("particles.pvd")).unwrap();
+        assert_eq!(pvd::tests::parse_pvd(&pvd_text).len(), 2);
+        assert_eq!(out.snapshot_count(), 2);
+        assert_eq!(out.truncate_after(1.0).unwrap(), 2..2);
         std::fs::remove_dir_all(&base).unwrap();
     }
 }

@@ -189,6 +189,27 @@ impl ProbeWriter {
         self.flush()
     }
 
+    /// Drops the rows after `t_s` (a run stopped unstable keeps what was still sound); they
+    /// leave the files on the next [`flush`](Self::flush).
+    pub fn truncate_after(&mut self, t_s: f64) {
+        for f in &mut self.files {
+            let mut kept = 0;
+            let mut end = 0;
+            for (k, line) in f.text.split_inclusive('\n').enumerate() {
+                // The header, then rows whose time (written round-trip exact) is within t_s.
+                let t = line.split(',').next().and_then(|t| t.parse::<f64>().ok());
+                if k > 0 && t.is_none_or(|t| t > t_s) {
+                    break;
+                }
+                kept = k;
+                end += line.len();
+            }
+            f.text.truncate(end);
+            self.rows = kept;
+        }
+        self.dirty = true;
+    }
+
     /// Makes the recorded rows durable by atomically rewriting every CSV (no-op when nothing was
     /// recorded since the last successful flush).
     pub fn flush(&mut self) -> Result<(), OutputError> {
@@ -270,6 +291,36 @@ mod tests {
             .map(|e| e.unwrap().file_name().into_string().unwrap())
             .collect();
         assert_eq!(names.len(), 3, "{names:?}");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// A stopped run's rows after a time are dropped from every file, exactly at the time
+    /// written (round-trip), and recording goes on after them.
+    #[test]
+    fn truncate_after_keeps_the_rows_up_to_a_time() {
+        let d = temp_dir("probes-truncate");
+        let out = OutputDir::create(&d).unwrap();
+        let mut w = out
+            .probe_writer(&cols(&[("a", "height_m"), ("b", "front_m")]))
+            .unwrap();
+        for k in 0..5 {
+            let t = 0.1 * k as f64;
+            w.record(t, &[t, 2.0 * t]).unwrap();
+        }
+        w.truncate_after(0.1 + 0.1);
+        assert_eq!(w.rows(), 3);
+        w.flush().unwrap();
+        assert_eq!(
+            std::fs::read_to_string(d.join("probes/b.csv")).unwrap(),
+            "t_s,front_m\n0,0\n0.1,0.2\n0.2,0.4\n"
+        );
+        w.truncate_after(-1.0);
+        w.record(7.0, &[1.0, 2.0]).unwrap();
+        w.flush().unwrap();
+        assert_eq!(
+            std::fs::read_to_string(d.join("probes/a.csv")).unwrap(),
+            "t_s,height_m\n7,1\n"
+        );
         std::fs::remove_dir_all(&d).unwrap();
     }
 

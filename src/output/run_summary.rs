@@ -34,9 +34,14 @@ pub struct RunSummary {
     pub outputs: u64,
     /// "completed" | "stopped: <reason>"
     pub status: String,
-    /// The case's warnings (`Scenario::warnings`).
+    /// The case's warnings (`Scenario::warnings`), and the run's (the density beyond
+    /// `time.density_variation_warn`).
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// The fluid's largest density variation |ρ/ρ0 − 1| over the run (over the probe
+    /// intervals; None in a summary written before it was measured).
+    #[serde(default)]
+    pub max_density_variation: Option<f64>,
     /// The `--set` overrides the case was loaded with, where the run knows them (`wgsph run`,
     /// `resume`, `validate`; None through the library without a `CaseSource`). `wgsph validate
     /// --reuse` takes a run made with its mode's overrides.
@@ -104,6 +109,7 @@ mod tests {
             outputs: 51,
             status: "completed".into(),
             warnings: vec!["body[0] ('plate') has fixed ghosts and is 0.01 m thick".into()],
+            max_density_variation: Some(0.0125),
         }
     }
 

@@ -49,6 +49,8 @@ impl Params {
             nu: nu as f32,
             delta_coef: (ph.delta_sph * ph.h * ph.c0) as f32,
             cfl: sc.time.cfl as f32,
+            density_warn: sc.time.density_variation_warn as f32,
+            density_stop: sc.time.density_variation_stop as f32,
             n_probes: sc.probes.len() as u32,
             n_mirror_planes: sc.walls.mirror_planes.len() as u32,
             ghost_mls: sc.walls.ghost_correction.code(),

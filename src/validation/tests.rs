@@ -34,6 +34,7 @@ fn summary(case: &str, excluded: u64) -> RunSummary {
         outputs: 1,
         status: "completed".into(),
         warnings: Vec::new(),
+        max_density_variation: None,
         overrides: None,
         fingerprint: None,
         case_file: None,

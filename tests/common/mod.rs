@@ -141,6 +141,8 @@ pub fn scenario(
             probe_every_s: 0.1,
             cfl: 0.2,
             output_boundary: Default::default(),
+            density_variation_warn: TimeControl::DENSITY_VARIATION_WARN,
+            density_variation_stop: TimeControl::DENSITY_VARIATION_STOP,
         },
         walls: WallParams::defaults(physics_dx, 0.5, 9.81),
         periodic: [false; 3],
