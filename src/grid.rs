@@ -115,23 +115,34 @@ impl Grid {
         !self.periodic.iter().any(|&p| p) && total <= self.slots as u64
     }
 
-    /// The slot of a world position, as `slot_of_cell(cell_of(..))` computes it on the GPU: a
-    /// position on the far face is in the last cell, one at a period's end in cell 0.
+    /// The slot of a world position, as `slot_of_cell(cell_of(..))` computes it on the GPU.
     pub fn slot_of(&self, off: [f32; 3], b: [u32; 3]) -> u32 {
+        self.slot_of_cell(self.cell_of(off, b))
+    }
+
+    /// The cell of a world position, as `cell_of` in shaders/lib/common.wgsl: a position on the
+    /// far face is in the last cell, one at a period's end in cell 0.
+    pub fn cell_of(&self, off: [f32; 3], b: [u32; 3]) -> [i64; 3] {
         let k = self.cells_per_block as i64;
-        let c: [u32; 3] = [0, 1, 2].map(|a| {
+        [0, 1, 2].map(|a| {
             let inv = (1.0 / self.cell_size[a]) as f32;
             let local = ((off[a] * inv).floor() as i64).clamp(0, k - 1);
             let c = b[a] as i64 * k + local;
             let n = self.cells[a] as i64;
-            (if self.periodic[a] {
+            if self.periodic[a] {
                 c % n
             } else {
                 c.min(n - 1)
-            }) as u32
-        });
-        let lin = c[0].wrapping_add(
-            self.cells[0].wrapping_mul(c[1].wrapping_add(self.cells[1].wrapping_mul(c[2]))),
+            }
+        })
+    }
+
+    /// The hash slot of cell `c` (which may lie outside the grid), as `slot_of_cell` in
+    /// shaders/lib/common.wgsl: its linear index in wrapping u32 arithmetic, masked.
+    pub fn slot_of_cell(&self, c: [i64; 3]) -> u32 {
+        let u = c.map(|x| x as u32);
+        let lin = u[0].wrapping_add(
+            self.cells[0].wrapping_mul(u[1].wrapping_add(self.cells[1].wrapping_mul(u[2]))),
         );
         lin & (self.slots - 1)
     }

@@ -1,5 +1,6 @@
 //! wgsph: GPU weakly-compressible SPH for fluid–solid interaction, on wgpu/WGSL.
 
+pub mod bench;
 pub mod body;
 pub mod case;
 pub mod checkpoint;

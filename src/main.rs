@@ -407,20 +407,41 @@ fn bench(
     let ctx = context(adapter)?;
     let mut solver = wgsph::sph::Solver::new(&ctx, &sc).context("setting up the GPU solver")?;
     solver.run_steps(warmup)?;
+    let t0 = solver.time();
     let start = Instant::now();
     solver.run_steps(steps)?;
     let wall = start.elapsed().as_secs_f64();
+    let simulated = solver.time() - t0;
     let n = solver.particle_count();
+    let work = wgsph::bench::neighbour_work(
+        &solver.grid,
+        sc.physics.dim,
+        sc.physics.h,
+        &solver.read_particles()?,
+    );
     println!("case            {}", sc.name);
     println!("adapter         {}", ctx.describe());
     println!("particles       {n}");
     println!("steps           {steps}");
-    println!("wall seconds    {wall:.3}");
+    println!("wall seconds    {wall:.4e}");
     println!("particle-steps/s {:.4e}", steps as f64 * n as f64 / wall);
+    // The fair figure between integrators of different steps (and force evaluations a step).
+    println!("simulated s/wall s {:.4e}", simulated / wall);
+    println!("mean dt s       {:.4e}", simulated / steps.max(1) as f64);
     println!(
         "bytes/particle  {:.1}",
         solver.gpu_bytes() as f64 / n as f64
     );
+    // Per particle and step, in the last state (src/bench.rs).
+    println!(
+        "candidates/particle {:.1} (fluid {:.1})",
+        work.candidates, work.fluid_candidates
+    );
+    println!(
+        "neighbours/particle {:.1} (fluid {:.1})",
+        work.neighbours, work.fluid_neighbours
+    );
+    println!("dispatches/step {}", solver.dispatches_per_step());
     if stages {
         print_stages(&solver.profile_steps(steps)?, steps, n);
     }

@@ -505,8 +505,9 @@ fn validate_refuses_unknown_cases_and_both_modes() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("cannot be used with"));
 }
 
-/// `bench` reports the throughput and memory; with `--stages`, a table of each stage's GPU time
-/// whose shares add up to the whole.
+/// `bench` reports the throughput and memory, the work (simulated time per wall second, the
+/// mean step, candidates and neighbours per particle, dispatches per step); with `--stages`, a
+/// table of each stage's GPU time whose shares add up to the whole.
 #[test]
 fn bench_reports_throughput_and_the_stages() {
     let o = wgsph()
@@ -529,10 +530,35 @@ fn bench_reports_throughput_and_the_stages() {
     );
     let value = |key: &str| -> f64 {
         let line = stdout.lines().find(|l| l.starts_with(key)).unwrap();
-        line[key.len()..].trim().parse().unwrap()
+        let first = line[key.len()..].split_whitespace().next().unwrap();
+        first.parse().unwrap()
     };
     assert!(value("particle-steps/s") > 0.0, "{stdout}");
     assert!(value("bytes/particle") > 0.0, "{stdout}");
+    // 10 steps of about dt: simulated time per wall time is their sum over the wall time.
+    let dt = value("mean dt s");
+    assert!(dt > 1e-6 && dt < 1e-2, "{stdout}");
+    let speed = value("simulated s/wall s");
+    assert!(
+        (speed / (10.0 * dt / value("wall seconds")) - 1.0).abs() < 5e-3,
+        "{stdout}"
+    );
+    // h = 1.3 dx in 2D: 21 lattice points within 2h in the bulk, fewer at the walls and the
+    // surface; cells of 2h hold some 6.8 particles each, 9 cells are tested.
+    let (candidates, neighbours) = (value("candidates/particle"), value("neighbours/particle"));
+    assert!(neighbours > 10.0 && neighbours < 21.5, "{stdout}");
+    assert!(
+        candidates > 2.0 * neighbours && candidates < 9.0 * 6.8,
+        "{stdout}"
+    );
+    // At least one dispatch for each stage of the table.
+    let dispatches = value("dispatches/step");
+    let n_stages = stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("stage "))
+        .count()
+        - 2;
+    assert!(dispatches >= n_stages as f64, "{stdout}");
     // Rows after the table's header: name, ms/step, share, "%", ns/particle.
     let rows: Vec<Vec<&str>> = stdout
         .lines()

@@ -131,10 +131,20 @@ impl Kernel {
         groups: u32,
     ) {
         let (x, y) = fold_groups(groups);
+        DISPATCHES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, bind, &[]);
         pass.dispatch_workgroups(x, y, 1);
     }
+}
+
+/// Dispatches recorded by this process (every one goes through `Kernel::dispatch_groups`): what
+/// `wgsph bench` counts a step's dispatches with.
+static DISPATCHES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// The dispatches recorded so far by this process.
+pub fn dispatches_recorded() -> u64 {
+    DISPATCHES.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 /// Workgroup grid for `groups` groups: x ≤ 65535, x·y ≥ groups. Kernels recover the linear

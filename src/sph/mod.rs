@@ -378,6 +378,15 @@ impl Solver {
         encoder
     }
 
+    /// The dispatches one step records (counted by recording a step that is never submitted).
+    pub fn dispatches_per_step(&mut self) -> u64 {
+        let before = crate::gpu::kernel::dispatches_recorded();
+        drop(self.encode_steps(1));
+        // The step was not taken: the parity stays.
+        self.parity = 1 - self.parity;
+        crate::gpu::kernel::dispatches_recorded() - before
+    }
+
     /// The stages of one step (`Passes::record_step`); flips the parity.
     fn record_step(&mut self, r: Recorder<'_>) {
         self.passes.record_step(r, self.parity);

@@ -1,0 +1,164 @@
+//! `wgsph bench`'s work report: what a step does per particle beside what it costs, the
+//! figures that predict a GPU's speed from its bandwidth and show a regression on any adapter.
+
+use crate::grid::Grid;
+use crate::layout::KIND_EXCLUDED;
+use crate::output::Particles;
+use crate::scenario::Kind;
+
+/// The neighbour search's work in one state of the particles: per particle in the grid, and
+/// per fluid particle (whose loop, `fluid_rates`, does the most per neighbour).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NeighbourWork {
+    /// Particles the neighbour loop tests: those of the cell-list ranges around each.
+    pub candidates: f64,
+    /// Candidates within the kernel's support 2h (the particle itself included).
+    pub neighbours: f64,
+    pub fluid_candidates: f64,
+    pub fluid_neighbours: f64,
+}
+
+/// The candidates and neighbours of `particles` on `grid`, counted on the host as the GPU's
+/// `neighbour_ranges` (shaders/lib/neighbours.wgsl) visits them: on a dense grid the three
+/// cells of a row along x around each particle's cell (the rows inside the grid), otherwise
+/// the distinct hash slots of the 3^d cells around it, with every particle a slot holds.
+/// Excluded particles are in no cell.
+pub fn neighbour_work(grid: &Grid, dim: u32, h: f64, particles: &Particles) -> NeighbourWork {
+    let live: Vec<usize> = (0..particles.pos.len())
+        .filter(|&i| particles.kind[i] != KIND_EXCLUDED)
+        .collect();
+    let cells: Vec<[i64; 3]> = live
+        .iter()
+        .map(|&i| {
+            let (off, b) = grid.to_block(particles.pos[i]);
+            grid.cell_of(off, b)
+        })
+        .collect();
+    // The particles of each slot (indices into `live`).
+    let mut by_slot: std::collections::HashMap<u32, Vec<usize>> = Default::default();
+    for (k, c) in cells.iter().enumerate() {
+        by_slot.entry(grid.slot_of_cell(*c)).or_default().push(k);
+    }
+    let support2 = (2.0 * h) * (2.0 * h);
+    // (candidates, neighbours, particles) of all and of the fluid.
+    let mut all = [0u64; 3];
+    let mut fluid = [0u64; 3];
+    for (k, c) in cells.iter().enumerate() {
+        let x = particles.pos[live[k]];
+        let mut mine = [0u64, 0, 1];
+        for slot in slots_around(grid, dim, *c) {
+            let Some(list) = by_slot.get(&slot) else {
+                continue;
+            };
+            mine[0] += list.len() as u64;
+            mine[1] += list
+                .iter()
+                .filter(|&&j| {
+                    let y = particles.pos[live[j]];
+                    (0..3).map(|a| (x[a] - y[a]).powi(2)).sum::<f64>() < support2
+                })
+                .count() as u64;
+        }
+        let is_fluid = particles.kind[live[k]] == Kind::Fluid as u32;
+        for a in 0..3 {
+            all[a] += mine[a];
+            fluid[a] += if is_fluid { mine[a] } else { 0 };
+        }
+    }
+    let per = |s: [u64; 3], a: usize| s[a] as f64 / s[2].max(1) as f64;
+    NeighbourWork {
+        candidates: per(all, 0),
+        neighbours: per(all, 1),
+        fluid_candidates: per(fluid, 0),
+        fluid_neighbours: per(fluid, 1),
+    }
+}
+
+/// The slots whose particles the GPU tests around cell `c` (each once).
+fn slots_around(grid: &Grid, dim: u32, c: [i64; 3]) -> Vec<u32> {
+    let g = grid.cells.map(|n| n as i64);
+    let zr = if dim == 3 { 1 } else { 0 };
+    let mut slots = Vec::with_capacity(27);
+    for dz in -zr..=zr {
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                let mut n = [c[0] + dx, c[1] + dy, c[2] + dz];
+                if grid.dense() {
+                    // Rows inside the grid only; a row's x range is clamped to it.
+                    if n[1] < 0 || n[1] >= g[1] || n[2] < 0 || n[2] >= g[2] {
+                        continue;
+                    }
+                    if n[0] < 0 || n[0] >= g[0] {
+                        continue;
+                    }
+                } else {
+                    for a in 0..3 {
+                        if grid.periodic[a] {
+                            n[a] = n[a].rem_euclid(g[a]);
+                        }
+                    }
+                }
+                let s = grid.slot_of_cell(n);
+                if !slots.contains(&s) {
+                    slots.push(s);
+                }
+            }
+        }
+    }
+    slots
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::Domain;
+
+    /// A 2D square lattice of spacing dx on a dense grid of cells 2h = 2.6 dx: away from the
+    /// edges a particle has the lattice points within 2.6 dx as neighbours (21, itself
+    /// included) and its 3 × 3 cells' particles as candidates; an excluded particle counts in
+    /// neither.
+    #[test]
+    fn a_lattice_has_the_neighbours_of_its_spacing() {
+        let (dx, h) = (0.01, 0.013);
+        let domain = Domain {
+            min: [0.0; 3],
+            max: [1.0, 1.0, 0.0],
+        };
+        let n = 100;
+        let mut pos = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                pos.push([(i as f64 + 0.5) * dx, (j as f64 + 0.5) * dx, 0.0]);
+            }
+        }
+        let count = pos.len();
+        let mut p = Particles {
+            pos,
+            vel: vec![[0.0; 3]; count],
+            rho: vec![1000.0; count],
+            pressure: vec![0.0; count],
+            kind: vec![0; count],
+            id: (0..count as u32).collect(),
+            energy: None,
+            stress: None,
+        };
+        let grid = Grid::new(&domain, h, 2, count, [false; 3]).unwrap();
+        assert!(grid.dense());
+        let w = neighbour_work(&grid, 2, h, &p);
+        // Interior: 21 lattice points within 2.6 dx; the edges have fewer.
+        assert!(w.neighbours < 21.0 && w.neighbours > 19.0, "{w:?}");
+        assert_eq!(
+            (w.fluid_candidates, w.fluid_neighbours),
+            (w.candidates, w.neighbours)
+        );
+        // 3 × 3 cells of (2.6 dx)² hold about 9 × 6.76 particles.
+        let cell_area = (2.0 * h * (1.0 + 1e-4) / dx).powi(2);
+        assert!(
+            w.candidates < 9.0 * cell_area && w.candidates > 0.8 * 9.0 * cell_area,
+            "{w:?}"
+        );
+        p.kind[50 * n + 50] = KIND_EXCLUDED;
+        let without = neighbour_work(&grid, 2, h, &p);
+        assert!(without.neighbours < w.neighbours);
+    }
+}
