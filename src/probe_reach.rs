@@ -84,10 +84,13 @@ impl Reach {
     fn new(sc: &Scenario) -> Option<Self> {
         let dim = sc.physics.dim as usize;
         let dx = sc.physics.dx;
-        let mut n = [1usize; 3];
-        for a in 0..dim {
-            n[a] = (((sc.domain.max[a] - sc.domain.min[a]) / dx).ceil() as usize).max(1);
-        }
+        let n = [0, 1, 2].map(|a| {
+            if a < dim {
+                (((sc.domain.max[a] - sc.domain.min[a]) / dx).ceil() as usize).max(1)
+            } else {
+                1
+            }
+        });
         let total = n.iter().map(|&c| c as u64).product::<u64>();
         if total > MAX_CELLS {
             return None;
