@@ -682,3 +682,80 @@ point_m = [0.12, 0.09]
         }
     }
 }
+
+/// The output folder's lock (issue 36): a live process's lock (this test's own pid) makes
+/// `run` and a resume of the folder refuse, naming the folder and the process, and leaves the
+/// lock as it was; a dead process's lock (a pid above Linux's pid_max) is taken over; after a
+/// run no lock is left.
+#[test]
+fn a_locked_output_folder_is_refused_and_a_stale_lock_taken_over() {
+    let out = temp_dir("lock");
+    std::fs::create_dir_all(&*out).unwrap();
+    let lock = out.join(".wgsph.lock");
+    let me = std::process::id().to_string();
+    let run = || {
+        wgsph()
+            .args(["run", "-q", "cases/hydrostatic_2d.toml"])
+            .args([
+                "--set",
+                "time.end_s=0.01",
+                "--checkpoint-every",
+                "0.005s",
+                "--out",
+            ])
+            .arg(&*out)
+            .output()
+            .unwrap()
+    };
+    let refused = |o: std::process::Output, what: &str| {
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{what}: {stderr}");
+        let says = format!(
+            "{} is in use by another wgsph run (process {me}",
+            out.display()
+        );
+        assert!(stderr.contains(&says), "{what}: {stderr}");
+        assert_eq!(
+            std::fs::read_to_string(&lock).unwrap(),
+            format!("{me}\n"),
+            "{what}"
+        );
+    };
+    std::fs::write(&lock, format!("{me}\n")).unwrap();
+    refused(run(), "run");
+    assert!(
+        !out.join("probes").exists(),
+        "the refused run wrote nothing"
+    );
+    std::fs::write(&lock, "4194305\n").unwrap();
+    let o = run();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("probes/height.csv").is_file());
+    let left: Vec<_> = (std::fs::read_dir(&*out).unwrap().flatten())
+        .map(|e| e.file_name())
+        .filter(|n| n.to_string_lossy().starts_with(".wgsph"))
+        .collect();
+    assert!(
+        left.is_empty(),
+        "the lock is removed when the run ends: {left:?}"
+    );
+    // A resume takes the lock before it reads the checkpoint (the CLI reads it first for the
+    // case file, and a completed run keeps none): through the library.
+    std::fs::write(&lock, format!("{me}\n")).unwrap();
+    let sc = wgsph::case::load(std::path::Path::new("cases/hydrostatic_2d.toml"), &[]).unwrap();
+    let Err(e) = wgsph::run::resume(
+        common::gpu(),
+        &sc,
+        &out,
+        &Default::default(),
+        &mut wgsph::progress::LogLines::default(),
+    ) else {
+        panic!("the resume of a locked folder went ahead");
+    };
+    let says = format!(
+        "{} is in use by another wgsph run (process {me}",
+        out.display()
+    );
+    assert!(format!("{e:#}").contains(&says), "resume: {e:#}");
+    assert_eq!(std::fs::read_to_string(&lock).unwrap(), format!("{me}\n"));
+}
