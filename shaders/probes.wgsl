@@ -65,34 +65,91 @@ fn probe_pressure(x: vec3<f32>) -> f32 {
     return s.pressure / s.volume;
 }
 
-// Free-surface height on the vertical line through x: highest point where the fluid volume
-// fraction Σ W V reaches ½, found by stepping down from the domain top by h/4 and
-// interpolating linearly.
-fn probe_height(x: vec3<f32>) -> f32 {
+// Wave gauges. The free-surface height on the vertical line through a gauge's foot x is the
+// highest point of the lattice z_k = x_up + k·h/4 (k = 0 … up to the domain top) where the
+// fluid volume fraction Σ W V reaches ½, interpolated linearly towards the point above it.
+//
+// A serial walk down that lattice from the domain top (as this once was) costs one kernel sum
+// per h/4 of air: thousands in a tall domain at a fine dx, and lavapipe (llvmpipe's gallivm)
+// silently ends every loop of an invocation after 65535 iterations in all, so a gauge read 0
+// with no warning (issue 36). The search is instead spread over the fluid particles
+// (`probe_height_search`): a lattice point where Σ W V > 0 lies within 2h of some fluid
+// particle, so each particle near the line tries the lattice points within its support,
+// from the top down, and keeps the first where Σ W V ≥ ½ (atomicMax of k + 1 in probe_out);
+// the largest over particles is the highest such point on the whole line, at a cost per
+// invocation bounded by the kernel support, whatever the domain's height. `probe_points` then
+// interpolates there (`probe_height`).
+
+const HEIGHT_STEPS_PER_H: f32 = 4.0;
+
+// The gauge's lattice point k on the line through x.
+fn height_point(x: vec3<f32>, k: u32) -> vec3<f32> {
+    var p = x;
+    p[DIM - 1u] = x[DIM - 1u] + f32(k) * (params.h / HEIGHT_STEPS_PER_H);
+    return p;
+}
+
+// The highest lattice index on the line through x: the last point at or below the domain top.
+fn height_top_index(x: vec3<f32>) -> u32 {
     let up = DIM - 1u;
-    let step = 0.25 * params.h;
-    var point = x;
-    var above_z = params.domain_size[up];
-    var above = 0.0;
-    var z = params.domain_size[up];
-    loop {
-        if (z < x[up]) {
-            return 0.0;
-        }
-        point[up] = z;
-        let v = fluid_sums(point).volume;
-        if (v >= 0.5) {
-            if (z == params.domain_size[up]) {
-                return z - x[up];
-            }
-            let t = (v - 0.5) / max(v - above, 1e-6);
-            return mix(z, above_z, t) - x[up];
-        }
-        above = v;
-        above_z = z;
-        z -= step;
+    return u32(max(floor((params.domain_size[up] - x[up]) / (params.h / HEIGHT_STEPS_PER_H)), 0.0));
+}
+
+@compute @workgroup_size(WG)
+fn probe_height_search(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles || code_kind(code[i]) != KIND_FLUID) {
+        return;
     }
-    return 0.0;
+    let up = DIM - 1u;
+    let xi = domain_pos(pos[i]);
+    let step = params.h / HEIGHT_STEPS_PER_H;
+    let support2 = 4.0 * params.h * params.h;
+    for (var k = 0u; k < params.n_probes; k++) {
+        let def = probes[k];
+        if (def.kind != PROBE_HEIGHT) {
+            continue;
+        }
+        var across = xi - def.point;
+        across[up] = 0.0;
+        let d2 = dot(across, across);
+        if (d2 >= support2) {
+            continue;
+        }
+        // The lattice points within the particle's support, one more at each end against f32
+        // rounding (a point tried needlessly costs a sum, never a wrong answer).
+        let r = sqrt(support2 - d2);
+        let rel = xi[up] - def.point[up];
+        let hi = i32(floor((rel + r) / step)) + 1;
+        let lo = max(i32(ceil((rel - r) / step)) - 1, 0);
+        var kk = min(hi, i32(height_top_index(def.point)));
+        for (; kk >= lo; kk--) {
+            // A point no higher than one already found cannot raise the answer.
+            if (u32(kk) + 1u <= atomicLoad(&probe_out[k])) {
+                break;
+            }
+            if (fluid_sums(height_point(def.point, u32(kk))).volume >= 0.5) {
+                atomicMax(&probe_out[k], u32(kk) + 1u);
+                break;
+            }
+        }
+    }
+}
+
+// The height above x of the surface `probe_height_search` found (`found`: its k + 1, 0 where
+// no point of the line reaches Σ W V = ½: a dry gauge reads 0), interpolated linearly between
+// that point and the one above it, and at most the domain top.
+fn probe_height(x: vec3<f32>, found: u32) -> f32 {
+    if (found == 0u) {
+        return 0.0;
+    }
+    let up = DIM - 1u;
+    let p = height_point(x, found - 1u);
+    let above = height_point(x, found);
+    let v = fluid_sums(p).volume;
+    let v_above = fluid_sums(above).volume;
+    let t = clamp((v - 0.5) / max(v - v_above, 1e-6), 0.0, 1.0);
+    return min(mix(p[up], above[up], t), params.domain_size[up]) - x[up];
 }
 
 // Σ_j a_j·n over the boundary particles j of a wall patch, a_j their rate (the fluid's force per
@@ -158,7 +215,7 @@ fn probe_points(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (def.kind == PROBE_PRESSURE) {
         atomicStore(&probe_out[k], bitcast<u32>(probe_pressure(def.point)));
     } else if (def.kind == PROBE_HEIGHT) {
-        atomicStore(&probe_out[k], bitcast<u32>(probe_height(def.point)));
+        atomicStore(&probe_out[k], bitcast<u32>(probe_height(def.point, atomicLoad(&probe_out[k]))));
     } else if (def.kind == PROBE_WALL_PRESSURE) {
         atomicStore(&probe_out[k], bitcast<u32>(probe_wall_force(def)));
     }

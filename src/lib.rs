@@ -13,6 +13,7 @@ pub mod layout;
 pub mod logging;
 pub mod output;
 pub mod plot;
+pub mod probe_reach;
 pub mod progress;
 pub mod reference;
 pub mod run;

@@ -292,6 +292,10 @@ pub fn run(
     progress: &mut dyn Progress,
 ) -> Result<RunReport> {
     check_capacity(ctx, sc.particles.len())?;
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create the output folder {}", dir.display()))?;
+    // Held until this returns, on every path: no second run writes here meanwhile.
+    let _lock = crate::output::DirLock::acquire(dir)?;
     remove_previous_outputs(dir)?;
     let mut runner = Runner::create(ctx, sc, dir, options)?;
     runner.outputs.write(&runner.solver)?;
@@ -313,6 +317,12 @@ pub fn resume(
     options: &RunOptions,
     progress: &mut dyn Progress,
 ) -> Result<RunReport> {
+    // Held until this returns: no other run or resume writes here meanwhile. A folder that
+    // is not there has no checkpoint either, which Checkpoint::read says.
+    let _lock = dir
+        .is_dir()
+        .then(|| crate::output::DirLock::acquire(dir))
+        .transpose()?;
     if let Some(summary) = completed_run(dir, sc) {
         log::info!(
             "{}: the run in {} is already complete (t = {:.6} s, time.end_s = {} s): nothing to \

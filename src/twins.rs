@@ -68,6 +68,7 @@ fn every_twin_is_named_as_its_wgsl_function() {
         probes::SHADER => [
             probes::probe_pressure,
             probes::probe_height,
+            probes::probe_height_search,
             probes::probe_front,
         ],
     };

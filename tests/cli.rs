@@ -576,3 +576,212 @@ fn bench_reports_throughput_and_the_stages() {
     assert!((sum - 100.0).abs() < 0.05 * stages.len() as f64, "{stdout}");
     assert_eq!(share(all), 100.0, "{stdout}");
 }
+
+/// A wave gauge in a domain tall compared with h, at 10× finer dx than the shipped
+/// hydrostatic case (issue 36): the tank 0.1 m wide and 0.6 m high (1.2 m of domain with the
+/// open top's room), 0.02 m of water, dx = 2 mm; far more cells than particles, so the grid is
+/// hashed. The gauge once walked down from the domain top by h/4 and read exactly 0 at every
+/// sample (lavapipe ends an invocation's loops after 65535 iterations); it must read the
+/// water's depth.
+#[test]
+fn a_height_gauge_reads_the_surface_of_a_tall_tank_at_a_fine_dx() {
+    let out = temp_dir("tall-gauge");
+    let o = wgsph()
+        .args(["run", "-q", "cases/hydrostatic_2d.toml"])
+        .args(["--set", "particles.dx_m=0.002"])
+        .args(["--set", "tank.max_m=[0.1, 0.6]"])
+        .args(["--set", "fluid_block[0].max_m=[0.1, 0.02]"])
+        .args(["--set", "probe[0].point_m=[0.05, 0.01]"])
+        .args(["--set", "probe[1].base_m=[0.05, 0.0]"])
+        .args(["--set", "probe[2].point_m=[0.05, 0.0]"])
+        .args(["--set", "probe[2].radius_m=0.01"])
+        .args(["--set", "time.end_s=0.001"])
+        .args(["--set", "time.probe_every_s=0.0005"])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("probes/height.csv")).unwrap();
+    let rows: Vec<f64> = (csv.lines().skip(1))
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(rows.len(), 3, "{csv}");
+    for h in rows {
+        assert!(
+            (h - 0.02).abs() < 0.002,
+            "the gauge reads {h} m over 0.02 m of water\n{csv}"
+        );
+    }
+}
+
+/// Probes that can never measure (issue 36): a pressure point and a gauge inside an obstacle
+/// that reaches the lid of a closed tank, and a pressure point inside the tank's wall. Each is
+/// named in a warning at set-up (log and run.json) and reads `nan` at every sample, never a
+/// silent 0; the probes in reach of the water read numbers.
+#[test]
+fn probes_that_cannot_measure_warn_and_read_nan() {
+    let dir = temp_dir("blind");
+    std::fs::create_dir_all(&*dir).unwrap();
+    let case = dir.join("blind.toml");
+    std::fs::write(
+        &case,
+        r#"name = "blind"
+dimension = 2
+[particles]
+dx_m = 0.005
+[physics]
+gravity_m_s2 = [0.0, -9.81]
+sound_speed_coef = 10.0
+[time]
+end_s = 0.002
+output_every_s = 1.0
+probe_every_s = 0.001
+[tank]
+min_m = [0.0, 0.0]
+max_m = [0.2, 0.1]
+open_top = false
+[[fluid_block]]
+min_m = [0.0, 0.0]
+max_m = [0.1, 0.05]
+[[obstacle]]
+min_m = [0.15, 0.0]
+max_m = [0.18, 0.1]
+[[probe]]
+name = "in_obstacle"
+kind = "pressure"
+point_m = [0.165, 0.03]
+[[probe]]
+name = "gauge_in_obstacle"
+kind = "height"
+base_m = [0.165, 0.0]
+[[probe]]
+name = "in_wall"
+kind = "pressure"
+point_m = [-0.0075, 0.05]
+[[probe]]
+name = "gauge"
+kind = "height"
+base_m = [0.05, 0.0]
+[[probe]]
+name = "air"
+kind = "pressure"
+point_m = [0.12, 0.09]
+"#,
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = wgsph()
+        .arg("run")
+        .arg(&case)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    let warnings: Vec<&str> = (summary["warnings"].as_array().unwrap().iter())
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    for (name, blind) in [
+        ("in_obstacle", true),
+        ("gauge_in_obstacle", true),
+        ("in_wall", true),
+        ("gauge", false),
+        ("air", false),
+    ] {
+        let said = format!("probe '{name}'");
+        let warned = warnings
+            .iter()
+            .any(|w| w.contains(&said) && w.contains("reads nan"));
+        assert_eq!(warned, blind, "{name}: {warnings:#?}");
+        assert_eq!(stderr.contains(&said), blind, "{name}: {stderr}");
+        let csv = std::fs::read_to_string(out.join(format!("probes/{name}.csv"))).unwrap();
+        let values: Vec<&str> = (csv.lines().skip(1))
+            .map(|l| l.split(',').nth(1).unwrap())
+            .collect();
+        assert_eq!(values.len(), 3, "{csv}");
+        for v in values {
+            assert_eq!(v == "nan", blind, "{name}: {csv}");
+        }
+    }
+}
+
+/// The output folder's lock (issue 36): a live process's lock (this test's own pid) makes
+/// `run` and a resume of the folder refuse, naming the folder and the process, and leaves the
+/// lock as it was; a dead process's lock (a pid above Linux's pid_max) is taken over; after a
+/// run no lock is left.
+#[test]
+fn a_locked_output_folder_is_refused_and_a_stale_lock_taken_over() {
+    let out = temp_dir("lock");
+    std::fs::create_dir_all(&*out).unwrap();
+    let lock = out.join(".wgsph.lock");
+    let me = std::process::id().to_string();
+    let run = || {
+        wgsph()
+            .args(["run", "-q", "cases/hydrostatic_2d.toml"])
+            .args([
+                "--set",
+                "time.end_s=0.01",
+                "--checkpoint-every",
+                "0.005s",
+                "--out",
+            ])
+            .arg(&*out)
+            .output()
+            .unwrap()
+    };
+    let refused = |o: std::process::Output, what: &str| {
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{what}: {stderr}");
+        let says = format!(
+            "{} is in use by another wgsph run (process {me}",
+            out.display()
+        );
+        assert!(stderr.contains(&says), "{what}: {stderr}");
+        assert_eq!(
+            std::fs::read_to_string(&lock).unwrap(),
+            format!("{me}\n"),
+            "{what}"
+        );
+    };
+    std::fs::write(&lock, format!("{me}\n")).unwrap();
+    refused(run(), "run");
+    assert!(
+        !out.join("probes").exists(),
+        "the refused run wrote nothing"
+    );
+    std::fs::write(&lock, "4194305\n").unwrap();
+    let o = run();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("probes/height.csv").is_file());
+    let left: Vec<_> = (std::fs::read_dir(&*out).unwrap().flatten())
+        .map(|e| e.file_name())
+        .filter(|n| n.to_string_lossy().starts_with(".wgsph"))
+        .collect();
+    assert!(
+        left.is_empty(),
+        "the lock is removed when the run ends: {left:?}"
+    );
+    // A resume takes the lock before it reads the checkpoint (the CLI reads it first for the
+    // case file, and a completed run keeps none): through the library.
+    std::fs::write(&lock, format!("{me}\n")).unwrap();
+    let sc = wgsph::case::load(std::path::Path::new("cases/hydrostatic_2d.toml"), &[]).unwrap();
+    let Err(e) = wgsph::run::resume(
+        common::gpu(),
+        &sc,
+        &out,
+        &Default::default(),
+        &mut wgsph::progress::LogLines::default(),
+    ) else {
+        panic!("the resume of a locked folder went ahead");
+    };
+    let says = format!(
+        "{} is in use by another wgsph run (process {me}",
+        out.display()
+    );
+    assert!(format!("{e:#}").contains(&says), "resume: {e:#}");
+    assert_eq!(std::fs::read_to_string(&lock).unwrap(), format!("{me}\n"));
+}

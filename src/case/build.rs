@@ -1070,7 +1070,7 @@ fn finish(
         &probes, &walls, &particles, h,
     ));
     let n_particles = particles.len();
-    Ok(Scenario {
+    let mut sc = Scenario {
         name: case.name,
         physics,
         time: case.time,
@@ -1092,7 +1092,25 @@ fn finish(
         inlets,
         outlets: case.outlets,
         warnings,
-    })
+    };
+    // Probes that can never measure: said here, and NaN in their CSV (probe_reach.rs).
+    let blind = crate::probe_reach::unmeasurable(&sc);
+    for (i, why) in blind.into_iter().enumerate() {
+        if let Some(why) = why {
+            let p = &sc.probes[i];
+            sc.warnings.push(format!(
+                "probe '{}' ({}) cannot measure: {why}; it reads nan for the whole run; fix: \
+                 move it into the fluid's reach (a pressure point in the water or the air above \
+                 it, a gauge's base_m under the water's surface)",
+                p.name,
+                match p.kind {
+                    ProbeKind::Pressure { .. } => "point_m",
+                    _ => "base_m",
+                },
+            ));
+        }
+    }
+    Ok(sc)
 }
 
 /// The physics of the scenario.

@@ -18,6 +18,7 @@
 //! ```
 
 mod atomic;
+mod lock;
 mod particle_file;
 mod probes_csv;
 mod pvd;
@@ -29,6 +30,7 @@ use std::io;
 use std::path::{Path, PathBuf};
 
 pub use atomic::write_atomic;
+pub use lock::{DirLock, LOCK_FILE};
 pub use particle_file::{particle_files, ParticleFile, Particles};
 pub use probes_csv::ProbeWriter;
 pub use run_summary::RunSummary;
@@ -89,6 +91,19 @@ pub enum OutputError {
         dir: PathBuf,
         name: String,
         reason: &'static str,
+    },
+    /// Another live run holds the output folder's lock (`lock::DirLock`).
+    #[error(
+        "{} is in use by another wgsph run (process {pid}, lock file {}): two runs into one \
+         folder would mix their files; wait for it to finish or choose another --out (if no \
+         such run is alive, remove the lock file)",
+        dir.display(),
+        lock.display()
+    )]
+    Locked {
+        dir: PathBuf,
+        pid: u32,
+        lock: PathBuf,
     },
     /// A file the engine wrote cannot be read back (`reason` says why).
     #[error("cannot read {}: {reason}", path.display())]

@@ -29,29 +29,62 @@ pub fn probe_pressure(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> f64 {
     }
 }
 
-/// Height above `base` of the highest point of the vertical line where Σ W V reaches ½,
-/// stepping down by h/4 from `top` (the domain top) and interpolating linearly.
+/// Lattice points per h on a gauge's line (`HEIGHT_STEPS_PER_H` in probes.wgsl).
+pub const HEIGHT_STEPS_PER_H: f64 = 4.0;
+
+/// The gauge's lattice point k on the vertical line through `base`: base + k·h/4.
+fn height_point(ph: &Physics, base: [f64; 3], k: usize) -> [f64; 3] {
+    let up = ph.dim as usize - 1;
+    let mut x = base;
+    x[up] += k as f64 * ph.h / HEIGHT_STEPS_PER_H;
+    x
+}
+
+/// The highest lattice index k whose point lies on the line through `base` between it and
+/// `top` (the domain top) and has Σ W V ≥ ½; None where there is none (a dry gauge). By its
+/// definition: a walk down the lattice from the highest point a fluid particle's support
+/// reaches (the GPU spreads the same search over the particles, probes.wgsl).
+pub fn probe_height_search(
+    ph: &Physics,
+    parts: &[RefParticle],
+    base: [f64; 3],
+    top: f64,
+) -> Option<usize> {
+    let up = ph.dim as usize - 1;
+    let step = ph.h / HEIGHT_STEPS_PER_H;
+    let k_top = ((top - base[up]) / step).floor().max(0.0) as usize;
+    let reach = parts
+        .iter()
+        .filter(|p| p.kind == FLUID)
+        .filter(|p| {
+            let mut d = sub(p.pos, base);
+            d[up] = 0.0;
+            dot(d, d) < 4.0 * ph.h * ph.h
+        })
+        .map(|p| p.pos[up] + 2.0 * ph.h)
+        .fold(f64::NEG_INFINITY, f64::max);
+    if reach < base[up] {
+        return None;
+    }
+    let k_reach = (((reach - base[up]) / step).floor() as usize + 1).min(k_top);
+    (0..=k_reach)
+        .rev()
+        .find(|&k| sums(ph, parts, height_point(ph, base, k)).0 >= 0.5)
+}
+
+/// Height above `base` of the surface on the vertical line through it: the point
+/// `probe_height_search` finds, interpolated linearly towards the lattice point above where
+/// Σ W V = ½, at most `top`; 0 where none is found.
 pub fn probe_height(ph: &Physics, parts: &[RefParticle], base: [f64; 3], top: f64) -> f64 {
     let up = ph.dim as usize - 1;
-    let step = 0.25 * ph.h;
-    let mut x = base;
-    let (mut above, mut above_z) = (0.0, top);
-    let mut z = top;
-    while z >= base[up] {
-        x[up] = z;
-        let v = sums(ph, parts, x).0;
-        if v >= 0.5 {
-            if z == top {
-                return z - base[up];
-            }
-            let t = (v - 0.5) / (v - above).max(1e-6);
-            return z + (above_z - z) * t - base[up];
-        }
-        above = v;
-        above_z = z;
-        z -= step;
-    }
-    0.0
+    let Some(k) = probe_height_search(ph, parts, base, top) else {
+        return 0.0;
+    };
+    let (x, above) = (height_point(ph, base, k), height_point(ph, base, k + 1));
+    let v = sums(ph, parts, x).0;
+    let v_above = sums(ph, parts, above).0;
+    let t = ((v - 0.5) / (v - v_above).max(1e-6)).clamp(0.0, 1.0);
+    (x[up] + (above[up] - x[up]) * t).min(top) - base[up]
 }
 
 /// max over fluid of (x − origin)·axis (axis normalised).

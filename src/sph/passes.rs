@@ -114,7 +114,17 @@ impl Passes {
                     Bodies::new(device, &shader(&bodies::SHADER)?, b, motions, base)
                 })
                 .transpose()?,
-            probes: Probes::new(device, &probe_module, b, &sc.probes, defs, ph.particle_mass)?,
+            probes: Probes::new(
+                device,
+                &probe_module,
+                b,
+                &sc.probes,
+                defs,
+                ph.particle_mass,
+                (crate::probe_reach::unmeasurable(sc).iter())
+                    .map(Option::is_some)
+                    .collect(),
+            )?,
             points: PointTracker::new(device, &probe_module, b, &sc.points)?,
         })
     }

@@ -138,10 +138,13 @@ pub fn decode_ordered(bits: u32) -> f32 {
 pub struct Probes {
     points: ParityKernel,
     front: ParityKernel,
+    height: ParityKernel,
     kinds: Vec<u32>,
     /// What a probe's word is multiplied by: −m/area for wall pressures (the GPU sums the
     /// boundary particles' rates along the normal), 1 otherwise.
     scales: Vec<f64>,
+    /// The probes that cannot measure ([`crate::probe_reach::unmeasurable`]): they read NaN.
+    blind: Vec<bool>,
     n: u32,
 }
 
@@ -153,10 +156,12 @@ impl Probes {
         probes: &[Probe],
         defs: &[ProbeDef],
         particle_mass: f64,
+        blind: Vec<bool>,
     ) -> Result<Self> {
         Ok(Self {
             points: ParityKernel::new(device, module, "probe_points", |p| b.at(p))?,
             front: ParityKernel::new(device, module, "probe_front", |p| b.at(p))?,
+            height: ParityKernel::new(device, module, "probe_height_search", |p| b.at(p))?,
             kinds: defs.iter().map(|d| d.kind).collect(),
             scales: probes
                 .iter()
@@ -165,6 +170,7 @@ impl Probes {
                     _ => 1.0,
                 })
                 .collect(),
+            blind,
             n: b.n,
         })
     }
@@ -180,6 +186,11 @@ impl Probes {
             label: Some("probes"),
             timestamp_writes: None,
         });
+        // The gauges' search over the particles first: `probe_points` interpolates where it
+        // found the surface (probes.wgsl).
+        if self.kinds.contains(&PROBE_HEIGHT) {
+            self.height.dispatch(&mut pass, p, self.n);
+        }
         self.points.dispatch(&mut pass, p, self.kinds.len() as u32);
         if self.kinds.contains(&PROBE_FRONT) {
             self.front.dispatch(&mut pass, p, self.n);
@@ -192,8 +203,11 @@ impl Probes {
             .iter()
             .zip(&self.scales)
             .zip(raw)
-            .map(|((&k, &scale), &w)| {
-                if k == PROBE_FRONT {
+            .zip(&self.blind)
+            .map(|(((&k, &scale), &w), &blind)| {
+                if blind {
+                    f64::NAN
+                } else if k == PROBE_FRONT {
                     decode_ordered(w) as f64
                 } else {
                     scale * f32::from_bits(w) as f64
