@@ -411,17 +411,19 @@ struct Runner<'a> {
 }
 
 /// The weakly-compressible check of a run ([`DensityVariation`]) over each probe interval
-/// against `time.density_variation_warn`.
+/// against `time.density_variation_warn` and `_stop`.
 #[derive(Clone, Copy, Debug)]
 struct DensityWatch {
     warn: f64,
+    stop: f64,
     /// The largest variation so far and the end of the probe interval it was seen in.
     max: (f64, f64),
     /// When the fluid last went beyond `warn` (None while within it), and the largest share
     /// of it beyond since.
     beyond: Option<(f64, f64)>,
-    /// The end of the last probe interval within `warn`: a run stopped unstable keeps its
-    /// outputs up to here.
+    /// The end of the last probe interval that was sound (the fluid within `warn`, and no
+    /// particle of it beyond `stop`: a blow-up can start in a few particles): a run stopped
+    /// unstable keeps its outputs up to here.
     last_sound_s: f64,
     /// How many times the fluid went beyond `warn`.
     episodes: u32,
@@ -431,6 +433,7 @@ impl DensityWatch {
     fn new(sc: &Scenario, t0: f64) -> Self {
         Self {
             warn: sc.time.density_variation_warn,
+            stop: sc.time.density_variation_stop,
             max: (0.0, t0),
             beyond: None,
             last_sound_s: t0,
@@ -489,7 +492,7 @@ impl DensityWatch {
             }
             (false, None) => {}
         }
-        if !d.beyond_warn() {
+        if !d.beyond_warn() && d.max <= self.stop {
             self.last_sound_s = t;
         }
     }
@@ -691,9 +694,9 @@ impl<'a> Runner<'a> {
         })
     }
 
-    /// A run stopped unstable: drops the outputs after the last probe interval whose density
-    /// stayed within `time.density_variation_warn` (particle files, PNGs, probe and body rows),
-    /// which already show the instability. Says what it dropped.
+    /// A run stopped unstable: drops the outputs after the last sound probe interval
+    /// ([`DensityWatch::last_sound_s`]: particle files, PNGs, probe and body rows), which
+    /// already show the instability. Says what it dropped.
     fn keep_sound_outputs(&mut self) -> Result<Option<String>> {
         let t = self.density.last_sound_s;
         let dropped = self.outputs.out.truncate_after(t)?;
@@ -709,12 +712,14 @@ impl<'a> Runner<'a> {
         }
         self.probes.truncate_after(t);
         self.bodies.csv.truncate_after(t);
-        Ok(self.density.beyond.map(|(since, _)| {
+        Ok((t < self.solver.time()).then(|| {
             format!(
-                " (the density went beyond ±{:.1} % at t = {since:.4} s: {} particle output(s) \
-                 and the probe rows after t = {t:.6} s, the last state within it, were removed)",
+                " ({} particle output(s) and the probe rows after t = {t:.6} s, the last sound \
+                 state (within ±{:.1} % of ρ0 but for at most 1 % of the fluid, none beyond \
+                 ±{:.1} %), were removed)",
+                dropped.len(),
                 100.0 * self.density.warn,
-                dropped.len()
+                100.0 * self.density.stop
             )
         }))
     }

@@ -141,10 +141,10 @@ fn a_run_beyond_the_weakly_compressible_limit_warns_and_completes() {
 }
 
 /// The same run with the stop at 8 %: it stops at the impact (t ≈ 0.27 s) with a message
-/// naming the limit and the fix, and keeps only the outputs up to the last probe interval
-/// within the warning limit: every particle file it keeps has at most 1 % of its fluid beyond
-/// 4 %, the output of t = 0.27 s written before the stop is gone, and so are the probe rows
-/// after the last sound time.
+/// naming the limit and the fix, and keeps only the outputs up to the last sound probe
+/// interval: every particle file it keeps has at most 1 % of its fluid beyond 4 % and none
+/// beyond 8 %, the output of t = 0.27 s written before the stop is gone, and so are the probe
+/// rows after the last sound time.
 #[test]
 fn a_run_far_beyond_the_limit_stops_and_keeps_only_sound_outputs() {
     let dir = common::Scratch::new("density-stop");
@@ -180,6 +180,8 @@ fn a_run_far_beyond_the_limit_stops_and_keeps_only_sound_outputs() {
             "t = {t} s: {:.1} % of the fluid beyond 4 %",
             100.0 * share
         );
+        // No particle beyond the stop limit either (a blow-up can start in a few).
+        assert_eq!(share_beyond(&dir.join(file), 0.08), 0.0, "t = {t} s");
     }
     // No file of the series is left beyond the ones listed.
     let files = std::fs::read_dir(dir.join("particles")).unwrap().count();

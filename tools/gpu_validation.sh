@@ -45,7 +45,7 @@ command_of() {
     info) echo "$wgsph info" ;;
     # DualSPHysics' performance case at its published sizes (docs/performance.md).
     bench_spheric2) echo "$wgsph bench cases/bench_spheric2.toml --steps 500 --stages" ;;
-    bench_spheric2_1M) echo "$wgsph bench cases/bench_spheric2.toml --set particles.dx_m=0.0123 --steps 300" ;;
+    bench_spheric2_1M) echo "$wgsph bench cases/bench_spheric2.toml --set particles.dx_m=0.0114 --steps 300" ;;
     bench_dam_break_3d) echo "$wgsph bench cases/dam_break_3d.toml --steps 500 --stages" ;;
     # 1.05 M particles: bytes per particle and throughput at scale.
     bench_dam_break_3d_1M) echo "$wgsph bench cases/dam_break_3d.toml --set particles.dx_m=0.01 --steps 300" ;;
