@@ -84,11 +84,8 @@ fn slots_around(grid: &Grid, dim: u32, c: [i64; 3]) -> Vec<u32> {
             for dx in -1..=1 {
                 let mut n = [c[0] + dx, c[1] + dy, c[2] + dz];
                 if grid.dense() {
-                    // Rows inside the grid only; a row's x range is clamped to it.
-                    if n[1] < 0 || n[1] >= g[1] || n[2] < 0 || n[2] >= g[2] {
-                        continue;
-                    }
-                    if n[0] < 0 || n[0] >= g[0] {
+                    // Rows inside the grid only, each clamped to it.
+                    if (0..3).any(|a| n[a] < 0 || n[a] >= g[a]) {
                         continue;
                     }
                 } else {

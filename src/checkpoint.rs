@@ -102,8 +102,10 @@ pub struct OutputState {
     pub body_tables: Vec<String>,
     /// Wall time spent so far [s].
     pub wall_s: f64,
-    /// The fluid's largest density variation so far and when it was seen [s].
+    /// The fluid's largest density variation so far and when it was seen [s], and how many
+    /// times the fluid went beyond `time.density_variation_warn` (run.json's warning).
     pub max_density_variation: (f64, f64),
+    pub density_episodes: u32,
 }
 
 /// Everything needed to continue a run.
@@ -137,6 +139,8 @@ struct Header {
     policy: Option<CheckpointPolicy>,
     #[serde(default)]
     max_density_variation: (f64, f64),
+    #[serde(default)]
+    density_episodes: u32,
     /// For people reading the header; `time_bits` is what resumes.
     time_s: f64,
     time_bits: u64,
@@ -257,6 +261,7 @@ impl Checkpoint {
             adapter: self.adapter.clone(),
             policy: self.policy,
             max_density_variation: o.max_density_variation,
+            density_episodes: o.density_episodes,
             time_s: self.time_s,
             time_bits: self.time_s.to_bits(),
             wall_s: o.wall_s,
@@ -379,6 +384,7 @@ impl Checkpoint {
                 body_tables: h.body_tables,
                 wall_s: h.wall_s,
                 max_density_variation: h.max_density_variation,
+                density_episodes: h.density_episodes,
             },
             solver: SolverState {
                 parity: h.parity,
@@ -473,6 +479,7 @@ mod tests {
                 probe_tables: vec!["t_s,pressure_pa\n0,1.5\n".into()],
                 body_tables: vec![],
                 max_density_variation: (0.021, 0.15),
+                density_episodes: 2,
                 wall_s: 12.5,
             },
             solver: SolverState {

@@ -374,8 +374,11 @@ pub fn resume(
     runner.next_output = o.next_output_s;
     runner.wall_before = o.wall_s;
     runner.last_checkpoint = Some(ck.time_s);
-    runner.density = DensityWatch::new(sc, ck.time_s);
-    runner.density.max = o.max_density_variation;
+    runner.density = DensityWatch {
+        max: o.max_density_variation,
+        episodes: o.density_episodes,
+        ..DensityWatch::new(sc, ck.time_s)
+    };
     runner.next_checkpoint_sim = options
         .checkpoint
         .every_sim_s
@@ -453,15 +456,18 @@ impl DensityWatch {
     /// impact can take a run across the limit and back several times; the summary counts).
     fn observe(&mut self, name: &str, d: DensityVariation, t: f64) {
         self.record_max(d, t);
-        let first = self.episodes <= 1;
+        // The first crossing and return are logged; later ones at debug level.
+        let level = |first: u32, loud| {
+            if self.episodes <= first {
+                loud
+            } else {
+                log::Level::Debug
+            }
+        };
         match (d.beyond_warn(), self.beyond) {
             (true, None) => {
                 log::log!(
-                    if self.episodes == 0 {
-                        log::Level::Warn
-                    } else {
-                        log::Level::Debug
-                    },
+                    level(0, log::Level::Warn),
                     "{name}: at t = {t:.4} s {:.1} % of the fluid's particles are more than \
                      time.density_variation_warn = {:.1} % from ρ0 (up to {:.1} %), beyond the \
                      weakly-compressible limit: raise physics.sound_speed_coef (c0 at least 10 \
@@ -478,11 +484,7 @@ impl DensityWatch {
             }
             (false, Some((since, share))) => {
                 log::log!(
-                    if first {
-                        log::Level::Info
-                    } else {
-                        log::Level::Debug
-                    },
+                    level(1, log::Level::Info),
                     "{name}: at t = {t:.4} s the fluid is back within ±{:.1} % of ρ0 (beyond it \
                      since t = {since:.4} s, with up to {:.1} % of its particles)",
                     100.0 * self.warn,
@@ -815,6 +817,7 @@ impl<'a> Runner<'a> {
                 body_tables: self.bodies.csv.texts(),
                 wall_s: self.wall_before + self.started.elapsed().as_secs_f64(),
                 max_density_variation: self.density.max,
+                density_episodes: self.density.episodes,
             },
             solver: self.solver.save_state()?,
         };

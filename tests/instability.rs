@@ -59,13 +59,17 @@ fn unstable_run_stops_with_step_time_and_keeps_outputs() {
     assert!(dir.join("particles/particles_000000.vtu").is_file());
 }
 
-/// The 2D dam break, coarse (800 fluid particles), with `set` over it, run into `dir`.
-fn dam_break(dir: &std::path::Path, set: &[&str]) -> wgsph::run::RunReport {
+/// The 2D dam break, coarse (800 fluid particles), with `set` over it.
+fn dam_break_case(set: &[&str]) -> Scenario {
     let mut overrides = vec!["particles.dx_m=0.0073", "time.end_s=0.4"];
     overrides.extend_from_slice(set);
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let sc =
-        wgsph::case::load(std::path::Path::new("cases/dam_break_2d.toml"), &overrides).unwrap();
+    wgsph::case::load(std::path::Path::new("cases/dam_break_2d.toml"), &overrides).unwrap()
+}
+
+/// [`dam_break_case`] run into `dir`.
+fn dam_break(dir: &std::path::Path, set: &[&str]) -> wgsph::run::RunReport {
+    let sc = dam_break_case(set);
     wgsph::run::run(
         gpu(),
         &sc,
@@ -212,4 +216,36 @@ fn a_run_with_too_slow_a_sound_speed_stops_at_once() {
         "{msg}"
     );
     assert!(report.summary.simulated_time_s < 0.01, "{msg}");
+}
+
+/// The same run halted after the impact (t = 0.35 s) and resumed: the resumed run's run.json
+/// still says the fluid went beyond the limit, with the largest variation of the first part.
+#[test]
+fn a_resumed_run_remembers_the_density_beyond_the_limit() {
+    let dir = common::Scratch::new("density-resume");
+    let sc = dam_break_case(&[
+        "physics.sound_speed_coef=5",
+        "time.density_variation_warn=0.04",
+        "time.density_variation_stop=0.5",
+    ]);
+    let halted = wgsph::run::RunOptions {
+        halt_at_s: Some(0.35),
+        ..Default::default()
+    };
+    let mut progress = wgsph::progress::LogLines::default();
+    let first = wgsph::run::run(gpu(), &sc, &dir, &halted, &mut progress).unwrap();
+    assert!(first.interrupted_at_s.is_some());
+    let max = first.summary.max_density_variation.unwrap();
+    assert!(max > 0.04, "largest density variation {max}");
+    let done = wgsph::run::resume(gpu(), &sc, &dir, &Default::default(), &mut progress).unwrap();
+    assert_eq!(done.summary.status, "completed");
+    assert_eq!(done.summary.max_density_variation, Some(max));
+    assert!(
+        done.summary
+            .warnings
+            .iter()
+            .any(|w| w.contains("time.density_variation_warn = 4.0 %")),
+        "{:?}",
+        done.summary.warnings
+    );
 }
