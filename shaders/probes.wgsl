@@ -9,6 +9,9 @@ struct ProbeDef {
     axis: vec3<f32>,    // unit vector: a front's direction, a wall patch's normal (into the fluid)
     radius: f32,        // a wall patch's radius across its normal
     face: u32,          // a fixed wall patch's face (WallSensor::face_id), else NO_FACE
+    bins: u32,          // a continuous front's first word in front_bins
+    words: u32,         // its words of bin bits (the end follows them)
+    bin_width: f32,     // its bin width along the axis (2h)
 }
 
 const NO_FACE: u32 = 0xFFFFFFFFu;
@@ -17,6 +20,7 @@ const PROBE_PRESSURE: u32 = 0u;
 const PROBE_HEIGHT: u32 = 1u;
 const PROBE_FRONT: u32 = 2u;
 const PROBE_WALL_PRESSURE: u32 = 3u;
+const PROBE_FRONT_CONTINUOUS: u32 = 4u;
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;
@@ -25,6 +29,7 @@ const PROBE_WALL_PRESSURE: u32 = 3u;
 @group(0) @binding(5) var<storage, read> probes: array<ProbeDef>;
 @group(0) @binding(6) var<storage, read_write> probe_out: array<atomic<u32>>;
 @group(0) @binding(9) var<storage, read> rate: array<vec4<f32>>;
+@group(0) @binding(10) var<storage, read_write> front_bins: array<atomic<u32>>;
 
 struct KernelSums {
     volume: f32,        // Σ_j W V_j over fluid (the Shepard denominator)
@@ -229,6 +234,22 @@ fn ordered_bits(f: f32) -> u32 {
 
 // Front probes: max over fluid of (x − origin)·axis. The host zeroes `probe_out` first
 // (0 is below every ordered value).
+//
+// A continuous front is the largest reach of the water that extends from the origin along
+// the axis without a gap: the fluid's reaches ≥ 0 are binned in widths of the kernel support
+// 2h (one bit a bin, set here), `probe_front_walk` finds the last bin of the first run of wet
+// bins, and `probe_front_continuous` takes the largest reach up to it. Two fluid particles
+// whose reaches differ by more than 2h cannot be neighbours, so an empty bin is a gap no
+// particle bridges: a droplet at least 4h ahead of the tongue is never counted, one less than
+// 2h ahead always is.
+fn front_bin(def: ProbeDef, reach: f32) -> u32 {
+    return u32(floor(reach / def.bin_width));
+}
+
+fn in_front_bins(def: ProbeDef, reach: f32) -> bool {
+    return reach >= 0.0 && reach < f32(def.words * 32u) * def.bin_width;
+}
+
 @compute @workgroup_size(WG)
 fn probe_front(
     @builtin(global_invocation_id) gid: vec3<u32>,
@@ -244,12 +265,81 @@ fn probe_front(
     }
     for (var k = 0u; k < params.n_probes; k++) {
         let def = probes[k];
+        let reach_k = dot(x - def.point, def.axis);
+        if (def.kind == PROBE_FRONT_CONTINUOUS) {
+            if (fluid && in_front_bins(def, reach_k)) {
+                let b = front_bin(def, reach_k);
+                atomicOr(&front_bins[def.bins + b / 32u], 1u << (b % 32u));
+            }
+            continue;
+        }
         if (def.kind != PROBE_FRONT) {
             continue;
         }
-        let reach = select(-3.0e38, dot(x - def.point, def.axis), fluid);
+        let reach = select(-3.0e38, reach_k, fluid);
         let largest = workgroup_max(li, vec3<f32>(reach, 0.0, 0.0));
         if (li == 0u) {
+            atomicMax(&probe_out[k], ordered_bits(largest.x));
+        }
+    }
+}
+
+// One invocation a continuous front: the end of its first run of wet bins, stored after its
+// bits as the number of bins up to it (0: no fluid binned). A word at a time: a probe's words
+// stay below lavapipe's 65535 loop iterations (`FrontBins`).
+@compute @workgroup_size(WG)
+fn probe_front_walk(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let k = gid.x;
+    if (k >= params.n_probes || probes[k].kind != PROBE_FRONT_CONTINUOUS) {
+        return;
+    }
+    let def = probes[k];
+    var wet = false;
+    var end = 0u;
+    for (var w = 0u; w < def.words; w++) {
+        let bits = atomicLoad(&front_bins[def.bins + w]);
+        var dry = ~bits;
+        if (!wet) {
+            if (bits == 0u) {
+                continue;
+            }
+            wet = true;
+            // Only the dry bins above the first wet one end the run.
+            dry &= ~0u << countTrailingZeros(bits);
+        }
+        if (dry != 0u) {
+            end = w * 32u + countTrailingZeros(dry);
+            break;
+        }
+        end = (w + 1u) * 32u;
+    }
+    atomicStore(&front_bins[def.bins + def.words], end);
+}
+
+@compute @workgroup_size(WG)
+fn probe_front_continuous(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    let i = linear_index(gid, nwg);
+    var fluid = false;
+    var x = vec3<f32>(0.0);
+    if (i < params.n_particles) {
+        fluid = code_kind(code[i]) == KIND_FLUID;
+        x = domain_pos(pos[i]);
+    }
+    for (var k = 0u; k < params.n_probes; k++) {
+        let def = probes[k];
+        if (def.kind != PROBE_FRONT_CONTINUOUS) {
+            continue;
+        }
+        let reach_k = dot(x - def.point, def.axis);
+        let end = atomicLoad(&front_bins[def.bins + def.words]);
+        let counted = fluid && in_front_bins(def, reach_k) && front_bin(def, reach_k) < end;
+        let reach = select(-3.0e38, reach_k, counted);
+        let largest = workgroup_max(li, vec3<f32>(reach, 0.0, 0.0));
+        if (li == 0u && largest.x > -1.0e38) {
             atomicMax(&probe_out[k], ordered_bits(largest.x));
         }
     }

@@ -176,7 +176,11 @@ pub struct ProbeDef {
     pub radius: f32,
     /// A wall-pressure probe's face on a fixed wall (`WallSensor::face_id`), else `NO_FACE`.
     pub face: u32,
-    pub pad: [u32; 3],
+    /// A continuous front's first word in `front_bins` (its `words` of bits, then the end).
+    pub bins: u32,
+    pub words: u32,
+    /// A continuous front's bin width along its axis.
+    pub bin_width: f32,
 }
 
 /// `ProbeDef::face` of a probe that is not a fixed wall's sensor.
@@ -655,7 +659,7 @@ mod tests {
             &probes::SHADER,
             "ProbeDef",
             ProbeDef,
-            [point, kind, axis, radius, face]
+            [point, kind, axis, radius, face, bins, words, bin_width]
         );
         check_layout!(
             &interaction::SHADER,

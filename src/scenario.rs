@@ -206,8 +206,15 @@ pub enum ProbeKind {
     /// Water height along the vertical line through `base` (a wave gauge): highest fluid
     /// particle near the line, measured from `base`'s vertical coordinate.
     Height { base: [f64; 3] },
-    /// Surge front: largest (x − origin)·axis over fluid particles.
-    Front { origin: [f64; 3], axis: [f64; 3] },
+    /// Surge front: largest (x − origin)·axis over fluid particles, or with `continuous` over
+    /// the water that reaches along the axis from the origin without a gap: fluid projected
+    /// onto the axis in bins of the kernel support 2h, the front ends at the first empty bin
+    /// past the first wet one, so a droplet more than 2h–4h ahead of the tongue does not count.
+    Front {
+        origin: [f64; 3],
+        axis: [f64; 3],
+        continuous: bool,
+    },
     /// Pressure on a patch of wall, as a transducer reads it: the fluid's force on the wall's
     /// boundary particles whose columns lie within `radius` of `point` (measured across
     /// `normal`, from 3h behind the face to h in front of it), along −`normal`, divided by the

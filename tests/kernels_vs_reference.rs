@@ -600,6 +600,7 @@ fn probes_match_reference() {
                 kind: ProbeKind::Front {
                     origin: [0.01, 0.02, 0.0],
                     axis,
+                    continuous: false,
                 },
                 body: None,
             },
@@ -714,6 +715,137 @@ fn height_probes_match_reference_in_a_tall_domain() {
                 "dim {dim} gauge {k}: {cpu} m, the water is {depth} m deep"
             );
         }
+    }
+}
+
+/// Continuous fronts (issue 36): a jittered block of water on a floor with two droplets ahead
+/// of it along x, the first 1.5h past the block (within the kernel support: part of the
+/// water), the second 6h past the first (beyond it). The plain front reads the second droplet;
+/// the continuous front, along x and along a tilted axis, the first, as the twin does.
+#[test]
+fn continuous_fronts_leave_out_droplets_ahead_of_the_water() {
+    for dim in [2u32, 3] {
+        let dx = 0.01;
+        let up = dim as usize - 1;
+        let ph = physics(dim, dx, 15.0);
+        let h = ph.h;
+        let mut rng = Rng(21 + dim as u64);
+        let (length, depth) = (0.2, 0.06);
+        let mut max = [0.05; 3];
+        max[0] = length;
+        max[up] = depth;
+        if dim == 2 {
+            max[2] = 0.0;
+        }
+        let mut parts: Vec<Particle> = lattice(dim, dx, [0.0; 3], max)
+            .into_iter()
+            .map(|p| {
+                let wall = p[up] < 2.0 * dx;
+                let mut pos = p;
+                if !wall {
+                    for x in pos.iter_mut().take(dim as usize) {
+                        *x += rng.range(-0.2, 0.2) * dx;
+                    }
+                }
+                Particle {
+                    pos,
+                    vel: [0.0; 3],
+                    rho: 1000.0,
+                    kind: if wall { Kind::Wall } else { Kind::Fluid },
+                }
+            })
+            .collect();
+        let block_end = (parts.iter())
+            .filter(|p| p.kind == Kind::Fluid)
+            .map(|p| p.pos[0])
+            .fold(f64::MIN, f64::max);
+        let mut droplet = |x: f64| {
+            let mut pos = [0.02; 3];
+            pos[0] = x;
+            pos[up] = 3.0 * dx;
+            if dim == 2 {
+                pos[2] = 0.0;
+            }
+            parts.push(Particle {
+                pos,
+                vel: [0.0; 3],
+                rho: 1000.0,
+                kind: Kind::Fluid,
+            });
+        };
+        let near = block_end + 1.5 * h;
+        let far = near + 6.0 * h;
+        droplet(near);
+        droplet(far);
+        let mut tilted = [1.0, -0.3, 0.2];
+        if dim == 2 {
+            tilted[2] = 0.0;
+        }
+        let fronts = [
+            ([1.0, 0.0, 0.0], false),
+            ([1.0, 0.0, 0.0], true),
+            (tilted, true),
+        ];
+        let probes = (fronts.iter().enumerate())
+            .map(|(k, &(axis, continuous))| Probe {
+                name: format!("f{k}"),
+                kind: ProbeKind::Front {
+                    origin: [0.0; 3],
+                    axis,
+                    continuous,
+                },
+                body: None,
+            })
+            .collect();
+        let (mut dmin, mut dmax) = ([-0.05; 3], [0.5; 3]);
+        if dim == 2 {
+            (dmin[2], dmax[2]) = (0.0, 0.0);
+        }
+        let sc = scenario(
+            ph,
+            parts,
+            Domain {
+                min: dmin,
+                max: dmax,
+            },
+            probes,
+        );
+        let solver = Solver::new(gpu(), &sc).unwrap();
+        let (parts, _) = gpu_particles_and_codes(&solver);
+        let gpu_values = solver.sample_probes().unwrap();
+        let cpu: Vec<f64> = (fronts.iter())
+            .map(|&(axis, continuous)| {
+                if continuous {
+                    let n_bins = 1 << 16;
+                    reference::probes::probe_front_continuous(
+                        &parts,
+                        [0.0; 3],
+                        axis,
+                        2.0 * h,
+                        n_bins,
+                    )
+                } else {
+                    reference::probes::probe_front(&parts, [0.0; 3], axis)
+                }
+            })
+            .collect();
+        println!("dim {dim}: GPU {gpu_values:?} CPU {cpu:?}; droplets at {near}, {far}");
+        for k in 0..fronts.len() {
+            assert!((gpu_values[k] - cpu[k]).abs() < 1e-5, "dim {dim} front {k}");
+        }
+        assert!(
+            (cpu[0] - far).abs() < 1e-9,
+            "the plain front is the far droplet"
+        );
+        assert!(
+            (cpu[1] - near).abs() < 1e-9,
+            "the continuous front is the near droplet"
+        );
+        let tilted_plain = reference::probes::probe_front(&parts, [0.0; 3], tilted);
+        assert!(
+            cpu[2] < tilted_plain - 4.0 * h,
+            "the tilted continuous front stops short of the far droplet"
+        );
     }
 }
 

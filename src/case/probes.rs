@@ -86,6 +86,7 @@ pub(super) fn probe(
                     &p.axis,
                     "the direction of the surge, e.g. [1.0, 0.0]",
                 )?,
+                continuous: p.continuous.unwrap_or(false),
             }
         }
         ProbeName::WallPressure => wall_pressure(ctx, &path, p, dim)?,
@@ -131,9 +132,15 @@ fn check_probe_fields(
     let present = fields
         .iter()
         .map(|(field, value)| (*field, value.is_some()))
-        .chain([("radius_m", p.radius_m.is_some())]);
+        .chain([
+            ("radius_m", p.radius_m.is_some()),
+            ("continuous", p.continuous.is_some()),
+        ]);
     for (field, value) in present {
         let f = format!("{path}.{field}");
+        if field == "continuous" && p.kind == ProbeName::Front {
+            continue; // optional: the furthest particle by default
+        }
         match (needs.contains(&field), value) {
             (true, false) => {
                 let add = if field == "radius_m" {

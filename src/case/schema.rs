@@ -351,6 +351,8 @@ pub(super) struct RawProbe {
     pub base_m: Option<Vec<f64>>,
     pub origin_m: Option<Vec<f64>>,
     pub axis: Option<Vec<f64>>,
+    /// A front probe that follows the continuous water rather than the furthest particle.
+    pub continuous: Option<bool>,
     /// A wall-pressure probe's face normal, into the fluid.
     pub normal: Option<Vec<f64>>,
     /// A wall-pressure probe's radius across its normal.
@@ -925,6 +927,12 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "probe[].axis",
         "the direction of a front probe",
         "axis = [1.0, 0.0]",
+    ),
+    f(
+        "probe[].continuous",
+        "whether a front probe follows the continuous water (true) or the furthest fluid \
+         particle (false, the default)",
+        "continuous = true",
     ),
     f(
         "probe[].normal",

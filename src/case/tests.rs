@@ -338,6 +338,14 @@ fn dam_break_2d_builds() {
         s.probes[0].kind,
         ProbeKind::Front {
             axis: [1.0, 0.0, 0.0],
+            continuous: false,
+            ..
+        }
+    ));
+    assert!(matches!(
+        s.probes[1].kind,
+        ProbeKind::Front {
+            continuous: true,
             ..
         }
     ));
@@ -1001,6 +1009,15 @@ fn options_that_do_not_go_together() {
         &[],
         Some(25),
         &["probe[0].axis", "non-zero"],
+    );
+    assert_err(
+        &base_with(
+            "point_m = [0.5, 0.05]",
+            "point_m = [0.5, 0.05]\ncontinuous = true",
+        ),
+        &[],
+        Some(25),
+        &["probe[0].continuous", "not used by a \"pressure\" probe"],
     );
     assert_err(
         &base_with("name = \"P1\"", "name = \"P 1\""),

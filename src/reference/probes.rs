@@ -97,6 +97,35 @@ pub fn probe_front(parts: &[RefParticle], origin: [f64; 3], axis: [f64; 3]) -> f
         .fold(f64::NEG_INFINITY, f64::max)
 }
 
+/// Continuous front (probes.wgsl, `probe_front_walk`): the largest reach ≥ 0 of the fluid in
+/// the first run of wet bins of `width` along `axis` from `origin` (`n_bins` of them); NaN
+/// without fluid in the bins.
+pub fn probe_front_continuous(
+    parts: &[RefParticle],
+    origin: [f64; 3],
+    axis: [f64; 3],
+    width: f64,
+    n_bins: usize,
+) -> f64 {
+    let n = dot(axis, axis).sqrt();
+    let reaches: Vec<f64> = (parts.iter())
+        .filter(|p| p.kind == FLUID)
+        .map(|p| dot(sub(p.pos, origin), axis) / n)
+        .filter(|&r| r >= 0.0 && r < n_bins as f64 * width)
+        .collect();
+    let mut wet = vec![false; n_bins];
+    for r in &reaches {
+        wet[(r / width).floor() as usize] = true;
+    }
+    let Some(first) = wet.iter().position(|&w| w) else {
+        return f64::NAN;
+    };
+    let end = (first..n_bins).find(|&b| !wet[b]).unwrap_or(n_bins);
+    (reaches.iter())
+        .filter(|&&r| ((r / width).floor() as usize) < end)
+        .fold(f64::NAN, |m, &r| m.max(r))
+}
+
 /// Pressure on a wall patch: −m Σ_j a_j·n / area over the patch's boundary particles j
 /// (`WallPatch`), a_j their rates from `interaction::rates` with `walls.reactions`; a fixed
 /// wall's particle that belongs to a sensor of another face (`WallParams::sensor_of`) is left

@@ -58,7 +58,9 @@ const EMPTY_PROBES: [ProbeDef; 1] = [ProbeDef {
     axis: [0.0; 3],
     radius: 0.0,
     face: crate::layout::NO_FACE,
-    pad: [0; 3],
+    bins: 0,
+    words: 0,
+    bin_width: 0.0,
 }];
 
 /// How many entries each fixed table of `CaseTables` (shaders/lib/common.wgsl) has: the case's

@@ -119,6 +119,8 @@ pub struct Solver {
     attached_probes: Option<(Vec<crate::scenario::Probe>, Vec<[f64; 3]>)>,
     /// Each probe's face on a fixed wall (`probes::probe_faces`).
     probe_faces: Vec<u32>,
+    /// The continuous fronts' bins (`probes::FrontBins`).
+    front_bins: probes::FrontBins,
     bodies: Option<HostBodies>,
     parity: usize,
     t_base: f64,
@@ -155,7 +157,8 @@ impl Solver {
         // reach `faults`.
         let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let probe_faces = probes::probe_faces(&sc.probes, &sc.walls);
-        let defs = probes::probe_defs(&sc.probes, grid.origin, &probe_faces);
+        let front_bins = probes::FrontBins::new(&grid, ph.h, &sc.probes)?;
+        let defs = probes::probe_defs(&sc.probes, grid.origin, &probe_faces, front_bins);
         let packed = initial::pack(sc, &grid);
         let body_motions = bodies::initial_motions(sc, params.body_id_base);
         let solid = initial::solid_states(sc)?;
@@ -208,6 +211,7 @@ impl Solver {
             energy: ph.energy,
             n_solid: solid.len() as u32,
             probe_faces,
+            front_bins,
             attached_probes: sc.probes.iter().any(|p| p.body.is_some()).then(|| {
                 (
                     sc.probes.clone(),
@@ -589,7 +593,12 @@ impl Solver {
                     None => p.clone(),
                 })
                 .collect();
-            let defs = probes::probe_defs(&placed, self.grid.origin, &self.probe_faces);
+            let defs = probes::probe_defs(
+                &placed,
+                self.grid.origin,
+                &self.probe_faces,
+                self.front_bins,
+            );
             self.queue
                 .write_buffer(&self.buffers.probes, 0, bytemuck::cast_slice(&defs));
         }

@@ -23,6 +23,57 @@ pub const PROBE_PRESSURE: u32 = 0;
 pub const PROBE_HEIGHT: u32 = 1;
 pub const PROBE_FRONT: u32 = 2;
 pub const PROBE_WALL_PRESSURE: u32 = 3;
+pub const PROBE_FRONT_CONTINUOUS: u32 = 4;
+
+/// Bins along a continuous front's axis (probes.wgsl, `probe_front_walk`): the kernel support
+/// 2h wide, enough of them to cover the domain's diagonal from anywhere in it.
+#[derive(Clone, Copy, Debug)]
+pub struct FrontBins {
+    pub width: f64,
+    pub words: u32,
+}
+
+/// lavapipe ends an invocation's loops after 65 535 iterations in all (probes.wgsl): the
+/// walk over a front's words must stay below that.
+const MAX_FRONT_WORDS: f64 = 60_000.0;
+
+impl FrontBins {
+    /// The bins for `probes` (an error only where one of them is a continuous front).
+    pub fn new(grid: &crate::grid::Grid, h: f64, probes: &[Probe]) -> Result<Self> {
+        let width = 2.0 * h;
+        let diagonal = grid.extent.iter().map(|e| e * e).sum::<f64>().sqrt();
+        let words = (diagonal / width / 32.0).ceil() + 1.0;
+        let continuous = (probes.iter()).any(|p| {
+            matches!(
+                p.kind,
+                ProbeKind::Front {
+                    continuous: true,
+                    ..
+                }
+            )
+        });
+        if continuous && words > MAX_FRONT_WORDS {
+            anyhow::bail!(
+                "a continuous front probe needs {words} words of bins ({diagonal} m of domain \
+                 diagonal in bins of 2h = {width} m), more than {MAX_FRONT_WORDS}: use a \
+                 smaller domain or `continuous = false`"
+            );
+        }
+        Ok(Self {
+            width,
+            words: words.min(MAX_FRONT_WORDS) as u32,
+        })
+    }
+}
+
+/// The words of `front_bins` the probes `defs` use (at least one, so the buffer exists).
+pub fn front_bin_words(defs: &[ProbeDef]) -> usize {
+    (defs.iter())
+        .filter(|d| d.kind == PROBE_FRONT_CONTINUOUS)
+        .map(|d| (d.bins + d.words + 1) as usize)
+        .max()
+        .unwrap_or(1)
+}
 
 /// Each probe's face: for a wall-pressure probe on a fixed wall (one of `walls.sensors`), its
 /// sensor's face (`WallParams::sensor_faces`); `NO_FACE` for every other probe.
@@ -56,9 +107,16 @@ pub fn check_wall_pressure(sc: &crate::scenario::Scenario) -> Result<()> {
 }
 
 /// GPU definitions of the probes, in domain coordinates (from the domain's min corner);
-/// `faces` from [`probe_faces`].
-pub fn probe_defs(probes: &[Probe], origin: [f64; 3], faces: &[u32]) -> Vec<ProbeDef> {
+/// `faces` from [`probe_faces`]; each continuous front gets `bins.words` words of bits and
+/// one for its end, in probe order.
+pub fn probe_defs(
+    probes: &[Probe],
+    origin: [f64; 3],
+    faces: &[u32],
+    bins: FrontBins,
+) -> Vec<ProbeDef> {
     let rel = |p: &[f64; 3]| [0, 1, 2].map(|a| (p[a] - origin[a]) as f32);
+    let mut next_word = 0;
     (probes.iter().zip(faces))
         .map(|(p, &face)| match &p.kind {
             ProbeKind::Pressure { point } => ProbeDef {
@@ -73,14 +131,30 @@ pub fn probe_defs(probes: &[Probe], origin: [f64; 3], faces: &[u32]) -> Vec<Prob
                 face,
                 ..Default::default()
             },
-            ProbeKind::Front { origin: o, axis } => {
+            ProbeKind::Front {
+                origin: o,
+                axis,
+                continuous,
+            } => {
                 let norm = axis.iter().map(|a| a * a).sum::<f64>().sqrt();
-                ProbeDef {
+                let def = ProbeDef {
                     point: rel(o),
                     kind: PROBE_FRONT,
                     axis: axis.map(|a| (a / norm) as f32),
                     face,
                     ..Default::default()
+                };
+                if !continuous {
+                    return def;
+                }
+                let first = next_word;
+                next_word += bins.words + 1;
+                ProbeDef {
+                    kind: PROBE_FRONT_CONTINUOUS,
+                    bins: first,
+                    words: bins.words,
+                    bin_width: bins.width as f32,
+                    ..def
                 }
             }
             ProbeKind::WallPressure(patch) => ProbeDef {
@@ -89,7 +163,7 @@ pub fn probe_defs(probes: &[Probe], origin: [f64; 3], faces: &[u32]) -> Vec<Prob
                 axis: patch.normal.map(|a| a as f32),
                 radius: patch.radius as f32,
                 face,
-                pad: [0; 3],
+                ..Default::default()
             },
         })
         .collect()
@@ -108,9 +182,14 @@ pub fn moved(probe: &Probe, center0: [f64; 3], pose: &Pose) -> Probe {
             point: place(point),
         },
         ProbeKind::Height { base } => ProbeKind::Height { base: place(base) },
-        ProbeKind::Front { origin, axis } => ProbeKind::Front {
+        ProbeKind::Front {
+            origin,
+            axis,
+            continuous,
+        } => ProbeKind::Front {
             origin: place(origin),
             axis: (pose.rotation * DVec3::from_array(*axis)).to_array(),
+            continuous: *continuous,
         },
         ProbeKind::WallPressure(patch) => ProbeKind::WallPressure(WallPatch {
             point: place(&patch.point),
@@ -138,7 +217,11 @@ pub fn decode_ordered(bits: u32) -> f32 {
 pub struct Probes {
     points: ParityKernel,
     front: ParityKernel,
+    front_walk: ParityKernel,
+    front_continuous: ParityKernel,
     height: ParityKernel,
+    /// The continuous fronts' bits of wet bins and ends (`probe_front_walk`).
+    front_bins: wgpu::Buffer,
     kinds: Vec<u32>,
     /// What a probe's word is multiplied by: −m/area for wall pressures (the GPU sums the
     /// boundary particles' rates along the normal), 1 otherwise.
@@ -158,10 +241,18 @@ impl Probes {
         particle_mass: f64,
         blind: Vec<bool>,
     ) -> Result<Self> {
+        let front_bins = storage(device, "front bins", 4 * front_bin_words(defs) as u64);
+        let kernel = |entry| {
+            ParityKernel::new(device, module, entry, |p| {
+                b.at(p).with("front_bins", &front_bins)
+            })
+        };
         Ok(Self {
-            points: ParityKernel::new(device, module, "probe_points", |p| b.at(p))?,
-            front: ParityKernel::new(device, module, "probe_front", |p| b.at(p))?,
-            height: ParityKernel::new(device, module, "probe_height_search", |p| b.at(p))?,
+            points: kernel("probe_points")?,
+            front: kernel("probe_front")?,
+            front_walk: kernel("probe_front_walk")?,
+            front_continuous: kernel("probe_front_continuous")?,
+            height: kernel("probe_height_search")?,
             kinds: defs.iter().map(|d| d.kind).collect(),
             scales: probes
                 .iter()
@@ -172,6 +263,7 @@ impl Probes {
                 .collect(),
             blind,
             n: b.n,
+            front_bins,
         })
     }
 
@@ -182,6 +274,10 @@ impl Probes {
     /// Records the probe evaluation on the arrays of parity `p` (cell list must be current).
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, b: &ParticleBuffers, p: usize) {
         encoder.clear_buffer(&b.probe_out, 0, None);
+        let continuous = self.kinds.contains(&PROBE_FRONT_CONTINUOUS);
+        if continuous {
+            encoder.clear_buffer(&self.front_bins, 0, None);
+        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("probes"),
             timestamp_writes: None,
@@ -192,8 +288,13 @@ impl Probes {
             self.height.dispatch(&mut pass, p, self.n);
         }
         self.points.dispatch(&mut pass, p, self.kinds.len() as u32);
-        if self.kinds.contains(&PROBE_FRONT) {
+        if continuous || self.kinds.contains(&PROBE_FRONT) {
             self.front.dispatch(&mut pass, p, self.n);
+        }
+        if continuous {
+            self.front_walk
+                .dispatch(&mut pass, p, self.kinds.len() as u32);
+            self.front_continuous.dispatch(&mut pass, p, self.n);
         }
     }
 
@@ -207,7 +308,7 @@ impl Probes {
             .map(|(((&k, &scale), &w), &blind)| {
                 if blind {
                     f64::NAN
-                } else if k == PROBE_FRONT {
+                } else if k == PROBE_FRONT || k == PROBE_FRONT_CONTINUOUS {
                     decode_ordered(w) as f64
                 } else {
                     scale * f32::from_bits(w) as f64

@@ -30,8 +30,11 @@ pub const KO_DATA: Reference = Reference {
 
 /// Column width a of the case file, m.
 pub const COLUMN_WIDTH_M: f64 = 0.146;
-/// The probe giving the front's distance from the left wall.
+/// The probe giving the front's distance from the left wall: the furthest fluid particle.
 pub const PROBE: &str = "front";
+/// The front of the continuous water (`continuous = true`: no droplet more than 2h–4h ahead
+/// of the tongue), reported beside it.
+pub const CONTINUOUS_PROBE: &str = "front_continuous";
 /// The run ends at T = 3, before the front reaches the far wall (Z = 4).
 pub const T_END: f64 = 3.0;
 /// The front speed is fitted over this range of T, once the column has collapsed: it does not
@@ -195,6 +198,14 @@ pub fn evaluate(sc: &Scenario, dir: &Path, bounds: Mode) -> Result<Evaluation> {
         None,
         None,
     ));
+    let continuous = front(sc, &probe_series(dir, CONTINUOUS_PROBE)?, &DATA)?;
+    metrics.extend(rows(
+        &continuous,
+        "Martin & Moyce",
+        ", continuous water",
+        None,
+        None,
+    ));
     Ok(Evaluation {
         metrics,
         figures: vec![Figure {
@@ -204,6 +215,7 @@ pub fn evaluate(sc: &Scenario, dir: &Path, bounds: Mode) -> Result<Evaluation> {
             y_label: "Z = z/a".into(),
             curves: vec![
                 sim_curve("wgsph", mm.sim),
+                sim_curve("wgsph, continuous water", continuous.sim),
                 reference_curve("Martin & Moyce (1952)", mm.experiment),
                 reference_curve("Koshizuka & Oka (1996)", ko.experiment),
             ],
