@@ -35,6 +35,11 @@ pub static BUILT_IN: &[BuiltIn] = &[
         text: include_str!("../../cases/hydrostatic_2d.toml"),
     },
     BuiltIn {
+        name: "hydrostatic_3d",
+        file: "cases/hydrostatic_3d.toml",
+        text: include_str!("../../cases/hydrostatic_3d.toml"),
+    },
+    BuiltIn {
         name: "dam_break_2d",
         file: "cases/dam_break_2d.toml",
         text: include_str!("../../cases/dam_break_2d.toml"),

@@ -194,6 +194,14 @@ pub static CASES: &[Case] = &[
         evaluate: hydrostatic::evaluate,
     },
     Case {
+        name: "hydrostatic_3d",
+        file: "cases/hydrostatic_3d.toml",
+        reference: "analytic: p = ρ0 g (H − z)",
+        citation: "",
+        overrides: hydrostatic::overrides_3d,
+        evaluate: hydrostatic::evaluate_3d,
+    },
+    Case {
         name: "dam_break_2d",
         file: "cases/dam_break_2d.toml",
         reference: dam_break::REFERENCE,

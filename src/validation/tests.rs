@@ -229,6 +229,7 @@ fn cases_are_selected_by_mode_and_name() {
         quick,
         [
             "hydrostatic_2d",
+            "hydrostatic_3d",
             "dam_break_2d",
             "dam_break_lobovsky_2d",
             "floating_box_2d",
