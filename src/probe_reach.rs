@@ -220,7 +220,8 @@ fn box_segment_distance2(cmin: [f64; 3], dx: f64, n: [usize; 3], a: [f64; 3], b:
         .sum()
 }
 
-fn fmt_point(x: &[f64; 3], dim: u32) -> String {
+/// The first `dim` coordinates of `x` to 6 significant digits, for messages.
+pub fn fmt_point(x: &[f64; 3], dim: u32) -> String {
     let parts: Vec<String> = x[..dim as usize]
         .iter()
         .map(|c| format!("{}", sig(*c)))

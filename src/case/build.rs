@@ -1056,6 +1056,13 @@ fn finish(
     );
     let physics = physics(&case, start, h);
     let mut probes = case.probes;
+    super::probes::place_on_faces(
+        ctx,
+        &mut probes,
+        &case.face_normals,
+        &particles,
+        (dim, dx, h),
+    )?;
     super::probes::resolve_wall_patches(ctx, &mut probes, &particles, dim, dx, h)?;
     let mut walls = walls(
         ctx,
@@ -1093,8 +1100,12 @@ fn finish(
         outlets: case.outlets,
         warnings,
     };
-    // Probes that can never measure: said here, and NaN in their CSV (probe_reach.rs).
+    // Probes that can never measure: said here, and NaN in their CSV (probe_reach.rs); those
+    // that can but start inside a wall or body, said too.
     let blind = crate::probe_reach::unmeasurable(&sc);
+    let is_blind: Vec<bool> = blind.iter().map(Option::is_some).collect();
+    let inside = super::probes::inside_walls(&sc.probes, &is_blind, &sc.particles, dim, dx);
+    sc.warnings.extend(inside);
     for (i, why) in blind.into_iter().enumerate() {
         if let Some(why) = why {
             let p = &sc.probes[i];
@@ -1176,6 +1187,15 @@ pub(super) fn build_solid_case(
     let d = solid_case_domain(ctx, &case)?;
     let n = particles.len();
     let points = super::probes::resolve_points(ctx, &case.points, &particles, &[], dim, dx)?;
+    let mut probes = case.probes;
+    let h = case.h_over_dx * dx;
+    super::probes::place_on_faces(
+        ctx,
+        &mut probes,
+        &case.face_normals,
+        &particles,
+        (dim, dx, h),
+    )?;
     let physics = Physics {
         dim: dim as u32,
         dx,
@@ -1211,7 +1231,7 @@ pub(super) fn build_solid_case(
             max: d.max,
         },
         particles,
-        probes: case.probes,
+        probes,
         points,
         walls,
         periodic: [false; 3],

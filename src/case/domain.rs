@@ -266,6 +266,7 @@ fn check_probes_inside(ctx: &Ctx<'_>, case: &Case, d: &Aabb) -> Result<(), CaseE
     let dim = case.dim;
     for (i, p) in case.probes.iter().enumerate() {
         let (field, point) = match &p.kind {
+            ProbeKind::Pressure { point } if case.face_normals[i].is_some() => ("face_m", *point),
             ProbeKind::Pressure { point } => ("point_m", *point),
             ProbeKind::Height { base } => ("base_m", *base),
             ProbeKind::Front { origin, .. } => ("origin_m", *origin),

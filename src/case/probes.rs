@@ -1,7 +1,9 @@
 //! Checks of one `[[probe]]`: a file-safe name, exactly the fields of its kind, vectors of the
-//! case's dimension (padded to 3 components), a non-zero front axis (normalised); and the
-//! choice of the particle a `"point"` probe follows.
+//! case's dimension (padded to 3 components), a non-zero front axis (normalised); the choice
+//! of the particle a `"point"` probe follows; a pressure probe given on a face placed in front
+//! of it at the case's dx, and one that starts inside a wall or body told.
 
+use crate::probe_reach::fmt_point;
 use crate::scenario::{
     Body, Particle, Probe, ProbeKind, TrackedPoint, WallParams, WallPatch, FACE_UNBOUNDED,
 };
@@ -11,9 +13,11 @@ use super::error::CaseError;
 use super::locate::Ctx;
 use super::schema::{ProbeName, RawProbe};
 
-/// A checked `[[probe]]`: a sampled quantity, or a point of a body to follow.
+/// A checked `[[probe]]`: a sampled quantity (with the unit normal of the face its point lies
+/// on, for a pressure probe given by `face_m`: [`place_on_faces`]), or a point of a body to
+/// follow.
 pub(super) enum Checked {
-    Sampled(Probe),
+    Sampled(Probe, Option<[f64; 3]>),
     Point(PointSpec),
 }
 
@@ -52,6 +56,7 @@ pub(super) fn probe(
     let get = |field: &str, v: &Option<Vec<f64>>, what: &str| {
         field_vector(ctx, &path, field, v, dim, what)
     };
+    let mut on_face = None;
     let kind = match p.kind {
         ProbeName::Point => {
             return Ok(Checked::Point(PointSpec {
@@ -59,6 +64,19 @@ pub(super) fn probe(
                 name: p.name.clone(),
                 point: get("point_m", &p.point_m, "the point to follow in metres")?,
             }))
+        }
+        ProbeName::Pressure if p.face_m.is_some() => {
+            let normal = get("normal", &p.normal, "the face's normal, into the fluid")?;
+            on_face = Some(unit(
+                ctx,
+                &format!("{path}.normal"),
+                normal,
+                &p.normal,
+                "the normal of a box's face towards the water, e.g. [1.0, 0.0, 0.0]",
+            )?);
+            ProbeKind::Pressure {
+                point: get("face_m", &p.face_m, "a point on a wall's face in metres")?,
+            }
         }
         ProbeName::Pressure => ProbeKind::Pressure {
             point: get("point_m", &p.point_m, "the sampling point in metres")?,
@@ -91,12 +109,15 @@ pub(super) fn probe(
         }
         ProbeName::WallPressure => wall_pressure(ctx, &path, p, dim)?,
     };
-    Ok(Checked::Sampled(Probe {
-        name: p.name.clone(),
-        kind,
-        // Resolved against the bodies once they are known (validate.rs).
-        body: None,
-    }))
+    Ok(Checked::Sampled(
+        Probe {
+            name: p.name.clone(),
+            kind,
+            // Resolved against the bodies once they are known (validate.rs).
+            body: None,
+        },
+        on_face,
+    ))
 }
 
 /// The fields of `p` at `path`: exactly those of its kind (a point probe attached to no body).
@@ -107,6 +128,7 @@ fn check_probe_fields(
     dim: usize,
 ) -> Result<(), CaseError> {
     let (kind_name, needs): (&str, &[&str]) = match p.kind {
+        ProbeName::Pressure if p.face_m.is_some() => ("pressure", &["face_m", "normal"]),
         ProbeName::Pressure => ("pressure", &["point_m"]),
         ProbeName::Height => ("height", &["base_m"]),
         ProbeName::Front => ("front", &["origin_m", "axis"]),
@@ -124,6 +146,7 @@ fn check_probe_fields(
     }
     let fields = [
         ("point_m", &p.point_m),
+        ("face_m", &p.face_m),
         ("base_m", &p.base_m),
         ("origin_m", &p.origin_m),
         ("axis", &p.axis),
@@ -433,6 +456,80 @@ pub(super) fn resolve_points(
             Ok(TrackedPoint {
                 name: s.name.clone(),
                 particle: k as u32,
+            })
+        })
+        .collect()
+}
+
+/// Each pressure probe given on a face (`face_m`, its `normals` entry) moved out along its
+/// normal to half a spacing in front of the face that the wall's particles have at this dx
+/// ([`WallPatch::resolve`]: half a spacing in front of their first layer), the centre of the
+/// first fluid layer. A shipped probe sits there at the shipped dx; given by its face, it stays
+/// there at any dx, however the lattice rounds the wall.
+pub(super) fn place_on_faces(
+    ctx: &Ctx<'_>,
+    probes: &mut [Probe],
+    normals: &[Option<[f64; 3]>],
+    particles: &[Particle],
+    (dim, dx, h): (usize, f64, f64),
+) -> Result<(), CaseError> {
+    for (i, (probe, normal)) in probes.iter_mut().zip(normals).enumerate() {
+        let (ProbeKind::Pressure { point }, Some(normal)) = (&mut probe.kind, normal) else {
+            continue;
+        };
+        let Some(patch) = WallPatch::resolve(particles, *point, *normal, 0.5 * dx, dim, dx, h)
+        else {
+            return Err(ctx.err(
+                &format!("probe[{i}].face_m"),
+                Some(format!("{:?}", &point[..dim])),
+                format!(
+                    "has no wall particle within particles.dx_m = {dx} of it across its normal \
+                     and within dx behind it: a pressure probe given by face_m samples in front \
+                     of the face of a particle wall"
+                ),
+                "put face_m on a face of the [tank], an [[obstacle]] or a [[body]] of particles \
+                 (dynamic, fixed_ghost or repulsive), with normal pointing into the fluid; or \
+                 give point_m, a point in the water, instead",
+            ));
+        };
+        let out = patch.face + 0.5 * dx;
+        *point = [0, 1, 2].map(|a| point[a] + out * normal[a]);
+    }
+    Ok(())
+}
+
+/// The warnings of the pressure probes (those not in `blind`) whose point starts inside a
+/// wall, an obstacle, a body or a solid: within the lattice cell (half a spacing along every
+/// axis) of one of its particles. Such a probe reads, through the kernel, the water in front of
+/// the face rather than the pressure at its point.
+pub(super) fn inside_walls(
+    probes: &[Probe],
+    blind: &[bool],
+    particles: &[Particle],
+    dim: usize,
+    dx: f64,
+) -> Vec<String> {
+    let half = 0.5 * dx * (1.0 - 1e-6);
+    let solid = |p: &&Particle| p.kind.is_boundary() || p.kind.is_solid();
+    (probes.iter().zip(blind))
+        .filter_map(|(probe, &blind)| {
+            let ProbeKind::Pressure { point } = probe.kind else {
+                return None;
+            };
+            let inside = (particles.iter().filter(solid))
+                .find(|p| (0..dim).all(|a| (p.pos[a] - point[a]).abs() < half))?;
+            (!blind).then(|| {
+                format!(
+                    "probe '{}' (point_m) starts inside a wall, an obstacle or a body: {} lies \
+                     within half a spacing (dx = {dx} m) of its particle at {}, so it reads the \
+                     water in front of the face through the kernel, not the pressure at its \
+                     point; fix: give the face instead (face_m and normal: the probe then \
+                     samples half a spacing in front of it at any dx), or move point_m into the \
+                     water",
+                    probe.name,
+                    fmt_point(&point, dim as u32),
+                    fmt_point(&inside.pos, dim as u32),
+                )
             })
         })
         .collect()

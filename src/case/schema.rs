@@ -348,12 +348,14 @@ pub(super) struct RawProbe {
     pub name: String,
     pub kind: ProbeName,
     pub point_m: Option<Vec<f64>>,
+    /// A pressure probe's point on a wall's face: it samples half a spacing in front of it.
+    pub face_m: Option<Vec<f64>>,
     pub base_m: Option<Vec<f64>>,
     pub origin_m: Option<Vec<f64>>,
     pub axis: Option<Vec<f64>>,
     /// A front probe that follows the continuous water rather than the furthest particle.
     pub continuous: Option<bool>,
-    /// A wall-pressure probe's face normal, into the fluid.
+    /// A wall-pressure probe's (or a pressure probe's on a face) face normal, into the fluid.
     pub normal: Option<Vec<f64>>,
     /// A wall-pressure probe's radius across its normal.
     pub radius_m: Option<f64>,
@@ -914,6 +916,12 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "point_m = [0.5, 0.05]",
     ),
     f(
+        "probe[].face_m",
+        "a point on the wall or obstacle face a pressure probe samples in front of (half a \
+         spacing out along normal, at the run's dx)",
+        "face_m = [0.8245, 0.5, 0.021]",
+    ),
+    f(
         "probe[].base_m",
         "the foot of a height gauge",
         "base_m = [0.5, 0.0]",
@@ -936,7 +944,8 @@ pub(super) const FIELDS: &[FieldHelp] = &[
     ),
     f(
         "probe[].normal",
-        "the normal of a wall-pressure probe's wall face, into the fluid",
+        "the normal of a wall-pressure probe's face, or of a pressure probe's face_m, into the \
+         fluid",
         "normal = [-1.0, 0.0]",
     ),
     f(

@@ -405,6 +405,113 @@ fn dam_break_3d_builds() {
     assert_eq!(s.particles.len(), 303_852);
 }
 
+/// The pressure probe `name`'s point.
+fn pressure_point(s: &Scenario, name: &str) -> [f64; 3] {
+    match s.probes.iter().find(|p| p.name == name).unwrap().kind {
+        ProbeKind::Pressure { point } => point,
+        ref k => panic!("{name}: {k:?}"),
+    }
+}
+
+/// SPHERIC's pressure probes, given on the box's faces (issue 34), sample half a spacing in
+/// front of the face its particles have at any dx: at the shipped dx where the probes were
+/// (x = 0.8250 + dx/2 and z = 0.1618 + dx/2), and at spacings that round the box to other
+/// sizes (0.0324 m: 4 lattice points along x, the box 0.129 m) a spacing in front of its
+/// particles' first layer, never inside it.
+#[test]
+fn pressure_probes_on_faces_follow_the_resolution() {
+    let s = load_str(DAM_3D, "cases/dam_break_3d.toml", &[]).unwrap();
+    let dx = 0.55 / 34.0;
+    let p1 = pressure_point(&s, "P1");
+    assert!((p1[0] - (0.8250 + 0.5 * dx)).abs() < 1e-4, "{p1:?}");
+    assert_eq!((p1[1], p1[2]), (0.5, 0.021));
+    let p5 = pressure_point(&s, "P5");
+    assert!((p5[2] - (0.1618 + 0.5 * dx)).abs() < 1e-4, "{p5:?}");
+    assert_eq!((p5[0], p5[1]), (0.8035, 0.5));
+    for dx in [0.55 / 34.0, 0.0323529, 0.025, 0.0107843] {
+        let s = load_str(
+            DAM_3D,
+            "cases/dam_break_3d.toml",
+            &sets(&[&format!("particles.dx_m={dx}")]),
+        )
+        .unwrap();
+        let in_box = |p: &&Particle| {
+            p.kind == Kind::Wall
+                && (0.6..0.9).contains(&p.pos[0])
+                && (0.2..0.8).contains(&p.pos[1])
+                && p.pos[2] > 0.0
+        };
+        let box_particles: Vec<&Particle> = s.particles.iter().filter(in_box).collect();
+        let front = box_particles
+            .iter()
+            .map(|p| p.pos[0])
+            .fold(f64::MIN, f64::max);
+        let top = box_particles
+            .iter()
+            .map(|p| p.pos[2])
+            .fold(f64::MIN, f64::max);
+        for (name, axis, face) in [("P1", 0, front), ("P4", 0, front), ("P5", 2, top)] {
+            let x = pressure_point(&s, name)[axis];
+            assert!(
+                (x - (face + dx)).abs() < 1e-9,
+                "dx {dx}: {name} at {x}, face {face}"
+            );
+        }
+        assert!(
+            !s.warnings.iter().any(|w| w.contains("starts inside")),
+            "dx {dx}: {:?}",
+            s.warnings
+        );
+    }
+}
+
+/// A pressure probe inside a wall is told (its point within half a spacing of a wall
+/// particle); one in the water or the air beside a wall is not. A probe given by its face
+/// needs that face's normal, no point_m, and a particle wall there.
+#[test]
+fn pressure_probes_inside_walls_and_on_faces_are_checked() {
+    let inside = |point: &str| {
+        let text = base_with("point_m = [0.5, 0.05]", &format!("point_m = {point}"));
+        let s = load_str(&text, "cases/t.toml", &[]).unwrap();
+        s.warnings.iter().any(|w| {
+            w.contains("probe 'P1' (point_m) starts inside a wall") && w.contains("face_m")
+        })
+    };
+    assert!(inside("[0.53, -0.04]"), "in the floor's first layer");
+    assert!(!inside("[0.5, 0.05]"), "in the water");
+    assert!(!inside("[0.95, 0.9]"), "in the air beside the right wall");
+    let on_floor = base_with(
+        "point_m = [0.5, 0.05]",
+        "face_m = [0.52, 0.0]\nnormal = [0.0, 1.0]",
+    );
+    let s = load_str(&on_floor, "cases/t.toml", &[]).unwrap();
+    assert_eq!(&pressure_point(&s, "P1")[..2], &[0.52, 0.05]);
+    assert_err(
+        &base_with(
+            "point_m = [0.5, 0.05]",
+            "face_m = [0.5, 0.3]\nnormal = [0.0, 1.0]",
+        ),
+        &[],
+        Some(24),
+        &["probe[0].face_m", "no wall particle", "point_m"],
+    );
+    assert_err(
+        &base_with("point_m = [0.5, 0.05]", "face_m = [0.5, 0.0]"),
+        &[],
+        Some(21),
+        &["probe[0].normal", "required"],
+    );
+    assert_err(
+        &base_with(
+            "point_m = [0.5, 0.05]",
+            "point_m = [0.5, 0.05]\nface_m = [0.5, 0.0]\nnormal = [0.0, 1.0]",
+        ),
+        &[],
+        Some(24),
+        &["probe[0].point_m", "face_m and normal"],
+    );
+}
+
 #[test]
 fn load_reads_files_and_reports_missing_ones() {
     let dir = std::env::temp_dir().join(format!("wgsph_case_test_{}", std::process::id()));

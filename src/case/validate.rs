@@ -83,6 +83,9 @@ pub(super) struct Case {
     pub domain: Option<Aabb>,
     pub walls: WallSettings,
     pub probes: Vec<Probe>,
+    /// Each probe's face normal where it is given on a face (`face_m`): its point lies on the
+    /// face until the particles are built ([`super::probes::place_on_faces`]).
+    pub face_normals: Vec<Option<[f64; 3]>>,
     /// `kind = "point"` probes; their particles are chosen once the particles are built.
     pub points: Vec<super::probes::PointSpec>,
     pub bodies: Vec<super::bodies::BodySpec>,
@@ -143,7 +146,7 @@ pub(super) fn validate(
     let tank_moves = tank.as_ref().is_some_and(|t| t.motion.is_some());
     walls.friction_pairs =
         super::friction::pairs(ctx, &raw.friction, &bodies, &solids, tank_moves)?;
-    let (probes, points) = probes(ctx, raw, dim, tank_moves, &bodies)?;
+    let ((probes, face_normals), points) = probes(ctx, raw, dim, tank_moves, &bodies)?;
     let CheckedPhysics {
         rho0,
         gravity,
@@ -178,6 +181,7 @@ pub(super) fn validate(
         domain,
         walls,
         probes,
+        face_normals,
         points,
         bodies,
         solids,
@@ -744,29 +748,34 @@ fn check_probe_names(ctx: &Ctx<'_>, raw: &RawCase) -> Result<(), CaseError> {
     Ok(())
 }
 
-/// `[[probe]]`: the sampled probes (with the body each is attached to) and the points.
+/// The sampled probes and their face normals.
+type SampledProbes = (Vec<Probe>, Vec<Option<[f64; 3]>>);
+
+/// `[[probe]]`: the sampled probes (with the body each is attached to, and the normal of the
+/// face each given by `face_m` lies on) and the points.
 fn probes(
     ctx: &Ctx<'_>,
     raw: &RawCase,
     dim: usize,
     tank_moves: bool,
     bodies: &[super::bodies::BodySpec],
-) -> Result<(Vec<Probe>, Vec<super::probes::PointSpec>), CaseError> {
-    let mut probes: Vec<Probe> = Vec::with_capacity(raw.probe.len());
+) -> Result<(SampledProbes, Vec<super::probes::PointSpec>), CaseError> {
+    let (mut probes, mut normals): SampledProbes = (Vec::new(), Vec::new());
     let mut points = Vec::new();
     for (i, p) in raw.probe.iter().enumerate() {
         match super::probes::probe(ctx, i, p, dim)? {
-            Checked::Sampled(mut probe) => {
+            Checked::Sampled(mut probe, normal) => {
                 probe.body = match &p.body {
                     None => None,
                     Some(name) => Some(attached_body(ctx, i, name, tank_moves, bodies)?),
                 };
                 probes.push(probe);
+                normals.push(normal);
             }
             Checked::Point(spec) => points.push(spec),
         }
     }
-    Ok((probes, points))
+    Ok(((probes, normals), points))
 }
 
 /// The index in the scenario's bodies (a moving tank first, then `[[body]]` in order) of the

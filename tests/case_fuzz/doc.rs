@@ -192,8 +192,9 @@ pub(crate) fn vector_len(path: &str, dim: usize) -> Option<usize> {
     let g = generic(path);
     let key = g.rsplit('.').next().unwrap_or(&g);
     match key {
-        "min_m" | "max_m" | "gravity_m_s2" | "velocity_m_s" | "center_m" | "point_m" | "base_m"
-        | "origin_m" | "pivot_m" | "translation_m" => Some(dim),
+        "min_m" | "max_m" | "gravity_m_s2" | "velocity_m_s" | "center_m" | "point_m" | "face_m"
+        | "base_m" | "origin_m" | "pivot_m" | "translation_m" => Some(dim),
+        "normal" if g.starts_with("probe") => Some(dim),
         "axis" if g == "motion.axis" => Some(3),
         "axis" => Some(dim),
         "angular_velocity_rad_s" => Some(if dim == 2 { 1 } else { 3 }),
