@@ -351,6 +351,15 @@ pub struct CaseOutcome {
 }
 
 impl CaseOutcome {
+    /// The case's wall time with its run's: an earlier run's (from its run.json) and this
+    /// evaluation's when the run was reused, else the whole case's.
+    pub fn run_wall_s(&self) -> f64 {
+        match (&self.summary, self.reused) {
+            (Some(r), true) => r.wall_time_s + self.wall_s,
+            _ => self.wall_s,
+        }
+    }
+
     /// No failure and no metric over its bound.
     pub fn passed(&self) -> bool {
         self.failure.is_none() && self.metrics.iter().all(|m| m.verdict() != Verdict::Fail)

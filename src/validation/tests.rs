@@ -686,6 +686,7 @@ fn a_report_of_reused_runs_opens_no_adapter() {
     write_probe(&dir, "p_floor", "pressure_pa", 0.01, 2.0, |_| exact(0.5));
     let mut s = completed_summary(case.name, &sc);
     s.overrides = Some(overrides);
+    s.wall_time_s = 123.4;
     write_run_json(&dir, &s);
     let opened = std::cell::Cell::new(0);
     let gpu = Gpu::lazy(|| {
@@ -703,6 +704,13 @@ fn a_report_of_reused_runs_opens_no_adapter() {
     let o = &report.cases[0];
     assert!(o.reused && o.failure.is_none(), "{o:?}");
     assert!(report.passed(), "{}", report.table());
+    // Its wall time is the earlier run's, not the evaluation's alone.
+    let md = report.markdown(&out);
+    assert!(
+        md.contains("| 123.4 s (the earlier run's; evaluated in"),
+        "{md}"
+    );
+    assert!((o.run_wall_s() - 123.4 - o.wall_s).abs() < 1e-9);
     // Without its run.json the case runs: the opener is called and its error is the case's
     // FAIL row, not a panic.
     std::fs::remove_file(dir.join(RUN_SUMMARY_FILE)).unwrap();
