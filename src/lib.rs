@@ -19,6 +19,7 @@ pub mod reference;
 pub mod run;
 pub mod scenario;
 pub mod sph;
+pub mod surface;
 #[cfg(test)]
 mod twins;
 pub mod validation;

@@ -15,6 +15,7 @@ use wgsph::checkpoint::{CaseSource, Checkpoint, CheckpointPolicy, CHECKPOINT_FIL
 use wgsph::gpu::context::list_adapters;
 use wgsph::gpu::{AdapterChoice, GpuContext};
 use wgsph::plot::snapshot::SnapshotField;
+use wgsph::probe_reach::sig;
 use wgsph::progress::{LogLines, Progress, ProgressBarView};
 use wgsph::run::{RunOptions, RunReport};
 
@@ -149,6 +150,30 @@ enum Command {
         /// another machine (a GPU's, copied back).
         #[arg(long)]
         reuse: bool,
+    },
+    /// Reconstruct the water's surface of every particle output of a finished 3D run
+    /// (DIR/particles/particles_NNNNNN.vtu) as triangle meshes, DIR/surface/surface_NNNNNN.vtu,
+    /// listed in DIR/surface.pvd for ParaView (splashsurf's marching cubes over the SPH density
+    /// of the fluid particles). The defaults come from the run's case, loaded again from the
+    /// file and overrides run.json records; each can be overridden.
+    Surface {
+        /// The run's output directory.
+        dir: PathBuf,
+        /// Half the side of a particle's cube of fluid, m (default: dx/2).
+        #[arg(long, value_name = "M")]
+        particle_radius: Option<f64>,
+        /// The reconstruction kernel's support radius, m (default: the run's 2h).
+        #[arg(long, value_name = "M")]
+        support_radius: Option<f64>,
+        /// Edge of the marching-cubes grid, m (default: dx/2).
+        #[arg(long, value_name = "M")]
+        cube_size: Option<f64>,
+        /// The surface is where the reconstructed density is this share of ρ0 (default 0.6).
+        #[arg(long, value_name = "SHARE")]
+        iso_threshold: Option<f64>,
+        /// The run's case file, where run.json does not record it or it has moved.
+        #[arg(long, value_name = "FILE")]
+        case: Option<PathBuf>,
     },
     /// List the adapters wgpu sees and their limits.
     Info,
@@ -346,6 +371,25 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             );
             Ok(ExitCode::from(report.exit_status()))
         }
+        Command::Surface {
+            dir,
+            particle_radius,
+            support_radius,
+            cube_size,
+            iso_threshold,
+            case,
+        } => {
+            let sc = wgsph::run::scenario_of_run(&dir, case.as_deref())?;
+            let d = wgsph::surface::SurfaceParams::for_scenario(&sc);
+            let params = wgsph::surface::SurfaceParams {
+                particle_radius: particle_radius.unwrap_or(d.particle_radius),
+                support_radius: support_radius.unwrap_or(d.support_radius),
+                cube_size: cube_size.unwrap_or(d.cube_size),
+                iso_threshold: iso_threshold.unwrap_or(d.iso_threshold),
+                rho0: d.rho0,
+            };
+            surface(&dir, &sc, &params, bars)
+        }
         Command::Info => info(cli.adapter),
         Command::Bench {
             case,
@@ -355,6 +399,31 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             stages,
         } => bench(cli.adapter, &case, &set, steps, warmup, stages),
     }
+}
+
+/// `wgsph surface`: the meshes of every particle output of the run in `dir`, with a bar.
+fn surface(
+    dir: &std::path::Path,
+    sc: &wgsph::scenario::Scenario,
+    params: &wgsph::surface::SurfaceParams,
+    bars: &MultiProgress,
+) -> Result<ExitCode> {
+    println!(
+        "surface of {}: particle radius {} m, support radius {} m, cubes of {} m, threshold {} ρ0",
+        sc.name,
+        sig(params.particle_radius),
+        sig(params.support_radius),
+        sig(params.cube_size),
+        sig(params.iso_threshold)
+    );
+    let bar = bars.add(indicatif::ProgressBar::no_length());
+    let pvd = wgsph::surface::surfaces_of_run(dir, sc, params, &mut |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })?;
+    bar.finish_and_clear();
+    println!("wrote {}", pvd.display());
+    Ok(ExitCode::SUCCESS)
 }
 
 /// `wgsph info`: every adapter with its limits and capacity, and the one `adapter` selects.

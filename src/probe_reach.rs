@@ -230,7 +230,7 @@ pub fn fmt_point(x: &[f64; 3], dim: u32) -> String {
 }
 
 /// `x` to 6 significant digits, for messages.
-fn sig(x: f64) -> f64 {
+pub fn sig(x: f64) -> f64 {
     if x == 0.0 || !x.is_finite() {
         return x;
     }

@@ -785,3 +785,68 @@ fn a_locked_output_folder_is_refused_and_a_stale_lock_taken_over() {
     assert!(format!("{e:#}").contains(&says), "resume: {e:#}");
     assert_eq!(std::fs::read_to_string(&lock).unwrap(), format!("{me}\n"));
 }
+
+/// `wgsph surface` on a short run of the 3D hydrostatic tank (dx = 0.04 m, water 0.4 m deep,
+/// still): one mesh per particle output in surface.pvd, each flat at the water's height within
+/// a fifth of a spacing over the tank's middle; a 2D run is refused with a message.
+#[test]
+fn surface_meshes_the_water_of_a_3d_run() {
+    let out = temp_dir("surface");
+    let o = wgsph()
+        .args(["run", "cases/hydrostatic_3d.toml", "--quiet"])
+        .args(["--set", "particles.dx_m=0.04", "--set", "time.end_s=0.02"])
+        .args(["--set", "time.output_every_s=0.01", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = wgsph().arg("surface").arg(&out).output().unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(stdout.contains("particle radius 0.02 m"), "{stdout}");
+    let pvd = std::fs::read_to_string(out.join("surface.pvd")).unwrap();
+    assert_eq!(
+        pvd.matches("<DataSet").count(),
+        3,
+        "t = 0, 0.01, 0.02: {pvd}"
+    );
+    for i in 0..3 {
+        let path = out.join(format!("surface/surface_{i:06}.vtu"));
+        let mesh = wgsph::output::SurfaceMesh::read(&path).unwrap();
+        let top: Vec<f64> = (mesh.vertices.iter())
+            .filter(|v| (0.12..0.28).contains(&v[0]) && (0.12..0.28).contains(&v[1]) && v[2] > 0.2)
+            .map(|v| v[2])
+            .collect();
+        assert!(top.len() > 10, "output {i}: {} top vertices", top.len());
+        for z in top {
+            assert!(
+                (z - 0.4).abs() < 0.2 * 0.04,
+                "output {i}: top vertex at z = {z}"
+            );
+        }
+    }
+    let flat = temp_dir("surface-2d");
+    let (code, stderr) = {
+        let o = wgsph()
+            .args(["run", "cases/hydrostatic_2d.toml", "--quiet"])
+            .args(["--set", "time.end_s=0.005", "--out"])
+            .arg(&flat)
+            .output()
+            .unwrap();
+        assert!(o.status.success());
+        let o = wgsph().arg("surface").arg(&flat).output().unwrap();
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).to_string(),
+        )
+    };
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("2D run") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+}

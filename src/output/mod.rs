@@ -15,6 +15,7 @@
 //! DIR/probes/<name>.csv                 "t_s,<column>" time series per probe
 //! DIR/run.json                          run summary
 //! DIR/snapshots/NNNNNN.png              with --snapshots: a picture of each particle snapshot
+//! DIR/surface.pvd, DIR/surface/surface_NNNNNN.vtu   `wgsph surface`: the water's surface
 //! ```
 
 mod atomic;
@@ -45,6 +46,83 @@ pub const PROBES_DIR: &str = "probes";
 pub const SNAPSHOTS_DIR: &str = "snapshots";
 /// Name of the run summary file inside the output directory.
 pub const RUN_SUMMARY_FILE: &str = "run.json";
+/// Name of the folder of free-surface meshes (`wgsph surface`: `surface_NNNNNN.vtu`, the index
+/// of the particle file) and of their series file.
+pub const SURFACE_DIR: &str = "surface";
+pub const SURFACE_PVD_FILE: &str = "surface.pvd";
+
+/// A triangle mesh of the water's surface at one output (`wgsph surface`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SurfaceMesh {
+    pub time_s: f64,
+    pub vertices: Vec<[f64; 3]>,
+    /// Vertex indices, counter-clockwise seen from outside the water.
+    pub triangles: Vec<[usize; 3]>,
+}
+
+impl SurfaceMesh {
+    /// Reads a mesh [`write_surface`] wrote; errors name the file and what is wrong.
+    pub fn read(path: &Path) -> Result<Self, OutputError> {
+        let bytes = std::fs::read(path).map_err(|e| OutputError::io("read", path, e))?;
+        let v = vtu::reader::Vtu::parse(&bytes).map_err(|reason| OutputError::Read {
+            path: path.to_path_buf(),
+            reason,
+        })?;
+        let parsed = (|| -> Result<Self, String> {
+            let points = v.f64s("Points", 3)?;
+            let corners = match v.arrays.get("connectivity").map(|a| a.vtk_type.as_str()) {
+                Some("Int64") => v
+                    .i64s("connectivity")?
+                    .into_iter()
+                    .map(|c| c as usize)
+                    .collect(),
+                _ => (v.i32s("connectivity")?.into_iter())
+                    .map(|c| c as usize)
+                    .collect::<Vec<_>>(),
+            };
+            if corners.len() != 3 * v.number_of_cells
+                || corners.iter().any(|&c| c >= v.number_of_points)
+            {
+                return Err("its cells are not triangles of its points".into());
+            }
+            Ok(SurfaceMesh {
+                time_s: v.f64s("TimeValue", 1)?.first().copied().unwrap_or(f64::NAN),
+                vertices: points.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+                triangles: corners
+                    .chunks_exact(3)
+                    .map(|c| [c[0], c[1], c[2]])
+                    .collect(),
+            })
+        })();
+        parsed.map_err(|reason| OutputError::Read {
+            path: path.to_path_buf(),
+            reason,
+        })
+    }
+}
+
+/// Writes `mesh`, the surface of particle file `index`, as DIR/surface/surface_NNNNNN.vtu,
+/// atomically. Returns its (time, path relative to DIR) for [`write_surface_series`].
+pub fn write_surface(
+    dir: &Path,
+    index: usize,
+    mesh: &SurfaceMesh,
+) -> Result<(f64, String), OutputError> {
+    let folder = dir.join(SURFACE_DIR);
+    std::fs::create_dir_all(&folder)
+        .map_err(|e| OutputError::io("create directory", &folder, e))?;
+    atomic::remove_stale_temps(&folder);
+    let rel = format!("{SURFACE_DIR}/surface_{index:06}.vtu");
+    write_atomic(&dir.join(&rel), |w| vtu::write_triangles_vtu(w, mesh))?;
+    Ok((mesh.time_s, rel))
+}
+
+/// Writes DIR/surface.pvd listing the surfaces `series` ([`write_surface`]'s), atomically.
+pub fn write_surface_series(dir: &Path, series: &[(f64, String)]) -> Result<PathBuf, OutputError> {
+    let pvd = dir.join(SURFACE_PVD_FILE);
+    write_atomic(&pvd, |w| pvd::write_pvd(w, series))?;
+    Ok(pvd)
+}
 
 /// Errors of the output module. Every message names the path involved and, for I/O failures,
 /// the OS error (which is part of the message rather than a chained `source`, so that

@@ -226,6 +226,70 @@ pub(crate) fn write_vtu(w: &mut dyn Write, snap: &Snapshot) -> io::Result<()> {
     Ok(())
 }
 
+/// VTK cell type of a triangle.
+const VTK_TRIANGLE: u8 = 5;
+
+/// Writes a complete `.vtu` of the triangle mesh `mesh` (`wgsph surface`): its vertices as
+/// points, one VTK_TRIANGLE cell per triangle, the time as field data.
+pub(crate) fn write_triangles_vtu(w: &mut dyn Write, mesh: &super::SurfaceMesh) -> io::Result<()> {
+    let (n, cells) = (mesh.vertices.len(), mesh.triangles.len());
+    let wide = n > i32::MAX as usize || 3 * cells > i32::MAX as usize;
+    let index_decl = |name, tuples| {
+        if wide {
+            ArrayDecl::new::<i64>(name, 1, tuples)
+        } else {
+            ArrayDecl::new::<i32>(name, 1, tuples)
+        }
+    };
+    let time = ArrayDecl::new::<f64>("TimeValue", 1, 1);
+    let points = ArrayDecl::new::<f64>("Points", 3, n);
+    let connectivity = index_decl("connectivity", 3 * cells);
+    let offsets = index_decl("offsets", cells);
+    let types = ArrayDecl::new::<u8>("types", 1, cells);
+    let order = [&time, &points, &connectivity, &offsets, &types];
+    let mut off = [0u64; 5];
+    let mut acc = 0u64;
+    for (o, d) in off.iter_mut().zip(order) {
+        *o = acc;
+        acc += d.block_bytes();
+    }
+    let mut xml = String::with_capacity(1024);
+    xml.push_str("<?xml version=\"1.0\"?>\n");
+    xml.push_str(
+        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n",
+    );
+    xml.push_str("  <UnstructuredGrid>\n    <FieldData>\n");
+    xml.push_str(&time.xml("      ", off[0], " NumberOfTuples=\"1\""));
+    xml.push_str("    </FieldData>\n");
+    xml.push_str(&format!(
+        "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{cells}\">\n      <Points>\n"
+    ));
+    xml.push_str(&points.xml("        ", off[1], ""));
+    xml.push_str("      </Points>\n      <Cells>\n");
+    for (d, o) in order[2..].iter().zip(&off[2..]) {
+        xml.push_str(&d.xml("        ", *o, ""));
+    }
+    xml.push_str("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n");
+    xml.push_str("  <AppendedData encoding=\"raw\">\n   _");
+    w.write_all(xml.as_bytes())?;
+
+    let mut chunk = Vec::with_capacity((1 << 16) + 64);
+    let c = &mut chunk;
+    write_block(w, &time, std::iter::once(mesh.time_s), c)?;
+    write_block(w, &points, mesh.vertices.iter().flatten().copied(), c)?;
+    let corners = mesh.triangles.iter().flatten().copied();
+    if wide {
+        write_block(w, &connectivity, corners.map(|v| v as i64), c)?;
+        write_block(w, &offsets, (1..=cells as i64).map(|k| 3 * k), c)?;
+    } else {
+        write_block(w, &connectivity, corners.map(|v| v as i32), c)?;
+        write_block(w, &offsets, (1..=cells as i32).map(|k| 3 * k), c)?;
+    }
+    write_block(w, &types, std::iter::repeat_n(VTK_TRIANGLE, cells), c)?;
+    w.write_all(b"\n  </AppendedData>\n</VTKFile>\n")?;
+    Ok(())
+}
+
 /// Reads the files written above back (`wgsph plot --snapshots`, the tests). Only this writer's
 /// layout is understood: raw appended arrays with UInt64 byte counts, little-endian. Errors say
 /// what is wrong in words; the caller names the file.
@@ -402,9 +466,12 @@ pub(crate) mod reader {
             self.values(name, "UInt32", 1, u32::from_le_bytes)
         }
 
-        #[cfg(test)]
         pub fn i32s(&self, name: &str) -> Result<Vec<i32>, String> {
             self.values(name, "Int32", 1, i32::from_le_bytes)
+        }
+
+        pub fn i64s(&self, name: &str) -> Result<Vec<i64>, String> {
+            self.values(name, "Int64", 1, i64::from_le_bytes)
         }
     }
 }
@@ -530,6 +597,35 @@ mod tests {
             .lines()
             .filter(|l| l.contains("<DataArray "))
             .all(|l| l.trim_end().ends_with("/>")));
+    }
+
+    /// A surface mesh reads back as written: points, one triangle cell per triangle, its time.
+    #[test]
+    fn triangle_meshes_round_trip() {
+        let mesh = crate::output::SurfaceMesh {
+            time_s: 0.25,
+            vertices: vec![
+                [0.0, 0.0, 1.0],
+                [1.0, 0.0, 1.0],
+                [0.0, 1.0, 1.0],
+                [1.0, 1.0, 1.5],
+            ],
+            triangles: vec![[0, 1, 2], [1, 3, 2]],
+        };
+        let mut buf = Vec::new();
+        write_triangles_vtu(&mut buf, &mesh).unwrap();
+        let v = Vtu::parse(&buf).unwrap();
+        assert_eq!((v.number_of_points, v.number_of_cells), (4, 2));
+        assert_eq!(v.f64s("TimeValue", 1).unwrap(), [0.25]);
+        let points = v.f64s("Points", 3).unwrap();
+        assert_eq!(points, mesh.vertices.concat());
+        assert_eq!(v.i32s("connectivity").unwrap(), [0, 1, 2, 1, 3, 2]);
+        assert_eq!(v.i32s("offsets").unwrap(), [3, 6]);
+        let types = &v.arrays["types"];
+        assert_eq!(
+            (types.vtk_type.as_str(), types.data.as_slice()),
+            ("UInt8", &[5u8, 5][..])
+        );
     }
 
     #[test]
