@@ -250,19 +250,28 @@ fn in_front_bins(def: ProbeDef, reach: f32) -> bool {
     return reach >= 0.0 && reach < f32(def.words * 32u) * def.bin_width;
 }
 
+// The particle of invocation i: whether it is fluid, and its position (none past the end).
+struct FluidAt {
+    fluid: bool,
+    x: vec3<f32>,
+}
+
+fn fluid_at(i: u32) -> FluidAt {
+    if (i >= params.n_particles) {
+        return FluidAt(false, vec3<f32>(0.0));
+    }
+    return FluidAt(code_kind(code[i]) == KIND_FLUID, domain_pos(pos[i]));
+}
+
 @compute @workgroup_size(WG)
 fn probe_front(
     @builtin(global_invocation_id) gid: vec3<u32>,
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) li: u32,
 ) {
-    let i = linear_index(gid, nwg);
-    var fluid = false;
-    var x = vec3<f32>(0.0);
-    if (i < params.n_particles) {
-        fluid = code_kind(code[i]) == KIND_FLUID;
-        x = domain_pos(pos[i]);
-    }
+    let at = fluid_at(linear_index(gid, nwg));
+    let fluid = at.fluid;
+    let x = at.x;
     for (var k = 0u; k < params.n_probes; k++) {
         let def = probes[k];
         let reach_k = dot(x - def.point, def.axis);
@@ -322,13 +331,9 @@ fn probe_front_continuous(
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) li: u32,
 ) {
-    let i = linear_index(gid, nwg);
-    var fluid = false;
-    var x = vec3<f32>(0.0);
-    if (i < params.n_particles) {
-        fluid = code_kind(code[i]) == KIND_FLUID;
-        x = domain_pos(pos[i]);
-    }
+    let at = fluid_at(linear_index(gid, nwg));
+    let fluid = at.fluid;
+    let x = at.x;
     for (var k = 0u; k < params.n_probes; k++) {
         let def = probes[k];
         if (def.kind != PROBE_FRONT_CONTINUOUS) {
