@@ -9,7 +9,8 @@ use anyhow::{bail, Context, Result};
 use splashsurf_lib::nalgebra::Vector3;
 
 use crate::output::{
-    particle_files, write_surface, write_surface_series, ParticleFile, SurfaceMesh,
+    create_surface_dir, particle_files, write_surface, write_surface_series, ParticleFile,
+    SurfaceMesh,
 };
 use crate::scenario::{Kind, Scenario};
 
@@ -121,6 +122,7 @@ pub fn surfaces_of_run(
             dir.display()
         );
     }
+    create_surface_dir(dir)?;
     let mut series = Vec::with_capacity(files.len());
     for (done, (index, file)) in files.iter().enumerate() {
         let read = ParticleFile::read(file)?;

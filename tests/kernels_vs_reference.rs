@@ -627,6 +627,41 @@ fn probes_match_reference() {
     }
 }
 
+/// The lattice from the origin to `max`, its two lowest rows (along the last axis of `dim`) a
+/// wall and the rest water jittered by ±0.2 dx, its densities 1000 kg/m³ each moved by up to
+/// ±`rho_jitter` of it (no draw when 0).
+fn water_on_a_floor(
+    dim: u32,
+    dx: f64,
+    max: [f64; 3],
+    rng: &mut Rng,
+    rho_jitter: f64,
+) -> Vec<Particle> {
+    let up = dim as usize - 1;
+    lattice(dim, dx, [0.0; 3], max)
+        .into_iter()
+        .map(|p| {
+            let wall = p[up] < 2.0 * dx;
+            let mut pos = p;
+            let mut rho = 1000.0;
+            if !wall {
+                for x in pos.iter_mut().take(dim as usize) {
+                    *x += rng.range(-0.2, 0.2) * dx;
+                }
+                if rho_jitter > 0.0 {
+                    rho *= 1.0 + rng.range(-rho_jitter, rho_jitter);
+                }
+            }
+            Particle {
+                pos,
+                vel: [0.0; 3],
+                rho,
+                kind: if wall { Kind::Wall } else { Kind::Fluid },
+            }
+        })
+        .collect()
+}
+
 /// Wave gauges in a domain tall compared with h (issue 36): a jittered block of water 0.05 m
 /// deep (2D: dx = 2 mm, 4 m of domain above it; 3D: dx = 1 cm, 1.5 m), far more cells than
 /// particles (a hashed grid), gauges in the middle, at a side and in between. The
@@ -647,24 +682,7 @@ fn height_probes_match_reference_in_a_tall_domain() {
         if dim == 2 {
             max[2] = 0.0;
         }
-        let parts: Vec<Particle> = lattice(dim, dx, [0.0; 3], max)
-            .into_iter()
-            .map(|p| {
-                let wall = p[up] < 2.0 * dx;
-                let mut pos = p;
-                if !wall {
-                    for x in pos.iter_mut().take(dim as usize) {
-                        *x += rng.range(-0.2, 0.2) * dx;
-                    }
-                }
-                Particle {
-                    pos,
-                    vel: [0.0; 3],
-                    rho: 1000.0 * (1.0 + if wall { 0.0 } else { rng.range(-0.005, 0.005) }),
-                    kind: if wall { Kind::Wall } else { Kind::Fluid },
-                }
-            })
-            .collect();
+        let parts = water_on_a_floor(dim, dx, max, &mut rng, 0.005);
         let mut dmax = [width; 3];
         dmax[up] = tall;
         if dim == 2 {
@@ -737,24 +755,7 @@ fn continuous_fronts_leave_out_droplets_ahead_of_the_water() {
         if dim == 2 {
             max[2] = 0.0;
         }
-        let mut parts: Vec<Particle> = lattice(dim, dx, [0.0; 3], max)
-            .into_iter()
-            .map(|p| {
-                let wall = p[up] < 2.0 * dx;
-                let mut pos = p;
-                if !wall {
-                    for x in pos.iter_mut().take(dim as usize) {
-                        *x += rng.range(-0.2, 0.2) * dx;
-                    }
-                }
-                Particle {
-                    pos,
-                    vel: [0.0; 3],
-                    rho: 1000.0,
-                    kind: if wall { Kind::Wall } else { Kind::Fluid },
-                }
-            })
-            .collect();
+        let mut parts = water_on_a_floor(dim, dx, max, &mut rng, 0.0);
         let block_end = (parts.iter())
             .filter(|p| p.kind == Kind::Fluid)
             .map(|p| p.pos[0])

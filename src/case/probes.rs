@@ -120,20 +120,22 @@ pub(super) fn probe(
     ))
 }
 
-/// The fields of `p` at `path`: exactly those of its kind (a point probe attached to no body).
+/// The fields of `p` at `path`: those its kind needs, and beside them only those it may take
+/// (a point probe attached to no body).
 fn check_probe_fields(
     ctx: &Ctx<'_>,
     path: &str,
     p: &RawProbe,
     dim: usize,
 ) -> Result<(), CaseError> {
-    let (kind_name, needs): (&str, &[&str]) = match p.kind {
-        ProbeName::Pressure if p.face_m.is_some() => ("pressure", &["face_m", "normal"]),
-        ProbeName::Pressure => ("pressure", &["point_m"]),
-        ProbeName::Height => ("height", &["base_m"]),
-        ProbeName::Front => ("front", &["origin_m", "axis"]),
-        ProbeName::Point => ("point", &["point_m"]),
-        ProbeName::WallPressure => ("wall_pressure", &["point_m", "normal", "radius_m"]),
+    let (kind_name, needs, optional): (&str, &[&str], &[&str]) = match p.kind {
+        ProbeName::Pressure if p.face_m.is_some() => ("pressure", &["face_m", "normal"], &[]),
+        ProbeName::Pressure => ("pressure", &["point_m"], &[]),
+        ProbeName::Height => ("height", &["base_m"], &[]),
+        // The furthest particle unless `continuous`.
+        ProbeName::Front => ("front", &["origin_m", "axis"], &["continuous"]),
+        ProbeName::Point => ("point", &["point_m"], &[]),
+        ProbeName::WallPressure => ("wall_pressure", &["point_m", "normal", "radius_m"], &[]),
     };
     if p.kind == ProbeName::Point && p.body.is_some() {
         return Err(ctx.err(
@@ -160,10 +162,10 @@ fn check_probe_fields(
             ("continuous", p.continuous.is_some()),
         ]);
     for (field, value) in present {
-        let f = format!("{path}.{field}");
-        if field == "continuous" && p.kind == ProbeName::Front {
-            continue; // optional: the furthest particle by default
+        if optional.contains(&field) {
+            continue;
         }
+        let f = format!("{path}.{field}");
         match (needs.contains(&field), value) {
             (true, false) => {
                 let add = if field == "radius_m" {
@@ -512,25 +514,24 @@ pub(super) fn inside_walls(
     let half = 0.5 * dx * (1.0 - 1e-6);
     let solid = |p: &&Particle| p.kind.is_boundary() || p.kind.is_solid();
     (probes.iter().zip(blind))
-        .filter_map(|(probe, &blind)| {
+        .filter(|(_, &blind)| !blind)
+        .filter_map(|(probe, _)| {
             let ProbeKind::Pressure { point } = probe.kind else {
                 return None;
             };
             let inside = (particles.iter().filter(solid))
                 .find(|p| (0..dim).all(|a| (p.pos[a] - point[a]).abs() < half))?;
-            (!blind).then(|| {
-                format!(
-                    "probe '{}' (point_m) starts inside a wall, an obstacle or a body: {} lies \
+            Some(format!(
+                "probe '{}' (point_m) starts inside a wall, an obstacle or a body: {} lies \
                      within half a spacing (dx = {dx} m) of its particle at {}, so it reads the \
                      water in front of the face through the kernel, not the pressure at its \
                      point; fix: give the face instead (face_m and normal: the probe then \
                      samples half a spacing in front of it at any dx), or move point_m into the \
                      water",
-                    probe.name,
-                    fmt_point(&point, dim as u32),
-                    fmt_point(&inside.pos, dim as u32),
-                )
-            })
+                probe.name,
+                fmt_point(&point, dim as u32),
+                fmt_point(&inside.pos, dim as u32),
+            ))
         })
         .collect()
 }

@@ -101,6 +101,16 @@ impl SurfaceMesh {
     }
 }
 
+/// Creates DIR/surface (an existing one is fine) and removes the temporary files a killed
+/// `wgsph surface` may have left there; before the first [`write_surface`].
+pub fn create_surface_dir(dir: &Path) -> Result<(), OutputError> {
+    let folder = dir.join(SURFACE_DIR);
+    std::fs::create_dir_all(&folder)
+        .map_err(|e| OutputError::io("create directory", &folder, e))?;
+    atomic::remove_stale_temps(&folder);
+    Ok(())
+}
+
 /// Writes `mesh`, the surface of particle file `index`, as DIR/surface/surface_NNNNNN.vtu,
 /// atomically. Returns its (time, path relative to DIR) for [`write_surface_series`].
 pub fn write_surface(
@@ -108,10 +118,6 @@ pub fn write_surface(
     index: usize,
     mesh: &SurfaceMesh,
 ) -> Result<(f64, String), OutputError> {
-    let folder = dir.join(SURFACE_DIR);
-    std::fs::create_dir_all(&folder)
-        .map_err(|e| OutputError::io("create directory", &folder, e))?;
-    atomic::remove_stale_temps(&folder);
     let rel = format!("{SURFACE_DIR}/surface_{index:06}.vtu");
     write_atomic(&dir.join(&rel), |w| vtu::write_triangles_vtu(w, mesh))?;
     Ok((mesh.time_s, rel))

@@ -33,7 +33,8 @@ fn params(dx: f64) -> SurfaceParams {
 
 /// A ball of lattice particles gives a sphere of the ball's radius: the radius of the sphere of
 /// the particles' volume N dx³ on average within a quarter spacing (measured: +0.1 dx), every
-/// vertex within half a spacing (the lattice's staircase outline: −0.13 … +0.37 dx).
+/// vertex within half a spacing (the lattice's staircase outline: −0.13 … +0.37 dx), every
+/// triangle facing outwards.
 #[test]
 fn a_ball_of_particles_gives_a_sphere_of_its_radius() {
     let (dx, r) = (0.01, 0.1);
@@ -56,6 +57,22 @@ fn a_ball_of_particles_gives_a_sphere_of_its_radius() {
         mesh.triangles.len()
     );
     assert!(mesh.triangles.len() > 1000);
+    // Every triangle is counter-clockwise seen from outside (its normal points away from the
+    // centre), as `SurfaceMesh` documents.
+    let outward = |t: &[usize; 3]| {
+        let [a, b, c] = t.map(|i| mesh.vertices[i]);
+        let (u, v) = (
+            [0, 1, 2].map(|k| b[k] - a[k]),
+            [0, 1, 2].map(|k| c[k] - a[k]),
+        );
+        let n =
+            [0, 1, 2].map(|k| u[(k + 1) % 3] * v[(k + 2) % 3] - u[(k + 2) % 3] * v[(k + 1) % 3]);
+        (0..3).map(|k| n[k] * a[k]).sum::<f64>() > 0.0
+    };
+    assert!(
+        mesh.triangles.iter().all(outward),
+        "a triangle faces inwards"
+    );
     assert!(
         (mean - r_eq).abs() < 0.25 * dx,
         "mean radius {mean}, ball {r_eq}"
