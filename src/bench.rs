@@ -1,10 +1,17 @@
-//! `wgsph bench`'s work report: what a step does per particle beside what it costs, the
+//! `wgsph bench`: timing a case's steps ([`measure`]), and its work report: what a step does per particle beside what it costs, the
 //! figures that predict a GPU's speed from its bandwidth and show a regression on any adapter.
 
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+
+use crate::gpu::GpuContext;
 use crate::grid::Grid;
 use crate::layout::KIND_EXCLUDED;
 use crate::output::Particles;
-use crate::scenario::Kind;
+use crate::scenario::{Kind, Scenario};
+use crate::sph::profile::StageTime;
+use crate::sph::Solver;
 
 /// The neighbour search's work in one state of the particles: per particle in the grid, and
 /// per fluid particle (whose loop, `fluid_rates`, does the most per neighbour).
@@ -103,6 +110,81 @@ fn slots_around(grid: &Grid, dim: u32, c: [i64; 3]) -> Vec<u32> {
         }
     }
     slots
+}
+
+/// What `wgsph bench` measures: `steps` steps of a case after `warmup`, on one adapter.
+#[derive(Clone, Debug)]
+pub struct BenchReport {
+    pub case: String,
+    pub adapter: String,
+    pub particles: u64,
+    pub steps: u64,
+    pub wall_s: f64,
+    /// Simulated seconds over the timed steps.
+    pub simulated_s: f64,
+    pub gpu_bytes: u64,
+    pub dispatches_per_step: u64,
+    /// The neighbour search's work in the last state.
+    pub work: NeighbourWork,
+    /// Each stage's GPU time over as many steps again, when asked for.
+    pub stages: Option<Vec<StageTime>>,
+}
+
+impl BenchReport {
+    pub fn particle_steps_per_s(&self) -> f64 {
+        self.steps as f64 * self.particles as f64 / self.wall_s
+    }
+
+    /// Simulated seconds per wall second: the fair figure between integrators of different
+    /// steps (and force evaluations a step).
+    pub fn simulated_per_wall(&self) -> f64 {
+        self.simulated_s / self.wall_s
+    }
+
+    pub fn mean_dt_s(&self) -> f64 {
+        self.simulated_s / self.steps.max(1) as f64
+    }
+}
+
+/// Times `steps` steps of `sc` on `ctx` after `warmup` untimed ones (shader compilation,
+/// caches); with `stages`, then each stage's GPU time over `steps` more (needs timestamp
+/// queries). `wgsph bench` and the Python package's `bench` print or return this.
+pub fn measure(
+    ctx: &GpuContext,
+    sc: &Scenario,
+    steps: u64,
+    warmup: u64,
+    stages: bool,
+) -> Result<BenchReport> {
+    let mut solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
+    solver.run_steps(warmup)?;
+    let t0 = solver.time();
+    let start = Instant::now();
+    solver.run_steps(steps)?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let simulated_s = solver.time() - t0;
+    let work = neighbour_work(
+        &solver.grid,
+        sc.physics.dim,
+        sc.physics.h,
+        &solver.read_particles()?,
+    );
+    let stages = match stages {
+        true => Some(solver.profile_steps(steps)?),
+        false => None,
+    };
+    Ok(BenchReport {
+        case: sc.name.clone(),
+        adapter: ctx.describe(),
+        particles: solver.particle_count(),
+        steps,
+        wall_s,
+        simulated_s,
+        gpu_bytes: solver.gpu_bytes(),
+        dispatches_per_step: solver.dispatches_per_step(),
+        work,
+        stages,
+    })
 }
 
 #[cfg(test)]

@@ -16,6 +16,7 @@ pub mod plot;
 pub mod probe_reach;
 pub mod progress;
 pub mod reference;
+pub mod resume;
 pub mod run;
 pub mod scenario;
 pub mod sph;

@@ -5,18 +5,18 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::MultiProgress;
 
-use wgsph::checkpoint::{CaseSource, Checkpoint, CheckpointPolicy, CHECKPOINT_FILE};
+use wgsph::checkpoint::{CaseSource, CheckpointPolicy};
 use wgsph::gpu::context::list_adapters;
 use wgsph::gpu::{AdapterChoice, GpuContext};
 use wgsph::plot::snapshot::SnapshotField;
 use wgsph::probe_reach::sig;
 use wgsph::progress::{LogLines, Progress, ProgressBarView};
+use wgsph::resume::ResumePlan;
 use wgsph::run::{RunOptions, RunReport};
 
 #[derive(Parser)]
@@ -474,45 +474,30 @@ fn bench(
 ) -> Result<ExitCode> {
     let sc = wgsph::case::load(case, set)?;
     let ctx = context(adapter)?;
-    let mut solver = wgsph::sph::Solver::new(&ctx, &sc).context("setting up the GPU solver")?;
-    solver.run_steps(warmup)?;
-    let t0 = solver.time();
-    let start = Instant::now();
-    solver.run_steps(steps)?;
-    let wall = start.elapsed().as_secs_f64();
-    let simulated = solver.time() - t0;
-    let n = solver.particle_count();
-    let work = wgsph::bench::neighbour_work(
-        &solver.grid,
-        sc.physics.dim,
-        sc.physics.h,
-        &solver.read_particles()?,
-    );
-    println!("case            {}", sc.name);
-    println!("adapter         {}", ctx.describe());
+    let r = wgsph::bench::measure(&ctx, &sc, steps, warmup, stages)?;
+    let n = r.particles;
+    println!("case            {}", r.case);
+    println!("adapter         {}", r.adapter);
     println!("particles       {n}");
     println!("steps           {steps}");
-    println!("wall seconds    {wall:.4e}");
-    println!("particle-steps/s {:.4e}", steps as f64 * n as f64 / wall);
+    println!("wall seconds    {:.4e}", r.wall_s);
+    println!("particle-steps/s {:.4e}", r.particle_steps_per_s());
     // The fair figure between integrators of different steps (and force evaluations a step).
-    println!("simulated s/wall s {:.4e}", simulated / wall);
-    println!("mean dt s       {:.4e}", simulated / steps.max(1) as f64);
-    println!(
-        "bytes/particle  {:.1}",
-        solver.gpu_bytes() as f64 / n as f64
-    );
+    println!("simulated s/wall s {:.4e}", r.simulated_per_wall());
+    println!("mean dt s       {:.4e}", r.mean_dt_s());
+    println!("bytes/particle  {:.1}", r.gpu_bytes as f64 / n as f64);
     // Per particle and step, in the last state (src/bench.rs).
     println!(
         "candidates/particle {:.1} (fluid {:.1})",
-        work.candidates, work.fluid_candidates
+        r.work.candidates, r.work.fluid_candidates
     );
     println!(
         "neighbours/particle {:.1} (fluid {:.1})",
-        work.neighbours, work.fluid_neighbours
+        r.work.neighbours, r.work.fluid_neighbours
     );
-    println!("dispatches/step {}", solver.dispatches_per_step());
-    if stages {
-        print_stages(&solver.profile_steps(steps)?, steps, n);
+    println!("dispatches/step {}", r.dispatches_per_step);
+    if let Some(times) = &r.stages {
+        print_stages(times, steps, n);
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -526,57 +511,17 @@ fn resume(
     quiet: bool,
     bars: &MultiProgress,
 ) -> Result<ExitCode> {
-    let ck_path = dir.join(CHECKPOINT_FILE);
-    if !ck_path.is_file() {
-        // A short run completes before its first checkpoint: say so rather than that the
-        // checkpoint is missing.
-        if let Ok(done) = wgsph::output::RunSummary::read(dir) {
-            if done.status == "completed" {
-                let what = format!(
-                    "{}: the run is already complete (t = {:.4} s) and left no checkpoint",
-                    dir.display(),
-                    done.simulated_time_s
-                );
-                if set.is_empty() {
-                    println!("already complete: {what}; nothing computed");
-                    return Ok(ExitCode::SUCCESS);
-                }
-                anyhow::bail!(
-                    "{what} to continue from with {set:?}: run the case again with the later \
-                     time.end_s (and --checkpoint-every to extend it later)"
-                );
-            }
+    let (sc, options) = match wgsph::resume::plan(dir, &set, checkpoint_every, None)? {
+        ResumePlan::Complete(what) => {
+            println!("already complete: {what}; nothing computed");
+            return Ok(ExitCode::SUCCESS);
         }
-    }
-    let ck = Checkpoint::read(&ck_path)?;
-    let Some(source) = ck.source.clone() else {
-        anyhow::bail!(
-            "{} does not record its case file (it was written through the library): \
-             resume it with wgsph::run::resume",
-            dir.join(CHECKPOINT_FILE).display()
-        );
+        ResumePlan::Continue { scenario, options } => (scenario, options),
     };
-    let overrides: Vec<String> = source.overrides.iter().chain(&set).cloned().collect();
-    let sc = wgsph::case::load(&source.path, &overrides)?;
     let ctx = context(adapter)?;
     let options = RunOptions {
-        snapshot_png: ck
-            .snapshot_field
-            .as_deref()
-            .map(|f| f.parse().map_err(anyhow::Error::msg))
-            .transpose()?,
-        // The run's own policy unless given anew (a checkpoint written before the policy was
-        // recorded: the default).
-        checkpoint: checkpoint_every
-            .or(ck.policy)
-            .unwrap_or_else(CheckpointPolicy::default_for_runs),
-        source: Some(CaseSource {
-            path: source.path,
-            overrides,
-        }),
         interrupt: Some(interrupt_flag()?),
-        halt_at_s: None,
-        ..Default::default()
+        ..options
     };
     let report = wgsph::run::resume(&ctx, &sc, dir, &options, &mut *progress(quiet, bars))?;
     Ok(finish(&report, dir, quiet))

@@ -111,20 +111,7 @@ pub fn load_str_limited(
     let (de_text, de_index, de_doc) = if parsed.is_empty() {
         (text, None, doc)
     } else {
-        let mut table: toml::Table = text
-            .parse()
-            .map_err(|e| diagnose::syntax(file_name, text, &e))?;
-        for o in &parsed {
-            overrides::apply(file_name, &mut table, o)?;
-        }
-        edited = toml::to_string(&table).map_err(|e| {
-            ctx.err(
-                "",
-                None,
-                format!("cannot apply the overrides: {e}"),
-                "check the --set values",
-            )
-        })?;
+        edited = edit(&ctx, text, &parsed)?;
         // The edit of a valid document is valid TOML; should it not be, the overrides are to
         // blame, not a line of the file.
         let doc = toml::de::DeTable::parse(&edited).map_err(|e| {
@@ -148,4 +135,53 @@ pub fn load_str_limited(
     let case_dir = Path::new(file_name).parent().unwrap_or(Path::new("."));
     let case = validate::validate(&ctx, &raw, &stem, case_dir)?;
     build::build(&ctx, case, max_particles)
+}
+
+/// The case text with `parsed` overrides applied to its document, re-serialised (the loader
+/// checks this text; comments and layout are lost).
+fn edit(ctx: &Ctx, text: &str, parsed: &[overrides::Override]) -> Result<String, CaseError> {
+    let mut table: toml::Table = text
+        .parse()
+        .map_err(|e| diagnose::syntax(ctx.file, text, &e))?;
+    for o in parsed {
+        overrides::apply(ctx.file, &mut table, o)?;
+    }
+    toml::to_string(&table).map_err(|e| {
+        ctx.err(
+            "",
+            None,
+            format!("cannot apply the overrides: {e}"),
+            "check the --set values",
+        )
+    })
+}
+
+/// The text of a case with `--set KEY=VALUE` overrides applied, as the loader reads it: `text`
+/// itself without overrides, else its document re-serialised with them (comments and layout
+/// lost). Errors as [`load_str`]'s for the same file and overrides. For writing a case out
+/// again (the Python package's `Case.to_toml`).
+pub fn with_overrides(
+    text: &str,
+    file_name: &str,
+    overrides: &[String],
+) -> Result<String, CaseError> {
+    let doc = toml::de::DeTable::parse(text).map_err(|e| diagnose::syntax(file_name, text, &e))?;
+    let index = Index::new(text, doc.get_ref());
+    let parsed: Vec<overrides::Override> = overrides
+        .iter()
+        .map(|arg| overrides::parse(file_name, arg))
+        .collect::<Result<_, _>>()?;
+    if parsed.is_empty() {
+        return Ok(text.to_string());
+    }
+    let keys: Vec<(String, String)> = parsed
+        .iter()
+        .map(|o| (o.key.clone(), o.arg.clone()))
+        .collect();
+    let ctx = Ctx {
+        file: file_name,
+        index: &index,
+        overrides: &keys,
+    };
+    edit(&ctx, text, &parsed)
 }

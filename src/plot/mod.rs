@@ -318,7 +318,7 @@ const TABLE_COLUMN: char = '.';
 
 /// Probe names, sorted: the file stems of DIR/probes/*.csv, and `<table>.<column>` for each
 /// value column of a table.
-fn probe_names(dir: &Path) -> Result<Vec<String>> {
+pub fn probe_names(dir: &Path) -> Result<Vec<String>> {
     let pdir = dir.join(PROBES_DIR);
     let mut names = Vec::new();
     for e in std::fs::read_dir(&pdir).with_context(|| {
@@ -399,7 +399,7 @@ pub fn parse_table_column(text: &str, name: &str, column: &str) -> Result<Series
 }
 
 /// The series of the probe `name` (see [`probe_names`]) in the run in `dir`.
-fn read_probe(dir: &Path, name: &str) -> Result<Series> {
+pub fn read_probe(dir: &Path, name: &str) -> Result<Series> {
     match name.split_once(TABLE_COLUMN) {
         Some((table, column)) => {
             read_table_column(&dir.join(PROBES_DIR).join(format!("{table}.csv")), column)

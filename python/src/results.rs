@@ -1,0 +1,253 @@
+//! `wgsph.Run`: a run folder's outputs as NumPy arrays, read with the engine's own readers
+//! (the probe CSVs with `wgsph plot`'s, the particle files with the one `plot --snapshots` and
+//! `surface` use), so what Python sees is what the command reads.
+
+use std::path::{Path, PathBuf};
+
+use numpy::{IntoPyArray, PyArrayMethods};
+use pyo3::exceptions::{PyIndexError, PyKeyError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use wgsph::output::{particle_files, ParticleFile, PARTICLES_DIR, PROBES_DIR, RUN_SUMMARY_FILE};
+
+use crate::errors::{to_py, WgsphError};
+
+/// A run folder: one `wgsph.run` wrote, or `wgsph run` (`Run.open(dir)`).
+#[pyclass(module = "wgsph", frozen)]
+pub struct Run {
+    dir: PathBuf,
+    interrupted_at_s: Option<f64>,
+    already_complete: bool,
+}
+
+impl Run {
+    pub fn finished(dir: PathBuf, interrupted_at_s: Option<f64>, already_complete: bool) -> Self {
+        Run {
+            dir,
+            interrupted_at_s,
+            already_complete,
+        }
+    }
+
+    fn probes_dir(&self) -> PathBuf {
+        self.dir.join(PROBES_DIR)
+    }
+
+    /// Every probe name, as `wgsph plot` lists them (`table.column` for a table's columns).
+    fn names(&self) -> PyResult<Vec<String>> {
+        if !self.probes_dir().is_dir() {
+            return Ok(Vec::new());
+        }
+        wgsph::plot::probe_names(&self.dir).map_err(to_py)
+    }
+
+    fn unknown(&self, what: &str, name: &str, known: &[String]) -> PyErr {
+        PyKeyError::new_err(format!(
+            "no {what} {name:?} in {}; it has: {}",
+            self.dir.display(),
+            if known.is_empty() {
+                "none".to_string()
+            } else {
+                known.join(", ")
+            }
+        ))
+    }
+}
+
+/// `values` as a 1-D array.
+fn array1<'py, T: numpy::Element>(py: Python<'py>, values: Vec<T>) -> Bound<'py, PyAny> {
+    values.into_pyarray(py).into_any()
+}
+
+/// Rows of three as an (n, 3) array.
+fn array_n3<'py, T: numpy::Element + Copy>(
+    py: Python<'py>,
+    rows: &[[T; 3]],
+) -> PyResult<Bound<'py, PyAny>> {
+    let flat: Vec<T> = rows.iter().flatten().copied().collect();
+    Ok(flat.into_pyarray(py).reshape([rows.len(), 3])?.into_any())
+}
+
+#[pymethods]
+impl Run {
+    /// Opens an existing run folder (one with run.json, probes/ or particles/).
+    #[staticmethod]
+    fn open(dir: PathBuf) -> PyResult<Self> {
+        let is_run = [RUN_SUMMARY_FILE, PROBES_DIR, PARTICLES_DIR]
+            .iter()
+            .any(|f| dir.join(f).exists());
+        if !is_run {
+            return Err(WgsphError::new_err(format!(
+                "{} is not a run folder: it has no {RUN_SUMMARY_FILE}, {PROBES_DIR}/ or \
+                 {PARTICLES_DIR}/; fix: give the folder `wgsph run --out` or wgsph.run(out=...) \
+                 wrote",
+                dir.display()
+            )));
+        }
+        Ok(Run::finished(dir, None, false))
+    }
+
+    /// The run's folder.
+    #[getter]
+    fn dir(&self) -> String {
+        self.dir.display().to_string()
+    }
+
+    /// run.json as a dict, or None while the run has not ended (or was killed).
+    #[getter]
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let path = self.dir.join(RUN_SUMMARY_FILE);
+        if !path.is_file() {
+            return Ok(None);
+        }
+        // The engine's reader checks the file; Python's json gives every field as written.
+        wgsph::output::RunSummary::read(&self.dir).map_err(|e| to_py(e.into()))?;
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| WgsphError::new_err(format!("cannot read {}: {e}", path.display())))?;
+        Ok(Some(py.import("json")?.call_method1("loads", (text,))?))
+    }
+
+    /// run.json's status ("completed", "interrupted ...", "stopped: ..."), or None.
+    #[getter]
+    fn status(&self) -> PyResult<Option<String>> {
+        if !self.dir.join(RUN_SUMMARY_FILE).is_file() {
+            return Ok(None);
+        }
+        let s = wgsph::output::RunSummary::read(&self.dir).map_err(|e| to_py(e.into()))?;
+        Ok(Some(s.status))
+    }
+
+    /// The simulated time of the checkpoint the run stopped at, when this call interrupted it.
+    #[getter]
+    fn interrupted_at_s(&self) -> Option<f64> {
+        self.interrupted_at_s
+    }
+
+    /// True when `resume` found the run already complete and computed nothing.
+    #[getter]
+    fn already_complete(&self) -> bool {
+        self.already_complete
+    }
+
+    /// Every probe name: the probe CSVs' stems, and `table.column` for each column of a body's
+    /// or tracked point's table (`body_box.y_m`).
+    fn probes(&self) -> PyResult<Vec<String>> {
+        self.names()
+    }
+
+    /// `(t, values)` of a probe (or of a table's column, `table.column`), as float64 arrays;
+    /// NaN where the probe had no value.
+    fn probe<'py>(
+        &self,
+        py: Python<'py>,
+        name: &str,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let names = self.names()?;
+        if !names.iter().any(|n| n == name) {
+            return Err(self.unknown("probe", name, &names));
+        }
+        let series = wgsph::plot::read_probe(&self.dir, name).map_err(to_py)?;
+        let (t, v): (Vec<f64>, Vec<f64>) = series.points.into_iter().unzip();
+        Ok((array1(py, t), array1(py, v)))
+    }
+
+    /// A table (`probes/<name>.csv`: a body's, `body_<name>`, or a tracked point's,
+    /// `point_<name>`) as a dict of float64 arrays, the time `t_s` first.
+    fn table<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>> {
+        let names = self.names()?;
+        let prefix = format!("{name}.");
+        let columns: Vec<&String> = names.iter().filter(|n| n.starts_with(&prefix)).collect();
+        if columns.is_empty() {
+            let tables: Vec<String> = names
+                .iter()
+                .filter_map(|n| n.split_once('.').map(|(t, _)| t.to_string()))
+                .collect::<std::collections::BTreeSet<_>>()
+                .into_iter()
+                .collect();
+            return Err(self.unknown("table", name, &tables));
+        }
+        let d = PyDict::new(py);
+        for (k, column) in columns.iter().enumerate() {
+            let series = wgsph::plot::read_probe(&self.dir, column).map_err(to_py)?;
+            if k == 0 {
+                let t: Vec<f64> = series.points.iter().map(|p| p.0).collect();
+                d.set_item(&series.columns.0, array1(py, t))?;
+            }
+            let v: Vec<f64> = series.points.iter().map(|p| p.1).collect();
+            d.set_item(&column[prefix.len()..], array1(py, v))?;
+        }
+        Ok(d)
+    }
+
+    /// A body's table, `probes/body_<name>.csv` (see `table`).
+    fn body<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>> {
+        self.table(py, &format!("body_{name}"))
+    }
+
+    /// A tracked point's table, `probes/point_<name>.csv` (see `table`).
+    fn point<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>> {
+        self.table(py, &format!("point_{name}"))
+    }
+
+    /// The number of particle outputs.
+    #[getter]
+    fn outputs(&self) -> PyResult<usize> {
+        Ok(self.files()?.len())
+    }
+
+    /// Particle output `i` (negative from the end) as a dict: position (n, 3) float64,
+    /// velocity (n, 3) float32, density, pressure (float32), kind, id (uint32), the extra
+    /// fields the run writes (energy, tau_xx ...), and time_s (a float). With `complete`, an
+    /// output that left out unmoved walls (`time.output_boundary = "first"`) gets them back
+    /// from the first output.
+    #[pyo3(signature = (i = -1, complete = false))]
+    fn particles<'py>(
+        &self,
+        py: Python<'py>,
+        i: isize,
+        complete: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let files = self.files()?;
+        let n = files.len() as isize;
+        let k = if i < 0 { i + n } else { i };
+        if !(0..n).contains(&k) {
+            return Err(PyIndexError::new_err(format!(
+                "particle output {i} of {n} in {}",
+                self.dir.join(PARTICLES_DIR).display()
+            )));
+        }
+        let read = |path: &Path| ParticleFile::read(path).map_err(|e| to_py(e.into()));
+        let file = read(&files[k as usize].1)?;
+        let p = if complete && k > 0 {
+            file.particles.completed_from(&read(&files[0].1)?.particles)
+        } else {
+            file.particles
+        };
+        let d = PyDict::new(py);
+        d.set_item("time_s", file.time_s)?;
+        d.set_item("position", array_n3(py, &p.pos)?)?;
+        d.set_item("velocity", array_n3(py, &p.vel)?)?;
+        d.set_item("density", array1(py, p.rho.clone()))?;
+        d.set_item("pressure", array1(py, p.pressure.clone()))?;
+        d.set_item("kind", array1(py, p.kind.clone()))?;
+        d.set_item("id", array1(py, p.id.clone()))?;
+        for (name, values) in p.extra_arrays() {
+            d.set_item(name, array1(py, values))?;
+        }
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Run({:?})", self.dir.display().to_string())
+    }
+}
+
+impl Run {
+    fn files(&self) -> PyResult<Vec<(usize, PathBuf)>> {
+        if !self.dir.join(PARTICLES_DIR).is_dir() {
+            return Ok(Vec::new());
+        }
+        particle_files(&self.dir).map_err(|e| to_py(e.into()))
+    }
+}
