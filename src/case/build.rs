@@ -275,7 +275,7 @@ fn obstacle_ranges(
     for (i, o) in case.obstacles.iter().enumerate() {
         let Some(r) = lat.range_in(o) else {
             return Err(ctx.err(
-                &format!("obstacle[{i}].max_m"),
+                &format!("{}.max_m", case.obstacle_paths[i]),
                 None,
                 format!(
                     "the obstacle ({}) is too thin to hold one wall particle on the particle \
@@ -331,7 +331,7 @@ fn inlet_layouts(
                 case.obstacles
                     .iter()
                     .position(overlaps)
-                    .map(|j| format!("obstacle[{j}]"))
+                    .map(|j| case.obstacle_paths[j].clone())
             })
             .or_else(|| {
                 case.inlets[..i]
@@ -389,7 +389,7 @@ fn particle_budget(
         } else {
             all
         };
-        parts.push((format!("obstacle[{i}]"), count));
+        parts.push((case.obstacle_paths[i].clone(), count));
     }
     let n_wall_parts = parts.len();
     for (i, b) in case.bodies.iter().enumerate() {

@@ -63,8 +63,8 @@ fn solid_boxes(case: &Case, lat: &Lattice, wall: Option<&TankWall>) -> Vec<(Stri
     let mut solid: Vec<(String, Aabb)> = case
         .obstacles
         .iter()
-        .enumerate()
-        .map(|(i, o)| (format!("obstacle[{i}]"), *o))
+        .zip(&case.obstacle_paths)
+        .map(|(o, path)| (path.clone(), *o))
         .collect();
     if let Some(w) = wall {
         let (mut min, mut max) = ([0.0; 3], [0.0; 3]);

@@ -297,6 +297,8 @@ pub(super) struct RawObstacle {
     pub max_m: Vec<f64>,
     pub wall: Option<WallName>,
     pub slip: Option<SlipName>,
+    /// `false` leaves the obstacle out (a case with and without it from one file, `--set`).
+    pub enabled: Option<bool>,
 }
 
 /// Parameters of the wall treatments: `[walls]`.
@@ -346,6 +348,8 @@ pub(super) struct RawBox {
 #[serde(deny_unknown_fields)]
 pub(super) struct RawProbe {
     pub name: String,
+    /// `false` leaves the probe out (one that needs an obstacle left out, say).
+    pub enabled: Option<bool>,
     pub kind: ProbeName,
     pub point_m: Option<Vec<f64>>,
     /// A pressure probe's point on a wall's face: it samples half a spacing in front of it.
@@ -673,6 +677,11 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "slip = \"no_slip\"",
     ),
     f(
+        "obstacle[].enabled",
+        "false leaves the obstacle out (true, the default)",
+        "enabled = true",
+    ),
+    f(
         "domain",
         "the [domain] table",
         "[domain] with min_m and max_m",
@@ -941,6 +950,11 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "whether a front probe follows the continuous water (true) or the furthest fluid \
          particle (false, the default)",
         "continuous = true",
+    ),
+    f(
+        "probe[].enabled",
+        "false leaves the probe out (true, the default)",
+        "enabled = true",
     ),
     f(
         "probe[].normal",

@@ -589,6 +589,59 @@ fn overrides_change_the_case() {
         .all(|p| p.vel == [1.0, 0.0, 0.0]));
 }
 
+/// The street flood without its building, from the shipped file: the building (obstacle[3])
+/// and its front sensor (probe[5]) left out with `--set`; an obstacle after one left out keeps
+/// its index in messages.
+#[test]
+fn obstacles_and_probes_can_be_left_out() {
+    let text = std::fs::read_to_string("cases/street_flood_3d.toml").unwrap();
+    let coarse = "particles.dx_m=0.04";
+    let with = load_str(&text, "s.toml", &sets(&[coarse])).unwrap();
+    let without = sets(&[
+        coarse,
+        "obstacle[3].enabled=false",
+        "probe[5].enabled=false",
+    ]);
+    let without = load_str(&text, "s.toml", &without).unwrap();
+    let walls = |s: &Scenario| s.count(Kind::Wall);
+    // The building's particles: the wall particles in its box (x 0.8–1 m, y 0–0.2 m, above
+    // the street), and no other, are gone.
+    let building = |s: &Scenario| {
+        (s.particles.iter())
+            .filter(|p| p.kind == Kind::Wall)
+            .filter(|p| {
+                (0.79..1.01).contains(&p.pos[0])
+                    && (0.001..0.21).contains(&p.pos[1])
+                    && p.pos[2] > 0.0
+            })
+            .count()
+    };
+    assert!(building(&with) > 100, "{}", building(&with));
+    assert_eq!(building(&without), 0);
+    assert_eq!(walls(&with) - walls(&without), building(&with));
+    assert_eq!(without.count(Kind::Fluid), with.count(Kind::Fluid));
+    let names = |s: &Scenario| s.probes.iter().map(|p| p.name.clone()).collect::<Vec<_>>();
+    assert!(names(&with).contains(&"front".to_string()));
+    assert_eq!(names(&without).len() + 1, names(&with).len());
+    assert!(!names(&without).contains(&"front".to_string()));
+    // The obstacle after the one left out keeps its index in messages.
+    assert!(
+        (without.warnings.iter()).any(|w| w.starts_with("obstacle[4] is 0.06 m along x")),
+        "{:?}",
+        without.warnings
+    );
+    assert_err(
+        &base_with(
+            "[[probe]]",
+            "[[obstacle]]\nmin_m = [0.6, 0.6]\nmax_m = [0.8, 0.8]\nenabled = false\n\n\
+             [[obstacle]]\nmin_m = [0.6, 0.6]\nmax_m = [0.8, 0.6001]\n\n[[probe]]",
+        ),
+        &[],
+        None,
+        &["obstacle[1].max_m", "too thin"],
+    );
+}
+
 #[test]
 fn override_errors_name_the_set() {
     assert_err(

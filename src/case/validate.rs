@@ -80,6 +80,9 @@ pub(super) struct Case {
     pub obstacles: Vec<Aabb>,
     /// The wall treatment of each obstacle (never `Mirror`).
     pub obstacle_walls: Vec<Treatment>,
+    /// Each obstacle's place in the file, `obstacle[i]`, for messages (an obstacle with
+    /// `enabled = false` is left out, and the ones after it keep their index).
+    pub obstacle_paths: Vec<String>,
     pub domain: Option<Aabb>,
     pub walls: WallSettings,
     pub probes: Vec<Probe>,
@@ -133,7 +136,7 @@ pub(super) fn validate(
     let tank = tank(ctx, raw, dim, case_dir)?;
     let solids = solids(ctx, raw, dim)?;
     let blocks = blocks(ctx, raw, dim)?;
-    let (obstacles, obstacle_walls) = obstacles(ctx, raw, dim)?;
+    let (obstacles, obstacle_walls, obstacle_paths) = obstacles(ctx, raw, dim)?;
     let mut walls = wall_settings(ctx, raw)?;
     let domain = match &raw.domain {
         Some(d) => Some(aabb(ctx, "domain", &d.min_m, &d.max_m, dim, "the domain")?),
@@ -178,6 +181,7 @@ pub(super) fn validate(
         blocks,
         obstacles,
         obstacle_walls,
+        obstacle_paths,
         domain,
         walls,
         probes,
@@ -615,15 +619,19 @@ fn blocks(ctx: &Ctx<'_>, raw: &RawCase, dim: usize) -> Result<Vec<Block>, CaseEr
     Ok(blocks)
 }
 
-/// `[[obstacle]]`: each box and its wall treatment (not mirror).
+/// `[[obstacle]]`: each enabled box, its wall treatment (not mirror) and its path.
 fn obstacles(
     ctx: &Ctx<'_>,
     raw: &RawCase,
     dim: usize,
-) -> Result<(Vec<Aabb>, Vec<Treatment>), CaseError> {
+) -> Result<(Vec<Aabb>, Vec<Treatment>, Vec<String>), CaseError> {
     let mut obstacles = Vec::with_capacity(raw.obstacle.len());
     let mut obstacle_walls = Vec::with_capacity(raw.obstacle.len());
+    let mut paths = Vec::with_capacity(raw.obstacle.len());
     for (i, o) in raw.obstacle.iter().enumerate() {
+        if o.enabled == Some(false) {
+            continue;
+        }
         let path = format!("obstacle[{i}]");
         obstacles.push(aabb(ctx, &path, &o.min_m, &o.max_m, dim, "the obstacle")?);
         if o.wall == Some(WallName::Mirror) {
@@ -635,8 +643,9 @@ fn obstacles(
             ));
         }
         obstacle_walls.push(treatment(ctx, &path, o.wall, o.slip)?);
+        paths.push(path);
     }
-    Ok((obstacles, obstacle_walls))
+    Ok((obstacles, obstacle_walls, paths))
 }
 
 /// `[walls]` (the friction pairs are added later, once the bodies are known).
@@ -763,6 +772,9 @@ fn probes(
     let (mut probes, mut normals): SampledProbes = (Vec::new(), Vec::new());
     let mut points = Vec::new();
     for (i, p) in raw.probe.iter().enumerate() {
+        if p.enabled == Some(false) {
+            continue;
+        }
         match super::probes::probe(ctx, i, p, dim)? {
             Checked::Sampled(mut probe, normal) => {
                 probe.body = match &p.body {

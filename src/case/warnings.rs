@@ -216,11 +216,12 @@ fn rounded_obstacles(case: &Case, dx: f64, points: &[[f64; 3]]) -> Vec<String> {
             let filled = n[a] * dx;
             if (filled - len).abs() > BLOCK_ROUNDING * len {
                 out.push(format!(
-                    "obstacle[{i}] is {} m along {axis} but holds {} lattice points of dx = {} \
+                    "{} is {} m along {axis} but holds {} lattice points of dx = {} \
                      m: its particles span {} m ({:+.1} %), and its faces stand where the \
                      lattice puts them; fix: a particles.dx_m at which the box spans a whole \
                      number of spacings on the lattice (it starts at the tank's inner corner), \
                      or a box that does",
+                    case.obstacle_paths[i],
                     num(len),
                     n[a],
                     num(dx),
@@ -305,7 +306,7 @@ fn thin_ghosts(case: &Case, dx: f64, h: f64) -> Vec<String> {
                 .fold(f64::MAX, f64::min);
             (thickness < limit).then(|| {
                 warning(
-                    format!("obstacle[{i}] ({})", fmt_box(b, dim)),
+                    format!("{} ({})", case.obstacle_paths[i], fmt_box(b, dim)),
                     thickness,
                     false,
                 )
