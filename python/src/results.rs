@@ -153,29 +153,44 @@ impl Run {
     }
 
     /// A table (`probes/<name>.csv`: a body's, `body_<name>`, or a tracked point's,
-    /// `point_<name>`) as a dict of float64 arrays, the time `t_s` first.
+    /// `point_<name>`) as a dict of float64 arrays in the file's column order, time first.
     fn table<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>> {
-        let names = self.names()?;
-        let prefix = format!("{name}.");
-        let columns: Vec<&String> = names.iter().filter(|n| n.starts_with(&prefix)).collect();
-        if columns.is_empty() {
-            let tables: Vec<String> = names
-                .iter()
-                .filter_map(|n| n.split_once('.').map(|(t, _)| t.to_string()))
-                .collect::<std::collections::BTreeSet<_>>()
-                .into_iter()
-                .collect();
-            return Err(self.unknown("table", name, &tables));
-        }
+        let path = self.probes_dir().join(format!("{name}.csv"));
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(_) => {
+                let tables: Vec<String> = self
+                    .names()?
+                    .iter()
+                    .filter_map(|n| n.split_once('.').map(|(t, _)| t.to_string()))
+                    .collect::<std::collections::BTreeSet<_>>()
+                    .into_iter()
+                    .collect();
+                return Err(self.unknown("table", name, &tables));
+            }
+        };
+        // The header names the columns (the first line not blank or a `#` comment); each is
+        // read with the engine's parser, which checks every row.
+        let header = text
+            .lines()
+            .find(|l| !l.trim().is_empty() && !l.starts_with('#'))
+            .unwrap_or_default();
+        let columns: Vec<&str> = header.split(',').map(str::trim).collect();
+        let file = path.display().to_string();
         let d = PyDict::new(py);
-        for (k, column) in columns.iter().enumerate() {
-            let series = wgsph::plot::read_probe(&self.dir, column).map_err(to_py)?;
-            if k == 0 {
+        for (k, column) in columns.iter().enumerate().skip(1) {
+            let series = wgsph::plot::parse_table_column(&text, &file, column).map_err(to_py)?;
+            if k == 1 {
                 let t: Vec<f64> = series.points.iter().map(|p| p.0).collect();
                 d.set_item(&series.columns.0, array1(py, t))?;
             }
             let v: Vec<f64> = series.points.iter().map(|p| p.1).collect();
-            d.set_item(&column[prefix.len()..], array1(py, v))?;
+            d.set_item(*column, array1(py, v))?;
+        }
+        if d.is_empty() {
+            return Err(WgsphError::new_err(format!(
+                "{file}: no columns after the time in its header {header:?}"
+            )));
         }
         Ok(d)
     }

@@ -84,3 +84,19 @@ def test_bench(tiny_case):
     assert r["particles"] == 318 and r["steps"] == 5
     assert r["particle_steps_per_s"] > 0 and r["simulated_s"] > 0
     assert r["stages"] is None
+
+
+def test_body_and_point_tables_equal_their_csv(tmp_path):
+    case = wgsph.Case.load(DAM_BREAK.parent / "floating_box_2d.toml")
+    case.set("particles.dx_m", 0.04)
+    case.set("time.end_s", 0.02)
+    run = wgsph.run(case, out=tmp_path, adapter=ADAPTER, progress=False)
+    for table, name in [(run.body("box"), "body_box"), (run.point("corner"), "point_corner")]:
+        path = tmp_path / "probes" / f"{name}.csv"
+        header = [l for l in path.read_text().splitlines() if not l.startswith("#")][0]
+        assert list(table) == header.split(","), name
+        for column, values in zip(table, csv_columns(path)):
+            assert same_bits(table[column], values), (name, column)
+    assert run.body("box")["y_m"][0] == 0.32
+    with pytest.raises(KeyError, match="body_box"):
+        run.table("body_boat")
