@@ -13,7 +13,7 @@ use indicatif::MultiProgress;
 use wgsph::checkpoint::{CaseSource, CheckpointPolicy};
 use wgsph::gpu::context::list_adapters;
 use wgsph::gpu::{AdapterChoice, GpuContext};
-use wgsph::plot::snapshot::SnapshotField;
+use wgsph::plot::snapshot::{SnapshotField, SnapshotPainter};
 use wgsph::probe_reach::sig;
 use wgsph::progress::{LogLines, Progress, ProgressBarView};
 use wgsph::resume::ResumePlan;
@@ -46,8 +46,8 @@ enum Command {
         /// Override a case field, e.g. --set particles.dx_m=0.005 (repeatable).
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         set: Vec<String>,
-        /// Also draw every particle output as DIR/snapshots/NNNNNN.png (3D: the x-z slice
-        /// through the middle of the domain).
+        /// Also draw every particle output as DIR/snapshots/NNNNNN.png (3D: a perspective
+        /// view of the particles, the walls on the camera's side cut away).
         #[arg(long)]
         snapshots: bool,
         /// Colour of the fluid in the snapshots (default: pressure).
@@ -108,14 +108,18 @@ enum Command {
         #[arg(long, value_name = "SECONDS")]
         smooth: Option<f64>,
         /// Also draw every particle file (particles/particles_NNNNNN.vtu) as
-        /// DIR/snapshots/NNNNNN.png, the pictures `wgsph run --snapshots` draws (3D: the x-z
-        /// slice through the middle of the domain). The case is loaded again from the file and
-        /// overrides run.json records.
+        /// DIR/snapshots/NNNNNN.png, the pictures `wgsph run --snapshots` draws (3D: a
+        /// perspective view, on the adapter --adapter picks). The case is loaded again from
+        /// the file and overrides run.json records.
         #[arg(long)]
         snapshots: bool,
         /// Colour of the fluid in the snapshots (default: pressure).
         #[arg(long, value_name = "pressure|speed", requires = "snapshots")]
         snapshot_field: Option<SnapshotField>,
+        /// 3D: draw the x-z slice through the middle of the domain (|y - y_mid| < 2 dx, the
+        /// water's inside) instead of the perspective view; no GPU adapter needed.
+        #[arg(long, requires = "snapshots")]
+        slice: bool,
         /// The run's case file, where run.json does not record it or it has moved (the
         /// overrides still come from run.json).
         #[arg(long, value_name = "FILE", requires = "snapshots")]
@@ -318,12 +322,18 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             smooth,
             snapshots,
             snapshot_field,
+            slice,
             case,
         } => {
             if snapshots {
                 let sc = wgsph::run::scenario_of_run(&dir, case.as_deref())?;
                 let field = snapshot_field.unwrap_or_default();
-                let pngs = wgsph::plot::snapshot::draw_particle_files(&dir, &sc, field)?;
+                // Only a 3D perspective view needs an adapter.
+                let ctx = (sc.physics.dim == 3 && !slice)
+                    .then(|| context(cli.adapter))
+                    .transpose()?;
+                let painter = SnapshotPainter::for_scenario(ctx.as_ref(), &sc, field, slice)?;
+                let pngs = wgsph::plot::snapshot::draw_particle_files(&dir, &sc, &painter)?;
                 println!(
                     "wrote {} snapshots into {}",
                     pngs.len(),

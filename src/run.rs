@@ -15,7 +15,7 @@ use crate::checkpoint::{
 };
 use crate::gpu::GpuContext;
 use crate::output::{OutputDir, ParticleFile, ProbeWriter, RunSummary, SNAPSHOTS_DIR};
-use crate::plot::snapshot::{SnapshotField, SnapshotView};
+use crate::plot::snapshot::{SnapshotField, SnapshotPainter};
 use crate::progress::{Progress, RunStatus};
 use crate::scenario::{Kind, OutputBoundary, ProbeKind, Scenario};
 use crate::sph::{check_capacity, DensityVariation, Solver, Unstable};
@@ -32,7 +32,8 @@ pub fn probe_column(kind: &ProbeKind) -> &'static str {
 /// Options of a run beyond its case.
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
-    /// Also draw every particle snapshot as DIR/snapshots/NNNNNN.png, coloured by this field.
+    /// Also draw every particle snapshot as DIR/snapshots/NNNNNN.png (3D: in perspective, on
+    /// the run's device), coloured by this field.
     pub snapshot_png: Option<SnapshotField>,
     pub checkpoint: CheckpointPolicy,
     /// The case file and overrides, recorded in checkpoints for `wgsph resume`.
@@ -136,7 +137,7 @@ fn completed_run(dir: &Path, sc: &Scenario) -> Option<RunSummary> {
 /// from the same read-back).
 struct ParticleOutputs {
     out: OutputDir,
-    png: Option<SnapshotView>,
+    png: Option<SnapshotPainter>,
     /// With `time.output_boundary = "first"`: the positions of that first output (every
     /// particle, in id order); the later outputs leave out the boundary particles still there.
     first_pos: Option<Vec<[f64; 3]>>,
@@ -530,7 +531,7 @@ impl<'a> Runner<'a> {
                 let pngs = dir.join(SNAPSHOTS_DIR);
                 std::fs::create_dir_all(&pngs)
                     .with_context(|| format!("cannot create {}", pngs.display()))?;
-                Some(SnapshotView::for_scenario(sc, field)?)
+                Some(SnapshotPainter::for_scenario(Some(ctx), sc, field, false)?)
             }
             None => None,
         };

@@ -850,3 +850,101 @@ fn surface_meshes_the_water_of_a_3d_run() {
         "{stderr}"
     );
 }
+
+/// 3D snapshots are perspective views on the adapter (lavapipe here): the still tank of
+/// `hydrostatic_3d` seen from the front left and above, the near walls cut away. Where the
+/// camera puts the water's surface and the near edge's middle, the picture shows fluid
+/// colours (never grey: viridis has no grey), where it puts the back wall, a wall's grey;
+/// with the fluid excluded the water's pixels are no longer fluid; the same snapshot renders
+/// to the same bytes. Then `run --snapshots` and `plot --snapshots` draw the same PNGs.
+#[test]
+fn snapshots_3d_are_perspective_views_of_the_particles() {
+    use wgsph::plot::perspective::{PerspectiveView, PICTURE};
+    use wgsph::plot::snapshot::SnapshotField;
+    let set = ["particles.dx_m=0.04".to_string()];
+    let sc = wgsph::case::load(std::path::Path::new("cases/hydrostatic_3d.toml"), &set).unwrap();
+    let view = PerspectiveView::for_scenario(common::gpu(), &sc, SnapshotField::Pressure).unwrap();
+    let n = sc.particles.len();
+    let pos: Vec<[f64; 3]> = sc.particles.iter().map(|p| p.pos).collect();
+    let kind: Vec<u32> = sc.particles.iter().map(|p| p.kind as u32).collect();
+    let rho: Vec<f32> = sc.particles.iter().map(|p| p.rho as f32).collect();
+    let pressure: Vec<f32> = pos.iter().map(|p| (9810.0 * (0.4 - p[2])) as f32).collect();
+    let (vel, id) = (vec![[0.0f32; 3]; n], (0..n as u32).collect::<Vec<_>>());
+    let snapshot = |kind: &[u32]| -> Vec<u8> {
+        let snap = wgsph::output::Snapshot {
+            time_s: 0.0,
+            pos: &pos,
+            vel: &vel,
+            rho: &rho,
+            pressure: &pressure,
+            kind,
+            id: &id,
+            extra: &[],
+        };
+        view.picture(&snap).unwrap()
+    };
+    let picture = snapshot(&kind);
+    assert_eq!(picture.len(), (PICTURE.0 * PICTURE.1 * 3) as usize);
+    let at = |img: &[u8], p: [f64; 3]| -> [u8; 3] {
+        let (c, r) = (view.camera())
+            .pixel(glam::DVec3::from(p), PICTURE)
+            .unwrap();
+        let i = 3 * (r as usize * PICTURE.0 as usize + c as usize);
+        [img[i], img[i + 1], img[i + 2]]
+    };
+    let grey = |c: [u8; 3]| c.iter().max().unwrap() - c.iter().min().unwrap() < 8;
+    let white = |c: [u8; 3]| c.iter().all(|&v| v > 250);
+    // Particle centres (the lattice at dx = 0.04 m is at 0.02 + 0.04 k): the top layer of the
+    // water, the middle of the water's near vertical edge.
+    let surface = [0.22, 0.22, 0.38];
+    let near_edge = [0.02, 0.02, 0.22];
+    for p in [surface, near_edge] {
+        let c = at(&picture, p);
+        assert!(!grey(c) && !white(c), "{p:?}: {c:?} is not the water's");
+    }
+    // The back wall's inner face, above the water.
+    let back_wall = [0.22, 0.42, 0.46];
+    let c = at(&picture, back_wall);
+    assert!(grey(c) && !white(c), "back wall {c:?}: not a wall");
+    let excluded: Vec<u32> = (kind.iter())
+        .map(|&k| if k == 0 { wgsph::sph::EXCLUDED } else { k })
+        .collect();
+    let dry = snapshot(&excluded);
+    assert!(grey(at(&dry, surface)), "{:?}", at(&dry, surface));
+    assert!(
+        snapshot(&kind) == picture,
+        "the same snapshot drew other pixels"
+    );
+
+    let out = temp_dir("perspective");
+    let o = wgsph()
+        .args(["run", "cases/hydrostatic_3d.toml", "--quiet", "--snapshots"])
+        .args(["--set", "particles.dx_m=0.04", "--set", "time.end_s=0.01"])
+        .args(["--set", "time.output_every_s=0.01", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let read = |name: &str| std::fs::read(out.join("snapshots").join(name)).unwrap();
+    let names = ["000000.png", "000001.png"];
+    let by_the_run: Vec<Vec<u8>> = names.iter().map(|n| read(n)).collect();
+    std::fs::remove_dir_all(out.join("snapshots")).unwrap();
+    let o = wgsph()
+        .arg("plot")
+        .arg(&*out)
+        .arg("--snapshots")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for (name, run) in names.iter().zip(&by_the_run) {
+        assert!(read(name) == *run, "{name} differs from the run's");
+    }
+    let info = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(out.join("snapshots").join(names[1])).unwrap(),
+    ))
+    .read_info()
+    .unwrap()
+    .info()
+    .clone();
+    assert!(info.width > PICTURE.0 && info.height > PICTURE.1);
+}

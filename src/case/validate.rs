@@ -619,12 +619,11 @@ fn blocks(ctx: &Ctx<'_>, raw: &RawCase, dim: usize) -> Result<Vec<Block>, CaseEr
     Ok(blocks)
 }
 
+/// The enabled obstacles' boxes, wall treatments and paths in the file.
+type Obstacles = (Vec<Aabb>, Vec<Treatment>, Vec<String>);
+
 /// `[[obstacle]]`: each enabled box, its wall treatment (not mirror) and its path.
-fn obstacles(
-    ctx: &Ctx<'_>,
-    raw: &RawCase,
-    dim: usize,
-) -> Result<(Vec<Aabb>, Vec<Treatment>, Vec<String>), CaseError> {
+fn obstacles(ctx: &Ctx<'_>, raw: &RawCase, dim: usize) -> Result<Obstacles, CaseError> {
     let mut obstacles = Vec::with_capacity(raw.obstacle.len());
     let mut obstacle_walls = Vec::with_capacity(raw.obstacle.len());
     let mut paths = Vec::with_capacity(raw.obstacle.len());

@@ -2,7 +2,8 @@
 //! of side dx coloured by pressure or speed, boundary particles grey, excluded particles not
 //! drawn, with axes in metres and a colour bar.
 //!
-//! 2D draws the x–y plane. 3D draws the x–z plane (z up) through a slice
+//! 2D draws the x–y plane. 3D draws a perspective view ([`super::perspective`]), or, asked for
+//! (`wgsph plot DIR --snapshots --slice`), the x–z plane (z up) through a slice
 //! |y − y_mid| < 2 dx at the middle of the domain, nearest the mid-plane drawn last: a
 //! projection of the whole depth would show the tank's side walls in front of everything.
 //!
@@ -17,7 +18,9 @@ use anyhow::{anyhow, bail, Context, Result};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
+use super::perspective::PerspectiveView;
 use super::{register_font, write_png};
+use crate::gpu::GpuContext;
 use crate::output::{particle_files, ParticleFile, Snapshot, SNAPSHOTS_DIR};
 use crate::scenario::{Domain, Kind, Scenario};
 use crate::sph::EXCLUDED;
@@ -138,17 +141,52 @@ impl ColorScale {
     }
 }
 
+/// What draws a run's snapshots: the plane of a 2D run or the x–z slice of a 3D one
+/// ([`SnapshotView`]), or a 3D run's perspective view ([`PerspectiveView`], on a GPU device).
+pub enum SnapshotPainter {
+    Plane(SnapshotView),
+    Perspective(Box<PerspectiveView>),
+}
+
+impl SnapshotPainter {
+    /// The painter of a run of `sc`: 3D in perspective on `ctx`'s device unless `slice`.
+    /// Errors for a 3D perspective without a device.
+    pub fn for_scenario(
+        ctx: Option<&GpuContext>,
+        sc: &Scenario,
+        field: SnapshotField,
+        slice: bool,
+    ) -> Result<Self> {
+        if sc.physics.dim == 2 || slice {
+            return Ok(SnapshotPainter::Plane(SnapshotView::for_scenario(
+                sc, field,
+            )?));
+        }
+        let ctx = ctx.ok_or_else(|| anyhow!("a 3D perspective snapshot needs a GPU adapter"))?;
+        let view = PerspectiveView::for_scenario(ctx, sc, field)?;
+        Ok(SnapshotPainter::Perspective(Box::new(view)))
+    }
+
+    /// Draws `snap` and writes it to `path` as PNG, atomically.
+    pub fn write_png(&self, path: &Path, snap: &Snapshot) -> Result<()> {
+        match self {
+            SnapshotPainter::Plane(view) => view.write_png(path, snap),
+            SnapshotPainter::Perspective(view) => view.write_png(path, snap),
+        }
+    }
+}
+
 /// Draws every particle file of the run of `sc` in `dir` (`DIR/particles/particles_NNNNNN.vtu`)
-/// as `DIR/snapshots/NNNNNN.png` with the view and colour scale the run itself draws with
-/// `--snapshots`: the same pictures, after the run (`wgsph plot DIR --snapshots`). A file that
-/// left out the unmoved boundary particles (`time.output_boundary = "first"`) is completed with
-/// those of the first file. Returns the PNGs written.
+/// as `DIR/snapshots/NNNNNN.png` with `painter`, the pictures the run itself draws with
+/// `--snapshots` when `painter` is its own: the same pictures, after the run (`wgsph plot DIR
+/// --snapshots`). A file that left out the unmoved boundary particles
+/// (`time.output_boundary = "first"`) is completed with those of the first file. Returns the
+/// PNGs written.
 pub fn draw_particle_files(
     dir: &Path,
     sc: &Scenario,
-    field: SnapshotField,
+    painter: &SnapshotPainter,
 ) -> Result<Vec<PathBuf>> {
-    let view = SnapshotView::for_scenario(sc, field)?;
     let files = particle_files(dir)?;
     if files.is_empty() {
         bail!(
@@ -175,7 +213,8 @@ pub fn draw_particle_files(
             ),
         };
         let png = pngs.join(format!("{index:06}.png"));
-        view.write_png(&png, &particles.snapshot(read.time_s, &[]))
+        painter
+            .write_png(&png, &particles.snapshot(read.time_s, &[]))
             .with_context(|| format!("drawing {}", file.display()))?;
         written.push(png);
         if *index == 0 {
@@ -388,44 +427,45 @@ impl SnapshotView {
                 color.filled(),
             )
         }))?;
-        self.draw_colorbar(&bar)?;
+        draw_colorbar(&bar, &self.scale, self.field)?;
         root.present()?;
         Ok(chart.as_coord_spec().clone())
     }
+}
 
-    /// The colour bar, aligned with the plotting area, labelled with the field and its unit.
-    fn draw_colorbar<'a>(
-        &self,
-        area: &DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>,
-    ) -> std::result::Result<(), Box<dyn std::error::Error + 'a>> {
-        let (lo, hi) = self.scale.range();
-        let mut bar = ChartBuilder::on(area)
-            .margin(MARGIN)
-            .margin_left(4)
-            .x_label_area_size(X_LABEL_AREA)
-            .right_y_label_area_size(COLORBAR_WIDTH - 4 - MARGIN - 24)
-            .build_cartesian_2d(0.0..1.0, lo..hi)?;
-        // Decimals enough for ticks about a tenth of the range apart: "4500", "2.50", "0.0150".
-        let decimals = (2.0 - (hi - lo).log10().floor()).clamp(0.0, 9.0) as usize;
-        bar.configure_mesh()
-            .disable_x_mesh()
-            .disable_y_mesh()
-            .disable_x_axis()
-            .y_label_formatter(&|v| format!("{v:.decimals$}"))
-            .y_desc(self.field.label())
-            .label_style(("sans-serif", 13))
-            .axis_desc_style(("sans-serif", 14))
-            .draw()?;
-        let step = (hi - lo) / COLORBAR_BANDS as f64;
-        bar.draw_series((0..COLORBAR_BANDS).map(|k| {
-            let v0 = lo + k as f64 * step;
-            Rectangle::new(
-                [(0.0, v0), (1.0, v0 + step)],
-                self.scale.color(v0 + 0.5 * step).filled(),
-            )
-        }))?;
-        Ok(())
-    }
+/// The colour bar of `scale` in `area`, labelled with `field` and its unit.
+pub(super) fn draw_colorbar<'a>(
+    area: &DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>,
+    scale: &ColorScale,
+    field: SnapshotField,
+) -> std::result::Result<(), Box<dyn std::error::Error + 'a>> {
+    let (lo, hi) = scale.range();
+    let mut bar = ChartBuilder::on(area)
+        .margin(MARGIN)
+        .margin_left(4)
+        .x_label_area_size(X_LABEL_AREA)
+        .right_y_label_area_size(COLORBAR_WIDTH - 4 - MARGIN - 24)
+        .build_cartesian_2d(0.0..1.0, lo..hi)?;
+    // Decimals enough for ticks about a tenth of the range apart: "4500", "2.50", "0.0150".
+    let decimals = (2.0 - (hi - lo).log10().floor()).clamp(0.0, 9.0) as usize;
+    bar.configure_mesh()
+        .disable_x_mesh()
+        .disable_y_mesh()
+        .disable_x_axis()
+        .y_label_formatter(&|v| format!("{v:.decimals$}"))
+        .y_desc(field.label())
+        .label_style(("sans-serif", 13))
+        .axis_desc_style(("sans-serif", 14))
+        .draw()?;
+    let step = (hi - lo) / COLORBAR_BANDS as f64;
+    bar.draw_series((0..COLORBAR_BANDS).map(|k| {
+        let v0 = lo + k as f64 * step;
+        Rectangle::new(
+            [(0.0, v0), (1.0, v0 + step)],
+            scale.color(v0 + 0.5 * step).filled(),
+        )
+    }))?;
+    Ok(())
 }
 
 #[cfg(test)]
