@@ -120,6 +120,10 @@ enum Command {
         /// water's inside) instead of the perspective view; no GPU adapter needed.
         #[arg(long, requires = "snapshots")]
         slice: bool,
+        /// Also write the snapshots as one animated PNG, DIR/snapshots/animation.png, at this
+        /// many frames a second (e.g. 10), for sharing.
+        #[arg(long, value_name = "FPS", requires = "snapshots")]
+        animation: Option<u16>,
         /// The run's case file, where run.json does not record it or it has moved (the
         /// overrides still come from run.json).
         #[arg(long, value_name = "FILE", requires = "snapshots")]
@@ -323,6 +327,7 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             snapshots,
             snapshot_field,
             slice,
+            animation,
             case,
         } => {
             if snapshots {
@@ -339,6 +344,10 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                     pngs.len(),
                     dir.join(wgsph::output::SNAPSHOTS_DIR).display()
                 );
+                if let Some(fps) = animation {
+                    let path = wgsph::plot::animation::write_animation(&dir, &pngs, fps)?;
+                    println!("wrote {}", path.display());
+                }
             }
             let opts = wgsph::plot::PlotOptions {
                 references,

@@ -12,6 +12,7 @@
 //! Text is drawn with the embedded DejaVu Sans (`assets/fonts/`, Bitstream Vera licence) through
 //! plotters' pure-Rust `ab_glyph` path: no system font or library is needed.
 
+pub mod animation;
 pub mod perspective;
 pub mod snapshot;
 
