@@ -4,10 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::exceptions::{PyIndexError, PyKeyError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyByteArray, PyDict};
 
 use wgsph::output::{particle_files, ParticleFile, PARTICLES_DIR, PROBES_DIR, RUN_SUMMARY_FILE};
 
@@ -55,18 +54,36 @@ impl Run {
     }
 }
 
-/// `values` as a 1-D array.
-fn array1<'py, T: numpy::Element>(py: Python<'py>, values: Vec<T>) -> Bound<'py, PyAny> {
-    values.into_pyarray(py).into_any()
+/// A value type of the arrays, with its NumPy dtype (little-endian, as the files are).
+trait Dtype: bytemuck::Pod {
+    const DTYPE: &'static str;
+}
+
+impl Dtype for f64 {
+    const DTYPE: &'static str = "<f8";
+}
+
+impl Dtype for f32 {
+    const DTYPE: &'static str = "<f4";
+}
+
+impl Dtype for u32 {
+    const DTYPE: &'static str = "<u4";
+}
+
+/// `values` as a 1-D NumPy array: one copy into a bytearray that the array then owns through
+/// `numpy.frombuffer` (writable, no second copy). Done through NumPy's Python API rather than
+/// its C API (rust-numpy): nothing to keep in step with NumPy's versions, and a smaller build.
+fn array1<'py, T: Dtype>(py: Python<'py>, values: &[T]) -> PyResult<Bound<'py, PyAny>> {
+    let bytes = PyByteArray::new(py, bytemuck::cast_slice(values));
+    py.import("numpy")?
+        .call_method1("frombuffer", (bytes, T::DTYPE))
 }
 
 /// Rows of three as an (n, 3) array.
-fn array_n3<'py, T: numpy::Element + Copy>(
-    py: Python<'py>,
-    rows: &[[T; 3]],
-) -> PyResult<Bound<'py, PyAny>> {
-    let flat: Vec<T> = rows.iter().flatten().copied().collect();
-    Ok(flat.into_pyarray(py).reshape([rows.len(), 3])?.into_any())
+fn array_n3<'py, T: Dtype>(py: Python<'py>, rows: &[[T; 3]]) -> PyResult<Bound<'py, PyAny>> {
+    let flat: &[T] = bytemuck::cast_slice(rows);
+    array1(py, flat)?.call_method1("reshape", ((rows.len(), 3),))
 }
 
 #[pymethods]
@@ -149,7 +166,7 @@ impl Run {
         }
         let series = wgsph::plot::read_probe(&self.dir, name).map_err(to_py)?;
         let (t, v): (Vec<f64>, Vec<f64>) = series.points.into_iter().unzip();
-        Ok((array1(py, t), array1(py, v)))
+        Ok((array1(py, &t)?, array1(py, &v)?))
     }
 
     /// A table (`probes/<name>.csv`: a body's, `body_<name>`, or a tracked point's,
@@ -182,10 +199,10 @@ impl Run {
             let series = wgsph::plot::parse_table_column(&text, &file, column).map_err(to_py)?;
             if k == 1 {
                 let t: Vec<f64> = series.points.iter().map(|p| p.0).collect();
-                d.set_item(&series.columns.0, array1(py, t))?;
+                d.set_item(&series.columns.0, array1(py, &t)?)?;
             }
             let v: Vec<f64> = series.points.iter().map(|p| p.1).collect();
-            d.set_item(*column, array1(py, v))?;
+            d.set_item(*column, array1(py, &v)?)?;
         }
         if d.is_empty() {
             return Err(WgsphError::new_err(format!(
@@ -243,12 +260,12 @@ impl Run {
         d.set_item("time_s", file.time_s)?;
         d.set_item("position", array_n3(py, &p.pos)?)?;
         d.set_item("velocity", array_n3(py, &p.vel)?)?;
-        d.set_item("density", array1(py, p.rho.clone()))?;
-        d.set_item("pressure", array1(py, p.pressure.clone()))?;
-        d.set_item("kind", array1(py, p.kind.clone()))?;
-        d.set_item("id", array1(py, p.id.clone()))?;
+        d.set_item("density", array1(py, &p.rho)?)?;
+        d.set_item("pressure", array1(py, &p.pressure)?)?;
+        d.set_item("kind", array1(py, &p.kind)?)?;
+        d.set_item("id", array1(py, &p.id)?)?;
         for (name, values) in p.extra_arrays() {
-            d.set_item(name, array1(py, values))?;
+            d.set_item(name, array1(py, &values)?)?;
         }
         Ok(d)
     }
