@@ -512,9 +512,9 @@ impl WallPatch {
     /// on the circle is left out); a sensor narrower than the spacing takes the nearest column
     /// (all of them, between several). Its radius is moved halfway to the next column left
     /// out, and its area is the number of distinct columns (tangential positions to dx/4) times
-    /// dx^(dim − 1). `None` when no boundary
-    /// particle lies within max(radius, dx) of `point` across the normal, or the nearest lie
-    /// more than dx behind it (`point` is not on the wall's face).
+    /// dx^(dim − 1). `None` when no boundary particle lies within max(radius, dx) of `point`
+    /// across the normal, or the nearest lie more than dx behind it, or every column of them
+    /// runs on along the normal past the slab (`point` is not on a face with this normal).
     pub fn resolve(
         particles: &[Particle],
         point: [f64; 3],
@@ -533,6 +533,7 @@ impl WallPatch {
             column: [i64; 3],
             /// (x − point)·normal.
             d: f64,
+            pos: [f64; 3],
         }
         let candidates: Vec<Candidate> = particles
             .iter()
@@ -545,6 +546,7 @@ impl WallPatch {
                     across: t2.sqrt(),
                     column,
                     d,
+                    pos: p.pos,
                 })
             })
             .collect();
@@ -586,6 +588,20 @@ impl WallPatch {
         // The wall's first layer is the lowest of them: a column that runs into a concave
         // corner also holds the other wall's particles, in front of this wall's face.
         let first_layer = tops.iter().map(|t| t.1).fold(f64::INFINITY, f64::min);
+        // No face across the normal where every column runs on, a boundary particle a spacing
+        // in front of its outermost one in the slab: a wall along the normal (a sensor on a
+        // building left out of the case finds the street's floor), not a face.
+        let runs_on = |top: &Candidate| {
+            let next: [f64; 3] = std::array::from_fn(|a| top.pos[a] + dx * normal[a]);
+            (particles.iter().filter(|p| p.kind.is_boundary()))
+                .any(|p| (0..3).all(|a| (p.pos[a] - next[a]).abs() < 0.25 * dx))
+        };
+        let outermost = tops.iter().filter_map(|(column, top)| {
+            (taken.iter()).find(|c| c.column == *column && c.d == *top)
+        });
+        if outermost.clone().count() > 0 && outermost.map(|c| *c).all(runs_on) {
+            return None;
+        }
         let (over_lo, over_hi) = Self::face_extent(
             particles,
             point,

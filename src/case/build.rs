@@ -1059,11 +1059,20 @@ fn finish(
     super::probes::place_on_faces(
         ctx,
         &mut probes,
+        &case.probe_paths,
         &case.face_normals,
         &particles,
         (dim, dx, h),
     )?;
-    super::probes::resolve_wall_patches(ctx, &mut probes, &particles, dim, dx, h)?;
+    super::probes::resolve_wall_patches(
+        ctx,
+        &mut probes,
+        &case.probe_paths,
+        &particles,
+        dim,
+        dx,
+        h,
+    )?;
     let mut walls = walls(
         ctx,
         &case.walls,
@@ -1074,7 +1083,11 @@ fn finish(
     )?;
     walls.mirror_planes = mirror_planes;
     warnings.extend(super::probes::sensors_meeting_at_edges(
-        &probes, &walls, &particles, h,
+        &probes,
+        &case.probe_paths,
+        &walls,
+        &particles,
+        h,
     ));
     let n_particles = particles.len();
     let mut sc = Scenario {
@@ -1192,6 +1205,7 @@ pub(super) fn build_solid_case(
     super::probes::place_on_faces(
         ctx,
         &mut probes,
+        &case.probe_paths,
         &case.face_normals,
         &particles,
         (dim, dx, h),

@@ -289,7 +289,7 @@ fn check_probes_inside(ctx: &Ctx<'_>, case: &Case, d: &Aabb) -> Result<(), CaseE
                 ),
             };
             return Err(ctx.err(
-                &format!("probe[{i}].{field}"),
+                &format!("{}.{field}", case.probe_paths[i]),
                 Some(format!("{:?}", &point[..dim])),
                 format!("lies outside {which} ({})", fmt_box(d, dim)),
                 fix,

@@ -292,19 +292,20 @@ const MAX_PATCH_RADIUS_H: f64 = 20.0;
 pub(super) fn resolve_wall_patches(
     ctx: &Ctx<'_>,
     probes: &mut [Probe],
+    paths: &[String],
     particles: &[Particle],
     dim: usize,
     dx: f64,
     h: f64,
 ) -> Result<(), CaseError> {
     let has_walls = particles.iter().any(|p| p.kind.is_boundary());
-    for (i, probe) in probes.iter_mut().enumerate() {
+    for (probe, path) in probes.iter_mut().zip(paths) {
         let ProbeKind::WallPressure(patch) = &mut probe.kind else {
             continue;
         };
         if patch.radius > MAX_PATCH_RADIUS_H * h {
             return Err(ctx.err(
-                &format!("probe[{i}].radius_m"),
+                &format!("{path}.radius_m"),
                 Some(format!("{}", patch.radius)),
                 format!(
                     "is more than {MAX_PATCH_RADIUS_H} h = {:.4} m: one GPU thread visits every \
@@ -316,7 +317,7 @@ pub(super) fn resolve_wall_patches(
         }
         if !has_walls {
             return Err(ctx.err(
-                &format!("probe[{i}].kind"),
+                &format!("{path}.kind"),
                 Some("\"wall_pressure\"".into()),
                 "sums the fluid's force on wall particles, and the case has none (no [tank] or \
                  [[obstacle]] of particles, or mirror walls only)",
@@ -336,7 +337,7 @@ pub(super) fn resolve_wall_patches(
             Some(resolved) => *patch = resolved,
             None => {
                 return Err(ctx.err(
-                    &format!("probe[{i}].point_m"),
+                    &format!("{path}.point_m"),
                     Some(format!("{:?}", &patch.point[..dim])),
                     format!(
                         "has no wall particle within radius_m = {} (or particles.dx_m = {dx}, \
@@ -362,14 +363,15 @@ pub(super) fn resolve_wall_patches(
 /// of that face which that sensor then misses.
 pub(super) fn sensors_meeting_at_edges(
     probes: &[Probe],
+    paths: &[String],
     walls: &WallParams,
     particles: &[Particle],
     h: f64,
 ) -> Vec<String> {
-    // Probe index and name of each sensor, in the order of `walls.sensors`.
-    let names: Vec<(usize, &str)> = (probes.iter().enumerate())
-        .filter(|(_, p)| p.body.is_none() && matches!(p.kind, ProbeKind::WallPressure(_)))
-        .map(|(i, p)| (i, p.name.as_str()))
+    // Path and name of each sensor, in the order of `walls.sensors`.
+    let names: Vec<(&str, &str)> = (probes.iter().zip(paths))
+        .filter(|(p, _)| p.body.is_none() && matches!(p.kind, ProbeKind::WallPressure(_)))
+        .map(|(p, path)| (path.as_str(), p.name.as_str()))
         .collect();
     let mut pairs: Vec<(usize, usize)> = Vec::new();
     for p in particles.iter().filter(|p| p.kind.is_boundary()) {
@@ -393,9 +395,9 @@ pub(super) fn sensors_meeting_at_edges(
         .map(|(owner, k)| {
             let ((i, a), (j, b)) = (names[owner], names[k]);
             format!(
-                "probe[{j}] ('{b}') and probe[{i}] ('{a}') meet at an edge: wall particles \
-                 within 2h = {:.4} m of probe[{j}]'s face lie in both columns and count for \
-                 probe[{i}]'s face, which they are nearer, so probe[{j}] misses the water \
+                "{j} ('{b}') and {i} ('{a}') meet at an edge: wall particles \
+                 within 2h = {:.4} m of {j}'s face lie in both columns and count for \
+                 {i}'s face, which they are nearer, so {j} misses the water \
                  they carry; fix: move the sensors apart, each more than 2h behind the other's \
                  face, or give them smaller radius_m",
                 2.0 * h
@@ -471,18 +473,19 @@ pub(super) fn resolve_points(
 pub(super) fn place_on_faces(
     ctx: &Ctx<'_>,
     probes: &mut [Probe],
+    paths: &[String],
     normals: &[Option<[f64; 3]>],
     particles: &[Particle],
     (dim, dx, h): (usize, f64, f64),
 ) -> Result<(), CaseError> {
-    for (i, (probe, normal)) in probes.iter_mut().zip(normals).enumerate() {
+    for ((probe, normal), path) in probes.iter_mut().zip(normals).zip(paths) {
         let (ProbeKind::Pressure { point }, Some(normal)) = (&mut probe.kind, normal) else {
             continue;
         };
         let Some(patch) = WallPatch::resolve(particles, *point, *normal, 0.5 * dx, dim, dx, h)
         else {
             return Err(ctx.err(
-                &format!("probe[{i}].face_m"),
+                &format!("{path}.face_m"),
                 Some(format!("{:?}", &point[..dim])),
                 format!(
                     "has no wall particle within particles.dx_m = {dx} of it across its normal \

@@ -590,8 +590,8 @@ fn overrides_change_the_case() {
 }
 
 /// The street flood without its building, from the shipped file: the building (obstacle[3])
-/// and its front sensor (probe[5]) left out with `--set`; an obstacle after one left out keeps
-/// its index in messages.
+/// and its front sensor (probe[5]) left out with `--set`; the sensor left in is refused; an
+/// obstacle or probe after one left out keeps its index in messages.
 #[test]
 fn obstacles_and_probes_can_be_left_out() {
     let text = std::fs::read_to_string("cases/street_flood_3d.toml").unwrap();
@@ -624,6 +624,22 @@ fn obstacles_and_probes_can_be_left_out() {
     assert!(names(&with).contains(&"front".to_string()));
     assert_eq!(names(&without).len() + 1, names(&with).len());
     assert!(!names(&without).contains(&"front".to_string()));
+    // Left in, the sensor of a building that is not there finds the street's floor along its
+    // normal, not a face: refused, named by its place in the file also with a probe before it
+    // left out.
+    let e = load_str(
+        &text,
+        "s.toml",
+        &sets(&[
+            coarse,
+            "obstacle[3].enabled=false",
+            "probe[0].enabled=false",
+        ]),
+    )
+    .err()
+    .expect("a sensor with no face")
+    .to_string();
+    assert!(e.contains("probe[5].point_m"), "{e}");
     // The obstacle after the one left out keeps its index in messages.
     assert!(
         (without.warnings.iter()).any(|w| w.starts_with("obstacle[4] is 0.06 m along x")),

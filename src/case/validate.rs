@@ -89,6 +89,9 @@ pub(super) struct Case {
     /// Each probe's face normal where it is given on a face (`face_m`): its point lies on the
     /// face until the particles are built ([`super::probes::place_on_faces`]).
     pub face_normals: Vec<Option<[f64; 3]>>,
+    /// Each probe's place in the file, `probe[i]`, for messages (a probe with `enabled =
+    /// false` is left out, and the ones after it keep their index).
+    pub probe_paths: Vec<String>,
     /// `kind = "point"` probes; their particles are chosen once the particles are built.
     pub points: Vec<super::probes::PointSpec>,
     pub bodies: Vec<super::bodies::BodySpec>,
@@ -149,7 +152,7 @@ pub(super) fn validate(
     let tank_moves = tank.as_ref().is_some_and(|t| t.motion.is_some());
     walls.friction_pairs =
         super::friction::pairs(ctx, &raw.friction, &bodies, &solids, tank_moves)?;
-    let ((probes, face_normals), points) = probes(ctx, raw, dim, tank_moves, &bodies)?;
+    let ((probes, face_normals, probe_paths), points) = probes(ctx, raw, dim, tank_moves, &bodies)?;
     let CheckedPhysics {
         rho0,
         gravity,
@@ -186,6 +189,7 @@ pub(super) fn validate(
         walls,
         probes,
         face_normals,
+        probe_paths,
         points,
         bodies,
         solids,
@@ -757,10 +761,10 @@ fn check_probe_names(ctx: &Ctx<'_>, raw: &RawCase) -> Result<(), CaseError> {
 }
 
 /// The sampled probes and their face normals.
-type SampledProbes = (Vec<Probe>, Vec<Option<[f64; 3]>>);
+type SampledProbes = (Vec<Probe>, Vec<Option<[f64; 3]>>, Vec<String>);
 
-/// `[[probe]]`: the sampled probes (with the body each is attached to, and the normal of the
-/// face each given by `face_m` lies on) and the points.
+/// `[[probe]]`: the enabled sampled probes (with the body each is attached to, the normal of
+/// the face each given by `face_m` lies on, and each one's path in the file) and the points.
 fn probes(
     ctx: &Ctx<'_>,
     raw: &RawCase,
@@ -768,7 +772,7 @@ fn probes(
     tank_moves: bool,
     bodies: &[super::bodies::BodySpec],
 ) -> Result<(SampledProbes, Vec<super::probes::PointSpec>), CaseError> {
-    let (mut probes, mut normals): SampledProbes = (Vec::new(), Vec::new());
+    let (mut probes, mut normals, mut paths): SampledProbes = (Vec::new(), Vec::new(), Vec::new());
     let mut points = Vec::new();
     for (i, p) in raw.probe.iter().enumerate() {
         if p.enabled == Some(false) {
@@ -782,11 +786,12 @@ fn probes(
                 };
                 probes.push(probe);
                 normals.push(normal);
+                paths.push(format!("probe[{i}]"));
             }
             Checked::Point(spec) => points.push(spec),
         }
     }
-    Ok(((probes, normals), points))
+    Ok(((probes, normals, paths), points))
 }
 
 /// The index in the scenario's bodies (a moving tank first, then `[[body]]` in order) of the
