@@ -596,10 +596,10 @@ impl WallPatch {
             (particles.iter().filter(|p| p.kind.is_boundary()))
                 .any(|p| (0..3).all(|a| (p.pos[a] - next[a]).abs() < 0.25 * dx))
         };
-        let outermost = tops.iter().filter_map(|(column, top)| {
+        let mut outermost = tops.iter().filter_map(|(column, top)| {
             (taken.iter()).find(|c| c.column == *column && c.d == *top)
         });
-        if outermost.clone().count() > 0 && outermost.map(|c| *c).all(runs_on) {
+        if outermost.all(|c| runs_on(c)) {
             return None;
         }
         let (over_lo, over_hi) = Self::face_extent(
