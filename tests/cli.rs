@@ -188,6 +188,24 @@ fn plot_snapshots_draws_from_the_particle_files_what_the_run_drew() {
 /// `time.output_boundary = "first"`: the later particle files leave out the tank's walls,
 /// which have not moved, and keep the fluid and the floating box's particles, which have; the
 /// pictures drawn from them afterwards are the run's own.
+/// Removes the `count` snapshots a run in `out` drew, draws them again from its particle files
+/// with `wgsph plot DIR --snapshots`, and asserts that each is the run's, byte for byte.
+fn redrawn_snapshots_are_the_runs(out: &std::path::Path, count: usize) {
+    let read = |k: usize| std::fs::read(out.join(format!("snapshots/{k:06}.png"))).unwrap();
+    let by_the_run: Vec<Vec<u8>> = (0..count).map(read).collect();
+    std::fs::remove_dir_all(out.join("snapshots")).unwrap();
+    let o = wgsph()
+        .arg("plot")
+        .arg(out)
+        .arg("--snapshots")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for (k, png) in by_the_run.iter().enumerate() {
+        assert!(read(k) == *png, "snapshot {k} differs from the run's");
+    }
+}
+
 #[test]
 fn later_outputs_leave_out_the_unmoved_walls() {
     let out = temp_dir("output-boundary");
@@ -220,21 +238,7 @@ fn later_outputs_leave_out_the_unmoved_walls() {
     assert_eq!(count(&last, 0), count(&first, 0));
     assert!(count(&last, 2) > 0 && count(&last, 2) == count(&first, 2));
     assert_eq!(last.id.len(), count(&last, 0) + count(&last, 2));
-    let pngs: Vec<Vec<u8>> = (0..3)
-        .map(|k| std::fs::read(out.join(format!("snapshots/{k:06}.png"))).unwrap())
-        .collect();
-    std::fs::remove_dir_all(out.join("snapshots")).unwrap();
-    let o = wgsph()
-        .arg("plot")
-        .arg(&*out)
-        .arg("--snapshots")
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    for (k, png) in pngs.iter().enumerate() {
-        let again = std::fs::read(out.join(format!("snapshots/{k:06}.png"))).unwrap();
-        assert!(again == *png, "snapshot {k} differs from the run's");
-    }
+    redrawn_snapshots_are_the_runs(&out, 3);
     // Without the first file the walls are nowhere: refused, not drawn without them.
     std::fs::remove_file(out.join("particles/particles_000000.vtu")).unwrap();
     let o = wgsph()
@@ -925,22 +929,9 @@ fn snapshots_3d_are_perspective_views_of_the_particles() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let read = |name: &str| std::fs::read(out.join("snapshots").join(name)).unwrap();
-    let names = ["000000.png", "000001.png"];
-    let by_the_run: Vec<Vec<u8>> = names.iter().map(|n| read(n)).collect();
-    std::fs::remove_dir_all(out.join("snapshots")).unwrap();
-    let o = wgsph()
-        .arg("plot")
-        .arg(&*out)
-        .arg("--snapshots")
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    for (name, run) in names.iter().zip(&by_the_run) {
-        assert!(read(name) == *run, "{name} differs from the run's");
-    }
+    redrawn_snapshots_are_the_runs(&out, 2);
     let info = png::Decoder::new(std::io::BufReader::new(
-        std::fs::File::open(out.join("snapshots").join(names[1])).unwrap(),
+        std::fs::File::open(out.join("snapshots/000001.png")).unwrap(),
     ))
     .read_info()
     .unwrap()
