@@ -14,8 +14,12 @@ from conftest import ADAPTER, DAM_BREAK, cli
 
 SCRIPT = textwrap.dedent(
     """
+    import signal
     import sys
     import wgsph
+    # Python's own Ctrl-C handler, as in a terminal or a notebook: a process started in the
+    # background by a shell inherits SIGINT ignored, and Python then keeps ignoring it.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     case = wgsph.Case.load(sys.argv[1])
     case.set("particles.dx_m", 0.02)
     case.set("time.end_s", 5.0)  # about a minute: it is interrupted long before
