@@ -91,14 +91,7 @@ pub fn load_str_limited(
     let doc = toml::de::DeTable::parse(text).map_err(|e| diagnose::syntax(file_name, text, &e))?;
     let index = Index::new(text, doc.get_ref());
 
-    let parsed: Vec<overrides::Override> = overrides
-        .iter()
-        .map(|arg| overrides::parse(file_name, arg))
-        .collect::<Result<_, _>>()?;
-    let keys: Vec<(String, String)> = parsed
-        .iter()
-        .map(|o| (o.key.clone(), o.arg.clone()))
-        .collect();
+    let (parsed, keys) = parse_overrides(file_name, overrides)?;
     let ctx = Ctx {
         file: file_name,
         index: &index,
@@ -156,6 +149,21 @@ fn edit(ctx: &Ctx, text: &str, parsed: &[overrides::Override]) -> Result<String,
     })
 }
 
+/// The parsed `--set` arguments and, for messages, each one's key with its argument.
+type ParsedOverrides = (Vec<overrides::Override>, Vec<(String, String)>);
+
+fn parse_overrides(file_name: &str, overrides: &[String]) -> Result<ParsedOverrides, CaseError> {
+    let parsed: Vec<overrides::Override> = overrides
+        .iter()
+        .map(|arg| overrides::parse(file_name, arg))
+        .collect::<Result<_, _>>()?;
+    let keys = parsed
+        .iter()
+        .map(|o| (o.key.clone(), o.arg.clone()))
+        .collect();
+    Ok((parsed, keys))
+}
+
 /// The text of a case with `--set KEY=VALUE` overrides applied, as the loader reads it: `text`
 /// itself without overrides, else its document re-serialised with them (comments and layout
 /// lost). Errors as [`load_str`]'s for the same file and overrides. For writing a case out
@@ -167,17 +175,10 @@ pub fn with_overrides(
 ) -> Result<String, CaseError> {
     let doc = toml::de::DeTable::parse(text).map_err(|e| diagnose::syntax(file_name, text, &e))?;
     let index = Index::new(text, doc.get_ref());
-    let parsed: Vec<overrides::Override> = overrides
-        .iter()
-        .map(|arg| overrides::parse(file_name, arg))
-        .collect::<Result<_, _>>()?;
+    let (parsed, keys) = parse_overrides(file_name, overrides)?;
     if parsed.is_empty() {
         return Ok(text.to_string());
     }
-    let keys: Vec<(String, String)> = parsed
-        .iter()
-        .map(|o| (o.key.clone(), o.arg.clone()))
-        .collect();
     let ctx = Ctx {
         file: file_name,
         index: &index,
