@@ -1,5 +1,6 @@
-//! `wgsph bench`: timing a case's steps ([`measure`]), and its work report: what a step does per particle beside what it costs, the
-//! figures that predict a GPU's speed from its bandwidth and show a regression on any adapter.
+//! `wgsph bench`: timing a case's steps ([`measure`]), and its work report: what a step does
+//! per particle beside what it costs, the figures that predict a GPU's speed from its
+//! bandwidth and show a regression on any adapter.
 
 use std::time::Instant;
 

@@ -188,6 +188,27 @@ fn plot_snapshots_draws_from_the_particle_files_what_the_run_drew() {
 /// `time.output_boundary = "first"`: the later particle files leave out the tank's walls,
 /// which have not moved, and keep the fluid and the floating box's particles, which have; the
 /// pictures drawn from them afterwards are the run's own.
+/// `hydrostatic_3d` at dx = 0.04 m to `end_s`, an output every 0.01 s, with `args`, in a
+/// scratch folder named after `name`; the run must succeed.
+fn run_tank_3d(name: &str, end_s: &str, args: &[&str]) -> common::Scratch {
+    let out = temp_dir(name);
+    let o = wgsph()
+        .args(["run", "cases/hydrostatic_3d.toml", "--quiet"])
+        .args(args)
+        .args([
+            "--set",
+            "particles.dx_m=0.04",
+            "--set",
+            &format!("time.end_s={end_s}"),
+        ])
+        .args(["--set", "time.output_every_s=0.01", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    out
+}
+
 /// Removes the `count` snapshots a run in `out` drew, draws them again from its particle files
 /// with `wgsph plot DIR --snapshots`, and asserts that each is the run's, byte for byte.
 fn redrawn_snapshots_are_the_runs(out: &std::path::Path, count: usize) {
@@ -795,15 +816,7 @@ fn a_locked_output_folder_is_refused_and_a_stale_lock_taken_over() {
 /// a fifth of a spacing over the tank's middle; a 2D run is refused with a message.
 #[test]
 fn surface_meshes_the_water_of_a_3d_run() {
-    let out = temp_dir("surface");
-    let o = wgsph()
-        .args(["run", "cases/hydrostatic_3d.toml", "--quiet"])
-        .args(["--set", "particles.dx_m=0.04", "--set", "time.end_s=0.02"])
-        .args(["--set", "time.output_every_s=0.01", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = run_tank_3d("surface", "0.02", &[]);
     let o = wgsph().arg("surface").arg(&out).output().unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
@@ -920,15 +933,7 @@ fn snapshots_3d_are_perspective_views_of_the_particles() {
         "the same snapshot drew other pixels"
     );
 
-    let out = temp_dir("perspective");
-    let o = wgsph()
-        .args(["run", "cases/hydrostatic_3d.toml", "--quiet", "--snapshots"])
-        .args(["--set", "particles.dx_m=0.04", "--set", "time.end_s=0.01"])
-        .args(["--set", "time.output_every_s=0.01", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = run_tank_3d("perspective", "0.01", &["--snapshots"]);
     redrawn_snapshots_are_the_runs(&out, 2);
     let info = png::Decoder::new(std::io::BufReader::new(
         std::fs::File::open(out.join("snapshots/000001.png")).unwrap(),

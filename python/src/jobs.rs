@@ -230,11 +230,28 @@ pub fn run(
         halt_at_s: None,
         ..Default::default()
     };
+    run_in(py, dir, choice, &flag, progress, move |ctx, dir, view| {
+        wgsph::run::run(ctx, &sc, dir, &options, view)
+    })
+}
+
+/// Runs `job` (the engine's run or resume into `dir`) on a device of `choice` while Python
+/// waits, Ctrl-C setting `flag`, with or without the progress bar; the run as a `Run`.
+fn run_in(
+    py: Python<'_>,
+    dir: PathBuf,
+    choice: AdapterChoice,
+    flag: &AtomicBool,
+    progress: bool,
+    job: impl FnOnce(&GpuContext, &std::path::Path, &mut dyn Progress) -> anyhow::Result<RunReport>
+        + Send
+        + 'static,
+) -> PyResult<Run> {
     let _quiet = QuietInfo::new(!progress);
     let job_dir = dir.clone();
-    let waited = wait_for(py, Some(&flag), move || {
+    let waited = wait_for(py, Some(flag), move || {
         let ctx = GpuContext::new(choice)?;
-        wgsph::run::run(&ctx, &sc, &job_dir, &options, &mut *progress_view(progress))
+        job(&ctx, &job_dir, &mut *progress_view(progress))
     })?;
     finish(py, waited, dir)
 }
@@ -291,13 +308,9 @@ pub fn resume(
         interrupt: Some(flag.clone()),
         ..options
     };
-    let _quiet = QuietInfo::new(!progress);
-    let job_dir = dir.clone();
-    let waited = wait_for(py, Some(&flag), move || {
-        let ctx = GpuContext::new(choice)?;
-        wgsph::run::resume(&ctx, &sc, &job_dir, &options, &mut *progress_view(progress))
-    })?;
-    finish(py, waited, dir)
+    run_in(py, dir, choice, &flag, progress, move |ctx, dir, view| {
+        wgsph::run::resume(ctx, &sc, dir, &options, view)
+    })
 }
 
 /// Times `steps` steps of `case` after `warmup`, as `wgsph bench`.

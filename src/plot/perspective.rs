@@ -15,7 +15,7 @@ use anyhow::{anyhow, bail, Result};
 use glam::{DMat4, DVec3};
 use plotters::prelude::*;
 
-use super::snapshot::{draw_colorbar, ColorScale, SnapshotField, BACKGROUND, NAN_COLOR};
+use super::snapshot::{draw_colorbar, ColorScale, SnapshotField, BACKGROUND};
 use super::{register_font, write_png};
 use crate::gpu::buffers::{map_read, readback_buffer};
 use crate::gpu::GpuContext;
@@ -47,7 +47,8 @@ const LID_COVER: f64 = 0.5;
 /// [0, 1]).
 #[derive(Clone, Debug)]
 pub struct Camera {
-    pub eye: DVec3,
+    /// Unit vector from the framed box's centre towards the camera.
+    pub to_eye: DVec3,
     pub right: DVec3,
     pub up: DVec3,
     pub view_proj: DMat4,
@@ -121,7 +122,7 @@ impl Camera {
             0.0,
         ]);
         Ok(Camera {
-            eye,
+            to_eye,
             right,
             up,
             view_proj: proj * view,
@@ -253,6 +254,60 @@ pub struct PerspectiveView {
     queue: wgpu::Queue,
     pipeline: wgpu::RenderPipeline,
     camera_group: wgpu::BindGroup,
+    targets: Targets,
+}
+
+/// What every frame is rendered into and read back through, made once for the run.
+struct Targets {
+    /// Pixels: [`PICTURE`] times [`SUPERSAMPLING`].
+    size: (u32, u32),
+    color: wgpu::Texture,
+    depth: wgpu::Texture,
+    staging: wgpu::Buffer,
+    /// Bytes of a row in `staging`: a texture copy's rows are padded to 256 bytes.
+    padded_row: u32,
+}
+
+impl Targets {
+    fn new(device: &wgpu::Device) -> Self {
+        let size = (PICTURE.0 * SUPERSAMPLING, PICTURE.1 * SUPERSAMPLING);
+        let target = |format, usage, label| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: size.0,
+                    height: size.1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let color = target(
+            COLOR_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            "snapshot colour",
+        );
+        let depth = target(
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+            "snapshot depth",
+        );
+        let padded_row = (4 * size.0).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let staging = readback_buffer(device, "snapshot readback", (padded_row * size.1) as u64);
+        Targets {
+            size,
+            color,
+            depth,
+            staging,
+            padded_row,
+        }
+    }
 }
 
 impl PerspectiveView {
@@ -269,10 +324,10 @@ impl PerspectiveView {
         let (lo, hi) = bounds(sc.particles.iter().map(|p| p.pos));
         let aspect = PICTURE.0 as f64 / PICTURE.1 as f64;
         let camera = Camera::framing(DVec3::from(lo), DVec3::from(hi), up_axis, aspect)?;
-        let to_eye = (camera.eye - 0.5 * (DVec3::from(lo) + DVec3::from(hi))).normalize();
-        let cut = Cutaway::of(sc, to_eye, up_axis);
+        let cut = Cutaway::of(sc, camera.to_eye, up_axis);
         let (device, queue) = (ctx.device.clone(), ctx.queue.clone());
         let (pipeline, camera_group) = pipeline(&device, &queue, &camera);
+        let targets = Targets::new(&device);
         let dx = sc.physics.dx as f32;
         Ok(PerspectiveView {
             case: sc.name.clone(),
@@ -286,6 +341,7 @@ impl PerspectiveView {
             queue,
             pipeline,
             camera_group,
+            targets,
         })
     }
 
@@ -305,7 +361,8 @@ impl PerspectiveView {
                     return None;
                 }
                 let (rgb, radius) = if is_fluid {
-                    (self.fluid_rgb(snap, i), self.fluid_radius)
+                    let c = self.scale.color(self.field.value(snap, i));
+                    ([c.0, c.1, c.2], self.fluid_radius)
                 } else {
                     (WALL_RGB, self.wall_radius)
                 };
@@ -318,61 +375,16 @@ impl PerspectiveView {
             .collect()
     }
 
-    fn fluid_rgb(&self, snap: &Snapshot, i: usize) -> [u8; 3] {
-        let value = match self.field {
-            SnapshotField::Pressure => snap.pressure[i] as f64,
-            SnapshotField::Speed => {
-                let v = snap.vel[i].map(|c| c as f64);
-                (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-            }
-        };
-        let c = if value.is_nan() {
-            NAN_COLOR
-        } else {
-            self.scale.color(value)
-        };
-        [c.0, c.1, c.2]
-    }
-
     /// The 3D picture of `snap` alone: RGB, [`PICTURE`] pixels.
     pub fn picture(&self, snap: &Snapshot) -> Result<Vec<u8>> {
         snap.validate(Path::new("snapshot picture"))?;
-        let instances = self.instances(snap);
-        let (w, h) = (PICTURE.0 * SUPERSAMPLING, PICTURE.1 * SUPERSAMPLING);
-        let rgba = self.render(&instances, (w, h))?;
-        Ok(downsample(&rgba, (w, h), SUPERSAMPLING))
+        let rgba = self.render(&self.instances(snap))?;
+        Ok(downsample(&rgba, self.targets.size, SUPERSAMPLING))
     }
 
-    /// Renders `instances` into an RGBA image of `size` pixels and reads it back.
-    fn render(&self, instances: &[SplatInstance], size: (u32, u32)) -> Result<Vec<u8>> {
-        let device = &self.device;
-        let extent = wgpu::Extent3d {
-            width: size.0,
-            height: size.1,
-            depth_or_array_layers: 1,
-        };
-        let target = |format, usage, label| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: extent,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let color = target(
-            COLOR_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            "snapshot colour",
-        );
-        let depth = target(
-            DEPTH_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-            "snapshot depth",
-        );
+    /// Renders `instances` into the render targets and reads the RGBA image back.
+    fn render(&self, instances: &[SplatInstance]) -> Result<Vec<u8>> {
+        let (device, t) = (&self.device, &self.targets);
         let bytes = bytemuck::cast_slice(instances);
         let vertices = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("snapshot splats"),
@@ -381,17 +393,12 @@ impl PerspectiveView {
             mapped_at_creation: false,
         });
         self.queue.write_buffer(&vertices, 0, bytes);
-        // Rows of a texture copy are padded to 256 bytes.
-        let row = 4 * size.0;
-        let padded =
-            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let staging = readback_buffer(device, "snapshot readback", (padded * size.1) as u64);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("snapshot"),
         });
         {
-            let color_view = color.create_view(&Default::default());
-            let depth_view = depth.create_view(&Default::default());
+            let color_view = t.color.create_view(&Default::default());
+            let depth_view = t.depth.create_view(&Default::default());
             let bg = |c: u8| c as f64 / 255.0;
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("snapshot splats"),
@@ -427,23 +434,24 @@ impl PerspectiveView {
             pass.draw(0..4, 0..instances.len() as u32);
         }
         encoder.copy_texture_to_buffer(
-            color.as_image_copy(),
+            t.color.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
-                buffer: &staging,
+                buffer: &t.staging,
                 layout: wgpu::TexelCopyBufferLayout {
                     offset: 0,
-                    bytes_per_row: Some(padded),
-                    rows_per_image: Some(size.1),
+                    bytes_per_row: Some(t.padded_row),
+                    rows_per_image: Some(t.size.1),
                 },
             },
-            extent,
+            t.color.size(),
         );
         self.queue.submit([encoder.finish()]);
-        let data = map_read(device, &staging)?;
-        let mut rgba = Vec::with_capacity((row * size.1) as usize);
-        for r in 0..size.1 as usize {
-            let start = r * padded as usize;
-            rgba.extend_from_slice(&data[start..start + row as usize]);
+        let data = map_read(device, &t.staging)?;
+        let row = 4 * t.size.0 as usize;
+        let mut rgba = Vec::with_capacity(row * t.size.1 as usize);
+        for r in 0..t.size.1 as usize {
+            let start = r * t.padded_row as usize;
+            rgba.extend_from_slice(&data[start..start + row]);
         }
         Ok(rgba)
     }

@@ -44,7 +44,7 @@ impl SnapshotField {
     }
 
     /// The value of particle `i` of `snap`.
-    fn value(self, snap: &Snapshot, i: usize) -> f64 {
+    pub(super) fn value(self, snap: &Snapshot, i: usize) -> f64 {
         match self {
             SnapshotField::Pressure => snap.pressure[i] as f64,
             SnapshotField::Speed => {
