@@ -1,7 +1,9 @@
 // Cell-list neighbour search, every step: cell key + atomic histogram, (prefix scan in
 // prefix_scan.wgsl), scatter, deterministic rank within each slot, reorder of particle arrays.
-// The slot order within a cell is by previous sorted index, so the same input on the same
-// adapter always gives the same order (atomics only decide a provisional placement).
+// The order within a slot is by particle id: it depends neither on the atomics (which only
+// decide a provisional placement) nor on where a particle was in the arrays before, so the
+// same particles give the same order however they were stored (a subdomain's particles with
+// its neighbours' halo among them sum in the same order as in one whole run).
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> code: array<u32>;
@@ -48,9 +50,9 @@ fn scatter(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     provisional[cell_start[keys[i]] + local_rank[i]] = i;
 }
 
-// Final place = slot start + number of particles of the same slot with a smaller previous
-// index. O(n_slot) per particle; the excluded slot keeps its provisional order (its particles
-// never interact, and outputs are written in id order).
+// Final place = slot start + number of particles of the same slot with a smaller id (ids are
+// unique). O(n_slot) per particle; the excluded slot keeps its provisional order (its
+// particles never interact, and outputs are written in id order).
 @compute @workgroup_size(WG)
 fn rank_in_cell(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let p = linear_index(gid, nwg);
@@ -65,9 +67,10 @@ fn rank_in_cell(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         return;
     }
     let end = cell_start[key + 1u];
+    let id = code[i] & ID_MASK;
     var rank = 0u;
     for (var q = start; q < end; q++) {
-        rank += select(0u, 1u, provisional[q] < i);
+        rank += select(0u, 1u, (code[provisional[q]] & ID_MASK) < id);
     }
     perm[start + rank] = i;
 }

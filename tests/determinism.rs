@@ -1,5 +1,5 @@
 //! The same input on the same adapter gives bit-identical results (no float atomics; the sort
-//! orders each cell by previous index).
+//! orders each slot by particle id).
 
 mod common;
 use common::gpu;

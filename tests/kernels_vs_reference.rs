@@ -3,10 +3,10 @@
 
 mod common;
 use common::*;
-use wgsph::layout::ID_MASK;
+use wgsph::layout::{unpack_block, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
 use wgsph::reference::{self, RefParticle};
 use wgsph::scenario::*;
-use wgsph::sph::Solver;
+use wgsph::sph::{Solver, Stage};
 
 struct Setup {
     dim: u32,
@@ -153,7 +153,8 @@ fn cell_list_sort_matches_reference_exactly() {
         let init: Vec<([f32; 3], [u32; 3])> =
             sc.particles.iter().map(|p| grid.to_block(p.pos)).collect();
         let keys = reference::cell_list::cell_key(grid, &init, &vec![false; init.len()]);
-        let (order, start) = reference::cell_list::sorted_order(grid, &keys);
+        let ids: Vec<u32> = (0..init.len() as u32).collect();
+        let (order, start) = reference::cell_list::sorted_order(grid, &keys, &ids);
         let (_, _, code) = solver.read_raw().unwrap();
         let ids: Vec<usize> = code.iter().map(|c| (c & ID_MASK) as usize).collect();
         assert_eq!(ids, order, "dim {} domain {}", s.dim, s.domain);
@@ -165,6 +166,38 @@ fn cell_list_sort_matches_reference_exactly() {
                 "sparse case must exercise hash collisions"
             );
         }
+    }
+}
+
+/// After particles have moved for some steps, the arrays' previous order is no longer the ids'
+/// order; the sort still orders each slot by id, whatever order the particles came in (what
+/// makes a subdomain sum its neighbours in the same order as a whole run).
+#[test]
+fn cell_list_orders_each_slot_by_id_after_motion() {
+    for s in setups() {
+        let sc = random_scenario(&s);
+        let mut solver = Solver::new(gpu(), &sc).unwrap();
+        solver.run_steps(200).unwrap();
+        solver.time_stage(Stage::CellList, 1).unwrap();
+        let (pos, _, code) = solver.read_raw().unwrap();
+        let grid = &solver.grid;
+        let at: Vec<([f32; 3], [u32; 3])> =
+            pos.iter().map(|p| (p.off, unpack_block(p.block))).collect();
+        let excluded: Vec<bool> = code
+            .iter()
+            .map(|c| c >> KIND_SHIFT == KIND_EXCLUDED)
+            .collect();
+        let keys = reference::cell_list::cell_key(grid, &at, &excluded);
+        let ids: Vec<u32> = code.iter().map(|c| c & ID_MASK).collect();
+        let (order, start) = reference::cell_list::sorted_order(grid, &keys, &ids);
+        let active = start[grid.slots as usize] as usize;
+        assert_eq!(
+            order[..active].to_vec(),
+            (0..active).collect::<Vec<_>>(),
+            "dim {} domain {}: not ordered by (slot, id)",
+            s.dim,
+            s.domain
+        );
     }
 }
 

@@ -40,14 +40,13 @@ impl Resolve for ScanLevel<'_> {
 pub struct CellList {
     cell_key: ParityKernel,
     scatter: Kernel,
-    rank_in_cell: Kernel,
+    rank_in_cell: ParityKernel,
     reorder: ParityKernel,
     reorder_motion: ParityKernel,
     reorder_energy: Option<ParityKernel>,
     scan_blocks: Kernel,
     scan_add: Kernel,
     bind_scatter: wgpu::BindGroup,
-    bind_rank: wgpu::BindGroup,
     /// (scan_blocks, scan_add) bind group of each level.
     bind_scan: Vec<(wgpu::BindGroup, Option<wgpu::BindGroup>)>,
     scan_sizes: Vec<u32>,
@@ -65,7 +64,6 @@ impl CellList {
         let parity = |entry: &str| ParityKernel::new(device, cells, entry, |p| b.at(p));
         let reorder_energy = energy.then(|| parity("reorder_energy")).transpose()?;
         let scatter = cells.kernel(device, "scatter")?;
-        let rank_in_cell = cells.kernel(device, "rank_in_cell")?;
         let scan_blocks = scan.kernel(device, "scan_blocks")?;
         let scan_add = scan.kernel(device, "scan_add")?;
         let mut levels: Vec<&wgpu::Buffer> = vec![&b.cell_start];
@@ -86,9 +84,8 @@ impl CellList {
         Ok(Self {
             cell_key: parity("cell_key")?,
             bind_scatter: scatter.bind(device, &b.unparitied())?,
-            bind_rank: rank_in_cell.bind(device, &b.unparitied())?,
             scatter,
-            rank_in_cell,
+            rank_in_cell: parity("rank_in_cell")?,
             reorder: parity("reorder")?,
             reorder_motion: parity("reorder_motion")?,
             reorder_energy,
@@ -111,7 +108,7 @@ impl CellList {
     pub fn encode(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.encode_key(pass, p);
         self.encode_scan(pass);
-        self.encode_scatter(pass);
+        self.encode_scatter(pass, p);
         self.encode_reorder(pass, p);
     }
 
@@ -120,10 +117,10 @@ impl CellList {
         self.cell_key.dispatch(pass, p, self.n);
     }
 
-    /// Each particle's place in the sorted order: after the slots, then within its cell.
-    pub fn encode_scatter(&self, pass: &mut wgpu::ComputePass<'_>) {
+    /// Each particle's place in the sorted order: after the slots, then by id within its slot.
+    pub fn encode_scatter(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.scatter.dispatch(pass, &self.bind_scatter, self.n);
-        self.rank_in_cell.dispatch(pass, &self.bind_rank, self.n);
+        self.rank_in_cell.dispatch(pass, p, self.n);
     }
 
     /// The particle arrays of parity `p` copied into the other parity in sorted order.

@@ -153,7 +153,7 @@ impl Passes {
         let cells = &self.cell_list;
         r.stage("sort_key", |pass| cells.encode_key(pass, p));
         r.stage("sort_scan", |pass| cells.encode_scan(pass));
-        r.stage("sort_scatter", |pass| cells.encode_scatter(pass));
+        r.stage("sort_scatter", |pass| cells.encode_scatter(pass, p));
         r.stage("sort_reorder", |pass| cells.encode_reorder(pass, p));
         if let Some(t) = &self.total_lagrangian {
             r.stage("total_lagrangian_index", |pass| t.encode_index(pass, q));
