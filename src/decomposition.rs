@@ -1,0 +1,319 @@
+//! Domain decomposition of a run over several ranks (issue 32): slabs of the one global cell
+//! grid along one axis, cut where they balance the ranks' work, the cell layers each rank sends
+//! its neighbours as halo, where a particle that left its slab goes, and when to move the cuts.
+//!
+//! Every rank keeps the global grid, so a particle's cell, and with it the order the sort gives
+//! a cell's particles (by id), does not depend on where the cuts are: a particle sums its
+//! neighbours in the same order in a subdomain as in the whole run.
+
+use std::ops::Range;
+
+use anyhow::{bail, Result};
+
+use crate::grid::Grid;
+use crate::scenario::{Kind, Particle};
+
+/// A step's work of a particle that moves (fluid, solid, inlet), the unit of the balance.
+pub const MOVING_WEIGHT: f64 = 1.0;
+
+/// A step's work of a boundary particle relative to a moving one: a wall or ghost particle
+/// only sums its density rate (or is interpolated) and is never integrated. An estimate, to be
+/// replaced by `bench --stages` on wall-only and fluid-only cases.
+pub const BOUNDARY_WEIGHT: f64 = 0.5;
+
+/// Move the cuts when the most loaded rank carries this much more than the mean.
+pub const REBALANCE_THRESHOLD: f64 = 0.1;
+
+/// A particle's weight in the balance.
+pub fn weight(kind: Kind) -> f64 {
+    match kind {
+        Kind::Fluid | Kind::Solid | Kind::Inlet => MOVING_WEIGHT,
+        Kind::Wall
+        | Kind::GhostNoSlip
+        | Kind::GhostFreeSlip
+        | Kind::Repulsive
+        | Kind::SolidClamped => BOUNDARY_WEIGHT,
+    }
+}
+
+/// The axis to cut: the one with the most cells (slabs across it are the thinnest faces for
+/// the most ranks). A periodic axis is not cut: its halos would wrap around the period.
+pub fn cut_axis(grid: &Grid, dim: u32) -> Result<usize> {
+    (0..dim as usize)
+        .filter(|&a| !grid.periodic[a])
+        .max_by_key(|&a| (grid.cells[a], std::cmp::Reverse(a)))
+        .ok_or_else(|| anyhow::anyhow!("every axis of the case is periodic: no axis to cut"))
+}
+
+/// The weighted particles of each cell layer along `axis`.
+pub fn layer_load(grid: &Grid, axis: usize, particles: &[Particle]) -> Vec<f64> {
+    let mut load = vec![0.0; grid.cells[axis] as usize];
+    for p in particles {
+        let (off, b) = grid.to_block(p.pos);
+        load[grid.cell_of(off, b)[axis] as usize] += weight(p.kind);
+    }
+    load
+}
+
+/// Slabs along one axis of the global grid: rank r owns the cell layers `bounds[r] ..
+/// bounds[r + 1]`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Slabs {
+    pub axis: usize,
+    bounds: Vec<u32>,
+}
+
+/// What one rank sends one neighbour every step: its particles in these cell layers.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct HaloSend {
+    pub to: usize,
+    pub layers: Range<u32>,
+}
+
+impl Slabs {
+    /// Cuts `load` (one entry per cell layer) into `ranks` slabs of as equal a load as whole
+    /// layers allow, each at least `min_layers` thick so that a halo of that many layers comes
+    /// from the next rank only.
+    pub fn balanced(axis: usize, load: &[f64], ranks: usize, min_layers: u32) -> Result<Self> {
+        let layers = load.len() as u32;
+        if ranks == 0 {
+            bail!("no ranks to cut the domain for");
+        }
+        if (ranks as u64) * (min_layers.max(1) as u64) > layers as u64 {
+            bail!(
+                "{ranks} ranks need at least {} cell layers along axis {axis} ({} each for the \
+                 halo), but the domain has {layers}: use fewer ranks or a finer particles.dx_m",
+                ranks as u64 * min_layers.max(1) as u64,
+                min_layers.max(1)
+            );
+        }
+        let min_layers = min_layers.max(1);
+        let mut prefix = vec![0.0; load.len() + 1];
+        for (c, l) in load.iter().enumerate() {
+            prefix[c + 1] = prefix[c] + l;
+        }
+        let total = prefix[load.len()];
+        let mut bounds = vec![0u32];
+        for k in 1..ranks {
+            let lo = bounds[k - 1] + min_layers;
+            let hi = layers - (ranks - k) as u32 * min_layers;
+            let target = total * k as f64 / ranks as f64;
+            // The cut whose prefix is nearest the target, within the thickness limits.
+            let mut cut = lo;
+            while cut < hi && prefix[cut as usize + 1] <= target {
+                cut += 1;
+            }
+            if cut > lo && target - prefix[cut as usize - 1] < prefix[cut as usize] - target {
+                cut -= 1;
+            }
+            bounds.push(cut.clamp(lo, hi));
+        }
+        bounds.push(layers);
+        Ok(Self { axis, bounds })
+    }
+
+    pub fn ranks(&self) -> usize {
+        self.bounds.len() - 1
+    }
+
+    /// The cell layers rank `r` owns.
+    pub fn range(&self, r: usize) -> Range<u32> {
+        self.bounds[r]..self.bounds[r + 1]
+    }
+
+    /// The rank that owns cell layer `layer` (layers past the grid belong to the last rank, as
+    /// `Grid::cell_of` clamps positions into the grid).
+    pub fn owner(&self, layer: u32) -> usize {
+        let inner = &self.bounds[1..self.bounds.len() - 1];
+        inner.partition_point(|&b| b <= layer)
+    }
+
+    /// The layers rank `r` sends each neighbour: its own within `layers` of their common cut.
+    /// With cells of the kernel support, one layer holds every particle a neighbour's particle
+    /// can reach.
+    pub fn halo_sends(&self, r: usize, layers: u32) -> Vec<HaloSend> {
+        let own = self.range(r);
+        let mut sends = Vec::new();
+        if r > 0 {
+            sends.push(HaloSend {
+                to: r - 1,
+                layers: own.start..(own.start + layers).min(own.end),
+            });
+        }
+        if r + 1 < self.ranks() {
+            sends.push(HaloSend {
+                to: r + 1,
+                layers: own.end.saturating_sub(layers).max(own.start)..own.end,
+            });
+        }
+        sends
+    }
+
+    /// Each rank's share of `load`.
+    pub fn rank_loads(&self, load: &[f64]) -> Vec<f64> {
+        (0..self.ranks())
+            .map(|r| {
+                let range = self.range(r);
+                load[range.start as usize..range.end as usize].iter().sum()
+            })
+            .collect()
+    }
+
+    /// How much more than the mean the most loaded rank carries (0: perfectly balanced).
+    pub fn imbalance(&self, load: &[f64]) -> f64 {
+        let loads = self.rank_loads(load);
+        let mean = loads.iter().sum::<f64>() / loads.len() as f64;
+        if mean <= 0.0 {
+            return 0.0;
+        }
+        loads.iter().fold(0.0f64, |m, &l| m.max(l)) / mean - 1.0
+    }
+
+    /// New cuts for `load` when the present ones are beyond [`REBALANCE_THRESHOLD`] and the new
+    /// ones are better; `None` keeps the present ones.
+    pub fn rebalanced(&self, load: &[f64], min_layers: u32) -> Option<Self> {
+        let now = self.imbalance(load);
+        if now <= REBALANCE_THRESHOLD {
+            return None;
+        }
+        let next = Self::balanced(self.axis, load, self.ranks(), min_layers).ok()?;
+        (next.imbalance(load) < now && next != *self).then_some(next)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::Domain;
+
+    fn grid(cells: [f64; 3], dim: u32) -> Grid {
+        let h = 0.05;
+        let support = 2.0 * h * (1.0 + 1e-4);
+        let max = cells.map(|c| c * support * 0.99999);
+        Grid::new(&Domain { min: [0.0; 3], max }, h, dim, 100_000, [false; 3]).unwrap()
+    }
+
+    #[test]
+    fn uniform_load_gives_equal_slabs() {
+        let s = Slabs::balanced(0, &[1.0; 40], 4, 1).unwrap();
+        assert_eq!(
+            (0..4).map(|r| s.range(r)).collect::<Vec<_>>(),
+            [0..10, 10..20, 20..30, 30..40]
+        );
+        assert_eq!(s.imbalance(&[1.0; 40]), 0.0);
+    }
+
+    #[test]
+    fn a_water_column_at_one_end_draws_the_cuts_to_it() {
+        // A dam break: 10 layers of water then a dry floor (boundary only).
+        let load: Vec<f64> = (0..50).map(|c| if c < 10 { 20.0 } else { 1.0 }).collect();
+        let s = Slabs::balanced(0, &load, 2, 1).unwrap();
+        assert!(s.range(0).end < 10, "{s:?}");
+        assert!(s.imbalance(&load) < 0.1, "{}", s.imbalance(&load));
+        let even = Slabs {
+            axis: 0,
+            bounds: vec![0, 25, 50],
+        };
+        assert!(even.imbalance(&load) > 0.5);
+        assert_eq!(even.rebalanced(&load, 1).as_ref(), Some(&s));
+        assert_eq!(s.rebalanced(&load, 1), None);
+    }
+
+    #[test]
+    fn slabs_keep_their_minimum_thickness() {
+        let mut load = vec![0.0; 12];
+        load[0] = 100.0;
+        let s = Slabs::balanced(0, &load, 3, 3).unwrap();
+        for r in 0..3 {
+            assert!(s.range(r).len() >= 3, "{s:?}");
+        }
+        assert_eq!(s.range(2).end, 12);
+        let err = Slabs::balanced(0, &load, 5, 3).unwrap_err().to_string();
+        assert!(
+            err.contains("5 ranks need at least 15 cell layers"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn every_layer_has_one_owner() {
+        let load: Vec<f64> = (0..37).map(|c| (c % 7) as f64 + 0.5).collect();
+        let s = Slabs::balanced(2, &load, 5, 2).unwrap();
+        for layer in 0..37 {
+            let owners: Vec<usize> = (0..5).filter(|&r| s.range(r).contains(&layer)).collect();
+            assert_eq!(owners, [s.owner(layer)], "layer {layer}");
+        }
+        // Past the grid (a position rounded past the far face): the last rank.
+        assert_eq!(s.owner(40), 4);
+    }
+
+    /// Every pair of particles within the kernel support owned by different ranks: each is in
+    /// a halo the other's rank receives (brute force over random particles).
+    #[test]
+    fn halos_hold_every_neighbour_across_a_cut() {
+        let g = grid([30.0, 8.0, 6.0], 3);
+        let axis = cut_axis(&g, 3).unwrap();
+        assert_eq!(axis, 0);
+        let mut rng = 12345u64;
+        let mut uniform = |scale: f64| {
+            rng = rng
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            scale * ((rng >> 11) as f64 / (1u64 << 53) as f64)
+        };
+        let particles: Vec<Particle> = (0..3000)
+            .map(|_| Particle {
+                pos: [0, 1, 2].map(|a| uniform(g.extent[a])),
+                vel: [0.0; 3],
+                rho: 1000.0,
+                kind: Kind::Fluid,
+            })
+            .collect();
+        let load = layer_load(&g, axis, &particles);
+        assert_eq!(load.iter().sum::<f64>(), 3000.0);
+        let s = Slabs::balanced(axis, &load, 3, 1).unwrap();
+        let layer = |p: &Particle| {
+            let (off, b) = g.to_block(p.pos);
+            g.cell_of(off, b)[axis] as u32
+        };
+        let support = 2.0 * 0.05;
+        let mut crossing = 0;
+        for i in &particles {
+            for j in &particles {
+                let d2: f64 = (0..3).map(|a| (i.pos[a] - j.pos[a]).powi(2)).sum();
+                let (ri, rj) = (s.owner(layer(i)), s.owner(layer(j)));
+                if d2 > support * support || ri == rj {
+                    continue;
+                }
+                crossing += 1;
+                let sent = s
+                    .halo_sends(rj, 1)
+                    .into_iter()
+                    .any(|h| h.to == ri && h.layers.contains(&layer(j)));
+                assert!(
+                    sent,
+                    "particle at {:?} (rank {rj}) not sent to rank {ri}",
+                    j.pos
+                );
+            }
+        }
+        assert!(crossing > 0, "no pair across a cut: the test tests nothing");
+    }
+
+    #[test]
+    fn a_periodic_axis_is_not_cut() {
+        let h = 0.05;
+        let g = Grid::new(
+            &Domain {
+                min: [0.0; 3],
+                max: [3.0, 1.0, 0.0],
+            },
+            h,
+            2,
+            1000,
+            [true, false, false],
+        )
+        .unwrap();
+        assert_eq!(cut_axis(&g, 2).unwrap(), 1);
+    }
+}
