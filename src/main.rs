@@ -282,6 +282,15 @@ fn finish(report: &RunReport, dir: &std::path::Path, quiet: bool) -> ExitCode {
 }
 
 fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
+    let solver_command = match cli.command {
+        Command::Run { .. } => Some("run"),
+        Command::Resume { .. } => Some("resume"),
+        Command::Bench { .. } => Some("bench"),
+        _ => None,
+    };
+    if let Some(name) = solver_command {
+        wgsph::ranks::refuse_several_ranks(name)?;
+    }
     match cli.command {
         Command::Run {
             case,

@@ -944,3 +944,46 @@ fn snapshots_3d_are_perspective_views_of_the_particles() {
     .clone();
     assert!(info.width > PICTURE.0 && info.height > PICTURE.1);
 }
+
+/// Under a launcher with several ranks (its environment says how many), a run is refused with
+/// the reason rather than run N times into one folder; one rank runs as without a launcher.
+#[test]
+fn a_launch_over_several_ranks_is_refused_until_subdomains_exist() {
+    let out = temp_dir("ranks");
+    for (var, ranks) in [("OMPI_COMM_WORLD_SIZE", "2"), ("PMI_SIZE", "4")] {
+        let o = wgsph()
+            .args([
+                "run",
+                "cases/hydrostatic_2d.toml",
+                "--set",
+                "time.end_s=0.01",
+            ])
+            .arg("--out")
+            .arg(&out)
+            .env(var, ranks)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success());
+        assert!(
+            stderr.contains(&format!(
+                "launched on {ranks} ranks, but a run cannot be split"
+            )),
+            "{stderr}"
+        );
+        assert!(!out.join("run.json").exists(), "nothing may be written");
+    }
+    let o = wgsph()
+        .args([
+            "run",
+            "cases/hydrostatic_2d.toml",
+            "--set",
+            "time.end_s=0.01",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .env("OMPI_COMM_WORLD_SIZE", "1")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

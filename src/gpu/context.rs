@@ -182,6 +182,20 @@ impl GpuContext {
         choice: AdapterChoice,
         restrict: impl FnOnce(&mut wgpu::Limits),
     ) -> Result<Self> {
+        Self::open(choice, 0, restrict)
+    }
+
+    /// The device of rank `rank` of a run over several ranks: adapter `rank mod n` of the n
+    /// adapters of the most preferred type that `choice` allows (ranks beyond n share them).
+    pub fn for_rank(choice: AdapterChoice, rank: usize) -> Result<Self> {
+        Self::open(choice, rank, |_| {})
+    }
+
+    fn open(
+        choice: AdapterChoice,
+        rank: usize,
+        restrict: impl FnOnce(&mut wgpu::Limits),
+    ) -> Result<Self> {
         let instance = instance();
         let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::PRIMARY));
         adapters.retain(|a| match choice {
@@ -190,7 +204,14 @@ impl GpuContext {
             AdapterChoice::Cpu => a.get_info().device_type == wgpu::DeviceType::Cpu,
         });
         adapters.sort_by_key(|a| preference(a.get_info().device_type));
-        let adapter = adapters.into_iter().next().ok_or_else(|| {
+        if let Some(best) = adapters
+            .first()
+            .map(|a| preference(a.get_info().device_type))
+        {
+            adapters.retain(|a| preference(a.get_info().device_type) == best);
+        }
+        let n = adapters.len().max(1);
+        let adapter = adapters.into_iter().nth(rank % n).ok_or_else(|| {
             anyhow!(
                 "no {} adapter found (adapter choice '{choice}'). For a software adapter install \
                  Mesa's lavapipe: apt-get install mesa-vulkan-drivers libvulkan1",
