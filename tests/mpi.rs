@@ -3,6 +3,8 @@
 //! see OpenMPI's `OMPI_COMM_WORLD_SIZE` and play their rank instead.
 #![cfg(feature = "mpi")]
 
+mod common;
+
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
