@@ -303,6 +303,49 @@ pub struct OutletDef {
     pub pad1: u32,
 }
 
+/// Mirrors `HaloCtl` in shaders/halo.wgsl: a subdomain's own cell layers along the cut axis,
+/// its halo thickness, which neighbours it has, and how many records `halo_out` holds.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct HaloCtl {
+    pub axis: u32,
+    pub own_lo: u32,
+    pub own_hi: u32,
+    pub layers: u32,
+    pub lower: u32,
+    pub upper: u32,
+    pub capacity: u32,
+    pub pad: u32,
+}
+
+/// Mirrors `HaloCounts` in shaders/halo.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct HaloCounts {
+    pub records: u32,
+    pub owned: u32,
+    pub tail: u32,
+    pub overflow: u32,
+}
+
+/// Mirrors `HaloRecord` in shaders/halo.wgsl: one particle sent to a neighbour, as a halo copy
+/// or as a migrant (`dest`: [`DEST_UPPER`] | [`DEST_MIGRANT`]).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct HaloRecord {
+    pub pos: Pos,
+    pub velrho: [f32; 4],
+    pub rate: [f32; 4],
+    pub code: u32,
+    pub dest: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+}
+
+/// `HaloRecord::dest`: to the neighbour above (else below); a migrant (else a halo copy).
+pub const DEST_UPPER: u32 = 1;
+pub const DEST_MIGRANT: u32 = 2;
+
 /// Mirrors `TlParams` in shaders/total_lagrangian.wgsl: the total-Lagrangian solid's
 /// particle count and first particle id (its particles have consecutive ids) and the cell
 /// quadrature factor dx²/12 (the materials are `Params::solid_materials`).
@@ -339,7 +382,7 @@ mod tests {
     use crate::sph::passes::SHADERS;
     use crate::sph::shader::{compose, ShaderConfig, ViscosityForm};
     use crate::sph::total_lagrangian;
-    use crate::sph::{bodies, elastic, integrate, interaction, open_boundaries, probes};
+    use crate::sph::{bodies, elastic, halo, integrate, interaction, open_boundaries, probes};
     use wgpu::naga;
 
     /// (size, [(member name, offset)]) of a struct type named `name` in the composed `pass`.
@@ -650,6 +693,30 @@ mod tests {
                 pressure
             ]
         );
+    }
+
+    #[test]
+    fn halo_structs_match_wgsl() {
+        check_layout!(
+            &halo::SHADER,
+            "HaloCtl",
+            HaloCtl,
+            [axis, own_lo, own_hi, layers, lower, upper, capacity]
+        );
+        check_layout!(
+            &halo::SHADER,
+            "HaloCounts",
+            HaloCounts,
+            [records, owned, tail, overflow]
+        );
+        check_layout!(
+            &halo::SHADER,
+            "HaloRecord",
+            HaloRecord,
+            [pos, velrho, rate, code, dest]
+        );
+        assert_eq!(wgsl_u32(&halo::SHADER, "DEST_UPPER"), DEST_UPPER);
+        assert_eq!(wgsl_u32(&halo::SHADER, "DEST_MIGRANT"), DEST_MIGRANT);
     }
 
     #[test]

@@ -11,8 +11,10 @@ use std::time::{Duration, Instant};
 use wgsph::decomposition::{cut_axis, layer_load, Slabs};
 use wgsph::gpu::{AdapterChoice, GpuContext};
 use wgsph::grid::Grid;
+use wgsph::layout::{ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
 use wgsph::ranks::{Mpi, Ranks};
-use wgsph::scenario::{Domain, Kind, Particle};
+use wgsph::scenario::{Domain, Kind, Particle, Scenario};
+use wgsph::sph::Solver;
 
 /// Whether this process is one rank of an `mpirun` job.
 fn under_mpirun() -> bool {
@@ -22,9 +24,18 @@ fn under_mpirun() -> bool {
 /// Runs `test` of this binary on `ranks` ranks; returns (success, stdout + stderr). Fails the
 /// test if the job has not ended after `limit`.
 fn mpirun(test: &str, ranks: u32, limit: Duration) -> (bool, String) {
+    mpirun_with(test, ranks, limit, &[])
+}
+
+/// As [`mpirun`], with environment variables `env` set for every rank.
+fn mpirun_with(test: &str, ranks: u32, limit: Duration, env: &[(&str, &str)]) -> (bool, String) {
     let exe = std::env::current_exe().unwrap();
-    let mut child = Command::new("mpirun")
-        .args(["--oversubscribe", "-np", &ranks.to_string()])
+    let mut command = Command::new("mpirun");
+    command.args(["--oversubscribe", "-np", &ranks.to_string()]);
+    for (k, v) in env {
+        command.args(["-x", &format!("{k}={v}")]);
+    }
+    let mut child = command
         .arg(exe)
         .args(["--exact", test, "--nocapture", "--test-threads=1"])
         // OpenMPI refuses root without these (CI runs as root).
@@ -170,4 +181,114 @@ fn a_failing_rank_ends_the_job_and_says_which() {
     // Rank 0 waits for a halo that never comes: only the abort ends it.
     let _ = ranks.exchange(&[(1, vec![1, 2, 3])], &[1]);
     unreachable!("rank 0 received from a rank that aborted");
+}
+
+/// The 2D dam break at a coarse dx: the water column at the tank's left end draws the balanced
+/// cut into it, and the collapsing water flows across the cut.
+fn dam_break() -> Scenario {
+    let set = ["particles.dx_m=0.0073".to_string()];
+    wgsph::case::load(std::path::Path::new("cases/dam_break_2d.toml"), &set).unwrap()
+}
+
+const STEPS: u64 = 1000;
+
+/// (id, position words, (v, ρ) bits) of every live particle, sorted by id.
+type Live = Vec<(u32, [u32; 4], [u32; 4])>;
+
+fn live_particles(solver: &Solver) -> Live {
+    let (pos, velrho, code) = solver.read_raw().unwrap();
+    let mut live: Live = (0..code.len())
+        .filter(|&k| code[k] >> KIND_SHIFT != KIND_EXCLUDED)
+        .map(|k| {
+            let p = pos[k];
+            let words = [
+                p.off[0].to_bits(),
+                p.off[1].to_bits(),
+                p.off[2].to_bits(),
+                p.block,
+            ];
+            (code[k] & ID_MASK, words, velrho[k].map(f32::to_bits))
+        })
+        .collect();
+    live.sort_by_key(|l| l.0);
+    live
+}
+
+/// Two subdomains, stepped together under mpirun, hold bit for bit the particles of one whole
+/// run after the same steps (positions, velocities and densities, by id), with halos swapped
+/// and particles migrated across the cut on the way.
+#[test]
+fn two_ranks_step_bit_identically_to_one_run() {
+    let out = std::env::temp_dir().join(format!("wgsph-mpi-two-ranks-{}", std::process::id()));
+    if !under_mpirun() {
+        std::fs::create_dir_all(&out).unwrap();
+        let dir = out.to_str().unwrap();
+        let (ok, log) = mpirun_with(
+            "two_ranks_step_bit_identically_to_one_run",
+            2,
+            Duration::from_secs(300),
+            &[("WGSPH_MPI_OUT", dir)],
+        );
+        assert!(ok, "the 2-rank job failed:\n{log}");
+        let mut whole = Solver::new(common::gpu(), &dam_break()).unwrap();
+        whole.run_steps(STEPS).unwrap();
+        let expected = live_particles(&whole);
+        let mut merged: Live = Vec::new();
+        let mut migrants_total = 0;
+        for r in 0..2 {
+            let bytes = std::fs::read(out.join(format!("rank{r}.bin"))).unwrap();
+            let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+            let (halo, migrants) = (words[0], words[1]);
+            println!("rank {r}: {halo} halo copies and {migrants} migrants sent");
+            assert!(halo > 0, "rank {r} sent no halo");
+            migrants_total += migrants;
+            merged.extend(
+                words[2..]
+                    .chunks(9)
+                    .map(|c| (c[0], [c[1], c[2], c[3], c[4]], [c[5], c[6], c[7], c[8]])),
+            );
+        }
+        std::fs::remove_dir_all(&out).ok();
+        merged.sort_by_key(|l| l.0);
+        assert_eq!(merged.len(), expected.len(), "particle counts differ");
+        let ids: Vec<u32> = merged.iter().map(|l| l.0).collect();
+        assert!(
+            ids.windows(2).all(|w| w[0] < w[1]),
+            "a particle is on both ranks"
+        );
+        let differ = merged.iter().zip(&expected).filter(|(a, b)| a != b).count();
+        assert_eq!(differ, 0, "{differ} particles differ from the whole run");
+        assert!(migrants_total > 0, "no particle crossed the cut");
+        return;
+    }
+    let ranks = Mpi::init().expect("MPI initialised once");
+    let r = ranks.rank();
+    let result = (|| -> anyhow::Result<()> {
+        let gpu = GpuContext::for_rank(AdapterChoice::Cpu, r)?;
+        let sc = dam_break();
+        let ph = &sc.physics;
+        let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic)?;
+        let axis = cut_axis(&grid, ph.dim)?;
+        let slabs = Slabs::balanced(
+            axis,
+            &layer_load(&grid, axis, &sc.particles),
+            ranks.size(),
+            1,
+        )?;
+        let mut solver = Solver::subdomain(&gpu, &sc, &slabs, &ranks)?;
+        solver.run_steps_ranked(STEPS, &ranks)?;
+        let counts = solver.ranked().unwrap();
+        let mut words = vec![counts.halo_sent as u32, counts.migrants_sent as u32];
+        for (id, p, v) in live_particles(&solver) {
+            words.push(id);
+            words.extend(p);
+            words.extend(v);
+        }
+        let dir = std::env::var("WGSPH_MPI_OUT")?;
+        std::fs::write(format!("{dir}/rank{r}.bin"), bytemuck::cast_slice(&words))?;
+        Ok(())
+    })();
+    if let Err(e) = result {
+        ranks.abort(&e);
+    }
 }

@@ -13,6 +13,7 @@ pub mod cell_list;
 pub mod density_filter;
 pub mod elastic;
 pub mod ghost;
+pub mod halo;
 #[cfg(feature = "test-hooks")]
 mod hooks;
 pub mod initial;
@@ -26,6 +27,7 @@ pub mod profile;
 mod readback;
 pub mod shader;
 pub mod state;
+pub mod subdomain;
 pub mod total_lagrangian;
 
 use anyhow::{bail, Result};
@@ -35,7 +37,7 @@ use crate::gpu::buffers::{map_read, read, readback_buffer};
 use crate::gpu::context::GpuFaults;
 use crate::gpu::GpuContext;
 use crate::grid::Grid;
-use crate::layout::{unpack_block, Params, Pos, SimState, KIND_EXCLUDED};
+use crate::layout::{unpack_block, HaloCtl, Params, Pos, SimState, KIND_EXCLUDED};
 use crate::scenario::{Kind, Scenario};
 use buffers::{CaseTables, InitialParticles, ParticleBuffers};
 pub use capacity::{capacity, check_capacity, Capacity};
@@ -138,10 +140,23 @@ pub struct Solver {
     n_fluid_at_start: u64,
     /// Per-stage timestamps, while [`Solver::profile_steps`] runs.
     profiler: Option<Profiler>,
+    /// A subdomain's counts over all ranks (`subdomain::Ranked`); None in a whole run.
+    ranked: Option<subdomain::Ranked>,
 }
 
 impl Solver {
     pub fn new(ctx: &GpuContext, sc: &Scenario) -> Result<Self> {
+        let mut solver = Self::build(ctx, sc, None)?;
+        // Warm-up: one step with dt = 0 sorts the particles, evaluates the initial rates and
+        // chooses the first dt; it moves nothing and is not counted.
+        solver.take_steps(1)?;
+        solver.initial_dt = solver.state.dt_cfl;
+        Ok(solver)
+    }
+
+    /// The solver of `sc` before its warm-up step: of the whole case, or with `subdomain` of
+    /// the particles in its own cell layers (the others excluded) and its halo pass.
+    fn build(ctx: &GpuContext, sc: &Scenario, subdomain: Option<HaloCtl>) -> Result<Self> {
         let ph = &sc.physics;
         let n = sc.particles.len();
         if n == 0 {
@@ -159,7 +174,11 @@ impl Solver {
         let probe_faces = probes::probe_faces(&sc.probes, &sc.walls);
         let front_bins = probes::FrontBins::new(&grid, ph.h, &sc.probes)?;
         let defs = probes::probe_defs(&sc.probes, grid.origin, &probe_faces, front_bins);
-        let packed = initial::pack(sc, &grid);
+        let mut packed = initial::pack(sc, &grid);
+        let ranked = subdomain.map(|ctl| {
+            let own = subdomain::exclude_others(&mut packed, &grid, &ctl);
+            subdomain::Ranked::new(n as u64, own)
+        });
         let body_motions = bodies::initial_motions(sc, params.body_id_base);
         let solid = initial::solid_states(sc)?;
         let buffers = ParticleBuffers::new(
@@ -182,7 +201,11 @@ impl Solver {
             cfg.tables,
             ph.energy,
         );
-        let passes = Passes::new(&device, sc, cfg, &grid, &buffers, &defs, body_motions)?;
+        let mut passes = Passes::new(&device, sc, cfg, &grid, &buffers, &defs, body_motions)?;
+        if let Some(ctl) = subdomain {
+            let module = shader::module(&device, &halo::SHADER, cfg)?;
+            passes.halo = Some(halo::Halo::new(&device, &module, &buffers, ctl)?);
+        }
         let bodies = passes.bodies.as_ref().map(|gpu| HostBodies {
             set: BodySet::new(&sc.bodies, ph.gravity, ph.dim),
             staging: readback_buffer(
@@ -200,7 +223,7 @@ impl Solver {
                 buffers.bytes() as f64 / n as f64
             );
         }
-        let mut solver = Self {
+        Ok(Self {
             device,
             queue: ctx.queue.clone(),
             faults: ctx.faults.clone(),
@@ -232,12 +255,8 @@ impl Solver {
             density_variation_stop: sc.time.density_variation_stop,
             n_fluid_at_start: sc.count(Kind::Fluid) as u64,
             profiler: None,
-        };
-        // Warm-up: one step with dt = 0 sorts the particles, evaluates the initial rates and
-        // chooses the first dt; it moves nothing and is not counted.
-        solver.take_steps(1)?;
-        solver.initial_dt = solver.state.dt_cfl;
-        Ok(solver)
+            ranked,
+        })
     }
 
     /// The bodies' host state (poses and last loads), if the case has bodies.
@@ -275,6 +294,9 @@ impl Solver {
     /// still wait behind their buffers, nor the fluid outlets removed, which sit in the same
     /// excluded slot).
     pub fn excluded(&self) -> u64 {
+        if let Some(ranked) = &self.ranked {
+            return ranked.excluded;
+        }
         let dormant = self
             .dormant_at_start
             .saturating_sub(self.state.inlet_joined);
@@ -307,6 +329,9 @@ impl Solver {
     /// Without bodies the steps go in one submission; with bodies one at a time, each between
     /// the host's predictor and corrector of the bodies.
     fn take_steps(&mut self, count: u32) -> Result<()> {
+        if self.ranked.is_some() {
+            bail!("a subdomain steps with its neighbours: Solver::run_steps_ranked");
+        }
         if self.bodies.is_none() {
             let encoder = self.encode_steps(count);
             self.queue.submit([encoder.finish()]);

@@ -10,6 +10,7 @@ use super::cell_list::{self, CellList};
 use super::density_filter::{self, DensityFilter};
 use super::elastic::{self, Elastic};
 use super::ghost::{self, Ghost};
+use super::halo::{self, Halo};
 use super::integrate::{self, Integrate};
 use super::interaction::{self, Interaction};
 use super::open_boundaries::{self, OpenBoundaries};
@@ -23,7 +24,7 @@ use crate::layout::{BodyMotion, ProbeDef};
 use crate::scenario::{Kind, Scenario, SolidFormulation};
 
 /// Every pass's shader, for the checks that compose them all.
-pub const SHADERS: [&Shader; 11] = [
+pub const SHADERS: [&Shader; 12] = [
     &cell_list::SHADER,
     &cell_list::SCAN_SHADER,
     &interaction::SHADER,
@@ -35,6 +36,7 @@ pub const SHADERS: [&Shader; 11] = [
     &elastic::SHADER,
     &total_lagrangian::SHADER,
     &open_boundaries::SHADER,
+    &halo::SHADER,
 ];
 
 /// The passes of a run; those of what the case lacks are `None`.
@@ -56,6 +58,8 @@ pub struct Passes {
     pub probes: Probes,
     /// Tracked points of bodies.
     pub points: Option<PointTracker>,
+    /// A subdomain's halo and migrants (`Solver::subdomain`); None in a whole run.
+    pub halo: Option<Halo>,
 }
 
 impl Passes {
@@ -126,6 +130,7 @@ impl Passes {
                     .collect(),
             )?,
             points: PointTracker::new(device, &probe_module, b, &sc.points)?,
+            halo: None,
         })
     }
 
@@ -136,20 +141,34 @@ impl Passes {
     }
 
     /// The stages of one step on the arrays of parity `p`, in order (the sort moves them to
-    /// parity `1 - p`, where the rest of the step works).
+    /// parity `1 - p`, where the rest of the step works). A subdomain swaps its halo and
+    /// migrants with its neighbours between the two halves.
     pub(super) fn record_step(&self, mut r: Recorder<'_>, p: usize) {
-        let q = 1 - p;
-        let bodies = self.bodies.as_ref();
+        self.record_to_exchange(&mut r, p);
+        self.record_from_exchange(&mut r, p);
+    }
+
+    /// The step up to the exchange: the predictors, and a subdomain's packing.
+    pub(super) fn record_to_exchange(&self, r: &mut Recorder<'_>, p: usize) {
         r.stage("predict", |pass| self.integrate.encode_predict(pass, p));
         if let Some(e) = &self.elastic {
             r.stage("elastic_predict", |pass| e.encode_predict(pass, p));
         }
-        if let Some(b) = bodies {
+        if let Some(b) = &self.bodies {
             r.stage("body_move", |pass| b.encode_move(pass, p));
         }
         if let Some(o) = &self.open_boundaries {
             r.stage("open_boundaries", |pass| o.encode(pass, p));
         }
+        if let Some(h) = &self.halo {
+            r.stage("halo_pack", |pass| h.encode_pack(pass, p));
+        }
+    }
+
+    /// The step from the exchange on: the sort, the sums and the correctors.
+    pub(super) fn record_from_exchange(&self, r: &mut Recorder<'_>, p: usize) {
+        let q = 1 - p;
+        let bodies = self.bodies.as_ref();
         let cells = &self.cell_list;
         r.stage("sort_key", |pass| cells.encode_key(pass, p));
         r.stage("sort_scan", |pass| cells.encode_scan(pass));
@@ -175,6 +194,9 @@ impl Passes {
         }
         if let Some(b) = bodies {
             r.stage("body_force", |pass| b.encode_force(pass, q));
+        }
+        if let Some(h) = &self.halo {
+            r.stage("halo_drop", |pass| h.encode_drop(pass, q));
         }
         r.stage("correct", |pass| self.integrate.encode_correct(pass, q));
         if let Some(f) = &self.density_filter {

@@ -1,0 +1,106 @@
+// A subdomain's exchange with its neighbours (issue 32; docs/scaling.md): slabs of the global
+// cell grid along one axis, each rank owning the cell layers [own_lo, own_hi).
+// `halo_pack`, after the predictor: every live particle outside the own layers has crossed a
+// cut and migrates (packed with its last rates); every own particle within `layers` of a cut
+// with a neighbour is packed as that neighbour's halo. The host reads the records, swaps them
+// with the neighbours and writes what it received after `tail`, the first entry of the last
+// sort's excluded slot (free ever since: excluded particles stay excluded).
+// A migrant stays in the sender's arrays for this step, as a halo copy: it is within one layer
+// of the cut it crossed, and the sender's particles there need it; the receiver's halo for the
+// sender was packed before it arrived.
+// `halo_drop`, after the interaction: the particles outside the own layers (the halo copies and
+// the migrants sent) are excluded, so that the corrector, its reductions and the outputs see
+// the rank's own particles only.
+
+@group(0) @binding(1) var<storage, read> pos: array<Pos>;
+@group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> code: array<u32>;
+@group(0) @binding(4) var<storage, read> rate: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> cell_start: array<u32>;
+
+// Mirrored by `sph::halo::HaloCtl`.
+struct HaloCtl {
+    axis: u32,
+    own_lo: u32,
+    own_hi: u32,
+    layers: u32,        // halo thickness in cell layers
+    lower: u32,         // 1: a neighbour owns the layers below own_lo
+    upper: u32,         // 1: a neighbour owns the layers from own_hi on
+    capacity: u32,      // records `halo_out` holds
+    pad: u32,
+}
+
+// Mirrored by `sph::halo::HaloCounts`.
+struct HaloCounts {
+    records: atomic<u32>,
+    owned: atomic<u32>,     // live own particles at packing
+    tail: u32,
+    overflow: atomic<u32>,  // records that did not fit
+}
+
+// Mirrored by `sph::halo::HaloRecord`.
+struct HaloRecord {
+    pos: Pos,
+    velrho: vec4<f32>,
+    rate: vec4<f32>,
+    code: u32,
+    dest: u32,          // DEST_UPPER | DEST_MIGRANT bits
+    pad0: u32,
+    pad1: u32,
+}
+
+const DEST_UPPER: u32 = 1u;
+const DEST_MIGRANT: u32 = 2u;
+
+@group(0) @binding(6) var<storage, read> halo_ctl: HaloCtl;
+@group(0) @binding(7) var<storage, read_write> halo_counts: HaloCounts;
+@group(0) @binding(8) var<storage, read_write> halo_out: array<HaloRecord>;
+
+fn layer_of(p: Pos) -> u32 {
+    return u32(cell_of(p)[halo_ctl.axis]);
+}
+
+fn pack_record(i: u32, dest: u32) {
+    let k = atomicAdd(&halo_counts.records, 1u);
+    if (k >= halo_ctl.capacity) {
+        atomicAdd(&halo_counts.overflow, 1u);
+        return;
+    }
+    halo_out[k] = HaloRecord(pos[i], velrho[i], rate[i], code[i], dest, 0u, 0u);
+}
+
+@compute @workgroup_size(WG)
+fn halo_pack(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i == 0u) {
+        // The last sort's excluded slot starts here; this step's sort has not run yet.
+        halo_counts.tail = cell_start[params.hash_mask + 1u];
+    }
+    if (i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
+        return;
+    }
+    let layer = layer_of(pos[i]);
+    if (layer < halo_ctl.own_lo || layer >= halo_ctl.own_hi) {
+        pack_record(i, DEST_MIGRANT | select(0u, DEST_UPPER, layer >= halo_ctl.own_hi));
+        return;
+    }
+    atomicAdd(&halo_counts.owned, 1u);
+    if (halo_ctl.lower != 0u && layer < halo_ctl.own_lo + halo_ctl.layers) {
+        pack_record(i, 0u);
+    }
+    if (halo_ctl.upper != 0u && layer + halo_ctl.layers >= halo_ctl.own_hi) {
+        pack_record(i, DEST_UPPER);
+    }
+}
+
+@compute @workgroup_size(WG)
+fn halo_drop(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
+        return;
+    }
+    let layer = layer_of(pos[i]);
+    if (layer < halo_ctl.own_lo || layer >= halo_ctl.own_hi) {
+        code[i] = with_kind(code[i], KIND_EXCLUDED);
+    }
+}

@@ -1,0 +1,134 @@
+//! A subdomain's halo and migrants (shaders/halo.wgsl; issue 32): `halo_pack` after the
+//! predictor, `halo_drop` after the interaction. The solver's `ranked_step` swaps the packed
+//! records with the neighbours between the two.
+
+use anyhow::{bail, Result};
+
+use super::buffers::ParticleBuffers;
+use crate::decomposition::Slabs;
+use crate::gpu::buffers::{read, storage, storage_init};
+use crate::gpu::kernel::{ParityKernel, ShaderModule};
+use crate::gpu::shader::Shader;
+use crate::layout::{HaloCounts, HaloCtl, HaloRecord, DEST_MIGRANT, DEST_UPPER};
+
+pub const SHADER: Shader = Shader {
+    name: "halo",
+    source: include_str!("../../shaders/halo.wgsl"),
+    libs: &[],
+};
+
+/// Cell layers of halo: cells are the kernel support 2h, so one layer holds every particle a
+/// neighbour's particle reaches in the passes a subdomain runs (`Solver::subdomain` refuses
+/// the passes that reach further: fixed ghosts, the density filter).
+pub const HALO_LAYERS: u32 = 1;
+
+/// Rank `rank`'s part of `slabs`: what `halo_pack` needs to know.
+pub fn control(slabs: &Slabs, rank: usize, capacity: u32) -> HaloCtl {
+    let own = slabs.range(rank);
+    HaloCtl {
+        axis: slabs.axis as u32,
+        own_lo: own.start,
+        own_hi: own.end,
+        layers: HALO_LAYERS,
+        lower: (rank > 0) as u32,
+        upper: (rank + 1 < slabs.ranks()) as u32,
+        capacity,
+        pad: 0,
+    }
+}
+
+pub struct Halo {
+    pack: ParityKernel,
+    drop: ParityKernel,
+    counts: wgpu::Buffer,
+    records: wgpu::Buffer,
+    n: u32,
+}
+
+/// What one `halo_pack` found: the records for each neighbour, the rank's own live particles,
+/// and where the free tail of the arrays starts.
+pub struct Packed {
+    /// (to the neighbour below, to the neighbour above): halo copies and migrants.
+    pub lower: Vec<HaloRecord>,
+    pub upper: Vec<HaloRecord>,
+    pub owned: u32,
+    pub tail: u32,
+    pub migrants: u32,
+}
+
+impl Halo {
+    pub fn new(
+        device: &wgpu::Device,
+        module: &ShaderModule,
+        b: &ParticleBuffers,
+        ctl: HaloCtl,
+    ) -> Result<Self> {
+        let ctl_buffer = storage_init(device, "halo ctl", std::slice::from_ref(&ctl));
+        let counts = storage(
+            device,
+            "halo counts",
+            std::mem::size_of::<HaloCounts>() as u64,
+        );
+        let records = storage(
+            device,
+            "halo records",
+            ctl.capacity as u64 * std::mem::size_of::<HaloRecord>() as u64,
+        );
+        let bufs = |p: usize| {
+            b.at(p)
+                .with("halo_ctl", &ctl_buffer)
+                .with("halo_counts", &counts)
+                .with("halo_out", &records)
+        };
+        Ok(Self {
+            pack: ParityKernel::new(device, module, "halo_pack", bufs)?,
+            drop: ParityKernel::new(device, module, "halo_drop", bufs)?,
+            counts,
+            records,
+            n: b.n,
+        })
+    }
+
+    /// Zeroes the counters; record outside a compute pass, before `encode_pack`.
+    pub fn clear(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.clear_buffer(&self.counts, 0, None);
+    }
+
+    /// Packs the migrants and the halo copies of the arrays of parity `p` (after the predictor,
+    /// before the sort); the migrants stay until `encode_drop`, as halo copies.
+    pub fn encode_pack(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.pack.dispatch(pass, p, self.n);
+    }
+
+    /// Excludes the halo copies and the migrants sent from the arrays of parity `q` (after the
+    /// interaction).
+    pub fn encode_drop(&self, pass: &mut wgpu::ComputePass<'_>, q: usize) {
+        self.drop.dispatch(pass, q, self.n);
+    }
+
+    /// Reads what the last `halo_pack` packed. Waits for the GPU.
+    pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Packed> {
+        let counts = read::<HaloCounts>(device, queue, &self.counts, 1)?[0];
+        if counts.overflow > 0 {
+            bail!(
+                "{} halo and migrant records did not fit the subdomain's {} (more particles \
+                 near the cuts than the buffers were made for)",
+                counts.overflow,
+                counts.records - counts.overflow
+            );
+        }
+        let records = read::<HaloRecord>(device, queue, &self.records, counts.records as usize)?;
+        let migrants = records
+            .iter()
+            .filter(|r| r.dest & DEST_MIGRANT != 0)
+            .count() as u32;
+        let (upper, lower) = records.into_iter().partition(|r| r.dest & DEST_UPPER != 0);
+        Ok(Packed {
+            lower,
+            upper,
+            owned: counts.owned,
+            tail: counts.tail,
+            migrants,
+        })
+    }
+}

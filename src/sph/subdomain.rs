@@ -1,0 +1,335 @@
+//! One rank's part of a run over several ranks (issue 32; docs/scaling.md): the particles of its
+//! own cell layers (slabs of the one global grid, `decomposition::Slabs`) in arrays as large as
+//! the whole run's, every other particle excluded; each step swaps its halo and migrants with
+//! its neighbours between the predictor and the sort (`Passes::record_to_exchange`,
+//! `record_from_exchange`), and the ranks agree on the time step and the stop rules.
+//!
+//! The grid, its slot table and the particle ids are the whole run's, and the sort orders each
+//! slot by id, so an own particle sums the same neighbours in the same order as in one whole
+//! run: the ranks' particles together are bit-identical to it (tests/mpi.rs).
+
+use anyhow::{bail, ensure, Result};
+
+use super::halo;
+use super::initial::Packed;
+use super::profile::Recorder;
+use super::Solver;
+use crate::decomposition::Slabs;
+use crate::gpu::GpuContext;
+use crate::grid::Grid;
+use crate::layout::{unpack_block, HaloCtl, HaloRecord, Pos, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
+use crate::ranks::Ranks;
+use crate::scenario::{DensityFilter, Kind, Scenario};
+
+/// A subdomain's counts, over all ranks where they say so.
+#[derive(Clone, Debug, Default)]
+pub struct Ranked {
+    /// Live particles of the whole run at the start.
+    live_at_start: u64,
+    /// Particles of the whole run that left the domain or became non-finite.
+    pub(super) excluded: u64,
+    /// Where the first step unpacks (no sort has run yet): after the own particles.
+    first_tail: Option<u32>,
+    /// This rank's totals: halo copies and migrants sent, and their bytes.
+    pub halo_sent: u64,
+    pub migrants_sent: u64,
+    pub bytes_sent: u64,
+}
+
+impl Ranked {
+    /// A subdomain of a run of `live` particles, with `own` of them first in its arrays.
+    pub(super) fn new(live: u64, own: u32) -> Self {
+        Self {
+            live_at_start: live,
+            first_tail: Some(own),
+            ..Default::default()
+        }
+    }
+}
+
+/// What a run split over ranks cannot do yet, named for the refusal.
+fn unsupported(sc: &Scenario) -> Vec<&'static str> {
+    let has = |kinds: &[Kind]| sc.particles.iter().any(|p| kinds.contains(&p.kind));
+    [
+        (!sc.bodies.is_empty(), "moving bodies"),
+        (sc.solids.is_some(), "elastic solids"),
+        (
+            !sc.inlets.is_empty() || !sc.outlets.is_empty(),
+            "inlets and outlets",
+        ),
+        (
+            has(&[Kind::GhostNoSlip, Kind::GhostFreeSlip]),
+            "fixed ghost walls (their interpolation reaches past one cell layer)",
+        ),
+        (
+            sc.physics.density_filter != DensityFilter::None,
+            "the density filter (it needs a second exchange a step)",
+        ),
+        (sc.physics.energy, "the energy equation"),
+    ]
+    .into_iter()
+    .filter_map(|(yes, what)| yes.then_some(what))
+    .collect()
+}
+
+/// Excludes the particles outside `ctl`'s own layers and puts the own ones first (the arrays'
+/// order is free: the sort orders them); returns how many are own.
+pub fn exclude_others(packed: &mut Packed, grid: &Grid, ctl: &HaloCtl) -> u32 {
+    let own = |k: usize| {
+        let p = packed.pos[k];
+        let layer = grid.cell_of(p.off, unpack_block(p.block))[ctl.axis as usize] as u32;
+        packed.code[k] >> KIND_SHIFT != KIND_EXCLUDED && (ctl.own_lo..ctl.own_hi).contains(&layer)
+    };
+    let (mine, others): (Vec<usize>, Vec<usize>) = (0..packed.pos.len()).partition(|&k| own(k));
+    let order: Vec<usize> = mine.iter().chain(&others).copied().collect();
+    packed.pos = order.iter().map(|&k| packed.pos[k]).collect();
+    packed.velrho = order.iter().map(|&k| packed.velrho[k]).collect();
+    packed.code = order
+        .iter()
+        .enumerate()
+        .map(|(at, &k)| {
+            let c = packed.code[k];
+            if at < mine.len() {
+                c
+            } else {
+                (KIND_EXCLUDED << KIND_SHIFT) | (c & ID_MASK)
+            }
+        })
+        .collect();
+    mine.len() as u32
+}
+
+impl Solver {
+    /// Rank `ranks.rank()`'s subdomain of `sc` cut by `slabs`, warmed up (its first sort and
+    /// rates, with its neighbours' halos; every rank must call this together).
+    pub fn subdomain(
+        ctx: &GpuContext,
+        sc: &Scenario,
+        slabs: &Slabs,
+        ranks: &dyn Ranks,
+    ) -> Result<Self> {
+        let missing = unsupported(sc);
+        if !missing.is_empty() {
+            bail!(
+                "a run split over ranks does not support {} yet (issue 32)",
+                missing.join(", ")
+            );
+        }
+        ensure!(
+            slabs.ranks() == ranks.size(),
+            "{} slabs for {} ranks",
+            slabs.ranks(),
+            ranks.size()
+        );
+        let n = sc.particles.len() as u32;
+        // A particle packs at most two records (a halo copy each way from a slab one layer
+        // thick, or one migrant).
+        let ctl = halo::control(slabs, ranks.rank(), 2 * n);
+        let mut solver = Self::build(ctx, sc, Some(ctl))?;
+        solver.ranked_step(ranks)?;
+        solver.initial_dt = solver.state.dt_cfl;
+        Ok(solver)
+    }
+
+    /// Takes `count` steps of CFL size on every rank together (as [`Solver::run_steps`]).
+    pub fn run_steps_ranked(&mut self, count: u64, ranks: &dyn Ranks) -> Result<()> {
+        self.start_untargeted();
+        for _ in 0..count {
+            let before = self.state.steps;
+            self.ranked_step(ranks)?;
+            self.steps += (self.state.steps - before) as u64;
+        }
+        self.check_stability()
+    }
+
+    /// This rank's counts (halo and migrants sent), if it is a subdomain.
+    pub fn ranked(&self) -> Option<&Ranked> {
+        self.ranked.as_ref()
+    }
+
+    /// One step of a subdomain: predict and pack, swap with the neighbours, unpack, the rest
+    /// of the step; then the ranks' smallest time step and their summed counts.
+    fn ranked_step(&mut self, ranks: &dyn Ranks) -> Result<()> {
+        let p = self.parity;
+        let halo = self
+            .passes
+            .halo
+            .as_ref()
+            .expect("a subdomain has a halo pass");
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        halo.clear(&mut encoder);
+        {
+            let mut r = Recorder::Shared(encoder.begin_compute_pass(&Default::default()));
+            self.passes.record_to_exchange(&mut r, p);
+        }
+        self.queue.submit([encoder.finish()]);
+        let packed = halo.read(&self.device, &self.queue)?;
+        self.faults.check()?;
+
+        let rank = ranks.rank();
+        let mut sends = Vec::new();
+        for (to, records) in [
+            (rank.checked_sub(1), &packed.lower),
+            ((rank + 1 < ranks.size()).then_some(rank + 1), &packed.upper),
+        ] {
+            match to {
+                Some(to) => sends.push((to, bytemuck::cast_slice(records).to_vec())),
+                None => ensure!(
+                    records.is_empty(),
+                    "rank {rank} packed records for no neighbour"
+                ),
+            }
+        }
+        let from: Vec<usize> = sends.iter().map(|(to, _)| *to).collect();
+        let received = ranks.exchange(&sends, &from)?;
+        let incoming: Vec<HaloRecord> = received
+            .iter()
+            .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, HaloRecord>(b))
+            .collect();
+        let ranked = self.ranked.as_mut().expect("a subdomain");
+        let tail = ranked.first_tail.take().unwrap_or(packed.tail);
+        let sent = packed.lower.len() + packed.upper.len();
+        ranked.migrants_sent += packed.migrants as u64;
+        ranked.halo_sent += sent as u64 - packed.migrants as u64;
+        ranked.bytes_sent += (sent * std::mem::size_of::<HaloRecord>()) as u64;
+        self.unpack(&incoming, tail, p)?;
+
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.passes.cell_list.clear(&mut encoder, &self.buffers);
+        {
+            let mut r = Recorder::Shared(encoder.begin_compute_pass(&Default::default()));
+            self.passes.record_from_exchange(&mut r, p);
+        }
+        self.queue.submit([encoder.finish()]);
+        self.parity = 1 - p;
+        let local = self.read_state()?;
+        self.agree(local, packed.owned + packed.migrants, ranks);
+        Ok(())
+    }
+
+    /// Writes the received particles into the free tail of the arrays of parity `p`.
+    fn unpack(&self, incoming: &[HaloRecord], tail: u32, p: usize) -> Result<()> {
+        let free = self.buffers.n.saturating_sub(tail) as usize;
+        if incoming.len() > free {
+            bail!(
+                "the subdomain received {} halo and migrant particles but has room for {free}",
+                incoming.len()
+            );
+        }
+        if incoming.is_empty() {
+            return Ok(());
+        }
+        let b = &self.buffers;
+        let write = |buffer: &wgpu::Buffer, bytes_each: usize, data: &[u8]| {
+            self.queue
+                .write_buffer(buffer, tail as u64 * bytes_each as u64, data);
+        };
+        let pos: Vec<Pos> = incoming.iter().map(|r| r.pos).collect();
+        let velrho: Vec<[f32; 4]> = incoming.iter().map(|r| r.velrho).collect();
+        let code: Vec<u32> = incoming.iter().map(|r| r.code).collect();
+        let rate: Vec<[f32; 4]> = incoming.iter().map(|r| r.rate).collect();
+        write(&b.pos[p], 16, bytemuck::cast_slice(&pos));
+        write(&b.velrho[p], 16, bytemuck::cast_slice(&velrho));
+        write(&b.code[p], 4, bytemuck::cast_slice(&code));
+        write(&b.rate, 16, bytemuck::cast_slice(&rate));
+        Ok(())
+    }
+
+    /// The ranks' common view after a step: the smallest time step (the GPU's choice
+    /// (integrate.wgsl `timestep`) repeated with it, so every rank takes the step one whole run
+    /// would), and the counts the stop rules read, summed; `live`: this rank's own particles
+    /// and migrants sent at packing.
+    fn agree(&mut self, local: crate::layout::SimState, live: u32, ranks: &dyn Ranks) {
+        let dt = ranks.min(local.dt_cfl as f64) as f32;
+        let mut gpu = local;
+        gpu.dt_cfl = dt;
+        let remaining = gpu.t_target_rel - gpu.t_rel;
+        gpu.dt = if remaining <= 1e-4 * dt {
+            0.0
+        } else {
+            dt.min(remaining)
+        };
+        self.queue
+            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&gpu));
+        let sums = ranks.sum_in_rank_order(&[
+            live as f64,
+            local.nan_count as f64,
+            local.beyond_warn_peak as f64,
+            local.beyond_stop_peak as f64,
+        ]);
+        let peak = -ranks.min(-(local.density_variation_peak as f64));
+        let ranked = self.ranked.as_mut().expect("a subdomain");
+        ranked.excluded = ranked.live_at_start.saturating_sub(sums[0] as u64);
+        self.state = gpu;
+        self.state.nan_count = sums[1] as u32;
+        self.state.beyond_warn_peak = sums[2] as u32;
+        self.state.beyond_stop_peak = sums[3] as u32;
+        self.state.density_variation_peak = peak as f32;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn load(case: &str, set: &[&str]) -> Scenario {
+        let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        crate::case::load(std::path::Path::new(case), &set).unwrap()
+    }
+
+    /// What a subdomain cannot run yet is named, case by case; a fluid with dynamic walls has
+    /// nothing to refuse.
+    #[test]
+    fn what_ranks_cannot_run_yet_is_named() {
+        assert!(unsupported(&load("cases/dam_break_2d.toml", &[])).is_empty());
+        let cases = [
+            ("cases/floating_box_2d.toml", "moving bodies"),
+            ("cases/oscillating_plate_2d.toml", "elastic solids"),
+            ("cases/water_injection_2d.toml", "inlets and outlets"),
+            ("cases/dam_break_2d.toml", "the energy equation"),
+        ];
+        for (case, what) in cases {
+            let set: &[&str] = if what == "the energy equation" {
+                &["physics.energy=true"]
+            } else {
+                &[]
+            };
+            let missing = unsupported(&load(case, set));
+            assert!(missing.contains(&what), "{case}: {missing:?}");
+        }
+    }
+
+    /// The own particles come first, unchanged; every other one is excluded with its id kept.
+    #[test]
+    fn a_subdomain_keeps_its_own_layers_first() {
+        let sc = load("cases/dam_break_2d.toml", &[]);
+        let ph = &sc.physics;
+        let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic).unwrap();
+        let whole = super::super::initial::pack(&sc, &grid);
+        let mut packed = super::super::initial::pack(&sc, &grid);
+        let ctl = HaloCtl {
+            axis: 1,
+            own_lo: 0,
+            own_hi: grid.cells[1] / 3,
+            ..Default::default()
+        };
+        let own = exclude_others(&mut packed, &grid, &ctl) as usize;
+        assert!(own > 0 && own < whole.code.len());
+        let mut ids: Vec<u32> = packed.code.iter().map(|c| c & ID_MASK).collect();
+        ids.sort();
+        assert_eq!(ids, (0..whole.code.len() as u32).collect::<Vec<_>>());
+        for (k, &c) in packed.code.iter().enumerate() {
+            let id = (c & ID_MASK) as usize;
+            let excluded = c >> KIND_SHIFT == KIND_EXCLUDED;
+            assert_eq!(excluded, k >= own, "entry {k}");
+            if !excluded {
+                assert_eq!(
+                    (c, packed.pos[k], packed.velrho[k]),
+                    (whole.code[id], whole.pos[id], whole.velrho[id])
+                );
+                let p = packed.pos[k];
+                assert!(grid.cell_of(p.off, unpack_block(p.block))[1] < ctl.own_hi as i64);
+            }
+        }
+    }
+}
