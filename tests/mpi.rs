@@ -183,15 +183,6 @@ fn a_failing_rank_ends_the_job_and_says_which() {
     unreachable!("rank 0 received from a rank that aborted");
 }
 
-/// The 2D dam break at a coarse dx: the water column at the tank's left end draws the balanced
-/// cut into it, and the collapsing water flows across the cut.
-fn dam_break() -> Scenario {
-    let set = ["particles.dx_m=0.0073".to_string()];
-    wgsph::case::load(std::path::Path::new("cases/dam_break_2d.toml"), &set).unwrap()
-}
-
-const STEPS: u64 = 1000;
-
 /// (id, position words, (v, ρ) bits) of every live particle, sorted by id.
 type Live = Vec<(u32, [u32; 4], [u32; 4])>;
 
@@ -214,28 +205,42 @@ fn live_particles(solver: &Solver) -> Live {
     live
 }
 
-/// Two subdomains, stepped together under mpirun, hold bit for bit the particles of one whole
-/// run after the same steps (positions, velocities and densities, by id), with halos swapped
-/// and particles migrated across the cut on the way.
-#[test]
-fn two_ranks_step_bit_identically_to_one_run() {
-    let out = std::env::temp_dir().join(format!("wgsph-mpi-two-ranks-{}", std::process::id()));
-    if !under_mpirun() {
-        std::fs::create_dir_all(&out).unwrap();
+/// A case cut into slabs and stepped on `ranks` ranks under mpirun, against its whole run.
+struct Comparison {
+    /// The test function that runs it (what mpirun launches).
+    test: &'static str,
+    case: &'static str,
+    set: &'static [&'static str],
+    ranks: u32,
+    steps: u64,
+    /// Whether particles must have crossed a cut by the end.
+    migrates: bool,
+}
+
+impl Comparison {
+    fn scenario(&self) -> Scenario {
+        let set: Vec<String> = self.set.iter().map(|s| s.to_string()).collect();
+        wgsph::case::load(std::path::Path::new(self.case), &set).unwrap()
+    }
+
+    /// The ranks' live particles, merged, equal the whole run's bit for bit, each on one rank;
+    /// every rank sent halos (and, if `migrates`, some particle crossed a cut).
+    fn check(&self) {
+        if under_mpirun() {
+            return self.rank();
+        }
+        let out = common::Scratch::new(&format!("mpi-{}", self.test));
+        std::fs::create_dir_all(&*out).unwrap();
         let dir = out.to_str().unwrap();
-        let (ok, log) = mpirun_with(
-            "two_ranks_step_bit_identically_to_one_run",
-            2,
-            Duration::from_secs(300),
-            &[("WGSPH_MPI_OUT", dir)],
-        );
-        assert!(ok, "the 2-rank job failed:\n{log}");
-        let mut whole = Solver::new(common::gpu(), &dam_break()).unwrap();
-        whole.run_steps(STEPS).unwrap();
+        let limit = Duration::from_secs(600);
+        let (ok, log) = mpirun_with(self.test, self.ranks, limit, &[("WGSPH_MPI_OUT", dir)]);
+        assert!(ok, "the {}-rank job failed:\n{log}", self.ranks);
+        let mut whole = Solver::new(common::gpu(), &self.scenario()).unwrap();
+        whole.run_steps(self.steps).unwrap();
         let expected = live_particles(&whole);
         let mut merged: Live = Vec::new();
         let mut migrants_total = 0;
-        for r in 0..2 {
+        for r in 0..self.ranks {
             let bytes = std::fs::read(out.join(format!("rank{r}.bin"))).unwrap();
             let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
             let (halo, migrants) = (words[0], words[1]);
@@ -248,47 +253,80 @@ fn two_ranks_step_bit_identically_to_one_run() {
                     .map(|c| (c[0], [c[1], c[2], c[3], c[4]], [c[5], c[6], c[7], c[8]])),
             );
         }
-        std::fs::remove_dir_all(&out).ok();
         merged.sort_by_key(|l| l.0);
         assert_eq!(merged.len(), expected.len(), "particle counts differ");
         let ids: Vec<u32> = merged.iter().map(|l| l.0).collect();
         assert!(
             ids.windows(2).all(|w| w[0] < w[1]),
-            "a particle is on both ranks"
+            "a particle is on two ranks"
         );
         let differ = merged.iter().zip(&expected).filter(|(a, b)| a != b).count();
         assert_eq!(differ, 0, "{differ} particles differ from the whole run");
-        assert!(migrants_total > 0, "no particle crossed the cut");
-        return;
+        assert!(
+            !self.migrates || migrants_total > 0,
+            "no particle crossed a cut"
+        );
     }
-    let ranks = Mpi::init().expect("MPI initialised once");
-    let r = ranks.rank();
-    let result = (|| -> anyhow::Result<()> {
-        let gpu = GpuContext::for_rank(AdapterChoice::Cpu, r)?;
-        let sc = dam_break();
-        let ph = &sc.physics;
-        let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic)?;
-        let axis = cut_axis(&grid, ph.dim)?;
-        let slabs = Slabs::balanced(
-            axis,
-            &layer_load(&grid, axis, &sc.particles),
-            ranks.size(),
-            1,
-        )?;
-        let mut solver = Solver::subdomain(&gpu, &sc, &slabs, &ranks)?;
-        solver.run_steps_ranked(STEPS, &ranks)?;
-        let counts = solver.ranked().unwrap();
-        let mut words = vec![counts.halo_sent as u32, counts.migrants_sent as u32];
-        for (id, p, v) in live_particles(&solver) {
-            words.push(id);
-            words.extend(p);
-            words.extend(v);
+
+    /// One rank's part: its subdomain stepped with the others, its live particles written to
+    /// `$WGSPH_MPI_OUT/rank<r>.bin` after its counts of halo copies and migrants sent.
+    fn rank(&self) {
+        let ranks = Mpi::init().expect("MPI initialised once");
+        let r = ranks.rank();
+        let result = (|| -> anyhow::Result<()> {
+            let gpu = GpuContext::for_rank(AdapterChoice::Cpu, r)?;
+            let sc = self.scenario();
+            let ph = &sc.physics;
+            let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic)?;
+            let axis = cut_axis(&grid, ph.dim)?;
+            let load = layer_load(&grid, axis, &sc.particles);
+            let slabs = Slabs::balanced(axis, &load, ranks.size(), 1)?;
+            let mut solver = Solver::subdomain(&gpu, &sc, &slabs, &ranks)?;
+            solver.run_steps_ranked(self.steps, &ranks)?;
+            let counts = solver.ranked().unwrap();
+            let mut words = vec![counts.halo_sent as u32, counts.migrants_sent as u32];
+            for (id, p, v) in live_particles(&solver) {
+                words.push(id);
+                words.extend(p);
+                words.extend(v);
+            }
+            let dir = std::env::var("WGSPH_MPI_OUT")?;
+            std::fs::write(format!("{dir}/rank{r}.bin"), bytemuck::cast_slice(&words))?;
+            Ok(())
+        })();
+        if let Err(e) = result {
+            ranks.abort(&e);
         }
-        let dir = std::env::var("WGSPH_MPI_OUT")?;
-        std::fs::write(format!("{dir}/rank{r}.bin"), bytemuck::cast_slice(&words))?;
-        Ok(())
-    })();
-    if let Err(e) = result {
-        ranks.abort(&e);
     }
+}
+
+/// Two subdomains of the 2D dam break, stepped together under mpirun, hold bit for bit the
+/// particles of one whole run after 1000 steps (positions, velocities and densities, by id):
+/// the cut lies across the water column, which falls through it (particles migrate).
+#[test]
+fn two_ranks_of_the_2d_dam_break_equal_one_run() {
+    Comparison {
+        test: "two_ranks_of_the_2d_dam_break_equal_one_run",
+        case: "cases/dam_break_2d.toml",
+        set: &["particles.dx_m=0.0073"],
+        ranks: 2,
+        steps: 1000,
+        migrates: true,
+    }
+    .check();
+}
+
+/// Three slabs of the 3D SPHERIC dam break at a coarse dx (36 k particles; 3D halos, a middle
+/// rank with two neighbours, the box obstacle): the same, after 40 steps.
+#[test]
+fn three_ranks_of_the_3d_dam_break_equal_one_run() {
+    Comparison {
+        test: "three_ranks_of_the_3d_dam_break_equal_one_run",
+        case: "cases/dam_break_3d.toml",
+        set: &["particles.dx_m=0.04"],
+        ranks: 3,
+        steps: 40,
+        migrates: false,
+    }
+    .check();
 }
