@@ -188,6 +188,102 @@ pub fn measure(
     })
 }
 
+/// One rank's part of a bench under mpirun (`measure_ranked`), per timed step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RankBench {
+    /// Own particles at the end.
+    pub own: u64,
+    pub halo_per_step: f64,
+    pub migrants_per_step: f64,
+    pub bytes_per_step: f64,
+    /// The step's wall time by part (`sph::subdomain::Split`), seconds per step.
+    pub split: crate::sph::subdomain::Split,
+}
+
+/// What `wgsph bench` measures under mpirun: the whole run's figures and each rank's.
+#[derive(Clone, Debug)]
+pub struct RankedBenchReport {
+    pub case: String,
+    pub particles: u64,
+    pub steps: u64,
+    /// The slowest rank's wall time over the timed steps.
+    pub wall_s: f64,
+    pub simulated_s: f64,
+    pub ranks: Vec<RankBench>,
+}
+
+impl RankedBenchReport {
+    /// Particle-steps per second of the whole run.
+    pub fn particle_steps_per_s(&self) -> f64 {
+        self.steps as f64 * self.particles as f64 / self.wall_s
+    }
+
+    /// How much more than the mean the rank with the most own particles holds.
+    pub fn imbalance(&self) -> f64 {
+        let own: Vec<f64> = self.ranks.iter().map(|r| r.own as f64).collect();
+        let mean = own.iter().sum::<f64>() / own.len().max(1) as f64;
+        own.iter().fold(0.0f64, |m, &x| m.max(x)) / mean.max(1.0) - 1.0
+    }
+}
+
+/// Times `steps` steps of `sc` cut into one slab per rank of `ranks`, after `warmup`, on every
+/// rank together (each on its `ctx`); every rank returns the same report.
+pub fn measure_ranked(
+    ctx: &GpuContext,
+    sc: &Scenario,
+    steps: u64,
+    warmup: u64,
+    ranks: &dyn crate::ranks::Ranks,
+) -> Result<RankedBenchReport> {
+    let slabs = crate::decomposition::slabs_for(sc, ranks.size())?;
+    let mut solver =
+        Solver::subdomain(ctx, sc, &slabs, ranks).context("setting up the subdomain")?;
+    solver.run_steps_ranked(warmup, ranks)?;
+    let before = solver.ranked().expect("a subdomain").clone();
+    let t0 = solver.time();
+    let start = Instant::now();
+    solver.run_steps_ranked(steps, ranks)?;
+    let wall_s = -ranks.min(-start.elapsed().as_secs_f64());
+    let after = solver.ranked().expect("a subdomain");
+    let per = |x: u64, x0: u64| (x - x0) as f64 / steps.max(1) as f64;
+    let split = after.split - before.split;
+    let mine = [
+        after.owned as f64,
+        per(after.halo_sent, before.halo_sent),
+        per(after.migrants_sent, before.migrants_sent),
+        per(after.bytes_sent, before.bytes_sent),
+        split.pack,
+        split.exchange,
+        split.compute,
+        split.agree,
+    ];
+    let each = steps.max(1) as f64;
+    let ranks = ranks
+        .gather(&mine)
+        .into_iter()
+        .map(|v| RankBench {
+            own: v[0] as u64,
+            halo_per_step: v[1],
+            migrants_per_step: v[2],
+            bytes_per_step: v[3],
+            split: crate::sph::subdomain::Split {
+                pack: v[4] / each,
+                exchange: v[5] / each,
+                compute: v[6] / each,
+                agree: v[7] / each,
+            },
+        })
+        .collect();
+    Ok(RankedBenchReport {
+        case: sc.name.clone(),
+        particles: sc.particles.len() as u64,
+        steps,
+        wall_s,
+        simulated_s: solver.time() - t0,
+        ranks,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

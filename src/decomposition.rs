@@ -11,7 +11,8 @@ use std::ops::Range;
 use anyhow::{bail, Result};
 
 use crate::grid::Grid;
-use crate::scenario::{Kind, Particle};
+use crate::scenario::{Kind, Particle, Scenario};
+use crate::sph::halo::HALO_LAYERS;
 
 /// A step's work of a particle that moves (fluid, solid, inlet), the unit of the balance.
 pub const MOVING_WEIGHT: f64 = 1.0;
@@ -53,6 +54,20 @@ pub fn layer_load(grid: &Grid, axis: usize, particles: &[Particle]) -> Vec<f64> 
         load[grid.cell_of(off, b)[axis] as usize] += weight(p.kind);
     }
     load
+}
+
+/// `sc` cut into `ranks` slabs of its grid (as the solver makes it) along [`cut_axis`], balanced
+/// over its particles' [`layer_load`].
+pub fn slabs_for(sc: &Scenario, ranks: usize) -> Result<Slabs> {
+    let ph = &sc.physics;
+    let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic)?;
+    let axis = cut_axis(&grid, ph.dim)?;
+    Slabs::balanced(
+        axis,
+        &layer_load(&grid, axis, &sc.particles),
+        ranks,
+        HALO_LAYERS,
+    )
 }
 
 /// Slabs along one axis of the global grid: rank r owns the cell layers `bounds[r] ..

@@ -500,6 +500,14 @@ fn bench(
     warmup: u64,
     stages: bool,
 ) -> Result<ExitCode> {
+    #[cfg(feature = "mpi")]
+    if wgsph::ranks::launched_size().is_some_and(|n| n > 1) {
+        anyhow::ensure!(
+            !stages,
+            "--stages times the stages of one device: run it without mpirun"
+        );
+        return bench_ranked(adapter, case, set, steps, warmup);
+    }
     let sc = wgsph::case::load(case, set)?;
     let ctx = context(adapter)?;
     let r = wgsph::bench::measure(&ctx, &sc, steps, warmup, stages)?;
@@ -526,6 +534,62 @@ fn bench(
     println!("dispatches/step {}", r.dispatches_per_step);
     if let Some(times) = &r.stages {
         print_stages(times, steps, n);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `mpirun -np N wgsph bench CASE`: the case cut into one slab per rank, every rank on its
+/// adapter (named on stderr), the figures of the whole run and each rank's printed by rank 0.
+/// A rank that fails ends the job, naming itself.
+#[cfg(feature = "mpi")]
+fn bench_ranked(
+    adapter: Option<AdapterChoice>,
+    case: &std::path::Path,
+    set: &[String],
+    steps: u64,
+    warmup: u64,
+) -> Result<ExitCode> {
+    use wgsph::ranks::{Mpi, Ranks};
+    let ranks = Mpi::init().ok_or_else(|| anyhow::anyhow!("MPI was initialised twice"))?;
+    let (rank, size) = (ranks.rank(), ranks.size());
+    let result = (|| {
+        let sc = wgsph::case::load(case, set)?;
+        let ctx = GpuContext::for_rank(AdapterChoice::resolve(adapter)?, rank)?;
+        eprintln!("rank {rank} of {size}: adapter {}", ctx.describe());
+        wgsph::bench::measure_ranked(&ctx, &sc, steps, warmup, &ranks)
+    })();
+    let r = match result {
+        Ok(r) => r,
+        Err(e) => ranks.abort(&e),
+    };
+    if rank != 0 {
+        return Ok(ExitCode::SUCCESS);
+    }
+    println!("case            {}", r.case);
+    println!("ranks           {size} (one slab each)");
+    println!("particles       {}", r.particles);
+    println!("steps           {steps}");
+    println!("wall seconds    {:.4e} (the slowest rank)", r.wall_s);
+    println!("particle-steps/s {:.4e}", r.particle_steps_per_s());
+    println!("simulated s/wall s {:.4e}", r.simulated_s / r.wall_s);
+    println!(
+        "imbalance       {:.1} % (own particles: the most loaded rank over the mean)",
+        100.0 * r.imbalance()
+    );
+    println!("rank  own particles  halo/step  migrants/step  halo bytes/step  ms/step: pack  exchange  compute  agree");
+    for (k, b) in r.ranks.iter().enumerate() {
+        let ms = |s: f64| 1e3 * s;
+        println!(
+            "{k:>4}  {:>13}  {:>9.1}  {:>13.2}  {:>15.0}  {:>13.3}  {:>8.3}  {:>7.3}  {:>5.3}",
+            b.own,
+            b.halo_per_step,
+            b.migrants_per_step,
+            b.bytes_per_step,
+            ms(b.split.pack),
+            ms(b.split.exchange),
+            ms(b.split.compute),
+            ms(b.split.agree)
+        );
     }
     Ok(ExitCode::SUCCESS)
 }

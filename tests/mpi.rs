@@ -8,7 +8,7 @@ mod common;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use wgsph::decomposition::{cut_axis, layer_load, Slabs};
+use wgsph::decomposition::{cut_axis, layer_load, slabs_for, Slabs};
 use wgsph::gpu::{AdapterChoice, GpuContext};
 use wgsph::grid::Grid;
 use wgsph::layout::{ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
@@ -276,11 +276,7 @@ impl Comparison {
         let result = (|| -> anyhow::Result<()> {
             let gpu = GpuContext::for_rank(AdapterChoice::Cpu, r)?;
             let sc = self.scenario();
-            let ph = &sc.physics;
-            let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic)?;
-            let axis = cut_axis(&grid, ph.dim)?;
-            let load = layer_load(&grid, axis, &sc.particles);
-            let slabs = Slabs::balanced(axis, &load, ranks.size(), 1)?;
+            let slabs = slabs_for(&sc, ranks.size())?;
             let mut solver = Solver::subdomain(&gpu, &sc, &slabs, &ranks)?;
             solver.run_steps_ranked(self.steps, &ranks)?;
             let counts = solver.ranked().unwrap();
@@ -329,4 +325,43 @@ fn three_ranks_of_the_3d_dam_break_equal_one_run() {
         migrates: false,
     }
     .check();
+}
+
+/// `mpirun -np 2 wgsph bench`: each rank names its adapter, rank 0 prints the whole run's
+/// figures and a line per rank with the halo it sent and where its step time went.
+#[test]
+fn bench_under_mpirun_reports_every_rank() {
+    let o = Command::new("mpirun")
+        .args(["--oversubscribe", "-np", "2", env!("CARGO_BIN_EXE_wgsph")])
+        .args(["bench", "cases/dam_break_2d.toml", "--adapter", "cpu"])
+        .args(["--steps", "20", "--warmup", "2"])
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert!(o.status.success(), "{stdout}\n{stderr}");
+    for r in 0..2 {
+        assert!(
+            stderr.contains(&format!("rank {r} of 2: adapter")),
+            "{stderr}"
+        );
+    }
+    assert!(
+        stdout.contains("ranks           2 (one slab each)"),
+        "{stdout}"
+    );
+    let rows: Vec<Vec<f64>> = stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("rank  own particles"))
+        .skip(1)
+        .map(|l| l.split_whitespace().map(|w| w.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 2, "{stdout}");
+    let own: f64 = rows.iter().map(|r| r[1]).sum();
+    assert_eq!(own, 4274.0, "every particle is own on one rank");
+    assert!(rows.iter().all(|r| r[2] > 0.0 && r[4] > 0.0), "{stdout}");
 }

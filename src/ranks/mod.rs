@@ -23,6 +23,18 @@ pub trait Ranks {
     /// 0, 1, 2, … on every rank: the same bits whatever order the messages arrive in.
     fn sum_in_rank_order(&self, x: &[f64]) -> Vec<f64>;
 
+    /// Every rank's `x` (same length everywhere), in rank order, on every rank (exact: each
+    /// value is added to zeros only).
+    fn gather(&self, x: &[f64]) -> Vec<Vec<f64>> {
+        let k = x.len();
+        let mut mine = vec![0.0; k * self.size()];
+        mine[self.rank() * k..(self.rank() + 1) * k].copy_from_slice(x);
+        let all = self.sum_in_rank_order(&mine);
+        (0..self.size())
+            .map(|r| all[r * k..(r + 1) * k].to_vec())
+            .collect()
+    }
+
     /// Sends each `(rank, bytes)` and returns what each of `from` sent this rank, in `from`'s
     /// order. Every rank must call it; a rank sends to exactly the ranks it receives from.
     fn exchange(&self, sends: &[(usize, Vec<u8>)], from: &[usize]) -> Result<Vec<Vec<u8>>>;
@@ -36,15 +48,21 @@ pub fn launched_size() -> Option<usize> {
         .find_map(|v| std::env::var(v).ok()?.trim().parse().ok())
 }
 
-/// Refuses a launch over several ranks: until the solver runs subdomains (issue 32), N copies
-/// would each run the whole case into the same folder. One rank under a launcher runs as
-/// without it.
+/// Refuses a launch over several ranks of what cannot run split yet: `run` and `resume` (the
+/// subdomains step, but their outputs, probes and checkpoints are not built: N copies would
+/// each run the whole case into the same folder), and `bench` in a build without MPI. One rank
+/// under a launcher runs as without it.
 pub fn refuse_several_ranks(command: &str) -> Result<()> {
     match launched_size() {
-        Some(n) if n > 1 => anyhow::bail!(
+        Some(n) if n > 1 && command == "bench" && !cfg!(feature = "mpi") => anyhow::bail!(
+            "`wgsph bench` was launched on {n} ranks, but this wgsph was built without MPI: \
+             build it with `cargo build --release --features mpi` (README: several ranks)"
+        ),
+        Some(n) if n > 1 && command != "bench" => anyhow::bail!(
             "`wgsph {command}` was launched on {n} ranks, but a run cannot be split over ranks \
-             yet (the decomposition and the MPI exchange exist; the solver's halo and migration \
-             passes do not): launch it with -np 1 or without mpirun"
+             yet: its subdomains step together (`mpirun -np {n} wgsph bench` runs them), but \
+             their outputs, probes and checkpoints do not exist; launch it with -np 1 or \
+             without mpirun"
         ),
         _ => Ok(()),
     }
@@ -113,6 +131,7 @@ mod tests {
         let one = Single;
         assert_eq!((one.rank(), one.size(), one.min(2.5)), (0, 1, 2.5));
         assert_eq!(one.sum_in_rank_order(&[1.0, 2.0]), vec![1.0, 2.0]);
+        assert_eq!(one.gather(&[3.0, -0.5]), vec![vec![3.0, -0.5]]);
         assert!(one.exchange(&[], &[]).unwrap().is_empty());
         assert!(one.exchange(&[(1, vec![0])], &[1]).is_err());
     }

@@ -34,6 +34,35 @@ pub struct Ranked {
     pub halo_sent: u64,
     pub migrants_sent: u64,
     pub bytes_sent: u64,
+    /// This rank's own particles at the last packing.
+    pub owned: u32,
+    /// This rank's wall time in each part of its steps, summed: [`Split`].
+    pub split: Split,
+}
+
+/// Where a subdomain's step time goes, in seconds summed over steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Split {
+    /// The GPU up to the exchange (predictors, packing) and reading the records back.
+    pub pack: f64,
+    /// Swapping the records with the neighbours (waiting for the slower one included).
+    pub exchange: f64,
+    /// Writing the received particles and the GPU from the sort to the time step.
+    pub compute: f64,
+    /// Agreeing on the time step and the counts (waiting for the slowest rank included).
+    pub agree: f64,
+}
+
+impl std::ops::Sub for Split {
+    type Output = Split;
+    fn sub(self, o: Split) -> Split {
+        Split {
+            pack: self.pack - o.pack,
+            exchange: self.exchange - o.exchange,
+            compute: self.compute - o.compute,
+            agree: self.agree - o.agree,
+        }
+    }
 }
 
 impl Ranked {
@@ -150,6 +179,7 @@ impl Solver {
     /// One step of a subdomain: predict and pack, swap with the neighbours, unpack, the rest
     /// of the step; then the ranks' smallest time step and their summed counts.
     fn ranked_step(&mut self, ranks: &dyn Ranks) -> Result<()> {
+        let start = std::time::Instant::now();
         let p = self.parity;
         let halo = self
             .passes
@@ -165,6 +195,7 @@ impl Solver {
         self.queue.submit([encoder.finish()]);
         let packed = halo.read(&self.device, &self.queue)?;
         self.faults.check()?;
+        let packed_at = std::time::Instant::now();
 
         let rank = ranks.rank();
         let mut sends = Vec::new();
@@ -182,6 +213,7 @@ impl Solver {
         }
         let from: Vec<usize> = sends.iter().map(|(to, _)| *to).collect();
         let received = ranks.exchange(&sends, &from)?;
+        let swapped_at = std::time::Instant::now();
         let incoming: Vec<HaloRecord> = received
             .iter()
             .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, HaloRecord>(b))
@@ -192,6 +224,7 @@ impl Solver {
         ranked.migrants_sent += packed.migrants as u64;
         ranked.halo_sent += sent as u64 - packed.migrants as u64;
         ranked.bytes_sent += (sent * std::mem::size_of::<HaloRecord>()) as u64;
+        ranked.owned = packed.owned;
         self.unpack(&incoming, tail, p)?;
 
         let mut encoder = self.device.create_command_encoder(&Default::default());
@@ -203,7 +236,13 @@ impl Solver {
         self.queue.submit([encoder.finish()]);
         self.parity = 1 - p;
         let local = self.read_state()?;
+        let computed_at = std::time::Instant::now();
         self.agree(local, packed.owned + packed.migrants, ranks);
+        let split = &mut self.ranked.as_mut().expect("a subdomain").split;
+        split.pack += (packed_at - start).as_secs_f64();
+        split.exchange += (swapped_at - packed_at).as_secs_f64();
+        split.compute += (computed_at - swapped_at).as_secs_f64();
+        split.agree += computed_at.elapsed().as_secs_f64();
         Ok(())
     }
 
