@@ -556,9 +556,22 @@ fn bench_ranked(
         let sc = wgsph::case::load(case, set)?;
         let ctx = GpuContext::for_rank(AdapterChoice::resolve(adapter)?, rank)?;
         eprintln!("rank {rank} of {size}: adapter {}", ctx.describe());
-        wgsph::bench::measure_ranked(&ctx, &sc, steps, warmup, &ranks)
+        // Rank 0 reports every rank's adapter.
+        let mine = ctx.describe().into_bytes();
+        let adapters = match rank {
+            0 => ranks.exchange(&[], &(1..size).collect::<Vec<_>>())?,
+            _ => ranks.exchange(&[(0, mine.clone())], &[])?,
+        };
+        let adapters: Vec<String> = std::iter::once(mine)
+            .chain(adapters)
+            .map(|b| String::from_utf8_lossy(&b).into_owned())
+            .collect();
+        Ok((
+            wgsph::bench::measure_ranked(&ctx, &sc, steps, warmup, &ranks)?,
+            adapters,
+        ))
     })();
-    let r = match result {
+    let (r, adapters) = match result {
         Ok(r) => r,
         Err(e) => ranks.abort(&e),
     };
@@ -567,6 +580,9 @@ fn bench_ranked(
     }
     println!("case            {}", r.case);
     println!("ranks           {size} (one slab each)");
+    for (k, a) in adapters.iter().enumerate() {
+        println!("adapter {k:<7} {a}");
+    }
     println!("particles       {}", r.particles);
     println!("steps           {steps}");
     println!("wall seconds    {:.4e} (the slowest rank)", r.wall_s);

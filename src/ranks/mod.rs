@@ -36,7 +36,7 @@ pub trait Ranks {
     }
 
     /// Sends each `(rank, bytes)` and returns what each of `from` sent this rank, in `from`'s
-    /// order. Every rank must call it; a rank sends to exactly the ranks it receives from.
+    /// order. Every rank must call it, and each rank in `from` must send to this one.
     fn exchange(&self, sends: &[(usize, Vec<u8>)], from: &[usize]) -> Result<Vec<Vec<u8>>>;
 }
 

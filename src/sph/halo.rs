@@ -22,8 +22,9 @@ pub const SHADER: Shader = Shader {
 /// the passes that reach further: fixed ghosts, the density filter).
 pub const HALO_LAYERS: u32 = 1;
 
-/// Rank `rank`'s part of `slabs`: what `halo_pack` needs to know.
-pub fn control(slabs: &Slabs, rank: usize, capacity: u32) -> HaloCtl {
+/// Rank `rank`'s part of `slabs`: what `halo_pack` needs to know (the records' capacity is
+/// set with the arrays' size, `Solver::build`).
+pub fn control(slabs: &Slabs, rank: usize) -> HaloCtl {
     let own = slabs.range(rank);
     HaloCtl {
         axis: slabs.axis as u32,
@@ -32,7 +33,7 @@ pub fn control(slabs: &Slabs, rank: usize, capacity: u32) -> HaloCtl {
         layers: HALO_LAYERS,
         lower: (rank > 0) as u32,
         upper: (rank + 1 < slabs.ranks()) as u32,
-        capacity,
+        capacity: 0,
         pad: 0,
     }
 }

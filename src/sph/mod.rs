@@ -164,7 +164,7 @@ impl Solver {
         }
         check_capacity(ctx, n)?;
         let grid = Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic)?;
-        let params = Params::from_scenario(sc, &grid)?;
+        let mut params = Params::from_scenario(sc, &grid)?;
         let cfg = ShaderConfig::of(sc)?;
         probes::check_wall_pressure(sc)?;
         let device = ctx.device.clone();
@@ -175,8 +175,15 @@ impl Solver {
         let front_bins = probes::FrontBins::new(&grid, ph.h, &sc.probes)?;
         let defs = probes::probe_defs(&sc.probes, grid.origin, &probe_faces, front_bins);
         let mut packed = initial::pack(sc, &grid);
-        let ranked = subdomain.map(|ctl| {
-            let own = subdomain::exclude_others(&mut packed, &grid, &ctl);
+        let mut subdomain = subdomain;
+        let ranked = subdomain.as_mut().map(|ctl| {
+            let own = subdomain::exclude_others(&mut packed, &grid, ctl);
+            let capacity = subdomain::capacity(own, n as u32);
+            packed.pos.truncate(capacity as usize);
+            packed.velrho.truncate(capacity as usize);
+            packed.code.truncate(capacity as usize);
+            params.n_particles = capacity;
+            ctl.capacity = subdomain::RECORDS_PER_PARTICLE * capacity;
             subdomain::Ranked::new(n as u64, own)
         });
         let body_motions = bodies::initial_motions(sc, params.body_id_base);

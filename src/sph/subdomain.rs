@@ -76,6 +76,18 @@ impl Ranked {
     }
 }
 
+/// Records a subdomain's packing buffer holds per particle of its arrays: a particle packs at
+/// most two (a halo copy each way from a slab one layer thick, or one migrant).
+pub const RECORDS_PER_PARTICLE: u32 = 2;
+
+/// The particles a subdomain's arrays hold: its own at the start twice over (its halo, and the
+/// water that flows in: the cuts do not move during a run yet), with room for a small slab's
+/// halo, and never more than the whole run's `n`. A rank that receives more than fits stops
+/// with a message saying so.
+pub fn capacity(own: u32, n: u32) -> u32 {
+    own.saturating_mul(2).saturating_add(4096).min(n)
+}
+
 /// What a run split over ranks cannot do yet, named for the refusal.
 fn unsupported(sc: &Scenario) -> Vec<&'static str> {
     let has = |kinds: &[Kind]| sc.particles.iter().any(|p| kinds.contains(&p.kind));
@@ -150,10 +162,7 @@ impl Solver {
             slabs.ranks(),
             ranks.size()
         );
-        let n = sc.particles.len() as u32;
-        // A particle packs at most two records (a halo copy each way from a slab one layer
-        // thick, or one migrant).
-        let ctl = halo::control(slabs, ranks.rank(), 2 * n);
+        let ctl = halo::control(slabs, ranks.rank());
         let mut solver = Self::build(ctx, sc, Some(ctl))?;
         solver.ranked_step(ranks)?;
         solver.initial_dt = solver.state.dt_cfl;
@@ -251,8 +260,11 @@ impl Solver {
         let free = self.buffers.n.saturating_sub(tail) as usize;
         if incoming.len() > free {
             bail!(
-                "the subdomain received {} halo and migrant particles but has room for {free}",
-                incoming.len()
+                "the subdomain received {} halo and migrant particles but has room for {free} \
+                 ({} in all): more water flowed into it than its arrays were made for, and the \
+                 cuts do not move during a run yet",
+                incoming.len(),
+                self.buffers.n
             );
         }
         if incoming.is_empty() {
