@@ -11,6 +11,8 @@
 // `halo_drop`, after the interaction: the particles outside the own layers (the halo copies and
 // the migrants sent) are excluded, so that the corrector, its reductions and the outputs see
 // the rank's own particles only.
+// `count_layers`: the rank's load per cell layer, from which the ranks move their cuts
+// (`Solver::rebalance`: the same packing without halos, then a sort).
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;
@@ -55,6 +57,9 @@ const DEST_MIGRANT: u32 = 2u;
 @group(0) @binding(6) var<storage, read> halo_ctl: HaloCtl;
 @group(0) @binding(7) var<storage, read_write> halo_counts: HaloCounts;
 @group(0) @binding(8) var<storage, read_write> halo_out: array<HaloRecord>;
+// Weighted own particles per cell layer along the axis (`count_layers`): 2 for a particle that
+// moves, 1 for a boundary particle (decomposition.rs's weights, doubled to be whole).
+@group(0) @binding(9) var<storage, read_write> layer_load: array<atomic<u32>>;
 
 fn layer_of(p: Pos) -> u32 {
     return u32(cell_of(p)[halo_ctl.axis]);
@@ -103,4 +108,18 @@ fn halo_drop(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     if (layer < halo_ctl.own_lo || layer >= halo_ctl.own_hi) {
         code[i] = with_kind(code[i], KIND_EXCLUDED);
     }
+}
+
+@compute @workgroup_size(WG)
+fn count_layers(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= params.n_particles) {
+        return;
+    }
+    let kind = code_kind(code[i]);
+    if (kind == KIND_EXCLUDED) {
+        return;
+    }
+    let moves = kind == KIND_FLUID || kind == KIND_SOLID || kind == KIND_INLET;
+    atomicAdd(&layer_load[layer_of(pos[i])], select(1u, 2u, moves));
 }

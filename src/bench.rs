@@ -198,6 +198,8 @@ pub struct RankBench {
     pub bytes_per_step: f64,
     /// The step's wall time by part (`sph::subdomain::Split`), seconds per step.
     pub split: crate::sph::subdomain::Split,
+    /// Times the cuts moved during the timed steps.
+    pub rebalances: u32,
 }
 
 /// What `wgsph bench` measures under mpirun: the whole run's figures and each rank's.
@@ -256,6 +258,7 @@ pub fn measure_ranked(
         split.exchange,
         split.compute,
         split.agree,
+        (after.rebalances - before.rebalances) as f64,
     ];
     let each = steps.max(1) as f64;
     let ranks = ranks
@@ -272,6 +275,7 @@ pub fn measure_ranked(
                 compute: v[6] / each,
                 agree: v[7] / each,
             },
+            rebalances: v[8] as u32,
         })
         .collect();
     Ok(RankedBenchReport {

@@ -589,8 +589,10 @@ fn bench_ranked(
     println!("particle-steps/s {:.4e}", r.particle_steps_per_s());
     println!("simulated s/wall s {:.4e}", r.simulated_s / r.wall_s);
     println!(
-        "imbalance       {:.1} % (own particles: the most loaded rank over the mean)",
-        100.0 * r.imbalance()
+        "imbalance       {:.1} % at the end (own particles: the most loaded rank over the \
+         mean); cuts moved {} times",
+        100.0 * r.imbalance(),
+        r.ranks[0].rebalances
     );
     println!("rank  own particles  halo/step  migrants/step  halo bytes/step  ms/step: pack  exchange  compute  agree");
     for (k, b) in r.ranks.iter().enumerate() {

@@ -215,6 +215,9 @@ struct Comparison {
     steps: u64,
     /// Whether particles must have crossed a cut by the end.
     migrates: bool,
+    /// Start from cuts at equal numbers of cell layers (not balanced), so that the ranks
+    /// move them during the run, which must then have happened.
+    uneven: bool,
 }
 
 impl Comparison {
@@ -243,12 +246,13 @@ impl Comparison {
         for r in 0..self.ranks {
             let bytes = std::fs::read(out.join(format!("rank{r}.bin"))).unwrap();
             let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-            let (halo, migrants) = (words[0], words[1]);
-            println!("rank {r}: {halo} halo copies and {migrants} migrants sent");
+            let (halo, migrants, rebalances) = (words[0], words[1], words[2]);
+            println!("rank {r}: {halo} halo copies and {migrants} migrants sent, {rebalances} rebalances");
             assert!(halo > 0, "rank {r} sent no halo");
+            assert!(!self.uneven || rebalances > 0, "the cuts never moved");
             migrants_total += migrants;
             merged.extend(
-                words[2..]
+                words[3..]
                     .chunks(9)
                     .map(|c| (c[0], [c[1], c[2], c[3], c[4]], [c[5], c[6], c[7], c[8]])),
             );
@@ -276,11 +280,22 @@ impl Comparison {
         let result = (|| -> anyhow::Result<()> {
             let gpu = GpuContext::for_rank(AdapterChoice::Cpu, r)?;
             let sc = self.scenario();
-            let slabs = slabs_for(&sc, ranks.size())?;
+            let slabs = match self.uneven {
+                false => slabs_for(&sc, ranks.size())?,
+                true => {
+                    let even = slabs_for(&sc, 1)?.range(0).len();
+                    let axis = slabs_for(&sc, 1)?.axis;
+                    Slabs::balanced(axis, &vec![1.0; even], ranks.size(), 1)?
+                }
+            };
             let mut solver = Solver::subdomain(&gpu, &sc, &slabs, &ranks)?;
             solver.run_steps_ranked(self.steps, &ranks)?;
             let counts = solver.ranked().unwrap();
-            let mut words = vec![counts.halo_sent as u32, counts.migrants_sent as u32];
+            let mut words = vec![
+                counts.halo_sent as u32,
+                counts.migrants_sent as u32,
+                counts.rebalances,
+            ];
             for (id, p, v) in live_particles(&solver) {
                 words.push(id);
                 words.extend(p);
@@ -308,6 +323,7 @@ fn two_ranks_of_the_2d_dam_break_equal_one_run() {
         ranks: 2,
         steps: 1000,
         migrates: true,
+        uneven: false,
     }
     .check();
 }
@@ -323,6 +339,24 @@ fn three_ranks_of_the_3d_dam_break_equal_one_run() {
         ranks: 3,
         steps: 40,
         migrates: false,
+        uneven: false,
+    }
+    .check();
+}
+
+/// Two ranks of the 2D dam break that start from cuts at equal numbers of cell layers (most of
+/// the water on one rank): the ranks move the cuts at their first look (step 100), and the
+/// particles still equal one whole run's bit for bit after 300 steps.
+#[test]
+fn ranks_that_move_their_cuts_still_equal_one_run() {
+    Comparison {
+        test: "ranks_that_move_their_cuts_still_equal_one_run",
+        case: "cases/dam_break_2d.toml",
+        set: &["particles.dx_m=0.0073"],
+        ranks: 2,
+        steps: 300,
+        migrates: false,
+        uneven: true,
     }
     .check();
 }

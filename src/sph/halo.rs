@@ -41,8 +41,13 @@ pub fn control(slabs: &Slabs, rank: usize) -> HaloCtl {
 pub struct Halo {
     pack: ParityKernel,
     drop: ParityKernel,
+    count_layers: ParityKernel,
+    ctl: wgpu::Buffer,
     counts: wgpu::Buffer,
     records: wgpu::Buffer,
+    layer_load: wgpu::Buffer,
+    /// Cell layers along the cut axis.
+    layers: u32,
     n: u32,
 }
 
@@ -58,13 +63,16 @@ pub struct Packed {
 }
 
 impl Halo {
+    /// The pass of a subdomain `ctl` on a grid of `layers` cell layers along its cut axis.
     pub fn new(
         device: &wgpu::Device,
         module: &ShaderModule,
         b: &ParticleBuffers,
         ctl: HaloCtl,
+        layers: u32,
     ) -> Result<Self> {
         let ctl_buffer = storage_init(device, "halo ctl", std::slice::from_ref(&ctl));
+        let layer_load = storage(device, "layer load", 4 * layers as u64);
         let counts = storage(
             device,
             "halo counts",
@@ -80,14 +88,44 @@ impl Halo {
                 .with("halo_ctl", &ctl_buffer)
                 .with("halo_counts", &counts)
                 .with("halo_out", &records)
+                .with("layer_load", &layer_load)
         };
         Ok(Self {
             pack: ParityKernel::new(device, module, "halo_pack", bufs)?,
             drop: ParityKernel::new(device, module, "halo_drop", bufs)?,
+            count_layers: ParityKernel::new(device, module, "count_layers", bufs)?,
+            ctl: ctl_buffer,
             counts,
             records,
+            layer_load,
+            layers,
             n: b.n,
         })
+    }
+
+    /// Replaces the subdomain's description (its cuts moved).
+    pub fn set_control(&self, queue: &wgpu::Queue, ctl: &HaloCtl) {
+        queue.write_buffer(&self.ctl, 0, bytemuck::bytes_of(ctl));
+    }
+
+    /// The rank's own particles per cell layer along the cut axis, weighted as
+    /// `decomposition::weight` (2 for a moving particle, 1 for a boundary one: doubled), from
+    /// the arrays of parity `p`. Waits for the GPU.
+    pub fn layer_load(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        p: usize,
+    ) -> Result<Vec<f64>> {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.clear_buffer(&self.layer_load, 0, None);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.count_layers.dispatch(&mut pass, p, self.n);
+        }
+        queue.submit([encoder.finish()]);
+        let load = read::<u32>(device, queue, &self.layer_load, self.layers as usize)?;
+        Ok(load.iter().map(|&w| 0.5 * w as f64).collect())
     }
 
     /// Zeroes the counters; record outside a compute pass, before `encode_pack`.

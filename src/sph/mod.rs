@@ -179,9 +179,7 @@ impl Solver {
         let ranked = subdomain.as_mut().map(|ctl| {
             let own = subdomain::exclude_others(&mut packed, &grid, ctl);
             let capacity = subdomain::capacity(own, n as u32);
-            packed.pos.truncate(capacity as usize);
-            packed.velrho.truncate(capacity as usize);
-            packed.code.truncate(capacity as usize);
+            subdomain::resize(&mut packed, capacity as usize);
             params.n_particles = capacity;
             ctl.capacity = subdomain::RECORDS_PER_PARTICLE * capacity;
             subdomain::Ranked::new(n as u64, own)
@@ -211,7 +209,8 @@ impl Solver {
         let mut passes = Passes::new(&device, sc, cfg, &grid, &buffers, &defs, body_motions)?;
         if let Some(ctl) = subdomain {
             let module = shader::module(&device, &halo::SHADER, cfg)?;
-            passes.halo = Some(halo::Halo::new(&device, &module, &buffers, ctl)?);
+            let layers = grid.cells[ctl.axis as usize];
+            passes.halo = Some(halo::Halo::new(&device, &module, &buffers, ctl, layers)?);
         }
         let bodies = passes.bodies.as_ref().map(|gpu| HostBodies {
             set: BodySet::new(&sc.bodies, ph.gravity, ph.dim),

@@ -38,7 +38,13 @@ pub struct Ranked {
     pub owned: u32,
     /// This rank's wall time in each part of its steps, summed: [`Split`].
     pub split: Split,
+    /// The present cuts (set once the subdomain is made), and how often they moved.
+    pub slabs: Option<Slabs>,
+    pub rebalances: u32,
 }
+
+/// Steps between two looks at the ranks' balance (`Solver::rebalance`).
+pub const REBALANCE_EVERY: u64 = 100;
 
 /// Where a subdomain's step time goes, in seconds summed over steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -80,12 +86,15 @@ impl Ranked {
 /// most two (a halo copy each way from a slab one layer thick, or one migrant).
 pub const RECORDS_PER_PARTICLE: u32 = 2;
 
-/// The particles a subdomain's arrays hold: its own at the start twice over (its halo, and the
-/// water that flows in: the cuts do not move during a run yet), with room for a small slab's
-/// halo, and never more than the whole run's `n`. A rank that receives more than fits stops
-/// with a message saying so.
+/// The particles a subdomain's arrays hold: its own at the start twice over (its halo, the
+/// water that flows in before the cuts move, and the entries the last step's halo copies
+/// still take until the next sort), with room for a small slab's halo; never more than twice
+/// the whole run's `n` (a rank that owns almost everything still takes its halo and
+/// migrants). A rank that receives more than fits stops with a message saying so.
 pub fn capacity(own: u32, n: u32) -> u32 {
-    own.saturating_mul(2).saturating_add(4096).min(n)
+    own.saturating_mul(2)
+        .saturating_add(4096)
+        .min(n.saturating_mul(2))
 }
 
 /// What a run split over ranks cannot do yet, named for the refusal.
@@ -140,6 +149,18 @@ pub fn exclude_others(packed: &mut Packed, grid: &Grid, ctl: &HaloCtl) -> u32 {
     mine.len() as u32
 }
 
+/// `packed` cut or padded to `capacity` entries, the padding excluded (ids repeat there, as
+/// among excluded particles anywhere: no pass reads them).
+pub fn resize(packed: &mut Packed, capacity: usize) {
+    let n = packed.code.len();
+    packed.pos.resize(capacity, Pos::default());
+    packed.velrho.resize(capacity, [0.0; 4]);
+    packed.code.truncate(capacity);
+    packed
+        .code
+        .extend((n..capacity).map(|k| (KIND_EXCLUDED << KIND_SHIFT) | (k % n.max(1)) as u32));
+}
+
 impl Solver {
     /// Rank `ranks.rank()`'s subdomain of `sc` cut by `slabs`, warmed up (its first sort and
     /// rates, with its neighbours' halos; every rank must call this together).
@@ -164,20 +185,115 @@ impl Solver {
         );
         let ctl = halo::control(slabs, ranks.rank());
         let mut solver = Self::build(ctx, sc, Some(ctl))?;
+        solver.ranked.as_mut().expect("a subdomain").slabs = Some(slabs.clone());
         solver.ranked_step(ranks)?;
         solver.initial_dt = solver.state.dt_cfl;
         Ok(solver)
     }
 
-    /// Takes `count` steps of CFL size on every rank together (as [`Solver::run_steps`]).
+    /// Takes `count` steps of CFL size on every rank together (as [`Solver::run_steps`]),
+    /// looking at the balance every [`REBALANCE_EVERY`] steps.
     pub fn run_steps_ranked(&mut self, count: u64, ranks: &dyn Ranks) -> Result<()> {
         self.start_untargeted();
         for _ in 0..count {
             let before = self.state.steps;
             self.ranked_step(ranks)?;
             self.steps += (self.state.steps - before) as u64;
+            if self.steps.is_multiple_of(REBALANCE_EVERY) {
+                self.rebalance(ranks)?;
+            }
         }
         self.check_stability()
+    }
+
+    /// Moves the cuts to where the ranks' present load balances, if the most loaded rank is
+    /// beyond `decomposition::REBALANCE_THRESHOLD` over the mean (every rank together, between
+    /// steps); whether they moved. Particles move exactly, so the run goes on as it would have.
+    pub fn rebalance(&mut self, ranks: &dyn Ranks) -> Result<bool> {
+        let halo = self
+            .passes
+            .halo
+            .as_ref()
+            .expect("a subdomain has a halo pass");
+        let mine = halo.layer_load(&self.device, &self.queue, self.parity)?;
+        let load = ranks.sum_in_rank_order(&mine);
+        let ranked = self.ranked.as_ref().expect("a subdomain");
+        let slabs = ranked.slabs.as_ref().expect("a subdomain's cuts");
+        let Some(next) = slabs.rebalanced(&load, halo::HALO_LAYERS) else {
+            return Ok(false);
+        };
+        log::info!(
+            "rank {}: cuts moved, imbalance {:.1} % -> {:.1} %",
+            ranks.rank(),
+            100.0 * slabs.imbalance(&load),
+            100.0 * next.imbalance(&load)
+        );
+        self.redistribute(next, ranks)?;
+        Ok(true)
+    }
+
+    /// Sends every particle to its owner under `next` (any rank), then sorts, so that the next
+    /// step's packing finds the free tail; the last rates follow the sort.
+    fn redistribute(&mut self, next: Slabs, ranks: &dyn Ranks) -> Result<()> {
+        let (rank, size, p) = (ranks.rank(), ranks.size(), self.parity);
+        let halo = self
+            .passes
+            .halo
+            .as_ref()
+            .expect("a subdomain has a halo pass");
+        let capacity = RECORDS_PER_PARTICLE * self.buffers.n;
+        // Migrants only: no halo this time.
+        let mut ctl = HaloCtl {
+            lower: 0,
+            upper: 0,
+            capacity,
+            ..halo::control(&next, rank)
+        };
+        halo.set_control(&self.queue, &ctl);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        halo.clear(&mut encoder);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            halo.encode_pack(&mut pass, p);
+            halo.encode_drop(&mut pass, p);
+        }
+        self.queue.submit([encoder.finish()]);
+        let packed = halo.read(&self.device, &self.queue)?;
+        let mut to: Vec<Vec<HaloRecord>> = vec![Vec::new(); size];
+        for r in packed.lower.into_iter().chain(packed.upper) {
+            let layer = self.grid.cell_of(r.pos.off, unpack_block(r.pos.block))[next.axis];
+            to[next.owner(layer as u32)].push(r);
+        }
+        ensure!(to[rank].is_empty(), "rank {rank} packed its own particles");
+        let others: Vec<usize> = (0..size).filter(|&q| q != rank).collect();
+        let sends: Vec<(usize, Vec<u8>)> = others
+            .iter()
+            .map(|&q| (q, bytemuck::cast_slice(&to[q]).to_vec()))
+            .collect();
+        let received = ranks.exchange(&sends, &others)?;
+        let incoming: Vec<HaloRecord> = received
+            .iter()
+            .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, HaloRecord>(b))
+            .collect();
+        self.unpack(&incoming, packed.tail, p)?;
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.passes.cell_list.clear(&mut encoder, &self.buffers);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.passes.cell_list.encode(&mut pass, p);
+        }
+        // The sort gathered the last rates into `rate_sorted`; the next predictor reads `rate`.
+        let b = &self.buffers;
+        encoder.copy_buffer_to_buffer(&b.rate_sorted, 0, &b.rate, 0, b.rate.size());
+        self.queue.submit([encoder.finish()]);
+        self.parity = 1 - p;
+        ctl.lower = (rank > 0) as u32;
+        ctl.upper = (rank + 1 < size) as u32;
+        halo.set_control(&self.queue, &ctl);
+        let ranked = self.ranked.as_mut().expect("a subdomain");
+        ranked.slabs = Some(next);
+        ranked.rebalances += 1;
+        self.faults.check()
     }
 
     /// This rank's counts (halo and migrants sent), if it is a subdomain.
@@ -261,8 +377,8 @@ impl Solver {
         if incoming.len() > free {
             bail!(
                 "the subdomain received {} halo and migrant particles but has room for {free} \
-                 ({} in all): more water flowed into it than its arrays were made for, and the \
-                 cuts do not move during a run yet",
+                 ({} in all): more water flowed into it than its arrays were made for before \
+                 the cuts moved",
                 incoming.len(),
                 self.buffers.n
             );
