@@ -67,13 +67,8 @@ fn particles_and_grid() -> (Vec<Particle>, Grid) {
         max: [3.0, 0.8, 0.6],
     };
     let grid = Grid::new(&domain, h, 3, 100_000, [false; 3]).unwrap();
-    let mut rng = 7u64;
-    let mut uniform = |scale: f64| {
-        rng = rng
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        scale * ((rng >> 11) as f64 / (1u64 << 53) as f64)
-    };
+    let mut rng = common::Rng(7);
+    let mut uniform = |scale: f64| rng.range(0.0, scale);
     let particles = (0..4000)
         .map(|k| Particle {
             // Denser towards x = 0, so the balanced cuts are not evenly spaced.
