@@ -1,8 +1,9 @@
 //! One rank's part of a run over several ranks (issue 32; docs/scaling.md): the particles of its
-//! own cell layers (slabs of the one global grid, `decomposition::Slabs`) in arrays as large as
-//! the whole run's, every other particle excluded; each step swaps its halo and migrants with
-//! its neighbours between the predictor and the sort (`Passes::record_to_exchange`,
-//! `record_from_exchange`), and the ranks agree on the time step and the stop rules.
+//! own cell layers (slabs of the one global grid, `decomposition::Slabs`) first in arrays of
+//! [`capacity`], the rest of them excluded; each step swaps its halo and migrants with its
+//! neighbours between the predictor and the sort (`Passes::record_to_exchange`,
+//! `record_from_exchange`), the ranks agree on the time step and the stop rules, and every
+//! [`REBALANCE_EVERY`] steps they may move the cuts (`Solver::rebalance`).
 //!
 //! The grid, its slot table and the particle ids are the whole run's, and the sort orders each
 //! slot by id, so an own particle sums the same neighbours in the same order as in one whole
