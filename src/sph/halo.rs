@@ -6,7 +6,7 @@ use anyhow::{bail, Result};
 
 use super::buffers::ParticleBuffers;
 use crate::decomposition::Slabs;
-use crate::gpu::buffers::{read, storage, storage_init};
+use crate::gpu::buffers::{map_read, read, readback_buffer, storage, storage_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
 use crate::layout::{HaloCounts, HaloCtl, HaloRecord, DEST_MIGRANT, DEST_UPPER};
@@ -22,8 +22,12 @@ pub const SHADER: Shader = Shader {
 /// the passes that reach further: fixed ghosts, the density filter).
 pub const HALO_LAYERS: u32 = 1;
 
+/// Records the packing buffer holds per particle of the arrays: a particle packs at most two
+/// (a halo copy each way from a slab one layer thick, or one migrant).
+pub const RECORDS_PER_PARTICLE: u32 = 2;
+
 /// Rank `rank`'s part of `slabs`: what `halo_pack` needs to know (the records' capacity is
-/// set with the arrays' size, `Solver::build`).
+/// the pass's own, set by [`Halo::new`]).
 pub fn control(slabs: &Slabs, rank: usize) -> HaloCtl {
     let own = slabs.range(rank);
     HaloCtl {
@@ -44,6 +48,8 @@ pub struct Halo {
     count_layers: ParityKernel,
     ctl: wgpu::Buffer,
     counts: wgpu::Buffer,
+    /// Where the counts are copied in the packing's own submission.
+    counts_staging: wgpu::Buffer,
     records: wgpu::Buffer,
     layer_load: wgpu::Buffer,
     /// Cell layers along the cut axis.
@@ -71,6 +77,10 @@ impl Halo {
         ctl: HaloCtl,
         layers: u32,
     ) -> Result<Self> {
+        let ctl = HaloCtl {
+            capacity: RECORDS_PER_PARTICLE * b.n,
+            ..ctl
+        };
         let ctl_buffer = storage_init(device, "halo ctl", std::slice::from_ref(&ctl));
         let layer_load = storage(device, "layer load", 4 * layers as u64);
         let counts = storage(
@@ -95,6 +105,11 @@ impl Halo {
             drop: ParityKernel::new(device, module, "halo_drop", bufs)?,
             count_layers: ParityKernel::new(device, module, "count_layers", bufs)?,
             ctl: ctl_buffer,
+            counts_staging: readback_buffer(
+                device,
+                "halo counts",
+                std::mem::size_of::<HaloCounts>() as u64,
+            ),
             counts,
             records,
             layer_load,
@@ -103,9 +118,17 @@ impl Halo {
         })
     }
 
-    /// Replaces the subdomain's description (its cuts moved).
-    pub fn set_control(&self, queue: &wgpu::Queue, ctl: &HaloCtl) {
-        queue.write_buffer(&self.ctl, 0, bytemuck::bytes_of(ctl));
+    /// The subdomain of rank `rank` under `slabs` from now on (its cuts moved); `halos: false`
+    /// packs migrants only.
+    pub fn set_cuts(&self, queue: &wgpu::Queue, slabs: &Slabs, rank: usize, halos: bool) {
+        let mut ctl = HaloCtl {
+            capacity: RECORDS_PER_PARTICLE * self.n,
+            ..control(slabs, rank)
+        };
+        if !halos {
+            (ctl.lower, ctl.upper) = (0, 0);
+        }
+        queue.write_buffer(&self.ctl, 0, bytemuck::bytes_of(&ctl));
     }
 
     /// The rank's own particles per cell layer along the cut axis, weighted as
@@ -133,6 +156,12 @@ impl Halo {
         encoder.clear_buffer(&self.counts, 0, None);
     }
 
+    /// Copies the counters for [`Halo::read`]; record after the pass that packed.
+    pub fn copy_counts(&self, encoder: &mut wgpu::CommandEncoder) {
+        let bytes = std::mem::size_of::<HaloCounts>() as u64;
+        encoder.copy_buffer_to_buffer(&self.counts, 0, &self.counts_staging, 0, bytes);
+    }
+
     /// Packs the migrants and the halo copies of the arrays of parity `p` (after the predictor,
     /// before the sort); the migrants stay until `encode_drop`, as halo copies.
     pub fn encode_pack(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
@@ -145,9 +174,11 @@ impl Halo {
         self.drop.dispatch(pass, q, self.n);
     }
 
-    /// Reads what the last `halo_pack` packed. Waits for the GPU.
+    /// Reads what the last `halo_pack` packed, once its submission (with `copy_counts`) is
+    /// made: the counts, then only as many records as were packed. Waits for the GPU.
     pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Packed> {
-        let counts = read::<HaloCounts>(device, queue, &self.counts, 1)?[0];
+        let counts: HaloCounts =
+            bytemuck::pod_read_unaligned(&map_read(device, &self.counts_staging)?);
         if counts.overflow > 0 {
             bail!(
                 "{} halo and migrant records did not fit the subdomain's {} (more particles \

@@ -175,13 +175,11 @@ impl Solver {
         let front_bins = probes::FrontBins::new(&grid, ph.h, &sc.probes)?;
         let defs = probes::probe_defs(&sc.probes, grid.origin, &probe_faces, front_bins);
         let mut packed = initial::pack(sc, &grid);
-        let mut subdomain = subdomain;
-        let ranked = subdomain.as_mut().map(|ctl| {
+        let ranked = subdomain.as_ref().map(|ctl| {
             let own = subdomain::exclude_others(&mut packed, &grid, ctl);
             let capacity = subdomain::capacity(own, n as u32);
             subdomain::resize(&mut packed, capacity as usize);
             params.n_particles = capacity;
-            ctl.capacity = subdomain::RECORDS_PER_PARTICLE * capacity;
             subdomain::Ranked::new(n as u64, own)
         });
         let body_motions = bodies::initial_motions(sc, params.body_id_base);

@@ -83,10 +83,6 @@ impl Ranked {
     }
 }
 
-/// Records a subdomain's packing buffer holds per particle of its arrays: a particle packs at
-/// most two (a halo copy each way from a slab one layer thick, or one migrant).
-pub const RECORDS_PER_PARTICLE: u32 = 2;
-
 /// The particles a subdomain's arrays hold: its own at the start twice over (its halo, the
 /// water that flows in before the cuts move, and the entries the last step's halo copies
 /// still take until the next sort), with room for a small slab's halo; never more than twice
@@ -242,15 +238,8 @@ impl Solver {
             .halo
             .as_ref()
             .expect("a subdomain has a halo pass");
-        let capacity = RECORDS_PER_PARTICLE * self.buffers.n;
         // Migrants only: no halo this time.
-        let mut ctl = HaloCtl {
-            lower: 0,
-            upper: 0,
-            capacity,
-            ..halo::control(&next, rank)
-        };
-        halo.set_control(&self.queue, &ctl);
+        halo.set_cuts(&self.queue, &next, rank, false);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         halo.clear(&mut encoder);
         {
@@ -258,6 +247,7 @@ impl Solver {
             halo.encode_pack(&mut pass, p);
             halo.encode_drop(&mut pass, p);
         }
+        halo.copy_counts(&mut encoder);
         self.queue.submit([encoder.finish()]);
         let packed = halo.read(&self.device, &self.queue)?;
         let mut to: Vec<Vec<HaloRecord>> = vec![Vec::new(); size];
@@ -288,9 +278,7 @@ impl Solver {
         encoder.copy_buffer_to_buffer(&b.rate_sorted, 0, &b.rate, 0, b.rate.size());
         self.queue.submit([encoder.finish()]);
         self.parity = 1 - p;
-        ctl.lower = (rank > 0) as u32;
-        ctl.upper = (rank + 1 < size) as u32;
-        halo.set_control(&self.queue, &ctl);
+        halo.set_cuts(&self.queue, &next, rank, true);
         let ranked = self.ranked.as_mut().expect("a subdomain");
         ranked.slabs = Some(next);
         ranked.rebalances += 1;
@@ -318,6 +306,7 @@ impl Solver {
             let mut r = Recorder::Shared(encoder.begin_compute_pass(&Default::default()));
             self.passes.record_to_exchange(&mut r, p);
         }
+        halo.copy_counts(&mut encoder);
         self.queue.submit([encoder.finish()]);
         let packed = halo.read(&self.device, &self.queue)?;
         self.faults.check()?;
