@@ -51,8 +51,9 @@ impl Ranks for Mpi {
     fn sum_in_rank_order(&self, x: &[f64]) -> Vec<f64> {
         let mut all = vec![0.0; x.len() * self.size()];
         self.world.all_gather_into(x, &mut all[..]);
+        // One part per rank (none when `x` is empty: the sum is empty too).
         let parts: Vec<Vec<f64>> = all.chunks(x.len().max(1)).map(<[f64]>::to_vec).collect();
-        super::sum_in_order(&parts[..self.size().min(parts.len())])
+        super::sum_in_order(&parts)
     }
 
     fn exchange(&self, sends: &[(usize, Vec<u8>)], from: &[usize]) -> Result<Vec<Vec<u8>>> {
