@@ -11,7 +11,7 @@ use std::ops::Range;
 use anyhow::{bail, Result};
 
 use crate::grid::Grid;
-use crate::scenario::{Kind, Particle, Scenario};
+use crate::scenario::{Kind, Particle, ProbeKind, Scenario};
 use crate::sph::halo::HALO_LAYERS;
 
 /// A step's work of a particle that moves (fluid, solid, inlet), the unit of the balance.
@@ -57,17 +57,62 @@ pub fn layer_load(grid: &Grid, axis: usize, particles: &[Particle]) -> Vec<f64> 
 }
 
 /// `sc` cut into `ranks` slabs of its grid (as the solver makes it) along [`cut_axis`], balanced
-/// over its particles' [`layer_load`].
+/// over its particles' [`layer_load`], no cut through a probe's [`probe_layers`].
 pub fn slabs_for(sc: &Scenario, ranks: usize) -> Result<Slabs> {
     let ph = &sc.physics;
     let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic)?;
     let axis = cut_axis(&grid, ph.dim)?;
-    Slabs::balanced(
+    let whole = probe_layers(sc, &grid, axis)?
+        .into_iter()
+        .flatten()
+        .collect();
+    Slabs::balanced_keeping(
         axis,
         &layer_load(&grid, axis, &sc.particles),
         ranks,
         HALO_LAYERS,
+        whole,
     )
+}
+
+/// The cell layers along `axis` each of `sc`'s probes reads (`None`: a front, which is a
+/// maximum over the fluid and combines over ranks exactly). A probe read within one rank's
+/// layers gives that rank the value one whole run gives, so the cuts keep these whole.
+///
+/// A point probe reads the 3^d cells around its point (probes.wgsl `fluid_sums`), a gauge
+/// those around its vertical line, a wall patch the cells of its box (`probe_wall_force`);
+/// each range has one layer more on each side against the GPU's f32 rounding of the point.
+pub fn probe_layers(sc: &Scenario, grid: &Grid, axis: usize) -> Result<Vec<Option<Range<u32>>>> {
+    let layers = grid.cells[axis] as i64;
+    let up = sc.physics.dim as usize - 1;
+    let layer_of = |x: f64| ((x - grid.origin[axis]) / grid.cell_size[axis]).floor() as i64;
+    let span =
+        |lo: i64, hi: i64| Some((lo - 1).clamp(0, layers) as u32..(hi + 2).clamp(0, layers) as u32);
+    sc.probes
+        .iter()
+        .map(|p| match &p.kind {
+            ProbeKind::Pressure { point } => {
+                Ok(span(layer_of(point[axis]) - 1, layer_of(point[axis]) + 1))
+            }
+            ProbeKind::Height { .. } if axis == up => bail!(
+                "probe '{}' is a wave gauge, but a run over several ranks cuts this case \
+                 along the vertical (its longest axis): the gauge would read water on \
+                 every rank; run it on one rank",
+                p.name
+            ),
+            ProbeKind::Height { base } => {
+                Ok(span(layer_of(base[axis]) - 1, layer_of(base[axis]) + 1))
+            }
+            ProbeKind::WallPressure(patch) => {
+                let e = patch.radius + 4.0 * sc.physics.h;
+                Ok(span(
+                    layer_of(patch.point[axis] - e),
+                    layer_of(patch.point[axis] + e),
+                ))
+            }
+            ProbeKind::Front { .. } => Ok(None),
+        })
+        .collect()
 }
 
 /// Slabs along one axis of the global grid: rank r owns the cell layers `bounds[r] ..
@@ -76,6 +121,8 @@ pub fn slabs_for(sc: &Scenario, ranks: usize) -> Result<Slabs> {
 pub struct Slabs {
     pub axis: usize,
     bounds: Vec<u32>,
+    /// Layer ranges no cut may split (the probes' [`probe_layers`]), also when they move.
+    whole: Vec<Range<u32>>,
 }
 
 /// What one rank sends one neighbour every step: its particles in these cell layers.
@@ -90,6 +137,19 @@ impl Slabs {
     /// layers allow, each at least `min_layers` thick so that a halo of that many layers comes
     /// from the next rank only.
     pub fn balanced(axis: usize, load: &[f64], ranks: usize, min_layers: u32) -> Result<Self> {
+        Self::balanced_keeping(axis, load, ranks, min_layers, Vec::new())
+    }
+
+    /// As [`Slabs::balanced`], with no cut inside any of the layer ranges `whole` (a cut at a
+    /// range's start or end is fine): where the balance would cut one, the nearest allowed
+    /// cut in load is taken.
+    pub fn balanced_keeping(
+        axis: usize,
+        load: &[f64],
+        ranks: usize,
+        min_layers: u32,
+        whole: Vec<Range<u32>>,
+    ) -> Result<Self> {
         let layers = load.len() as u32;
         if ranks == 0 {
             bail!("no ranks to cut the domain for");
@@ -121,10 +181,29 @@ impl Slabs {
             if cut > lo && target - prefix[cut as usize - 1] < prefix[cut as usize] - target {
                 cut -= 1;
             }
-            bounds.push(cut.clamp(lo, hi));
+            let cut = cut.clamp(lo, hi);
+            let allowed = |c: u32| !whole.iter().any(|r| r.start < c && c < r.end);
+            let off_target = |c: u32| (prefix[c as usize] - target).abs();
+            let nearest_allowed = || {
+                (lo..=hi)
+                    .filter(|&c| allowed(c))
+                    .min_by(|&a, &b| off_target(a).total_cmp(&off_target(b)))
+            };
+            let Some(cut) = allowed(cut).then_some(cut).or_else(nearest_allowed) else {
+                bail!(
+                    "no cut between cell layers {lo} and {hi} along axis {axis} leaves every \
+                     probe within one rank (a probe is read within one rank's layers): use \
+                     fewer ranks, or move the probes apart"
+                );
+            };
+            bounds.push(cut);
         }
         bounds.push(layers);
-        Ok(Self { axis, bounds })
+        Ok(Self {
+            axis,
+            bounds,
+            whole,
+        })
     }
 
     pub fn ranks(&self) -> usize {
@@ -191,7 +270,14 @@ impl Slabs {
         if now <= REBALANCE_THRESHOLD {
             return None;
         }
-        let next = Self::balanced(self.axis, load, self.ranks(), min_layers).ok()?;
+        let next = Self::balanced_keeping(
+            self.axis,
+            load,
+            self.ranks(),
+            min_layers,
+            self.whole.clone(),
+        )
+        .ok()?;
         (next.imbalance(load) < now && next != *self).then_some(next)
     }
 }
@@ -228,10 +314,32 @@ mod tests {
         let even = Slabs {
             axis: 0,
             bounds: vec![0, 25, 50],
+            whole: Vec::new(),
         };
         assert!(even.imbalance(&load) > 0.5);
         assert_eq!(even.rebalanced(&load, 1).as_ref(), Some(&s));
         assert_eq!(s.rebalanced(&load, 1), None);
+    }
+
+    #[test]
+    fn no_cut_splits_a_probes_layers() {
+        let load = [1.0; 40];
+        // Balanced, the cut would be at 20, inside 17..23: the nearest allowed cut in load.
+        let probe = 17..23;
+        let s = Slabs::balanced_keeping(0, &load, 2, 1, vec![probe]).unwrap();
+        assert!([17, 23].contains(&s.range(0).end), "{s:?}");
+        // Moving the cuts keeps the range whole too.
+        let mut heavy = load;
+        heavy[..10].iter_mut().for_each(|l| *l = 10.0);
+        let next = s.rebalanced(&heavy, 1).expect("imbalanced");
+        assert!(next.range(0).end <= 17, "{next:?}");
+        assert!(!next.whole.is_empty());
+        // A range over every place a cut may go leaves none.
+        let everywhere = 0..40;
+        let err = Slabs::balanced_keeping(0, &load, 2, 1, vec![everywhere])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("leaves every probe within one rank"), "{err}");
     }
 
     #[test]
