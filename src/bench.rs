@@ -188,20 +188,6 @@ pub fn measure(
     })
 }
 
-/// One rank's part of a bench under mpirun (`measure_ranked`), per timed step.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RankBench {
-    /// Own particles at the end.
-    pub own: u64,
-    pub halo_per_step: f64,
-    pub migrants_per_step: f64,
-    pub bytes_per_step: f64,
-    /// The step's wall time by part (`sph::subdomain::Split`), seconds per step.
-    pub split: crate::sph::subdomain::Split,
-    /// Times the cuts moved during the timed steps.
-    pub rebalances: u32,
-}
-
 /// What `wgsph bench` measures under mpirun: the whole run's figures and each rank's.
 #[derive(Clone, Debug)]
 pub struct RankedBenchReport {
@@ -211,7 +197,8 @@ pub struct RankedBenchReport {
     /// The slowest rank's wall time over the timed steps.
     pub wall_s: f64,
     pub simulated_s: f64,
-    pub ranks: Vec<RankBench>,
+    /// Each rank's part of the timed steps (its adapter named on rank 0 only).
+    pub ranks: Vec<crate::output::RankSummary>,
 }
 
 impl RankedBenchReport {
@@ -222,14 +209,15 @@ impl RankedBenchReport {
 
     /// How much more than the mean the rank with the most own particles holds.
     pub fn imbalance(&self) -> f64 {
-        let own: Vec<f64> = self.ranks.iter().map(|r| r.own as f64).collect();
+        let own: Vec<f64> = self.ranks.iter().map(|r| r.own_particles as f64).collect();
         let mean = own.iter().sum::<f64>() / own.len().max(1) as f64;
         own.iter().fold(0.0f64, |m, &x| m.max(x)) / mean.max(1.0) - 1.0
     }
 }
 
 /// Times `steps` steps of `sc` cut into one slab per rank of `ranks`, after `warmup`, on every
-/// rank together (each on its `ctx`); every rank returns the same report.
+/// rank together (each on its `ctx`); every rank returns the same report, but for the
+/// adapters' names (rank 0's only).
 pub fn measure_ranked(
     ctx: &GpuContext,
     sc: &Scenario,
@@ -246,38 +234,7 @@ pub fn measure_ranked(
     let start = Instant::now();
     solver.run_steps_ranked(steps, ranks)?;
     let wall_s = -ranks.min(-start.elapsed().as_secs_f64());
-    let after = solver.ranked().expect("a subdomain");
-    let per = |x: u64, x0: u64| (x - x0) as f64 / steps.max(1) as f64;
-    let split = after.split - before.split;
-    let mine = [
-        after.owned as f64,
-        per(after.halo_sent, before.halo_sent),
-        per(after.migrants_sent, before.migrants_sent),
-        per(after.bytes_sent, before.bytes_sent),
-        split.pack,
-        split.exchange,
-        split.compute,
-        split.agree,
-        (after.rebalances - before.rebalances) as f64,
-    ];
-    let each = steps.max(1) as f64;
-    let ranks = ranks
-        .gather(&mine)
-        .into_iter()
-        .map(|v| RankBench {
-            own: v[0] as u64,
-            halo_per_step: v[1],
-            migrants_per_step: v[2],
-            bytes_per_step: v[3],
-            split: crate::sph::subdomain::Split {
-                pack: v[4] / each,
-                exchange: v[5] / each,
-                compute: v[6] / each,
-                agree: v[7] / each,
-            },
-            rebalances: v[8] as u32,
-        })
-        .collect();
+    let ranks = solver.rank_summaries(&before, &ctx.describe(), ranks)?;
     Ok(RankedBenchReport {
         case: sc.name.clone(),
         particles: sc.particles.len() as u64,

@@ -302,7 +302,6 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             quiet,
         } => {
             let sc = wgsph::case::load(&case, &set)?;
-            let ctx = context(cli.adapter)?;
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
             let options = RunOptions {
                 snapshot_png: snapshots.then(|| snapshot_field.unwrap_or_default()),
@@ -316,6 +315,11 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                 halt_at_s: None,
                 ..Default::default()
             };
+            #[cfg(feature = "mpi")]
+            if wgsph::ranks::launched_size().is_some_and(|n| n > 1) {
+                return run_ranked(cli.adapter, &sc, &dir, &options, quiet, bars);
+            }
+            let ctx = context(cli.adapter)?;
             let report = wgsph::run::run(&ctx, &sc, &dir, &options, &mut *progress(quiet, bars))?;
             Ok(finish(&report, &dir, quiet))
         }
@@ -556,22 +560,9 @@ fn bench_ranked(
         let sc = wgsph::case::load(case, set)?;
         let ctx = GpuContext::for_rank(AdapterChoice::resolve(adapter)?, rank)?;
         eprintln!("rank {rank} of {size}: adapter {}", ctx.describe());
-        // Rank 0 reports every rank's adapter.
-        let mine = ctx.describe().into_bytes();
-        let adapters = match rank {
-            0 => ranks.exchange(&[], &(1..size).collect::<Vec<_>>())?,
-            _ => ranks.exchange(&[(0, mine.clone())], &[])?,
-        };
-        let adapters: Vec<String> = std::iter::once(mine)
-            .chain(adapters)
-            .map(|b| String::from_utf8_lossy(&b).into_owned())
-            .collect();
-        Ok((
-            wgsph::bench::measure_ranked(&ctx, &sc, steps, warmup, &ranks)?,
-            adapters,
-        ))
+        wgsph::bench::measure_ranked(&ctx, &sc, steps, warmup, &ranks)
     })();
-    let (r, adapters) = match result {
+    let r = match result {
         Ok(r) => r,
         Err(e) => ranks.abort(&e),
     };
@@ -580,8 +571,8 @@ fn bench_ranked(
     }
     println!("case            {}", r.case);
     println!("ranks           {size} (one slab each)");
-    for (k, a) in adapters.iter().enumerate() {
-        println!("adapter {k:<7} {a}");
+    for (k, b) in r.ranks.iter().enumerate() {
+        println!("adapter {k:<7} {}", b.adapter);
     }
     println!("particles       {}", r.particles);
     println!("steps           {steps}");
@@ -599,17 +590,50 @@ fn bench_ranked(
         let ms = |s: f64| 1e3 * s;
         println!(
             "{k:>4}  {:>13}  {:>9.1}  {:>13.2}  {:>15.0}  {:>13.3}  {:>8.3}  {:>7.3}  {:>5.3}",
-            b.own,
-            b.halo_per_step,
+            b.own_particles,
+            b.halo_particles_per_step,
             b.migrants_per_step,
-            b.bytes_per_step,
-            ms(b.split.pack),
-            ms(b.split.exchange),
-            ms(b.split.compute),
-            ms(b.split.agree)
+            b.halo_bytes_per_step,
+            ms(b.seconds_per_step.pack),
+            ms(b.seconds_per_step.exchange),
+            ms(b.seconds_per_step.compute),
+            ms(b.seconds_per_step.agree)
         );
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// `mpirun -np N wgsph run CASE`: the case cut into one slab per rank, every rank on its
+/// adapter (named on stderr), rank 0 reporting; the other ranks log warnings only. A rank that
+/// fails ends the job, naming itself.
+#[cfg(feature = "mpi")]
+fn run_ranked(
+    adapter: Option<AdapterChoice>,
+    sc: &wgsph::scenario::Scenario,
+    dir: &std::path::Path,
+    options: &RunOptions,
+    quiet: bool,
+    bars: &MultiProgress,
+) -> Result<ExitCode> {
+    use wgsph::ranks::{Mpi, Ranks};
+    let ranks = Mpi::init().ok_or_else(|| anyhow::anyhow!("MPI was initialised twice"))?;
+    let (rank, size) = (ranks.rank(), ranks.size());
+    if rank != 0 {
+        log::set_max_level(log::LevelFilter::Warn);
+    }
+    let result = (|| {
+        let ctx = GpuContext::for_rank(AdapterChoice::resolve(adapter)?, rank)?;
+        eprintln!("rank {rank} of {size}: adapter {}", ctx.describe());
+        let mut progress: Box<dyn Progress> = match rank {
+            0 => progress(quiet, bars),
+            _ => Box::new(LogLines::default()),
+        };
+        wgsph::run::run_on_ranks(&ctx, sc, dir, options, &mut *progress, &ranks)
+    })();
+    match result {
+        Ok(report) => Ok(finish(&report, dir, quiet || rank != 0)),
+        Err(e) => ranks.abort(&e),
+    }
 }
 
 /// `wgsph resume DIR`: the run continued from its checkpoint, with `set` over its overrides.

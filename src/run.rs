@@ -13,10 +13,12 @@ use crate::body;
 use crate::checkpoint::{
     fingerprint, CaseSource, Checkpoint, CheckpointPolicy, OutputState, CHECKPOINT_FILE,
 };
+use crate::decomposition::slabs_for;
 use crate::gpu::GpuContext;
-use crate::output::{OutputDir, ParticleFile, ProbeWriter, RunSummary, SNAPSHOTS_DIR};
+use crate::output::{OutputDir, ParticleFile, Piece, ProbeWriter, RunSummary, SNAPSHOTS_DIR};
 use crate::plot::snapshot::{SnapshotField, SnapshotPainter};
 use crate::progress::{Progress, RunStatus};
+use crate::ranks::Ranks;
 use crate::scenario::{Kind, OutputBoundary, ProbeKind, Scenario};
 use crate::sph::{check_capacity, DensityVariation, Solver, Unstable};
 
@@ -142,11 +144,17 @@ struct ParticleOutputs {
     /// particle, in id order); the later outputs leave out the boundary particles still there.
     first_pos: Option<Vec<[f64; 3]>>,
     boundary_first: bool,
+    /// A subdomain's piece holds its own particles only (not the halo copies it keeps
+    /// excluded).
+    own_only: bool,
 }
 
 impl ParticleOutputs {
     fn write(&mut self, solver: &Solver) -> Result<()> {
-        let p = solver.read_particles()?;
+        let mut p = solver.read_particles()?;
+        if self.own_only {
+            p = p.without_kind(crate::sph::EXCLUDED);
+        }
         let index = self.out.snapshot_count();
         let fewer = match &self.first_pos {
             Some(first) if self.boundary_first => Some(p.without_unmoved_boundary(first)),
@@ -293,16 +301,68 @@ pub fn run(
     progress: &mut dyn Progress,
 ) -> Result<RunReport> {
     check_capacity(ctx, sc.particles.len())?;
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create the output folder {}", dir.display()))?;
-    // Held until this returns, on every path: no second run writes here meanwhile.
-    let _lock = crate::output::DirLock::acquire(dir)?;
-    remove_previous_outputs(dir)?;
-    let mut runner = Runner::create(ctx, sc, dir, options)?;
-    runner.outputs.write(&runner.solver)?;
-    if !sc.probes.is_empty() {
-        runner.probes.record(0.0, &runner.solver.sample_probes()?)?;
+    start(ctx, sc, dir, options, progress, None)
+}
+
+/// Runs `sc` split over `ranks` (issue 32; every rank calls this together, each on its own
+/// `ctx`), into the one folder `dir`: each rank writes its piece of every particle output,
+/// rank 0 the `.pvtu` naming the pieces, the series, the probes' tables (the values one whole
+/// run gives) and run.json with every rank's part. No checkpoints yet: an interrupted run
+/// cannot be resumed. A rank that fails otherwise than by the run going unstable (which every
+/// rank sees at the same step) ends the job, naming itself.
+pub fn run_on_ranks(
+    ctx: &GpuContext,
+    sc: &Scenario,
+    dir: &Path,
+    options: &RunOptions,
+    progress: &mut dyn Progress,
+    ranks: &dyn Ranks,
+) -> Result<RunReport> {
+    if options.snapshot_png.is_some() {
+        bail!(
+            "--snapshots draws one device's particles, and a run over several ranks holds them \
+             on each: draw them after the run with `wgsph plot DIR --snapshots`"
+        );
     }
+    if ranks.rank() == 0 {
+        log::warn!(
+            "{}: a run over {} ranks writes no checkpoints yet (issue 32): if it is \
+             interrupted, it cannot be resumed",
+            sc.name,
+            ranks.size()
+        );
+    }
+    start(ctx, sc, dir, options, progress, Some(ranks))
+}
+
+/// The run from t = 0: the folder taken and emptied of an earlier run's outputs (by rank 0,
+/// before any other rank writes into it), the first outputs, then the steps.
+fn start(
+    ctx: &GpuContext,
+    sc: &Scenario,
+    dir: &Path,
+    options: &RunOptions,
+    progress: &mut dyn Progress,
+    ranks: Option<&dyn Ranks>,
+) -> Result<RunReport> {
+    let first = ranks.is_none_or(|r| r.rank() == 0);
+    // Held until this returns, on every path: no second run writes here meanwhile.
+    let _lock = match first {
+        true => {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create the output folder {}", dir.display()))?;
+            let lock = crate::output::DirLock::acquire(dir)?;
+            remove_previous_outputs(dir)?;
+            Some(lock)
+        }
+        false => None,
+    };
+    if let Some(r) = ranks {
+        r.barrier();
+    }
+    let mut runner = Runner::create(ctx, sc, dir, options, ranks)?;
+    runner.write_particles()?;
+    runner.record_probes()?;
     runner.bodies.record(&runner.solver)?;
     runner.go(progress)
 }
@@ -358,7 +418,7 @@ pub fn resume(
         );
     }
     check_capacity(ctx, sc.particles.len())?;
-    let mut runner = Runner::create(ctx, sc, dir, options)?;
+    let mut runner = Runner::create(ctx, sc, dir, options, None)?;
     runner
         .solver
         .restore_state(&ck.solver)
@@ -412,6 +472,10 @@ struct Runner<'a> {
     /// Simulated time of the last checkpoint written (or resumed from).
     last_checkpoint: Option<f64>,
     density: DensityWatch,
+    /// The ranks of a run split over several (None: one whole run).
+    ranks: Option<&'a dyn Ranks>,
+    /// This rank's counts at the start, of a run over several ranks.
+    ranked_start: crate::sph::subdomain::Ranked,
 }
 
 /// The weakly-compressible check of a run ([`DensityVariation`]) over each probe interval
@@ -524,8 +588,19 @@ impl<'a> Runner<'a> {
         sc: &'a Scenario,
         dir: &Path,
         options: &'a RunOptions,
+        ranks: Option<&'a dyn Ranks>,
     ) -> Result<Self> {
-        let out = OutputDir::create(dir)?;
+        let out = match ranks {
+            Some(r) => OutputDir::for_piece(
+                dir,
+                Piece {
+                    rank: r.rank(),
+                    ranks: r.size(),
+                },
+            )?,
+            None => OutputDir::create(dir)?,
+        };
+        let first = ranks.is_none_or(|r| r.rank() == 0);
         let png = match options.snapshot_png {
             Some(field) => {
                 let pngs = dir.join(SNAPSHOTS_DIR);
@@ -535,13 +610,17 @@ impl<'a> Runner<'a> {
             }
             None => None,
         };
-        let names: Vec<(String, String)> = sc
-            .probes
-            .iter()
+        // Rank 0 writes the tables.
+        let names: Vec<(String, String)> = (sc.probes.iter())
+            .filter(|_| first)
             .map(|p| (p.name.clone(), probe_column(&p.kind).to_string()))
             .collect();
         let probes = out.probe_writer(&names)?;
-        let solver = Solver::new(ctx, sc).context("setting up the GPU solver")?;
+        let solver = match ranks {
+            Some(r) => Solver::subdomain(ctx, sc, &slabs_for(sc, r.size())?, r),
+            None => Solver::new(ctx, sc),
+        }
+        .context("setting up the GPU solver")?;
         let bodies = BodyOutputs::new(&out, sc)?;
         let some = |n: usize, what: &str| match n {
             0 => String::new(),
@@ -559,9 +638,10 @@ impl<'a> Runner<'a> {
             solver.gpu_bytes() as f64 / sc.particles.len() as f64,
             solver.dt()
         );
-        for w in &sc.warnings {
+        for w in sc.warnings.iter().filter(|_| first) {
             log::warn!("{}: {w}", sc.name);
         }
+        let ranked_start = solver.ranked().cloned().unwrap_or_default();
         Ok(Self {
             ctx,
             sc,
@@ -574,6 +654,7 @@ impl<'a> Runner<'a> {
                 png,
                 first_pos: None,
                 boundary_first: sc.time.output_boundary == OutputBoundary::First,
+                own_only: ranks.is_some(),
             },
             next_output: sc.time.output_every_s.min(sc.time.end_s),
             next_checkpoint_sim: options.checkpoint.every_sim_s,
@@ -582,7 +663,50 @@ impl<'a> Runner<'a> {
             last_checkpoint_wall: Instant::now(),
             last_checkpoint: None,
             density: DensityWatch::new(sc, 0.0),
+            ranks,
+            ranked_start,
         })
+    }
+
+    /// Whether this process writes the run's tables and run.json: one whole run, or rank 0.
+    fn first(&self) -> bool {
+        self.ranks.is_none_or(|r| r.rank() == 0)
+    }
+
+    /// The particle outputs at the present time; over several ranks, every rank's piece, then
+    /// (rank 0) the `.pvtu` and the series.
+    fn write_particles(&mut self) -> Result<()> {
+        self.outputs.write(&self.solver)?;
+        if let Some(r) = self.ranks {
+            r.barrier();
+            self.outputs.out.publish_pieces()?;
+        }
+        Ok(())
+    }
+
+    /// Samples the probes (every rank together) and records them (rank 0).
+    fn record_probes(&mut self) -> Result<()> {
+        if self.sc.probes.is_empty() {
+            return Ok(());
+        }
+        let values = match self.ranks {
+            Some(r) => self.solver.sample_probes_ranked(r)?,
+            None => self.solver.sample_probes()?,
+        };
+        if self.first() {
+            self.probes.record(self.solver.time(), &values)?;
+        }
+        Ok(())
+    }
+
+    /// Every rank's part of the run, on rank 0 (every rank together); None for one whole run.
+    fn rank_summaries(&self) -> Result<Option<Vec<crate::output::RankSummary>>> {
+        let Some(r) = self.ranks else {
+            return Ok(None);
+        };
+        let adapter = self.ctx.describe();
+        let since = &self.ranked_start;
+        Ok(Some(self.solver.rank_summaries(since, &adapter, r)?))
     }
 
     fn status(&self) -> RunStatus {
@@ -610,6 +734,14 @@ impl<'a> Runner<'a> {
             // with what was written so far and the last checkpoint kept.
             match self.probe_interval(t) {
                 Err(e) => {
+                    // Every rank sees the run go unstable at the same step; anything else
+                    // befalls one rank, and the others would wait for it.
+                    if let Some(r) = self
+                        .ranks
+                        .filter(|_| e.downcast_ref::<Unstable>().is_none())
+                    {
+                        r.abort(&e);
+                    }
                     stopped = Some(e);
                     break;
                 }
@@ -656,6 +788,16 @@ impl<'a> Runner<'a> {
         }
         let n = sc.particles.len() as f64;
         let counts = particle_counts(sc);
+        let ranks = self.rank_summaries()?;
+        let (wall_s, gpu_bytes) = match self.ranks {
+            // The slowest rank's time; every rank's buffers.
+            Some(r) => (
+                -r.min(-end.wall_s),
+                r.sum_in_rank_order(&[self.solver.gpu_bytes() as f64])[0],
+            ),
+            None => (end.wall_s, self.solver.gpu_bytes() as f64),
+        };
+        let end = RunStatus { wall_s, ..end };
         let summary = RunSummary {
             case: sc.name.clone(),
             adapter: self.ctx.info.name.clone(),
@@ -671,7 +813,7 @@ impl<'a> Runner<'a> {
             simulated_time_s: end.time_s,
             wall_time_s: end.wall_s,
             particle_steps_per_s: end.particle_steps_per_s(),
-            gpu_bytes_per_particle: self.solver.gpu_bytes() as f64 / n,
+            gpu_bytes_per_particle: gpu_bytes / n,
             outputs: end.outputs as u64,
             status: match (&stopped, interrupted_at_s) {
                 (Some(e), _) => format!("stopped: {e:#}{resume_hint}"),
@@ -687,8 +829,11 @@ impl<'a> Runner<'a> {
                 .source
                 .as_ref()
                 .map(|s| s.path.to_string_lossy().into_owned()),
+            ranks,
         };
-        self.outputs.out.write_run_summary(&summary)?;
+        if self.first() {
+            self.outputs.out.write_run_summary(&summary)?;
+        }
         Ok(RunReport {
             summary,
             stopped,
@@ -740,19 +885,24 @@ impl<'a> Runner<'a> {
         {
             self.solver.lose_device();
         }
-        self.solver.advance_to(t)?;
-        self.density.observe(
-            &sc.name,
-            self.solver.density_variation(),
-            self.solver.time(),
-        );
-        if !sc.probes.is_empty() {
-            self.probes
-                .record(self.solver.time(), &self.solver.sample_probes()?)?;
+        match self.ranks {
+            Some(r) => self.solver.advance_to_ranked(t, r)?,
+            None => self.solver.advance_to(t)?,
         }
+        if self.first() {
+            self.density.observe(
+                &sc.name,
+                self.solver.density_variation(),
+                self.solver.time(),
+            );
+        } else {
+            self.density
+                .record_max(self.solver.density_variation(), self.solver.time());
+        }
+        self.record_probes()?;
         self.bodies.record(&self.solver)?;
         if self.solver.time() >= self.next_output - 1e-9 * every_out {
-            self.outputs.write(&self.solver)?;
+            self.write_particles()?;
             self.probes.flush()?;
             self.bodies.csv.flush()?;
             log::debug!(
@@ -762,12 +912,18 @@ impl<'a> Runner<'a> {
             );
             self.next_output = (self.next_output + every_out).min(sc.time.end_s);
         }
-        let halt = self.interrupted()
+        let mut halt = self.interrupted()
             || self
                 .options
                 .halt_at_s
                 .is_some_and(|h| self.solver.time() >= h - 1e-12 * sc.time.end_s);
         let end = self.solver.time() >= sc.time.end_s;
+        if let Some(r) = self.ranks {
+            // Every rank stops where any one is asked to (a signal reaches them at different
+            // steps); no checkpoint yet.
+            halt = r.min(if halt { 0.0 } else { 1.0 }) == 0.0;
+            return Ok(halt && !end);
+        }
         if !end && (halt || self.checkpoint_due()) {
             self.write_checkpoint()?;
         }

@@ -945,37 +945,43 @@ fn snapshots_3d_are_perspective_views_of_the_particles() {
     assert!(info.width > PICTURE.0 && info.height > PICTURE.1);
 }
 
-/// Under a launcher with several ranks (its environment says how many), a run is refused with
-/// the reason rather than run N times into one folder; one rank runs as without a launcher.
+/// Under a launcher with several ranks (its environment says how many), `resume` is refused
+/// with the reason (a run over several ranks writes no checkpoints yet), as is `run` in a
+/// build without MPI, rather than run N times into one folder; one rank runs as without a
+/// launcher. (`run` over ranks: tests/mpi.rs.)
 #[test]
-fn a_launch_over_several_ranks_is_refused_until_subdomains_exist() {
+fn a_launch_over_several_ranks_refuses_what_ranks_cannot_do_yet() {
     let out = temp_dir("ranks");
-    let launch = |var: &str, ranks: &str| {
-        wgsph()
-            .args([
-                "run",
-                "cases/hydrostatic_2d.toml",
-                "--set",
-                "time.end_s=0.01",
-            ])
-            .arg("--out")
-            .arg(&out)
-            .env(var, ranks)
-            .output()
-            .unwrap()
+    let command = |args: &[&str], var: &str, ranks: &str| {
+        wgsph().args(args).env(var, ranks).output().unwrap()
     };
+    let run = [
+        "run",
+        "cases/hydrostatic_2d.toml",
+        "--set",
+        "time.end_s=0.01",
+        "--out",
+    ];
+    let run: Vec<&str> = run.into_iter().chain(out.to_str()).collect();
     for (var, ranks) in [("OMPI_COMM_WORLD_SIZE", "2"), ("PMI_SIZE", "4")] {
-        let o = launch(var, ranks);
+        let o = command(&["resume", out.to_str().unwrap()], var, ranks);
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success());
         assert!(
             stderr.contains(&format!(
-                "launched on {ranks} ranks, but a run cannot be split"
+                "`wgsph resume` was launched on {ranks} ranks, but a run over several ranks \
+                 writes no checkpoints yet"
             )),
             "{stderr}"
         );
+        if !cfg!(feature = "mpi") {
+            let o = command(&run, var, ranks);
+            let stderr = String::from_utf8_lossy(&o.stderr);
+            assert!(!o.status.success());
+            assert!(stderr.contains("built without MPI"), "{stderr}");
+        }
         assert!(!out.join("run.json").exists(), "nothing may be written");
     }
-    let o = launch("OMPI_COMM_WORLD_SIZE", "1");
+    let o = command(&run, "OMPI_COMM_WORLD_SIZE", "1");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }

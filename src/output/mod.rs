@@ -12,6 +12,8 @@
 //! ```text
 //! DIR/particles.pvd                     series index (time + relative file per snapshot)
 //! DIR/particles/particles_000000.vtu    one file per snapshot, raw appended binary
+//!     (a run over N ranks: particles_000000.pvtu naming one piece per rank,
+//!     particles_000000_p0000.vtu … _pNNNN.vtu, each rank's own particles)
 //! DIR/probes/<name>.csv                 "t_s,<column>" time series per probe
 //! DIR/run.json                          run summary
 //! DIR/snapshots/NNNNNN.png              with --snapshots: a picture of each particle snapshot
@@ -34,7 +36,7 @@ pub use atomic::write_atomic;
 pub use lock::{DirLock, LOCK_FILE};
 pub use particle_file::{particle_files, ParticleFile, Particles};
 pub use probes_csv::ProbeWriter;
-pub use run_summary::RunSummary;
+pub use run_summary::{RankSummary, RunSummary};
 
 /// Name of the series file inside the output directory.
 pub const PVD_FILE: &str = "particles.pvd";
@@ -274,12 +276,36 @@ pub fn particle_file_path(dir: &Path, index: usize) -> PathBuf {
     dir.join(PARTICLES_DIR).join(particle_file_name(index))
 }
 
+/// The index of output `index` of a run over several ranks: `particles_NNNNNN.pvtu`.
+pub fn pieces_file_name(index: usize) -> String {
+    format!("particles_{index:06}.pvtu")
+}
+
+/// Rank `rank`'s piece of the output whose `.pvtu` is `pvtu` (a path or a name):
+/// `particles_NNNNNN_pRRRR.vtu` beside it.
+fn piece_of(pvtu: &str, rank: usize) -> String {
+    format!("{}_p{rank:04}.vtu", pvtu.trim_end_matches(".pvtu"))
+}
+
+/// Which piece of a run over several ranks an [`OutputDir`] writes.
+#[derive(Clone, Copy, Debug)]
+pub struct Piece {
+    pub rank: usize,
+    pub ranks: usize,
+}
+
 /// An output directory: owns the snapshot series and creates probe writers.
 #[derive(Debug)]
 pub struct OutputDir {
     dir: PathBuf,
-    /// (time, path relative to `dir` with '/' separators) of every snapshot written so far.
+    /// (time, path relative to `dir` with '/' separators) of every snapshot written so far
+    /// (of a run over several ranks, its `.pvtu`).
     snapshots: Vec<(f64, String)>,
+    /// Set for a run over several ranks: each output is one `.vtu` piece per rank and a
+    /// `.pvtu` naming them (written by rank 0, [`OutputDir::publish_pieces`]).
+    piece: Option<Piece>,
+    /// The further scalars of the last piece written (what the `.pvtu` declares).
+    extra_names: Vec<String>,
 }
 
 impl OutputDir {
@@ -298,7 +324,31 @@ impl OutputDir {
         Ok(OutputDir {
             dir: dir.to_path_buf(),
             snapshots: Vec::new(),
+            piece: None,
+            extra_names: Vec::new(),
         })
+    }
+
+    /// The output directory of rank `piece.rank` of a run over several ranks. Rank 0 creates it
+    /// as [`OutputDir::create`] does; the others only make sure its folders are there (rank 0
+    /// may already be writing into them), and must come after rank 0's.
+    pub fn for_piece(dir: &Path, piece: Piece) -> Result<Self, OutputError> {
+        let mut out = match piece.rank {
+            0 => Self::create(dir)?,
+            _ => {
+                let particles = dir.join(PARTICLES_DIR);
+                std::fs::create_dir_all(&particles)
+                    .map_err(|e| OutputError::io("create directory", &particles, e))?;
+                OutputDir {
+                    dir: dir.to_path_buf(),
+                    snapshots: Vec::new(),
+                    piece: None,
+                    extra_names: Vec::new(),
+                }
+            }
+        };
+        out.piece = Some(piece);
+        Ok(out)
     }
 
     pub fn path(&self) -> &Path {
@@ -319,8 +369,21 @@ impl OutputDir {
     /// atomically, then rewrites DIR/particles.pvd atomically listing every snapshot written so
     /// far (time + relative file). The .vtu is fully written and renamed before the .pvd that
     /// references it. Returns the path of the .vtu.
+    ///
+    /// Of a run over several ranks: writes this rank's piece, `particles_NNNNNN_pRRRR.vtu`, and
+    /// returns its path; the series lists the `.pvtu` that [`OutputDir::publish_pieces`]
+    /// writes once every rank's piece is in place.
     pub fn write_snapshot(&mut self, snap: &Snapshot) -> Result<PathBuf, OutputError> {
         let index = self.snapshots.len();
+        if let Some(piece) = self.piece {
+            let rel = format!("{PARTICLES_DIR}/{}", pieces_file_name(index));
+            let path = self.dir.join(piece_of(&rel, piece.rank));
+            snap.validate(&path)?;
+            write_atomic(&path, |w| vtu::write_vtu(w, snap))?;
+            self.snapshots.push((snap.time_s, rel));
+            self.extra_names = snap.extra.iter().map(|(n, _)| n.to_string()).collect();
+            return Ok(path);
+        }
         let rel = format!("{PARTICLES_DIR}/{}", particle_file_name(index));
         let vtu_path = particle_file_path(&self.dir, index);
         snap.validate(&vtu_path)?;
@@ -333,23 +396,48 @@ impl OutputDir {
         Ok(vtu_path)
     }
 
+    /// Rank 0 of a run over several ranks, once every rank has written its piece of the last
+    /// output: writes that output's `.pvtu`, then the `.pvd` listing it. Nothing on other ranks.
+    pub fn publish_pieces(&self) -> Result<(), OutputError> {
+        let (Some(piece), Some((_, rel))) = (self.piece, self.snapshots.last()) else {
+            return Ok(());
+        };
+        if piece.rank != 0 {
+            return Ok(());
+        }
+        let name = rel.rsplit('/').next().unwrap_or(rel);
+        let pieces: Vec<String> = (0..piece.ranks).map(|r| piece_of(name, r)).collect();
+        let extra: Vec<&str> = self.extra_names.iter().map(String::as_str).collect();
+        write_atomic(&self.dir.join(rel), |w| vtu::write_pvtu(w, &extra, &pieces))?;
+        write_atomic(&self.pvd_path(), |w| pvd::write_pvd(w, &self.snapshots))
+    }
+
     /// Drops the snapshots after `t_s` from the series: their files are removed and the `.pvd`
     /// rewritten (a run stopped unstable keeps what was still sound). Returns the indices of
-    /// the snapshots dropped.
+    /// the snapshots dropped. Of a run over several ranks, each rank removes its pieces and
+    /// rank 0 the `.pvtu` files and the `.pvd`.
     pub fn truncate_after(&mut self, t_s: f64) -> Result<std::ops::Range<usize>, OutputError> {
         let keep = self.snapshots.partition_point(|(t, _)| *t <= t_s);
+        let remove = |file: PathBuf| match std::fs::remove_file(&file) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                Err(OutputError::io("remove", &file, e))
+            }
+            _ => Ok(()),
+        };
+        let index_writer = self.piece.is_none_or(|p| p.rank == 0);
         for (_, rel) in &self.snapshots[keep..] {
-            let file = self.dir.join(rel);
-            match std::fs::remove_file(&file) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                    return Err(OutputError::io("remove", &file, e))
-                }
-                _ => {}
+            if let Some(piece) = self.piece {
+                remove(self.dir.join(piece_of(rel, piece.rank)))?;
+            }
+            if index_writer {
+                remove(self.dir.join(rel))?;
             }
         }
         let dropped = keep..self.snapshots.len();
         self.snapshots.truncate(keep);
-        write_atomic(&self.pvd_path(), |w| pvd::write_pvd(w, &self.snapshots))?;
+        if index_writer {
+            write_atomic(&self.pvd_path(), |w| pvd::write_pvd(w, &self.snapshots))?;
+        }
         Ok(dropped)
     }
 

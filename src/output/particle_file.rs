@@ -4,8 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use super::vtu::reader::Vtu;
-use super::{particle_file_name, OutputError, Snapshot, PARTICLES_DIR};
+use super::vtu::{pvtu_pieces, reader::Vtu};
+use super::{particle_file_name, pieces_file_name, OutputError, Snapshot, PARTICLES_DIR};
 use crate::scenario::Kind;
 
 /// Particles read back for output, in id order.
@@ -84,6 +84,16 @@ impl Particles {
         gather(&picks)
     }
 
+    /// These particles less those of `kind` (of a subdomain, its excluded entries: the
+    /// halo copies of other ranks' particles, and its particles that left the domain).
+    pub fn without_kind(&self, kind: u32) -> Particles {
+        let picks: Vec<(&Particles, usize)> = (0..self.id.len())
+            .filter(|&i| self.kind[i] != kind)
+            .map(|i| (self, i))
+            .collect();
+        gather(&picks)
+    }
+
     /// The snapshot of these particles at `time_s`, with `extra` (e.g. of
     /// [`Particles::extra_arrays`]) as its further scalars.
     pub fn snapshot<'a>(&'a self, time_s: f64, extra: &'a [(&'a str, &'a [f32])]) -> Snapshot<'a> {
@@ -133,12 +143,37 @@ pub struct ParticleFile {
 
 impl ParticleFile {
     /// Reads `path`; errors name it and say what is wrong (cut short, not written by wgsph).
+    /// A `.pvtu` (a run over several ranks) is read as its pieces together, in id order.
     pub fn read(path: &Path) -> Result<Self, OutputError> {
         let bytes = std::fs::read(path).map_err(|e| OutputError::io("read", path, e))?;
-        Self::parse(&bytes).map_err(|reason| OutputError::Read {
+        let failed = |reason| OutputError::Read {
             path: path.to_path_buf(),
             reason,
-        })
+        };
+        if path.extension().is_some_and(|e| e == "pvtu") {
+            let text = String::from_utf8_lossy(&bytes);
+            let folder = path.parent().unwrap_or(Path::new("."));
+            let pieces = pvtu_pieces(&text)
+                .map_err(failed)?
+                .iter()
+                .map(|p| Self::read(&folder.join(p)))
+                .collect::<Result<Vec<_>, _>>()?;
+            return Ok(Self::joined(&pieces));
+        }
+        Self::parse(&bytes).map_err(failed)
+    }
+
+    /// The pieces of one output as one, in id order (the time of the first).
+    fn joined(pieces: &[ParticleFile]) -> Self {
+        let mut picks: Vec<(&Particles, usize)> = pieces
+            .iter()
+            .flat_map(|f| (0..f.particles.id.len()).map(move |i| (&f.particles, i)))
+            .collect();
+        picks.sort_by_key(|(p, i)| p.id[*i]);
+        ParticleFile {
+            time_s: pieces.first().map_or(0.0, |f| f.time_s),
+            particles: gather(&picks),
+        }
     }
 
     fn parse(bytes: &[u8]) -> Result<Self, String> {
@@ -212,13 +247,15 @@ pub fn particle_files(dir: &Path) -> Result<Vec<(usize, PathBuf)>, OutputError> 
         let path = entry
             .map_err(|e| OutputError::io("read", &folder, e))?
             .path();
-        // The names `particle_file_name` gives, and no others.
+        // The names `particle_file_name` and `pieces_file_name` give, and no others (not the
+        // pieces).
         let index = path.file_name().and_then(|n| n.to_str()).and_then(|name| {
-            let digits = name.strip_prefix("particles_")?.strip_suffix(".vtu")?;
+            let stem = name.strip_prefix("particles_")?;
+            let digits = stem.strip_suffix(".vtu").or(stem.strip_suffix(".pvtu"))?;
             digits
                 .parse()
                 .ok()
-                .filter(|&i| particle_file_name(i) == name)
+                .filter(|&i| particle_file_name(i) == name || pieces_file_name(i) == name)
         });
         if let Some(index) = index {
             files.push((index, path));
@@ -329,6 +366,64 @@ mod tests {
             err.contains("particles_000000.vtu") && err.contains("cut short"),
             "{err}"
         );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A run over three ranks: each writes its piece of every output, rank 0 the `.pvtu`
+    /// naming them and the series; the `.pvtu` reads back as the pieces together in id order,
+    /// extra arrays included, and is what `particle_files` lists. Truncating the series
+    /// removes each rank's pieces and rank 0's `.pvtu`.
+    #[test]
+    fn pieces_of_several_ranks_read_back_as_one_output() {
+        use super::super::Piece;
+        let dir = temp_dir("pieces");
+        let all = Particles {
+            id: (0..30).collect(),
+            ..particles(30)
+        };
+        let ranks = 3;
+        let mut outs: Vec<OutputDir> = (0..ranks)
+            .map(|rank| OutputDir::for_piece(&dir, Piece { rank, ranks }).unwrap())
+            .collect();
+        for k in 0..2 {
+            for (rank, out) in outs.iter_mut().enumerate() {
+                // Rank r holds the ids r, r + 3, …, not in id order.
+                let mine: Vec<(&Particles, usize)> = (0..30)
+                    .rev()
+                    .filter(|i| i % ranks == rank)
+                    .map(|i| (&all, i))
+                    .collect();
+                let piece = gather(&mine);
+                let extra = piece.extra_arrays();
+                let extra: Vec<(&str, &[f32])> =
+                    extra.iter().map(|(n, v)| (*n, v.as_slice())).collect();
+                out.write_snapshot(&piece.snapshot(0.5 * k as f64, &extra))
+                    .unwrap();
+            }
+            for out in &outs {
+                out.publish_pieces().unwrap();
+            }
+        }
+        let files = particle_files(&dir).unwrap();
+        assert_eq!(files.len(), 2, "{files:?}");
+        assert!(files[1].1.ends_with("particles/particles_000001.pvtu"));
+        let read = ParticleFile::read(&files[1].1).unwrap();
+        assert_eq!((read.time_s, read.particles), (0.5, all));
+        let pvd = std::fs::read_to_string(dir.join("particles.pvd")).unwrap();
+        assert!(
+            pvd.contains("file=\"particles/particles_000001.pvtu\""),
+            "{pvd}"
+        );
+        for out in &mut outs {
+            assert_eq!(out.truncate_after(0.25).unwrap(), 1..2);
+        }
+        let left: Vec<String> = std::fs::read_dir(dir.join(PARTICLES_DIR))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.contains("000001"))
+            .collect();
+        assert!(left.is_empty(), "{left:?}");
+        assert_eq!(particle_files(&dir).unwrap().len(), 1);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

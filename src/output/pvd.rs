@@ -21,7 +21,7 @@ pub(crate) fn write_pvd(w: &mut dyn Write, snapshots: &[(f64, String)]) -> io::R
     w.write_all(b"  </Collection>\n</VTKFile>\n")
 }
 
-fn xml_escape(s: &str) -> String {
+pub(crate) fn xml_escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {

@@ -57,6 +57,25 @@ pub struct RunSummary {
     /// --snapshots` loads the case from it with `overrides` to draw the particle files.
     #[serde(default)]
     pub case_file: Option<String>,
+    /// A run over several ranks: each rank's part, in rank order (absent for one whole run).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ranks: Option<Vec<RankSummary>>,
+}
+
+/// One rank's part of a run over several ranks (`run.json`, `wgsph bench` under mpirun).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RankSummary {
+    pub adapter: String,
+    /// The particles this rank owned at the end.
+    pub own_particles: u64,
+    /// Halo copies, migrants and their bytes sent to the neighbours, per step.
+    pub halo_particles_per_step: f64,
+    pub migrants_per_step: f64,
+    pub halo_bytes_per_step: f64,
+    /// Wall seconds per step in each part of the step.
+    pub seconds_per_step: crate::sph::subdomain::Split,
+    /// Times the cuts moved.
+    pub rebalances: u32,
 }
 
 impl RunSummary {
@@ -91,6 +110,7 @@ mod tests {
             overrides: Some(vec!["time.end_s=1".into()]),
             fingerprint: Some("0123456789abcdef".into()),
             case_file: Some("/cases/x.toml".into()),
+            ranks: None,
             case: "dam_break_2d".into(),
             adapter: "NVIDIA H100 \"quoted\"".into(),
             backend: "Vulkan".into(),

@@ -58,6 +58,19 @@ impl<'a> ArrayDecl<'a> {
         }
     }
 
+    /// The declaration in a `.pvtu` (`PDataArray`: the type and components, no data).
+    fn pxml(&self, indent: &str) -> String {
+        let comps = if self.components > 1 {
+            format!(" NumberOfComponents=\"{}\"", self.components)
+        } else {
+            String::new()
+        };
+        format!(
+            "{indent}<PDataArray type=\"{}\" Name=\"{}\"{comps}/>\n",
+            self.vtk_type, self.name
+        )
+    }
+
     fn data_bytes(&self) -> u64 {
         (self.tuples * self.components * self.elem_size) as u64
     }
@@ -113,6 +126,64 @@ fn write_block<T: LeBytes>(
     Ok(())
 }
 
+/// The per-particle arrays of a particle file (after its points), for `n` particles.
+fn particle_arrays(n: usize) -> [ArrayDecl<'static>; 5] {
+    [
+        ArrayDecl::new::<f32>("velocity", 3, n),
+        ArrayDecl::new::<f32>("density", 1, n),
+        ArrayDecl::new::<f32>("pressure", 1, n),
+        ArrayDecl::new::<u32>("kind", 1, n),
+        ArrayDecl::new::<u32>("id", 1, n),
+    ]
+}
+
+/// Writes the `.pvtu` of one output of a run over several ranks: the arrays every piece holds
+/// (as [`write_vtu`] writes them, with the further scalars `extra`) and the pieces' files
+/// (relative to the `.pvtu`), so that ParaView opens the pieces as one data set.
+pub(crate) fn write_pvtu(w: &mut dyn Write, extra: &[&str], pieces: &[String]) -> io::Result<()> {
+    let mut xml = String::with_capacity(1024);
+    xml.push_str("<?xml version=\"1.0\"?>\n");
+    xml.push_str(
+        "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n",
+    );
+    xml.push_str("  <PUnstructuredGrid GhostLevel=\"0\">\n");
+    xml.push_str("    <PPointData Scalars=\"density\" Vectors=\"velocity\">\n");
+    let mut decls: Vec<ArrayDecl> = particle_arrays(0).into();
+    decls.extend(extra.iter().map(|name| ArrayDecl::new::<f32>(name, 1, 0)));
+    for d in decls {
+        xml.push_str(&d.pxml("      "));
+    }
+    xml.push_str("    </PPointData>\n    <PPoints>\n");
+    xml.push_str(&ArrayDecl::new::<f64>("Points", 3, 0).pxml("      "));
+    xml.push_str("    </PPoints>\n");
+    for piece in pieces {
+        xml.push_str(&format!(
+            "    <Piece Source=\"{}\"/>\n",
+            super::pvd::xml_escape(piece)
+        ));
+    }
+    xml.push_str("  </PUnstructuredGrid>\n</VTKFile>\n");
+    w.write_all(xml.as_bytes())
+}
+
+/// The `Source` of every piece a `.pvtu` written by [`write_pvtu`] names, in order.
+pub(crate) fn pvtu_pieces(text: &str) -> Result<Vec<String>, String> {
+    if !text.contains("type=\"PUnstructuredGrid\"") {
+        return Err("not a PUnstructuredGrid file".into());
+    }
+    let pieces: Vec<String> = text
+        .lines()
+        .filter_map(|l| {
+            let rest = l.trim_start().strip_prefix("<Piece Source=\"")?;
+            Some(rest[..rest.find('"')?].to_string())
+        })
+        .collect();
+    if pieces.is_empty() {
+        return Err("it names no pieces".into());
+    }
+    Ok(pieces)
+}
+
 /// Writes a complete `.vtu` for `snap` (arrays must all have `snap.len()` entries).
 pub(crate) fn write_vtu(w: &mut dyn Write, snap: &Snapshot) -> io::Result<()> {
     let n = snap.len();
@@ -127,11 +198,7 @@ pub(crate) fn write_vtu(w: &mut dyn Write, snap: &Snapshot) -> io::Result<()> {
     };
 
     let time = ArrayDecl::new::<f64>("TimeValue", 1, 1);
-    let velocity = ArrayDecl::new::<f32>("velocity", 3, n);
-    let density = ArrayDecl::new::<f32>("density", 1, n);
-    let pressure = ArrayDecl::new::<f32>("pressure", 1, n);
-    let kind = ArrayDecl::new::<u32>("kind", 1, n);
-    let id = ArrayDecl::new::<u32>("id", 1, n);
+    let [velocity, density, pressure, kind, id] = particle_arrays(n);
     let points = ArrayDecl::new::<f64>("Points", 3, n);
     let connectivity = index_decl("connectivity");
     let offsets = index_decl("offsets");

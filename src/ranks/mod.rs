@@ -38,6 +38,31 @@ pub trait Ranks {
     /// Sends each `(rank, bytes)` and returns what each of `from` sent this rank, in `from`'s
     /// order. Every rank must call it, and each rank in `from` must send to this one.
     fn exchange(&self, sends: &[(usize, Vec<u8>)], from: &[usize]) -> Result<Vec<Vec<u8>>>;
+
+    /// Says which rank failed and why on standard error, then ends every rank of the job (the
+    /// others would wait for this one forever).
+    fn abort(&self, why: &anyhow::Error) -> !;
+
+    /// Returns once every rank has called it.
+    fn barrier(&self) {
+        self.min(0.0);
+    }
+
+    /// Every rank's `text` in rank order, on rank 0; the other ranks get nothing.
+    fn gather_text(&self, text: &str) -> Result<Vec<String>> {
+        let others: Vec<usize> = (1..self.size()).collect();
+        let received = match self.rank() {
+            0 => self.exchange(&[], &others)?,
+            _ => {
+                self.exchange(&[(0, text.as_bytes().to_vec())], &[])?;
+                return Ok(Vec::new());
+            }
+        };
+        let texts = received
+            .iter()
+            .map(|b| String::from_utf8_lossy(b).into_owned());
+        Ok(std::iter::once(text.to_string()).chain(texts).collect())
+    }
 }
 
 /// How many ranks the launcher started this process among: OpenMPI's `OMPI_COMM_WORLD_SIZE`,
@@ -48,21 +73,20 @@ pub fn launched_size() -> Option<usize> {
         .find_map(|v| std::env::var(v).ok()?.trim().parse().ok())
 }
 
-/// Refuses a launch over several ranks of what cannot run split yet: `run` and `resume` (the
-/// subdomains step, but their outputs, probes and checkpoints are not built: N copies would
-/// each run the whole case into the same folder), and `bench` in a build without MPI. One rank
-/// under a launcher runs as without it.
+/// Refuses a launch over several ranks of what cannot run split yet: `resume` (a run over
+/// several ranks writes no checkpoints yet: N copies would each continue the whole case in the
+/// same folder), and `run` and `bench` in a build without MPI. One rank under a launcher runs
+/// as without it.
 pub fn refuse_several_ranks(command: &str) -> Result<()> {
     match launched_size() {
-        Some(n) if n > 1 && command == "bench" && !cfg!(feature = "mpi") => anyhow::bail!(
-            "`wgsph bench` was launched on {n} ranks, but this wgsph was built without MPI: \
-             build it with `cargo build --release --features mpi` (README: several ranks)"
+        Some(n) if n > 1 && command != "resume" && !cfg!(feature = "mpi") => anyhow::bail!(
+            "`wgsph {command}` was launched on {n} ranks, but this wgsph was built without \
+             MPI: build it with `cargo build --release --features mpi` (README: several ranks)"
         ),
-        Some(n) if n > 1 && command != "bench" => anyhow::bail!(
-            "`wgsph {command}` was launched on {n} ranks, but a run cannot be split over ranks \
-             yet: its subdomains step together (`mpirun -np {n} wgsph bench` runs them), but \
-             their outputs, probes and checkpoints do not exist; launch it with -np 1 or \
-             without mpirun"
+        Some(n) if n > 1 && command == "resume" => anyhow::bail!(
+            "`wgsph resume` was launched on {n} ranks, but a run over several ranks writes no \
+             checkpoints yet, so there is none to resume from: launch it with -np 1 or \
+             without mpirun to resume a run made on one"
         ),
         _ => Ok(()),
     }
@@ -94,6 +118,11 @@ impl Ranks for Single {
             "a single rank has no neighbours to swap halos with"
         );
         Ok(Vec::new())
+    }
+
+    fn abort(&self, why: &anyhow::Error) -> ! {
+        eprintln!("error: {why:#}");
+        std::process::exit(1)
     }
 }
 

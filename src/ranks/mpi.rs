@@ -24,12 +24,6 @@ impl Mpi {
             _universe: universe,
         })
     }
-
-    /// Says which rank failed and why on standard error, then ends every rank of the job.
-    pub fn abort(&self, why: &anyhow::Error) -> ! {
-        eprintln!("rank {} of {}: {why:#}", self.rank(), self.size());
-        self.world.abort(1)
-    }
 }
 
 impl Ranks for Mpi {
@@ -39,6 +33,11 @@ impl Ranks for Mpi {
 
     fn size(&self) -> usize {
         self.world.size() as usize
+    }
+
+    fn abort(&self, why: &anyhow::Error) -> ! {
+        eprintln!("rank {} of {}: {why:#}", self.rank(), self.size());
+        self.world.abort(1)
     }
 
     fn min(&self, x: f64) -> f64 {

@@ -24,6 +24,7 @@ pub mod params;
 pub mod passes;
 pub mod probes;
 pub mod profile;
+mod ranked_probes;
 mod readback;
 pub mod shader;
 pub mod state;
@@ -440,8 +441,9 @@ impl Solver {
         st
     }
 
-    /// Advances to exactly `t_target` (the last step is shortened to land on it).
-    pub fn advance_to(&mut self, t_target: f64) -> Result<()> {
+    /// Sets the GPU state for steps up to `t_target` (the first of them as the GPU's
+    /// `timestep` would choose it).
+    fn start_targeted(&mut self, t_target: f64) {
         let mut st = self.rebased_state();
         let remaining = t_target - self.t_base;
         st.t_target_rel = remaining as f32;
@@ -453,19 +455,35 @@ impl Solver {
         self.queue
             .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&st));
         self.state = st;
+    }
+
+    /// The steps to record at once on the way to the target time: enough to arrive at the
+    /// present dt, and one more. Steps recorded past the arrival take dt = 0: they move nothing
+    /// but sort and compute the rates, and the time step, at the state arrived at, from which
+    /// the next interval starts.
+    fn batch_to_target(&self) -> u32 {
+        let left = (self.state.t_target_rel - self.state.t_rel).max(0.0);
+        ((left / self.state.dt_cfl.max(1e-30)).ceil() as u32 + 1).clamp(1, MAX_BATCH)
+    }
+
+    /// Arrived at `t_target`: the host clock takes it exactly (the GPU's f32 clock is re-based
+    /// on the next call anyway).
+    fn arrive(&mut self, t_target: f64) {
+        self.t_base = self.t_base.max(t_target);
+        self.state.t_rel = 0.0;
+    }
+
+    /// Advances to exactly `t_target` (the last step is shortened to land on it).
+    pub fn advance_to(&mut self, t_target: f64) -> Result<()> {
+        self.start_targeted(t_target);
         while self.state.dt > 0.0 {
-            let left = (self.state.t_target_rel - self.state.t_rel).max(0.0);
-            let batch =
-                ((left / self.state.dt_cfl.max(1e-30)).ceil() as u32 + 1).clamp(1, MAX_BATCH);
+            let batch = self.batch_to_target();
             let before = self.state.steps;
             self.take_steps(batch)?;
             self.steps += (self.state.steps - before) as u64;
             self.check_stability()?;
         }
-        // Arrived: the host clock takes the exact target (the GPU's f32 clock is re-based on
-        // the next call anyway).
-        self.t_base = self.t_base.max(t_target);
-        self.state.t_rel = 0.0;
+        self.arrive(t_target);
         Ok(())
     }
 
@@ -631,22 +649,18 @@ impl Solver {
             self.queue
                 .write_buffer(&self.buffers.probes, 0, bytemuck::cast_slice(&defs));
         }
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("probes"),
-            });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
         self.passes
             .probes
             .encode(&mut encoder, &self.buffers, self.parity);
         self.queue.submit([encoder.finish()]);
-        let raw = read::<u32>(
-            &self.device,
-            &self.queue,
-            &self.buffers.probe_out,
-            self.params.n_probes as usize,
-        )?;
-        Ok(self.passes.probes.decode(&raw))
+        Ok(self.passes.probes.decode(&self.probe_words()?))
+    }
+
+    /// The probes' raw words (`probe_out`) as the last encoding left them.
+    fn probe_words(&self) -> Result<Vec<u32>> {
+        let n = self.params.n_probes as usize;
+        read::<u32>(&self.device, &self.queue, &self.buffers.probe_out, n)
     }
 
     /// World positions of the tracked points (`Scenario::points`, in order) at the current

@@ -273,9 +273,20 @@ impl Probes {
 
     /// Records the probe evaluation on the arrays of parity `p` (cell list must be current).
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, b: &ParticleBuffers, p: usize) {
+        self.encode_particles(encoder, b, p);
+        self.encode_continuous(encoder, p);
+    }
+
+    /// What each probe reads from the particles: the gauges, the points and wall patches, the
+    /// fronts and the continuous fronts' wet bins. Of a subdomain, its own particles' share.
+    pub fn encode_particles(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        b: &ParticleBuffers,
+        p: usize,
+    ) {
         encoder.clear_buffer(&b.probe_out, 0, None);
-        let continuous = self.kinds.contains(&PROBE_FRONT_CONTINUOUS);
-        if continuous {
+        if self.has_continuous() {
             encoder.clear_buffer(&self.front_bins, 0, None);
         }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -288,14 +299,39 @@ impl Probes {
             self.height.dispatch(&mut pass, p, self.n);
         }
         self.points.dispatch(&mut pass, p, self.kinds.len() as u32);
-        if continuous || self.kinds.contains(&PROBE_FRONT) {
+        if self.has_continuous() || self.kinds.contains(&PROBE_FRONT) {
             self.front.dispatch(&mut pass, p, self.n);
         }
-        if continuous {
-            self.front_walk
-                .dispatch(&mut pass, p, self.kinds.len() as u32);
-            self.front_continuous.dispatch(&mut pass, p, self.n);
+    }
+
+    /// The continuous fronts from their wet bins (all of them: of a subdomain, the ranks'
+    /// bins together, [`Probes::front_bins`]).
+    pub fn encode_continuous(&self, encoder: &mut wgpu::CommandEncoder, p: usize) {
+        if !self.has_continuous() {
+            return;
         }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("continuous fronts"),
+            timestamp_writes: None,
+        });
+        self.front_walk
+            .dispatch(&mut pass, p, self.kinds.len() as u32);
+        self.front_continuous.dispatch(&mut pass, p, self.n);
+    }
+
+    pub fn has_continuous(&self) -> bool {
+        self.kinds.contains(&PROBE_FRONT_CONTINUOUS)
+    }
+
+    /// The continuous fronts' bits of wet bins.
+    pub fn front_bins(&self) -> &wgpu::Buffer {
+        &self.front_bins
+    }
+
+    /// Whether probe `k` is a front: a maximum over the fluid, whose words combine over ranks
+    /// by their maximum (`ordered_bits` keeps the order of the values).
+    pub fn is_front(&self, k: usize) -> bool {
+        matches!(self.kinds[k], PROBE_FRONT | PROBE_FRONT_CONTINUOUS)
     }
 
     /// Values from the raw words read back.

@@ -9,18 +9,21 @@
 //! slot by id, so an own particle sums the same neighbours in the same order as in one whole
 //! run: the ranks' particles together are bit-identical to it (tests/mpi.rs).
 
+use std::ops::Range;
+
 use anyhow::{bail, ensure, Result};
 
 use super::halo;
 use super::initial::Packed;
 use super::profile::Recorder;
 use super::Solver;
-use crate::decomposition::Slabs;
+use crate::decomposition::{probe_layers, Slabs};
 use crate::gpu::GpuContext;
 use crate::grid::Grid;
 use crate::layout::{unpack_block, HaloCtl, HaloRecord, Pos, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
+use crate::output::RankSummary;
 use crate::ranks::Ranks;
-use crate::scenario::{DensityFilter, Kind, Scenario};
+use crate::scenario::{DensityFilter, Kind, OutputBoundary, Scenario};
 
 /// A subdomain's counts, over all ranks where they say so.
 #[derive(Clone, Debug, Default)]
@@ -42,13 +45,18 @@ pub struct Ranked {
     /// The present cuts (set once the subdomain is made), and how often they moved.
     pub slabs: Option<Slabs>,
     pub rebalances: u32,
+    /// The whole run's steps when these counts were taken.
+    pub steps: u64,
+    /// The cell layers each probe reads (`decomposition::probe_layers`; none for fronts): the
+    /// rank that owns them samples it.
+    pub(super) probe_layers: Vec<Option<Range<u32>>>,
 }
 
 /// Steps between two looks at the ranks' balance (`Solver::rebalance`).
 pub const REBALANCE_EVERY: u64 = 100;
 
 /// Where a subdomain's step time goes, in seconds summed over steps.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Split {
     /// The GPU up to the exchange (predictors, packing) and reading the records back.
     pub pack: f64,
@@ -113,6 +121,11 @@ fn unsupported(sc: &Scenario) -> Vec<&'static str> {
             "the density filter (it needs a second exchange a step)",
         ),
         (sc.physics.energy, "the energy equation"),
+        (!sc.points.is_empty(), "tracked points"),
+        (
+            sc.time.output_boundary == OutputBoundary::First,
+            "time.output_boundary = \"first\"",
+        ),
     ]
     .into_iter()
     .filter_map(|(yes, what)| yes.then_some(what))
@@ -182,7 +195,19 @@ impl Solver {
         );
         let ctl = halo::control(slabs, ranks.rank());
         let mut solver = Self::build(ctx, sc, Some(ctl))?;
-        solver.ranked.as_mut().expect("a subdomain").slabs = Some(slabs.clone());
+        let probes = probe_layers(sc, &solver.grid, slabs.axis)?;
+        for (p, layers) in sc.probes.iter().zip(&probes) {
+            if let Some(l) = layers.clone().filter(|l| !l.is_empty()) {
+                ensure!(
+                    slabs.owner(l.start) == slabs.owner(l.end - 1),
+                    "probe '{}' reads cell layers {l:?}, which the cuts {slabs:?} split",
+                    p.name
+                );
+            }
+        }
+        let ranked = solver.ranked.as_mut().expect("a subdomain");
+        ranked.slabs = Some(slabs.clone());
+        ranked.probe_layers = probes;
         solver.ranked_step(ranks)?;
         solver.initial_dt = solver.state.dt_cfl;
         Ok(solver)
@@ -193,14 +218,39 @@ impl Solver {
     pub fn run_steps_ranked(&mut self, count: u64, ranks: &dyn Ranks) -> Result<()> {
         self.start_untargeted();
         for _ in 0..count {
-            let before = self.state.steps;
-            self.ranked_step(ranks)?;
-            self.steps += (self.state.steps - before) as u64;
-            if self.steps.is_multiple_of(REBALANCE_EVERY) {
-                self.rebalance(ranks)?;
-            }
+            self.step_and_balance(ranks)?;
         }
         self.check_stability()
+    }
+
+    /// Advances every rank together to exactly `t_target` as [`Solver::advance_to`] advances
+    /// one whole run: the same steps (the ranks agree on each) in the same batches, the steps
+    /// of a batch past the arrival included (`batch_to_target`: they compute the rates the
+    /// next interval starts from); looks at the balance every [`REBALANCE_EVERY`] steps.
+    pub fn advance_to_ranked(&mut self, t_target: f64, ranks: &dyn Ranks) -> Result<()> {
+        self.start_targeted(t_target);
+        while self.state.dt > 0.0 {
+            for _ in 0..self.batch_to_target() {
+                self.step_and_balance(ranks)?;
+            }
+            self.check_stability()?;
+        }
+        self.arrive(t_target);
+        Ok(())
+    }
+
+    /// One step of every rank, and the balance looked at every [`REBALANCE_EVERY`] steps
+    /// taken (a step of dt = 0 is not one).
+    fn step_and_balance(&mut self, ranks: &dyn Ranks) -> Result<()> {
+        let before = self.state.steps;
+        self.ranked_step(ranks)?;
+        let taken = (self.state.steps - before) as u64;
+        self.steps += taken;
+        self.ranked.as_mut().expect("a subdomain").steps = self.steps;
+        if taken > 0 && self.steps.is_multiple_of(REBALANCE_EVERY) {
+            self.rebalance(ranks)?;
+        }
+        Ok(())
     }
 
     /// Moves the cuts to where the ranks' present load balances, if the most loaded rank is
@@ -283,6 +333,51 @@ impl Solver {
         ranked.slabs = Some(next);
         ranked.rebalances += 1;
         self.faults.check()
+    }
+
+    /// Every rank's part of the steps since `since` (this rank's counts then), in rank order,
+    /// on every rank; the adapters' names on rank 0 only (empty elsewhere). Every rank
+    /// together.
+    pub fn rank_summaries(
+        &self,
+        since: &Ranked,
+        adapter: &str,
+        ranks: &dyn Ranks,
+    ) -> Result<Vec<RankSummary>> {
+        let now = self.ranked.as_ref().expect("a subdomain");
+        let steps = (self.steps - since.steps).max(1) as f64;
+        let per = |x: u64, x0: u64| (x - x0) as f64 / steps;
+        let split = now.split - since.split;
+        let mine = [
+            now.owned as f64,
+            per(now.halo_sent, since.halo_sent),
+            per(now.migrants_sent, since.migrants_sent),
+            per(now.bytes_sent, since.bytes_sent),
+            split.pack / steps,
+            split.exchange / steps,
+            split.compute / steps,
+            split.agree / steps,
+            (now.rebalances - since.rebalances) as f64,
+        ];
+        let mut adapters = ranks.gather_text(adapter)?.into_iter();
+        Ok(ranks
+            .gather(&mine)
+            .into_iter()
+            .map(|v| RankSummary {
+                adapter: adapters.next().unwrap_or_default(),
+                own_particles: v[0] as u64,
+                halo_particles_per_step: v[1],
+                migrants_per_step: v[2],
+                halo_bytes_per_step: v[3],
+                seconds_per_step: Split {
+                    pack: v[4],
+                    exchange: v[5],
+                    compute: v[6],
+                    agree: v[7],
+                },
+                rebalances: v[8] as u32,
+            })
+            .collect())
     }
 
     /// This rank's counts (halo and migrants sent), if it is a subdomain.

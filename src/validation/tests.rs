@@ -38,6 +38,7 @@ fn summary(case: &str, excluded: u64) -> RunSummary {
         overrides: None,
         fingerprint: None,
         case_file: None,
+        ranks: None,
     }
 }
 

@@ -1,0 +1,60 @@
+//! The probes of a run over several ranks (issue 32), each rank sampling its own particles.
+//!
+//! A point probe, a gauge or a wall patch reads only the cell layers `probe_layers` names, and
+//! the cuts never split them (`Slabs::balanced_keeping`): the rank that owns those layers holds
+//! every particle the probe reads, in the order one whole run holds them, and gives its value
+//! bit for bit. A front is the largest reach over the fluid: the ranks' words combine by their
+//! maximum, and a continuous front's wet bins by their union before the walk — exact too.
+
+use anyhow::Result;
+
+use super::Solver;
+use crate::gpu::buffers::read;
+use crate::ranks::Ranks;
+
+impl Solver {
+    /// Samples every probe at the current time, every rank together; each rank gets the
+    /// values one whole run would give.
+    pub fn sample_probes_ranked(&self, ranks: &dyn Ranks) -> Result<Vec<f64>> {
+        let probes = &self.passes.probes;
+        if probes.is_empty() {
+            return Ok(Vec::new());
+        }
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        probes.encode_particles(&mut encoder, &self.buffers, self.parity);
+        self.queue.submit([encoder.finish()]);
+        if probes.has_continuous() {
+            self.unite_front_bins(ranks)?;
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            probes.encode_continuous(&mut encoder, self.parity);
+            self.queue.submit([encoder.finish()]);
+        }
+        let mine: Vec<f64> = self.probe_words()?.iter().map(|&w| w as f64).collect();
+        let all = ranks.gather(&mine);
+        let ranked = self.ranked.as_ref().expect("a subdomain");
+        let slabs = ranked.slabs.as_ref().expect("a subdomain's cuts");
+        let words: Vec<u32> = (0..mine.len())
+            .map(|k| match &ranked.probe_layers[k] {
+                _ if probes.is_front(k) => all.iter().map(|w| w[k] as u32).max().unwrap_or(0),
+                Some(layers) => all[slabs.owner(layers.start)][k] as u32,
+                None => unreachable!("every probe but a front reads some layers"),
+            })
+            .collect();
+        Ok(probes.decode(&words))
+    }
+
+    /// Replaces every rank's wet bins of the continuous fronts by the union of all ranks'.
+    fn unite_front_bins(&self, ranks: &dyn Ranks) -> Result<()> {
+        let buffer = self.passes.probes.front_bins();
+        let n = (buffer.size() / 4) as usize;
+        let mine = read::<u32>(&self.device, &self.queue, buffer, n)?;
+        let mine: Vec<f64> = mine.iter().map(|&w| w as f64).collect();
+        let all = ranks.gather(&mine);
+        let union: Vec<u32> = (0..n)
+            .map(|w| all.iter().fold(0, |u, r| u | r[w] as u32))
+            .collect();
+        self.queue
+            .write_buffer(buffer, 0, bytemuck::cast_slice(&union));
+        Ok(())
+    }
+}
