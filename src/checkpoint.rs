@@ -125,6 +125,26 @@ pub struct Checkpoint {
     pub time_s: f64,
     pub outputs: OutputState,
     pub solver: SolverState,
+    /// Of a run over several ranks: this rank's part (its `solver` is its subdomain's).
+    pub subdomain: Option<RankCheckpoint>,
+}
+
+/// A rank's part of the checkpoint of a run over several ranks. Rank 0's is `checkpoint.bin`,
+/// written last: the manifest, naming the generation (one of two alternating sets) of the
+/// other ranks' files ([`rank_checkpoint_file`]) that belong with it. A run killed while
+/// checkpointing keeps the last complete set: the manifest still names the other one.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RankCheckpoint {
+    pub rank: usize,
+    pub ranks: usize,
+    pub generation: u32,
+    pub ranked: crate::sph::subdomain::Ranked,
+}
+
+/// The checkpoint file of rank `rank` (> 0) of a run over several ranks, in generation
+/// `generation` (0 or 1).
+pub fn rank_checkpoint_file(rank: usize, generation: u32) -> String {
+    format!("checkpoint_g{generation}_p{rank:04}.bin")
 }
 
 #[derive(Serialize, Deserialize)]
@@ -155,6 +175,8 @@ struct Header {
     initial_dt_bits: u32,
     filter_last: u32,
     body_bits: Vec<u64>,
+    #[serde(default)]
+    subdomain: Option<RankCheckpoint>,
     /// (name, bytes) of the binary sections, in file order.
     sections: Vec<(String, u64)>,
 }
@@ -279,6 +301,7 @@ impl Checkpoint {
             initial_dt_bits: s.initial_dt.to_bits(),
             filter_last: s.filter_last,
             body_bits: s.bodies.iter().map(|x| x.to_bits()).collect(),
+            subdomain: self.subdomain.clone(),
             sections: sections
                 .iter()
                 .map(|(n, b)| (n.to_string(), b.len() as u64))
@@ -401,6 +424,7 @@ impl Checkpoint {
                 solid,
                 bodies: h.body_bits.into_iter().map(f64::from_bits).collect(),
             },
+            subdomain: h.subdomain,
         })
     }
 }
@@ -515,6 +539,7 @@ mod tests {
                 ),
                 bodies: vec![1.0 / 7.0; crate::body::SAVED_PER_BODY],
             },
+            subdomain: None,
         }
     }
 
@@ -583,6 +608,24 @@ mod tests {
         no_energy.solver.solid = None;
         no_energy.write(&path).unwrap();
         assert_eq!(Checkpoint::read(&path).unwrap(), no_energy);
+        // A rank's part of a run over ranks: its counts and cuts.
+        let mut ranked = crate::sph::subdomain::Ranked::default();
+        ranked.halo_sent = 12_345;
+        ranked.bytes_sent = 790_080;
+        ranked.owned = 2_000;
+        ranked.rebalances = 3;
+        ranked.slabs = Some(crate::decomposition::Slabs::balanced(1, &[1.0; 9], 3, 1).unwrap());
+        let rank = Checkpoint {
+            subdomain: Some(RankCheckpoint {
+                rank: 2,
+                ranks: 3,
+                generation: 1,
+                ranked,
+            }),
+            ..c
+        };
+        rank.write(&path).unwrap();
+        assert_eq!(Checkpoint::read(&path).unwrap(), rank);
         std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 

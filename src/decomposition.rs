@@ -117,7 +117,7 @@ pub fn probe_layers(sc: &Scenario, grid: &Grid, axis: usize) -> Result<Vec<Optio
 
 /// Slabs along one axis of the global grid: rank r owns the cell layers `bounds[r] ..
 /// bounds[r + 1]`.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Slabs {
     pub axis: usize,
     bounds: Vec<u32>,

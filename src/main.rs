@@ -317,7 +317,9 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             };
             #[cfg(feature = "mpi")]
             if wgsph::ranks::launched_size().is_some_and(|n| n > 1) {
-                return run_ranked(cli.adapter, &sc, &dir, &options, quiet, bars);
+                return on_ranks(cli.adapter, &dir, quiet, bars, |ctx, progress, ranks| {
+                    wgsph::run::run_on_ranks(ctx, &sc, &dir, &options, progress, ranks)
+                });
             }
             let ctx = context(cli.adapter)?;
             let report = wgsph::run::run(&ctx, &sc, &dir, &options, &mut *progress(quiet, bars))?;
@@ -603,17 +605,16 @@ fn bench_ranked(
     Ok(ExitCode::SUCCESS)
 }
 
-/// `mpirun -np N wgsph run CASE`: the case cut into one slab per rank, every rank on its
-/// adapter (named on stderr), rank 0 reporting; the other ranks log warnings only. A rank that
-/// fails ends the job, naming itself.
+/// `mpirun -np N wgsph run|resume`: `go` on every rank, each on its adapter (named on stderr),
+/// rank 0 reporting; the other ranks log warnings only. A rank that fails ends the job, naming
+/// itself.
 #[cfg(feature = "mpi")]
-fn run_ranked(
+fn on_ranks(
     adapter: Option<AdapterChoice>,
-    sc: &wgsph::scenario::Scenario,
     dir: &std::path::Path,
-    options: &RunOptions,
     quiet: bool,
     bars: &MultiProgress,
+    go: impl FnOnce(&GpuContext, &mut dyn Progress, &dyn wgsph::ranks::Ranks) -> Result<RunReport>,
 ) -> Result<ExitCode> {
     use wgsph::ranks::{Mpi, Ranks};
     let ranks = Mpi::init().ok_or_else(|| anyhow::anyhow!("MPI was initialised twice"))?;
@@ -628,7 +629,7 @@ fn run_ranked(
             0 => progress(quiet, bars),
             _ => Box::new(LogLines::default()),
         };
-        wgsph::run::run_on_ranks(&ctx, sc, dir, options, &mut *progress, &ranks)
+        go(&ctx, &mut *progress, &ranks)
     })();
     match result {
         Ok(report) => Ok(finish(&report, dir, quiet || rank != 0)),
@@ -652,11 +653,17 @@ fn resume(
         }
         ResumePlan::Continue { scenario, options } => (scenario, options),
     };
-    let ctx = context(adapter)?;
     let options = RunOptions {
         interrupt: Some(interrupt_flag()?),
         ..options
     };
+    #[cfg(feature = "mpi")]
+    if wgsph::ranks::launched_size().is_some_and(|n| n > 1) {
+        return on_ranks(adapter, dir, quiet, bars, |ctx, progress, ranks| {
+            wgsph::run::resume_on_ranks(ctx, &sc, dir, &options, progress, ranks)
+        });
+    }
+    let ctx = context(adapter)?;
     let report = wgsph::run::resume(&ctx, &sc, dir, &options, &mut *progress(quiet, bars))?;
     Ok(finish(&report, dir, quiet))
 }

@@ -11,7 +11,8 @@ use anyhow::{bail, Context, Result};
 
 use crate::body;
 use crate::checkpoint::{
-    fingerprint, CaseSource, Checkpoint, CheckpointPolicy, OutputState, CHECKPOINT_FILE,
+    fingerprint, rank_checkpoint_file, CaseSource, Checkpoint, CheckpointPolicy, OutputState,
+    RankCheckpoint, CHECKPOINT_FILE,
 };
 use crate::decomposition::slabs_for;
 use crate::gpu::GpuContext;
@@ -262,7 +263,14 @@ fn remove_previous_outputs(dir: &Path) -> Result<()> {
         .map(|f| dir.join(f))
         .filter(|p| p.is_file())
         .collect();
+    // The rank files of a run over several ranks' checkpoints.
+    let rank_checkpoints = std::fs::read_dir(dir).into_iter().flatten().flatten();
+    stale.extend(rank_checkpoints.map(|e| e.path()).filter(|p| {
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+        name.starts_with("checkpoint_g") && name.ends_with(".bin") && p.is_file()
+    }));
     for (sub, ext) in [
+        (PARTICLES_DIR, "pvtu"),
         (PARTICLES_DIR, "vtu"),
         (PROBES_DIR, "csv"),
         (SNAPSHOTS_DIR, "png"),
@@ -307,9 +315,10 @@ pub fn run(
 /// Runs `sc` split over `ranks` (issue 32; every rank calls this together, each on its own
 /// `ctx`), into the one folder `dir`: each rank writes its piece of every particle output,
 /// rank 0 the `.pvtu` naming the pieces, the series, the probes' tables (the values one whole
-/// run gives) and run.json with every rank's part. No checkpoints yet: an interrupted run
-/// cannot be resumed. A rank that fails otherwise than by the run going unstable (which every
-/// rank sees at the same step) ends the job, naming itself.
+/// run gives) and run.json with every rank's part; each rank checkpoints its subdomain
+/// ([`RankCheckpoint`]), and [`resume_on_ranks`] continues from them. A rank that fails
+/// otherwise than by the run going unstable (which every rank sees at the same step) ends the
+/// job, naming itself.
 pub fn run_on_ranks(
     ctx: &GpuContext,
     sc: &Scenario,
@@ -322,14 +331,6 @@ pub fn run_on_ranks(
         bail!(
             "--snapshots draws one device's particles, and a run over several ranks holds them \
              on each: draw them after the run with `wgsph plot DIR --snapshots`"
-        );
-    }
-    if ranks.rank() == 0 {
-        log::warn!(
-            "{}: a run over {} ranks writes no checkpoints yet (issue 32): if it is \
-             interrupted, it cannot be resumed",
-            sc.name,
-            ranks.size()
         );
     }
     start(ctx, sc, dir, options, progress, Some(ranks))
@@ -378,10 +379,86 @@ pub fn resume(
     options: &RunOptions,
     progress: &mut dyn Progress,
 ) -> Result<RunReport> {
+    resume_with(ctx, sc, dir, options, progress, None)
+}
+
+/// Continues the run over `ranks` in `dir` from its checkpoint (every rank together, as many
+/// as wrote it), as [`resume`] continues one whole run: bit-identical to an uninterrupted run
+/// over as many ranks on the same adapters.
+pub fn resume_on_ranks(
+    ctx: &GpuContext,
+    sc: &Scenario,
+    dir: &Path,
+    options: &RunOptions,
+    progress: &mut dyn Progress,
+    ranks: &dyn Ranks,
+) -> Result<RunReport> {
+    resume_with(ctx, sc, dir, options, progress, Some(ranks))
+}
+
+/// This rank's checkpoint in `dir`: `checkpoint.bin` (one whole run, or rank 0 of several,
+/// whose file is the manifest), or the file of rank r of the generation the manifest names.
+/// Errors when the checkpoint is of another case or was written by another number of ranks.
+fn checkpoint_of_rank(dir: &Path, sc: &Scenario, ranks: Option<&dyn Ranks>) -> Result<Checkpoint> {
+    let path = dir.join(CHECKPOINT_FILE);
+    let manifest = Checkpoint::read(&path)?;
+    if manifest.fingerprint != fingerprint(sc) {
+        bail!(
+            "{} was written by a different case than '{}' (particles, physics, walls, probes or \
+             bodies differ); resume with the case file and --set overrides the run started with",
+            path.display(),
+            sc.name
+        );
+    }
+    let written_by = manifest.subdomain.as_ref().map_or(1, |s| s.ranks);
+    let size = ranks.map_or(1, |r| r.size());
+    if written_by != size {
+        bail!(
+            "{} was written by a run over {written_by} rank(s); resume it on as many \
+             (`mpirun -np {written_by} wgsph resume {}`{})",
+            path.display(),
+            dir.display(),
+            if written_by == 1 {
+                ", or without mpirun"
+            } else {
+                ""
+            }
+        );
+    }
+    let (Some(r), Some(part)) = (ranks, &manifest.subdomain) else {
+        return Ok(manifest);
+    };
+    if r.rank() == 0 {
+        return Ok(manifest);
+    }
+    let mine = dir.join(rank_checkpoint_file(r.rank(), part.generation));
+    let ck = Checkpoint::read(&mine)?;
+    if ck.time_s.to_bits() != manifest.time_s.to_bits() || ck.fingerprint != manifest.fingerprint {
+        bail!(
+            "{} (t = {} s) does not belong with {} (t = {} s): the run was stopped while \
+             checkpointing and the files are not of one set",
+            mine.display(),
+            ck.time_s,
+            path.display(),
+            manifest.time_s
+        );
+    }
+    Ok(ck)
+}
+
+/// [`resume`] of one whole run or of every rank of several.
+fn resume_with(
+    ctx: &GpuContext,
+    sc: &Scenario,
+    dir: &Path,
+    options: &RunOptions,
+    progress: &mut dyn Progress,
+    ranks: Option<&dyn Ranks>,
+) -> Result<RunReport> {
+    let first = ranks.is_none_or(|r| r.rank() == 0);
     // Held until this returns: no other run or resume writes here meanwhile. A folder that
     // is not there has no checkpoint either, which Checkpoint::read says.
-    let _lock = dir
-        .is_dir()
+    let _lock = (first && dir.is_dir())
         .then(|| crate::output::DirLock::acquire(dir))
         .transpose()?;
     if let Some(summary) = completed_run(dir, sc) {
@@ -400,16 +477,7 @@ pub fn resume(
             already_complete: true,
         });
     }
-    let path = dir.join(CHECKPOINT_FILE);
-    let ck = Checkpoint::read(&path)?;
-    if ck.fingerprint != fingerprint(sc) {
-        bail!(
-            "{} was written by a different case than '{}' (particles, physics, walls, probes or \
-             bodies differ); resume with the case file and --set overrides the run started with",
-            path.display(),
-            sc.name
-        );
-    }
+    let ck = checkpoint_of_rank(dir, sc, ranks)?;
     if ck.adapter != ctx.info.name {
         log::warn!(
             "resuming on '{}' a run checkpointed on '{}': it continues, but not bit-identically",
@@ -417,12 +485,22 @@ pub fn resume(
             ck.adapter
         );
     }
-    check_capacity(ctx, sc.particles.len())?;
-    let mut runner = Runner::create(ctx, sc, dir, options, None)?;
+    if ranks.is_none() {
+        check_capacity(ctx, sc.particles.len())?;
+    }
+    let mut runner = Runner::create(ctx, sc, dir, options, ranks)?;
     runner
         .solver
         .restore_state(&ck.solver)
         .context("restoring the checkpoint")?;
+    if let (Some(r), Some(part)) = (ranks, &ck.subdomain) {
+        runner
+            .solver
+            .restore_subdomain(&part.ranked, r)
+            .context("restoring the checkpoint's subdomain")?;
+        // The next checkpoint goes to the other set: this one stays until it is complete.
+        runner.generation = 1 - part.generation;
+    }
     let o = ck.outputs;
     runner.outputs.out.resume_series(o.snapshots)?;
     if runner.outputs.boundary_first {
@@ -474,8 +552,9 @@ struct Runner<'a> {
     density: DensityWatch,
     /// The ranks of a run split over several (None: one whole run).
     ranks: Option<&'a dyn Ranks>,
-    /// This rank's counts at the start, of a run over several ranks.
-    ranked_start: crate::sph::subdomain::Ranked,
+    /// Of a run over several ranks: the set the next checkpoint's rank files go to
+    /// ([`RankCheckpoint`]).
+    generation: u32,
 }
 
 /// The weakly-compressible check of a run ([`DensityVariation`]) over each probe interval
@@ -641,7 +720,6 @@ impl<'a> Runner<'a> {
         for w in sc.warnings.iter().filter(|_| first) {
             log::warn!("{}: {w}", sc.name);
         }
-        let ranked_start = solver.ranked().cloned().unwrap_or_default();
         Ok(Self {
             ctx,
             sc,
@@ -664,7 +742,7 @@ impl<'a> Runner<'a> {
             last_checkpoint: None,
             density: DensityWatch::new(sc, 0.0),
             ranks,
-            ranked_start,
+            generation: 0,
         })
     }
 
@@ -704,9 +782,10 @@ impl<'a> Runner<'a> {
         let Some(r) = self.ranks else {
             return Ok(None);
         };
+        // Per step over the whole run (a resumed one's counts go on from its checkpoint).
         let adapter = self.ctx.describe();
-        let since = &self.ranked_start;
-        Ok(Some(self.solver.rank_summaries(since, &adapter, r)?))
+        let since = Default::default();
+        Ok(Some(self.solver.rank_summaries(&since, &adapter, r)?))
     }
 
     fn status(&self) -> RunStatus {
@@ -918,13 +997,14 @@ impl<'a> Runner<'a> {
                 .halt_at_s
                 .is_some_and(|h| self.solver.time() >= h - 1e-12 * sc.time.end_s);
         let end = self.solver.time() >= sc.time.end_s;
+        let mut due = self.checkpoint_due();
         if let Some(r) = self.ranks {
-            // Every rank stops where any one is asked to (a signal reaches them at different
-            // steps); no checkpoint yet.
-            halt = r.min(if halt { 0.0 } else { 1.0 }) == 0.0;
-            return Ok(halt && !end);
+            // Every rank stops, or checkpoints, where any one would (a signal, or a wall-clock
+            // interval, reaches them at different steps).
+            let any = |yes: bool| r.min(if yes { 0.0 } else { 1.0 }) == 0.0;
+            (halt, due) = (any(halt), any(due));
         }
-        if !end && (halt || self.checkpoint_due()) {
+        if !end && (halt || due) {
             self.write_checkpoint()?;
         }
         Ok(halt && !end)
@@ -977,9 +1057,29 @@ impl<'a> Runner<'a> {
                 density_episodes: self.density.episodes,
             },
             solver: self.solver.save_state()?,
+            subdomain: self.ranks.map(|r| RankCheckpoint {
+                rank: r.rank(),
+                ranks: r.size(),
+                generation: self.generation,
+                ranked: self.solver.ranked().cloned().unwrap_or_default(),
+            }),
         };
-        let path = self.outputs.out.path().join(CHECKPOINT_FILE);
-        ck.write(&path)?;
+        let dir = self.outputs.out.path();
+        match self.ranks {
+            None => ck.write(&dir.join(CHECKPOINT_FILE))?,
+            Some(r) => {
+                // The other ranks' files first; rank 0's, the manifest naming them, once
+                // they are all complete.
+                if r.rank() != 0 {
+                    ck.write(&dir.join(rank_checkpoint_file(r.rank(), self.generation)))?;
+                }
+                r.barrier();
+                if r.rank() == 0 {
+                    ck.write(&dir.join(CHECKPOINT_FILE))?;
+                }
+                self.generation = 1 - self.generation;
+            }
+        }
         self.last_checkpoint = Some(ck.time_s);
         self.last_checkpoint_wall = Instant::now();
         log::debug!("checkpoint at t = {:.6} s", ck.time_s);
@@ -1001,6 +1101,9 @@ mod tests {
             "particles.pvd",
             "run.json",
             "checkpoint.bin",
+            "checkpoint_g1_p0003.bin",
+            "particles/particles_000004.pvtu",
+            "particles/particles_000004_p0001.vtu",
             "particles/particles_000012.vtu",
             "probes/old_probe.csv",
             "snapshots/000003.png",

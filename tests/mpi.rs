@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use wgsph::decomposition::{cut_axis, layer_load, slabs_for, Slabs};
 use wgsph::gpu::{AdapterChoice, GpuContext};
 use wgsph::grid::Grid;
-use wgsph::layout::{ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
+use wgsph::layout::{unpack_block, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
 use wgsph::output::{particle_files, ParticleFile, RunSummary};
 use wgsph::ranks::{Mpi, Ranks};
 use wgsph::scenario::{Domain, Kind, Particle, Scenario};
@@ -212,6 +212,9 @@ struct Comparison {
     /// Start from cuts at equal numbers of cell layers (not balanced), so that the ranks
     /// move them during the run, which must then have happened.
     uneven: bool,
+    /// Save every rank's state after this many steps and take the rest in a new subdomain
+    /// restored from it (as `wgsph resume` does), not in the one that saved it.
+    restore_at: Option<u64>,
 }
 
 impl Comparison {
@@ -277,7 +280,29 @@ impl Comparison {
                 }
             };
             let mut solver = Solver::subdomain(&gpu, &sc, &slabs, &ranks)?;
-            solver.run_steps_ranked(self.steps, &ranks)?;
+            if let Some(at) = self.restore_at {
+                solver.run_steps_ranked(at, &ranks)?;
+                let (saved, ranked) = (solver.save_state()?, solver.ranked().unwrap().clone());
+                solver = Solver::subdomain(&gpu, &sc, &slabs, &ranks)?;
+                solver.restore_state(&saved)?;
+                solver.restore_subdomain(&ranked, &ranks)?;
+            }
+            let left = self.steps - self.restore_at.unwrap_or(0);
+            solver.run_steps_ranked(left, &ranks)?;
+            // Every rank holds the particles of its slab (the cuts as the ranks last moved
+            // them), give or take those that crossed a cut in the last step.
+            let ph = &sc.physics;
+            let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic)?;
+            let slabs = solver.ranked().unwrap().slabs.clone().unwrap();
+            let mine = slabs.range(r);
+            for (_, p, _) in live_particles(&solver) {
+                let off = [0, 1, 2].map(|a| f32::from_bits(p[a]));
+                let layer = grid.cell_of(off, unpack_block(p[3]))[slabs.axis] as u32;
+                anyhow::ensure!(
+                    layer + 1 >= mine.start && layer <= mine.end,
+                    "rank {r} holds a particle in layer {layer}, its slab is {mine:?}"
+                );
+            }
             let counts = solver.ranked().unwrap();
             let mut words = vec![
                 counts.halo_sent as u32,
@@ -302,34 +327,61 @@ impl Comparison {
 /// `mpirun -np 2 wgsph run` of the 2D dam break writes what one whole run writes: every
 /// particle output's pieces, read together through its `.pvtu`, hold bit for bit the whole
 /// run's live particles (each id once), and every probe's table (pressure at the wall, the
-/// front and the continuous front) is byte for byte the same. The cut lies across the water
-/// column, which falls through it: particles migrate, and run.json says how much each rank
-/// sent.
+/// front and the continuous front) is byte for byte the same. The 2-rank run goes to
+/// t = 0.04 s with checkpoints every 0.015 s (both sets of rank files used), then `mpirun -np
+/// 2 wgsph resume` takes it from t = 0.032 s to 0.06 s: the outputs before and after the
+/// resume are all compared. The cut lies across the water column, which falls through it:
+/// particles migrate, and run.json says how much each rank sent.
 #[test]
 fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
     let (one, two) = (
         common::Scratch::new("mpi-run-one"),
         common::Scratch::new("mpi-run-two"),
     );
-    let args = |out: &std::path::Path| -> Vec<std::ffi::OsString> {
-        let args = ["run", "cases/dam_break_2d.toml", "--set", "time.end_s=0.06"];
-        let tail = ["--adapter", "cpu", "--quiet", "--out"];
-        let args = args.iter().chain(&tail).map(|a| a.into());
+    let run = |end: &str, out: &std::path::Path| -> Vec<std::ffi::OsString> {
+        let args = [
+            "run",
+            "cases/dam_break_2d.toml",
+            "--set",
+            end,
+            "--quiet",
+            "--out",
+        ];
+        let args = args.iter().map(|a| a.into());
         args.chain([out.as_os_str().to_owned()]).collect()
     };
     let o = Command::new(env!("CARGO_BIN_EXE_wgsph"))
-        .args(args(&one))
+        .args(run("time.end_s=0.06", &one))
+        .args(["--adapter", "cpu"])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let o = Command::new("mpirun")
-        .args(["--oversubscribe", "-np", "2", env!("CARGO_BIN_EXE_wgsph")])
-        .args(args(&two))
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let on_two_ranks = |args: Vec<std::ffi::OsString>| {
+        let o = Command::new("mpirun")
+            .args(["--oversubscribe", "-np", "2", env!("CARGO_BIN_EXE_wgsph")])
+            .args(args)
+            .args(["--adapter", "cpu", "--checkpoint-every", "0.015"])
+            .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+            .output()
+            .unwrap();
+        let log =
+            String::from_utf8_lossy(&o.stdout).to_string() + &String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{log}");
+        log
+    };
+    on_two_ranks(run("time.end_s=0.04", &two));
+    for set in ["g0", "g1"] {
+        assert!(two.join(format!("checkpoint_{set}_p0001.bin")).is_file());
+    }
+    let resume = [
+        "resume".into(),
+        two.as_os_str().to_owned(),
+        "--set".into(),
+        "time.end_s=0.06".into(),
+    ];
+    let log = on_two_ranks(resume.to_vec());
+    assert!(log.contains("resuming from t = 0.032000 s"), "{log}");
 
     let (files_one, files_two) = (particle_files(&one).unwrap(), particle_files(&two).unwrap());
     assert_eq!(files_one.len(), files_two.len());
@@ -398,13 +450,16 @@ fn three_ranks_of_the_3d_dam_break_equal_one_run() {
         ranks: 3,
         steps: 40,
         uneven: false,
+        restore_at: None,
     }
     .check();
 }
 
 /// Two ranks of the 2D dam break that start from cuts at equal numbers of cell layers (most of
 /// the water on one rank): the ranks move the cuts at their first look (step 100), and the
-/// particles still equal one whole run's bit for bit after 300 steps.
+/// particles still equal one whole run's bit for bit after 300 steps, the last 100 of them
+/// taken by subdomains restored from the state saved at step 200 (with the moved cuts, which
+/// differ from the ones the new subdomains are made with).
 #[test]
 fn ranks_that_move_their_cuts_still_equal_one_run() {
     Comparison {
@@ -414,6 +469,7 @@ fn ranks_that_move_their_cuts_still_equal_one_run() {
         ranks: 2,
         steps: 300,
         uneven: true,
+        restore_at: Some(200),
     }
     .check();
 }

@@ -448,10 +448,15 @@ impl OutputDir {
 
     /// Resuming a run: the series is what the checkpoint lists (snapshots a killed run wrote
     /// after its checkpoint are dropped from the `.pvd` and overwritten by the resumed run).
+    ///
+    /// Of a run over several ranks, each rank checks its pieces and rank 0 the `.pvtu` files,
+    /// and only rank 0 writes the `.pvd`.
     pub fn resume_series(&mut self, snapshots: Vec<(f64, String)>) -> Result<(), OutputError> {
+        let index_writer = self.piece.is_none_or(|p| p.rank == 0);
         for (_, rel) in &snapshots {
-            let file = self.dir.join(rel);
-            if !file.is_file() {
+            let piece = self.piece.map(|p| self.dir.join(piece_of(rel, p.rank)));
+            let index = index_writer.then(|| self.dir.join(rel));
+            if let Some(file) = piece.into_iter().chain(index).find(|f| !f.is_file()) {
                 return Err(OutputError::Resume {
                     path: file,
                     reason: "a snapshot the checkpoint lists is missing".into(),
@@ -459,6 +464,9 @@ impl OutputDir {
             }
         }
         self.snapshots = snapshots;
+        if !index_writer {
+            return Ok(());
+        }
         write_atomic(&self.pvd_path(), |w| pvd::write_pvd(w, &self.snapshots))
     }
 

@@ -73,20 +73,13 @@ pub fn launched_size() -> Option<usize> {
         .find_map(|v| std::env::var(v).ok()?.trim().parse().ok())
 }
 
-/// Refuses a launch over several ranks of what cannot run split yet: `resume` (a run over
-/// several ranks writes no checkpoints yet: N copies would each continue the whole case in the
-/// same folder), and `run` and `bench` in a build without MPI. One rank under a launcher runs
-/// as without it.
+/// Refuses a launch over several ranks in a build without MPI (N copies would each run the
+/// whole case into the same folder). One rank under a launcher runs as without it.
 pub fn refuse_several_ranks(command: &str) -> Result<()> {
     match launched_size() {
-        Some(n) if n > 1 && command != "resume" && !cfg!(feature = "mpi") => anyhow::bail!(
+        Some(n) if n > 1 && !cfg!(feature = "mpi") => anyhow::bail!(
             "`wgsph {command}` was launched on {n} ranks, but this wgsph was built without \
              MPI: build it with `cargo build --release --features mpi` (README: several ranks)"
-        ),
-        Some(n) if n > 1 && command == "resume" => anyhow::bail!(
-            "`wgsph resume` was launched on {n} ranks, but a run over several ranks writes no \
-             checkpoints yet, so there is none to resume from: launch it with -np 1 or \
-             without mpirun to resume a run made on one"
         ),
         _ => Ok(()),
     }

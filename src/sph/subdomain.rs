@@ -11,7 +11,7 @@
 
 use std::ops::Range;
 
-use anyhow::{bail, ensure, Result};
+use anyhow::{bail, ensure, Context, Result};
 
 use super::halo;
 use super::initial::Packed;
@@ -25,8 +25,8 @@ use crate::output::RankSummary;
 use crate::ranks::Ranks;
 use crate::scenario::{DensityFilter, Kind, OutputBoundary, Scenario};
 
-/// A subdomain's counts, over all ranks where they say so.
-#[derive(Clone, Debug, Default)]
+/// A subdomain's counts, over all ranks where they say so (a checkpoint keeps them).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Ranked {
     /// Live particles of the whole run at the start.
     live_at_start: u64,
@@ -279,6 +279,50 @@ impl Solver {
         Ok(true)
     }
 
+    /// Puts a checkpoint's subdomain counts and cuts back, after [`Solver::restore_state`]
+    /// (every rank together, with the cuts the checkpoint's ranks had), and sorts the restored
+    /// arrays so that the next step's packing finds the free tail.
+    pub fn restore_subdomain(&mut self, saved: &Ranked, ranks: &dyn Ranks) -> Result<()> {
+        let slabs = saved
+            .slabs
+            .clone()
+            .context("the saved subdomain has no cuts")?;
+        ensure!(
+            slabs.ranks() == ranks.size(),
+            "the checkpoint was written by {} ranks; resume it on as many",
+            slabs.ranks()
+        );
+        let halo = self
+            .passes
+            .halo
+            .as_ref()
+            .expect("a subdomain has a halo pass");
+        halo.set_cuts(&self.queue, &slabs, ranks.rank(), true);
+        let ranked = self.ranked.as_mut().expect("a subdomain");
+        *ranked = Ranked {
+            first_tail: None,
+            ..saved.clone()
+        };
+        self.sort_in_place();
+        self.faults.check()
+    }
+
+    /// Sorts the present arrays (into the other parity), as a step's sort would: the free tail
+    /// is the excluded slot's start again. The last rates follow the particles.
+    fn sort_in_place(&mut self) {
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.passes.cell_list.clear(&mut encoder, &self.buffers);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.passes.cell_list.encode(&mut pass, self.parity);
+        }
+        // The sort gathered the last rates into `rate_sorted`; the next predictor reads `rate`.
+        let b = &self.buffers;
+        encoder.copy_buffer_to_buffer(&b.rate_sorted, 0, &b.rate, 0, b.rate.size());
+        self.queue.submit([encoder.finish()]);
+        self.parity = 1 - self.parity;
+    }
+
     /// Sends every particle to its owner under `next` (any rank), then sorts, so that the next
     /// step's packing finds the free tail; the last rates follow the sort.
     fn redistribute(&mut self, next: Slabs, ranks: &dyn Ranks) -> Result<()> {
@@ -317,17 +361,12 @@ impl Solver {
             .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, HaloRecord>(b))
             .collect();
         self.unpack(&incoming, packed.tail, p)?;
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        self.passes.cell_list.clear(&mut encoder, &self.buffers);
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.passes.cell_list.encode(&mut pass, p);
-        }
-        // The sort gathered the last rates into `rate_sorted`; the next predictor reads `rate`.
-        let b = &self.buffers;
-        encoder.copy_buffer_to_buffer(&b.rate_sorted, 0, &b.rate, 0, b.rate.size());
-        self.queue.submit([encoder.finish()]);
-        self.parity = 1 - p;
+        self.sort_in_place();
+        let halo = self
+            .passes
+            .halo
+            .as_ref()
+            .expect("a subdomain has a halo pass");
         halo.set_cuts(&self.queue, &next, rank, true);
         let ranked = self.ranked.as_mut().expect("a subdomain");
         ranked.slabs = Some(next);
