@@ -324,71 +324,75 @@ impl Comparison {
     }
 }
 
-/// `mpirun -np 2 wgsph run` of the 2D dam break writes what one whole run writes: every
-/// particle output's pieces, read together through its `.pvtu`, hold bit for bit the whole
-/// run's live particles (each id once), and every probe's table (pressure at the wall, the
-/// front and the continuous front) is byte for byte the same. The 2-rank run goes to
-/// t = 0.04 s with checkpoints every 0.015 s (both sets of rank files used), then `mpirun -np
-/// 2 wgsph resume` takes it from t = 0.032 s to 0.06 s: the outputs before and after the
-/// resume are all compared. The cut lies across the water column, which falls through it:
-/// particles migrate, and run.json says how much each rank sent.
-#[test]
-fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
-    let (one, two) = (
-        common::Scratch::new("mpi-run-one"),
-        common::Scratch::new("mpi-run-two"),
-    );
-    let run = |end: &str, out: &std::path::Path| -> Vec<std::ffi::OsString> {
-        let args = [
-            "run",
-            "cases/dam_break_2d.toml",
-            "--set",
-            end,
-            "--quiet",
-            "--out",
-        ];
-        let args = args.iter().map(|a| a.into());
-        args.chain([out.as_os_str().to_owned()]).collect()
-    };
+/// `wgsph ARGS --adapter cpu` of the 2D dam break (`run` with `end` as time.end_s into `out`
+/// when ARGS is empty).
+fn dam_break(end: &str, out: &std::path::Path) -> Vec<std::ffi::OsString> {
+    let args = ["run", "cases/dam_break_2d.toml", "--set", end, "--quiet"];
+    let args = args.iter().map(|a| a.into());
+    args.chain(["--out".into(), out.as_os_str().to_owned()])
+        .collect()
+}
+
+/// `wgsph ARGS --resume`-style arguments: `resume DIR --set time.end_s=END`.
+fn resume(dir: &std::path::Path, end: &str) -> Vec<std::ffi::OsString> {
+    let set = format!("time.end_s={end}");
+    vec![
+        "resume".into(),
+        dir.as_os_str().to_owned(),
+        "--set".into(),
+        set.into(),
+    ]
+}
+
+/// One whole run of `args` on lavapipe.
+fn on_one_rank(args: Vec<std::ffi::OsString>) {
     let o = Command::new(env!("CARGO_BIN_EXE_wgsph"))
-        .args(run("time.end_s=0.06", &one))
+        .args(args)
         .args(["--adapter", "cpu"])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let on_two_ranks = |args: Vec<std::ffi::OsString>| {
-        let o = Command::new("mpirun")
-            .args(["--oversubscribe", "-np", "2", env!("CARGO_BIN_EXE_wgsph")])
-            .args(args)
-            .args(["--adapter", "cpu", "--checkpoint-every", "0.015"])
-            .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-            .output()
-            .unwrap();
-        let log =
-            String::from_utf8_lossy(&o.stdout).to_string() + &String::from_utf8_lossy(&o.stderr);
-        assert!(o.status.success(), "{log}");
-        log
-    };
-    on_two_ranks(run("time.end_s=0.04", &two));
-    for set in ["g0", "g1"] {
-        assert!(two.join(format!("checkpoint_{set}_p0001.bin")).is_file());
-    }
-    let resume = [
-        "resume".into(),
-        two.as_os_str().to_owned(),
-        "--set".into(),
-        "time.end_s=0.06".into(),
-    ];
-    let log = on_two_ranks(resume.to_vec());
-    assert!(log.contains("resuming from t = 0.032000 s"), "{log}");
+}
 
-    let (files_one, files_two) = (particle_files(&one).unwrap(), particle_files(&two).unwrap());
+/// `mpirun -np 2 wgsph ARGS` on lavapipe with checkpoints every 0.015 s; its log.
+fn on_two_ranks(args: Vec<std::ffi::OsString>) -> String {
+    let o = mpirun_wgsph(args, &[]).output().unwrap();
+    let log = String::from_utf8_lossy(&o.stdout).to_string() + &String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{log}");
+    log
+}
+
+/// `mpirun -np 2 [EXPORT] wgsph ARGS` as [`on_two_ranks`] runs it, `EXPORT` the variables of
+/// the test's environment to pass on to the ranks (`-x NAME`).
+fn mpirun_wgsph(args: Vec<std::ffi::OsString>, export: &[&str]) -> Command {
+    let mut command = Command::new("mpirun");
+    command.args(["--oversubscribe", "-np", "2"]);
+    for name in export {
+        command.args(["-x", name]);
+    }
+    command
+        .arg(env!("CARGO_BIN_EXE_wgsph"))
+        .args(args)
+        .args(["--adapter", "cpu", "--checkpoint-every", "0.015"])
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
+    command
+}
+
+/// The particle outputs and probe tables of the run over ranks in `ranked` equal those of the
+/// whole run in `whole`: every output's pieces, read together through its `.pvtu`, hold bit
+/// for bit the whole run's live particles, each id once; every probe table byte for byte.
+/// Returns the live particles of the last output.
+fn assert_same_outputs(whole: &std::path::Path, ranked: &std::path::Path) -> usize {
+    let (files_one, files_two) = (
+        particle_files(whole).unwrap(),
+        particle_files(ranked).unwrap(),
+    );
     assert_eq!(files_one.len(), files_two.len());
     assert!(files_two
         .iter()
         .all(|(_, f)| f.extension().unwrap() == "pvtu"));
-    let pvd = std::fs::read_to_string(two.join("particles.pvd")).unwrap();
+    let pvd = std::fs::read_to_string(ranked.join("particles.pvd")).unwrap();
     assert!(pvd.contains("particles/particles_000001.pvtu"), "{pvd}");
     let mut live = 0;
     for ((_, a), (_, b)) in files_one.iter().zip(&files_two) {
@@ -410,14 +414,38 @@ fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
         assert_eq!(a.time_s.to_bits(), b.time_s.to_bits());
         live = whole.id.len();
     }
-    for e in std::fs::read_dir(one.join("probes")).unwrap() {
+    for e in std::fs::read_dir(whole.join("probes")).unwrap() {
         let name = e.unwrap().file_name();
         let (a, b) = (
-            std::fs::read(one.join("probes").join(&name)).unwrap(),
-            std::fs::read(two.join("probes").join(&name)).unwrap(),
+            std::fs::read(whole.join("probes").join(&name)).unwrap(),
+            std::fs::read(ranked.join("probes").join(&name)).unwrap(),
         );
         assert!(a == b, "probes/{name:?} differs");
     }
+    live
+}
+
+/// `mpirun -np 2 wgsph run` of the 2D dam break writes what one whole run writes
+/// ([`assert_same_outputs`]: the particles, pressure at the wall, the front and the continuous
+/// front). The 2-rank run goes to t = 0.04 s with checkpoints every 0.015 s (both sets of
+/// rank files used), then `mpirun -np 2 wgsph resume` takes it from t = 0.032 s to 0.06 s: the
+/// outputs before and after the resume are all compared. The cut lies across the water
+/// column, which falls through it: particles migrate, and run.json says how much each rank
+/// sent.
+#[test]
+fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
+    let (one, two) = (
+        common::Scratch::new("mpi-run-one"),
+        common::Scratch::new("mpi-run-two"),
+    );
+    on_one_rank(dam_break("time.end_s=0.06", &one));
+    on_two_ranks(dam_break("time.end_s=0.04", &two));
+    for set in ["g0", "g1"] {
+        assert!(two.join(format!("checkpoint_{set}_p0001.bin")).is_file());
+    }
+    let log = on_two_ranks(resume(&two, "0.06"));
+    assert!(log.contains("resuming from t = 0.032000 s"), "{log}");
+    let live = assert_same_outputs(&one, &two);
     let (a, b) = (
         RunSummary::read(&one).unwrap(),
         RunSummary::read(&two).unwrap(),
@@ -472,6 +500,84 @@ fn ranks_that_move_their_cuts_still_equal_one_run() {
         restore_at: Some(200),
     }
     .check();
+}
+
+/// The processes of this test's jobs that play rank `rank` (their environment carries `tag`
+/// and OpenMPI's rank).
+fn processes_of_rank(tag: &str, rank: usize) -> Vec<u32> {
+    let wanted = [tag.to_string(), format!("OMPI_COMM_WORLD_RANK={rank}")];
+    let entries = std::fs::read_dir("/proc").unwrap().flatten();
+    entries
+        .filter_map(|e| {
+            let pid: u32 = e.file_name().to_str()?.parse().ok()?;
+            let env = std::fs::read(e.path().join("environ")).ok()?;
+            let vars: Vec<&[u8]> = env.split(|&b| b == 0).collect();
+            let has = |w: &String| vars.contains(&w.as_bytes());
+            wanted.iter().all(has).then_some(pid)
+        })
+        .collect()
+}
+
+/// A rank killed mid-run (SIGKILL, as the out-of-memory killer or a lost node would) ends the
+/// whole job promptly, with mpirun naming the rank, and the last checkpoint it completed is
+/// kept: `mpirun -np 2 wgsph resume` continues from it and writes what one whole run writes.
+#[test]
+fn killing_a_rank_ends_the_job_and_its_last_checkpoint_resumes() {
+    let (one, two) = (
+        common::Scratch::new("mpi-kill-one"),
+        common::Scratch::new("mpi-kill-two"),
+    );
+    let (name, value) = ("WGSPH_KILL_TEST", std::process::id().to_string());
+    let tag = format!("{name}={value}");
+    let mut job = mpirun_wgsph(dam_break("time.end_s=0.2", &two), &[name]);
+    let mut job = job
+        .env(name, &value)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !two.join("checkpoint.bin").is_file() {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no checkpoint written"
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let victims = processes_of_rank(&tag, 1);
+    assert_eq!(victims.len(), 1, "rank 1's process: {victims:?}");
+    Command::new("kill")
+        .args(["-9", &victims[0].to_string()])
+        .status()
+        .unwrap();
+    let killed = Instant::now();
+    while job.try_wait().unwrap().is_none() {
+        assert!(
+            killed.elapsed() < Duration::from_secs(30),
+            "the job still runs"
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let o = job.wait_with_output().unwrap();
+    let log = String::from_utf8_lossy(&o.stdout).to_string() + &String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        log.contains("process rank 1") && log.contains("signal 9"),
+        "{log}"
+    );
+    // Rank 0 was waiting on rank 1: it is gone too.
+    while !processes_of_rank(&tag, 0).is_empty() {
+        assert!(
+            killed.elapsed() < Duration::from_secs(30),
+            "rank 0 still runs"
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    println!("the job ended {:?} after the kill", killed.elapsed());
+
+    on_two_ranks(resume(&two, "0.03"));
+    on_one_rank(dam_break("time.end_s=0.03", &one));
+    assert_same_outputs(&one, &two);
 }
 
 /// `mpirun -np 2 wgsph bench`: rank 0 names each rank's adapter and prints the whole run's

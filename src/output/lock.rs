@@ -123,14 +123,22 @@ fn take_over(dir: &Path, path: &Path, stale: Option<u32>, pid: u32) -> Result<()
     std::fs::remove_file(&aside).map_err(|e| OutputError::io("remove", &aside, e))
 }
 
-/// Whether process `pid` is alive. On Linux by /proc; elsewhere a lock is never taken to be
-/// stale (the error says to remove the file).
+/// Whether process `pid` is alive. On Linux by /proc, where a zombie (a process that ended
+/// and that its parent has not reaped yet: a rank just killed with its MPI job) keeps its
+/// entry but runs nothing; elsewhere a lock is never taken to be stale (the error says to
+/// remove the file).
 fn alive(pid: u32) -> bool {
-    if cfg!(target_os = "linux") {
-        Path::new("/proc").join(pid.to_string()).exists()
-    } else {
-        true
+    if !cfg!(target_os = "linux") {
+        return true;
     }
+    let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
+        return false;
+    };
+    // "pid (command) state …": the command may hold spaces and parentheses.
+    let state = stat
+        .rsplit_once(')')
+        .and_then(|(_, rest)| rest.trim_start().chars().next());
+    !matches!(state, Some('Z' | 'X'))
 }
 
 #[cfg(test)]
@@ -157,6 +165,23 @@ mod tests {
         assert!(!lock.exists());
         drop(DirLock::acquire(&d).unwrap());
         std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// A process that has ended but is not reaped yet (a zombie) holds no lock.
+    #[test]
+    #[cfg(target_os = "linux")]
+    fn a_zombie_is_not_alive() {
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let pid = child.id();
+        let start = std::time::Instant::now();
+        while alive(pid) {
+            assert!(start.elapsed().as_secs() < 10, "`true` still runs");
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        // Not reaped until now: its /proc entry was there all along.
+        assert!(Path::new("/proc").join(pid.to_string()).exists());
+        child.wait().unwrap();
+        assert!(alive(std::process::id()));
     }
 
     #[test]
