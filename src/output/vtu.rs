@@ -60,15 +60,20 @@ impl<'a> ArrayDecl<'a> {
 
     /// The declaration in a `.pvtu` (`PDataArray`: the type and components, no data).
     fn pxml(&self, indent: &str) -> String {
-        let comps = if self.components > 1 {
-            format!(" NumberOfComponents=\"{}\"", self.components)
-        } else {
-            String::new()
-        };
         format!(
-            "{indent}<PDataArray type=\"{}\" Name=\"{}\"{comps}/>\n",
-            self.vtk_type, self.name
+            "{indent}<PDataArray type=\"{}\" Name=\"{}\"{}/>\n",
+            self.vtk_type,
+            self.name,
+            self.components_attr()
         )
+    }
+
+    /// ` NumberOfComponents="k"` for k > 1 (VTK's default is 1).
+    fn components_attr(&self) -> String {
+        match self.components {
+            1 => String::new(),
+            k => format!(" NumberOfComponents=\"{k}\""),
+        }
     }
 
     fn data_bytes(&self) -> u64 {
@@ -81,11 +86,7 @@ impl<'a> ArrayDecl<'a> {
     }
 
     fn xml(&self, indent: &str, offset: u64, extra: &str) -> String {
-        let comps = if self.components > 1 {
-            format!(" NumberOfComponents=\"{}\"", self.components)
-        } else {
-            String::new()
-        };
+        let comps = self.components_attr();
         format!(
             "{indent}<DataArray type=\"{}\" Name=\"{}\"{comps}{extra} format=\"appended\" offset=\"{offset}\"/>\n",
             self.vtk_type, self.name
