@@ -215,12 +215,31 @@ struct Comparison {
     /// Save every rank's state after this many steps and take the rest in a new subdomain
     /// restored from it (as `wgsph resume` does), not in the one that saved it.
     restore_at: Option<u64>,
+    /// The box of an `[[outlet]]` added to the case (written beside the test binary before the
+    /// ranks start), which must have drained particles by the end.
+    outlet: Option<&'static str>,
 }
 
 impl Comparison {
     fn scenario(&self) -> Scenario {
         let set: Vec<String> = self.set.iter().map(|s| s.to_string()).collect();
-        wgsph::case::load(std::path::Path::new(self.case), &set).unwrap()
+        wgsph::case::load(&self.case_path(), &set).unwrap()
+    }
+
+    /// The case file: `case`, or with an outlet a copy of it with the outlet added.
+    fn case_path(&self) -> std::path::PathBuf {
+        match self.outlet {
+            None => self.case.into(),
+            Some(_) => std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+                .join(format!("{}.toml", self.test)),
+        }
+    }
+
+    /// Writes the case with its outlet ([`Comparison::case_path`]).
+    fn write_outlet_case(&self, outlet: &str) {
+        let case = std::fs::read_to_string(self.case).unwrap();
+        let table = format!("\n[[outlet]]\nname = \"drain\"\n{outlet}\n");
+        std::fs::write(self.case_path(), case + &table).unwrap();
     }
 
     /// The ranks' live particles, merged, equal the whole run's bit for bit, each on one rank;
@@ -228,6 +247,9 @@ impl Comparison {
     fn check(&self) {
         if under_mpirun() {
             return self.rank();
+        }
+        if let Some(outlet) = self.outlet {
+            self.write_outlet_case(outlet);
         }
         let out = common::Scratch::new(&format!("mpi-{}", self.test));
         std::fs::create_dir_all(&*out).unwrap();
@@ -238,16 +260,26 @@ impl Comparison {
         let mut whole = Solver::new(common::gpu(), &self.scenario()).unwrap();
         whole.run_steps(self.steps).unwrap();
         let expected = live_particles(&whole);
+        assert!(
+            self.outlet.is_none() || whole.drained() > 0,
+            "the outlet drained nothing: the test tests nothing"
+        );
+        println!("{} particles drained", whole.drained());
         let mut merged: Live = Vec::new();
         for r in 0..self.ranks {
             let bytes = std::fs::read(out.join(format!("rank{r}.bin"))).unwrap();
             let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-            let (halo, migrants, rebalances) = (words[0], words[1], words[2]);
+            let (halo, migrants, rebalances, drained) = (words[0], words[1], words[2], words[3]);
+            assert_eq!(
+                drained as u64,
+                whole.drained(),
+                "rank {r}'s count of the drained"
+            );
             println!("rank {r}: {halo} halo copies and {migrants} migrants sent, {rebalances} rebalances");
             assert!(halo > 0, "rank {r} sent no halo");
             assert!(!self.uneven || rebalances > 0, "the cuts never moved");
             merged.extend(
-                words[3..]
+                words[4..]
                     .chunks(9)
                     .map(|c| (c[0], [c[1], c[2], c[3], c[4]], [c[5], c[6], c[7], c[8]])),
             );
@@ -308,6 +340,7 @@ impl Comparison {
                 counts.halo_sent as u32,
                 counts.migrants_sent as u32,
                 counts.rebalances,
+                solver.drained() as u32,
             ];
             for (id, p, v) in live_particles(&solver) {
                 words.push(id);
@@ -479,6 +512,7 @@ fn three_ranks_of_the_3d_dam_break_equal_one_run() {
         steps: 40,
         uneven: false,
         restore_at: None,
+        outlet: None,
     }
     .check();
 }
@@ -498,6 +532,7 @@ fn ranks_that_move_their_cuts_still_equal_one_run() {
         steps: 300,
         uneven: true,
         restore_at: Some(200),
+        outlet: None,
     }
     .check();
 }
@@ -589,6 +624,25 @@ fn killing_a_rank_ends_the_job_and_its_last_checkpoint_resumes() {
     on_two_ranks(resume(&two, "0.03"));
     on_one_rank(dam_break("time.end_s=0.03", &one));
     assert_same_outputs(&one, &two);
+}
+
+/// The 2D dam break with an outlet just beyond the foot of the water column, which the column's
+/// corner flows into as it starts to fall. The ranks drain the same particles at the same
+/// steps as one whole run (the particles bit for bit, every rank's summed count of the drained
+/// equal to the whole run's, and not zero).
+#[test]
+fn ranks_with_an_outlet_drain_what_one_run_drains() {
+    Comparison {
+        test: "ranks_with_an_outlet_drain_what_one_run_drains",
+        case: "cases/dam_break_2d.toml",
+        set: &["particles.dx_m=0.0073"],
+        ranks: 2,
+        steps: 300,
+        uneven: false,
+        restore_at: None,
+        outlet: Some("min_m = [0.1465, -0.1]\nmax_m = [0.3, 0.06]"),
+    }
+    .check();
 }
 
 /// `mpirun -np 2 wgsph bench`: rank 0 names each rank's adapter and prints the whole run's

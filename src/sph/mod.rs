@@ -285,8 +285,7 @@ impl Solver {
     /// [`advance_to`](Self::advance_to) (or `run_steps`).
     pub fn density_variation(&self) -> DensityVariation {
         let s = &self.state;
-        let fluid =
-            (self.n_fluid_at_start + s.inlet_joined as u64).saturating_sub(s.drained as u64);
+        let fluid = (self.n_fluid_at_start + s.inlet_joined as u64).saturating_sub(self.drained());
         let share = |count: u32| count as f64 / fluid.max(1) as f64;
         DensityVariation {
             max: s.density_variation_peak as f64,
@@ -311,6 +310,9 @@ impl Solver {
 
     /// Fluid particles the outlets have removed.
     pub fn drained(&self) -> u64 {
+        if let Some(ranked) = &self.ranked {
+            return ranked.drained;
+        }
         self.state.drained as u64
     }
 

@@ -32,6 +32,8 @@ pub struct Ranked {
     live_at_start: u64,
     /// Particles of the whole run that left the domain or became non-finite.
     pub(super) excluded: u64,
+    /// Fluid particles of the whole run the outlets removed (each rank's GPU counts its own).
+    pub(super) drained: u64,
     /// Where the first step unpacks (no sort has run yet): after the own particles.
     first_tail: Option<u32>,
     /// This rank's totals: halo copies and migrants sent, and their bytes.
@@ -109,8 +111,8 @@ fn unsupported(sc: &Scenario) -> Vec<&'static str> {
         (!sc.bodies.is_empty(), "moving bodies"),
         (sc.solids.is_some(), "elastic solids"),
         (
-            !sc.inlets.is_empty() || !sc.outlets.is_empty(),
-            "inlets and outlets",
+            !sc.inlets.is_empty(),
+            "inlets (their waiting particles share the slot the arrivals are written into)",
         ),
         (
             has(&[Kind::GhostNoSlip, Kind::GhostFreeSlip]),
@@ -529,7 +531,8 @@ impl Solver {
     /// The ranks' common view after a step: the smallest time step (the GPU's choice
     /// (integrate.wgsl `timestep`) repeated with it, so every rank takes the step one whole run
     /// would), and the counts the stop rules read, summed; `live`: this rank's own particles
-    /// and migrants sent at packing.
+    /// and migrants sent at packing. The host's state keeps this rank's drained count (it
+    /// goes back to the GPU with a checkpoint), `Ranked::drained` the run's.
     fn agree(&mut self, local: crate::layout::SimState, live: u32, ranks: &dyn Ranks) {
         let dt = ranks.min(local.dt_cfl as f64) as f32;
         let mut gpu = local;
@@ -547,10 +550,16 @@ impl Solver {
             local.nan_count as f64,
             local.beyond_warn_peak as f64,
             local.beyond_stop_peak as f64,
+            local.drained as f64,
         ]);
         let peak = -ranks.min(-(local.density_variation_peak as f64));
         let ranked = self.ranked.as_mut().expect("a subdomain");
-        ranked.excluded = ranked.live_at_start.saturating_sub(sums[0] as u64);
+        ranked.drained = sums[4] as u64;
+        // What is neither live on a rank nor drained left the domain (the drained are
+        // excluded too, but counted apart, as one whole run counts them).
+        ranked.excluded = (ranked.live_at_start)
+            .saturating_sub(sums[0] as u64)
+            .saturating_sub(ranked.drained);
         self.state = gpu;
         self.state.nan_count = sums[1] as u32;
         self.state.beyond_warn_peak = sums[2] as u32;
