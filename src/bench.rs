@@ -12,6 +12,7 @@ use crate::layout::KIND_EXCLUDED;
 use crate::output::Particles;
 use crate::scenario::{Kind, Scenario};
 use crate::sph::profile::StageTime;
+use crate::sph::traffic::{StepCounts, Traffic};
 use crate::sph::Solver;
 
 /// The neighbour search's work in one state of the particles: per particle in the grid, and
@@ -127,6 +128,11 @@ pub struct BenchReport {
     pub dispatches_per_step: u64,
     /// The neighbour search's work in the last state.
     pub work: NeighbourWork,
+    /// What the traffic estimate counted with: the work, the kinds' shares, the slots.
+    pub counts: StepCounts,
+    /// Bytes read and written per particle-step by each stage, estimated from the work
+    /// (src/sph/traffic.rs).
+    pub traffic: Traffic,
     /// Each stage's GPU time over as many steps again, when asked for.
     pub stages: Option<Vec<StageTime>>,
 }
@@ -164,12 +170,10 @@ pub fn measure(
     solver.run_steps(steps)?;
     let wall_s = start.elapsed().as_secs_f64();
     let simulated_s = solver.time() - t0;
-    let work = neighbour_work(
-        &solver.grid,
-        sc.physics.dim,
-        sc.physics.h,
-        &solver.read_particles()?,
-    );
+    let particles = solver.read_particles()?;
+    let work = neighbour_work(&solver.grid, sc.physics.dim, sc.physics.h, &particles);
+    let counts = step_counts(sc, &solver.grid, &particles, work);
+    let traffic = Traffic::of_step(&solver.stage_names(), &counts);
     let stages = match stages {
         true => Some(solver.profile_steps(steps)?),
         false => None,
@@ -184,8 +188,43 @@ pub fn measure(
         gpu_bytes: solver.gpu_bytes(),
         dispatches_per_step: solver.dispatches_per_step(),
         work,
+        counts,
+        traffic,
         stages,
     })
+}
+
+/// What the traffic estimate needs of `sc` in the state `particles`, with its `work`.
+pub fn step_counts(
+    sc: &Scenario,
+    grid: &Grid,
+    particles: &Particles,
+    work: NeighbourWork,
+) -> StepCounts {
+    let live = particles
+        .kind
+        .iter()
+        .filter(|&&k| k != KIND_EXCLUDED)
+        .count();
+    let share = |kinds: &[Kind]| {
+        let of = |k: u32| kinds.iter().any(|&kind| kind as u32 == k);
+        particles.kind.iter().filter(|&&k| of(k)).count() as f64 / live.max(1) as f64
+    };
+    let density_filter_every = match sc.physics.density_filter {
+        crate::scenario::DensityFilter::None => None,
+        crate::scenario::DensityFilter::Shepard { every }
+        | crate::scenario::DensityFilter::Mls { every } => Some(every),
+    };
+    StepCounts {
+        dim: sc.physics.dim,
+        dense_grid: grid.dense(),
+        slots_per_particle: (grid.slots as f64 + 2.0) / live.max(1) as f64,
+        fluid_fraction: share(&[Kind::Fluid]),
+        ghost_fraction: share(&[Kind::GhostNoSlip, Kind::GhostFreeSlip]),
+        energy: sc.physics.energy,
+        density_filter_every,
+        work,
+    }
 }
 
 /// What `wgsph bench` measures under mpirun: the whole run's figures and each rank's.

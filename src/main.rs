@@ -537,9 +537,10 @@ fn bench(
         "neighbours/particle {:.1} (fluid {:.1})",
         r.work.neighbours, r.work.fluid_neighbours
     );
+    print_traffic(&r.traffic);
     println!("dispatches/step {}", r.dispatches_per_step);
     if let Some(times) = &r.stages {
-        print_stages(times, steps, n);
+        print_stages(times, &r.traffic, steps, n);
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -687,17 +688,55 @@ fn print_error_row(e: &wgsph::plot::ErrorSummary) {
     );
 }
 
-/// The GPU time of each stage per step, its share of the stages' sum, and per particle.
-fn print_stages(times: &[wgsph::sph::profile::StageTime], steps: u64, particles: u64) {
+/// The estimated bytes a particle-step moves (src/sph/traffic.rs), and the stages it leaves out.
+fn print_traffic(traffic: &wgsph::sph::traffic::Traffic) {
+    let total = traffic.total();
+    println!(
+        "bytes/particle-step  {:.0} read, {:.0} written (estimate: src/sph/traffic.rs)",
+        total.read, total.written
+    );
+    // Counted without caches: a GPU's caches serve most of the neighbour loops' loads.
+    println!(
+        "  of which neighbour loops {:.0} read, the rest streamed {:.0}",
+        traffic.neighbour_loop_read(),
+        total.total() - traffic.neighbour_loop_read()
+    );
+    let unmodelled = traffic.unmodelled();
+    if !unmodelled.is_empty() {
+        println!("  not estimated: {}", unmodelled.join(", "));
+    }
+}
+
+/// Each stage's GPU time per step, its share, its time per particle, and beside them its
+/// estimated bytes per particle-step and the bandwidth they imply over its time.
+fn print_stages(
+    times: &[wgsph::sph::profile::StageTime],
+    traffic: &wgsph::sph::traffic::Traffic,
+    steps: u64,
+    particles: u64,
+) {
     let total: f64 = times.iter().map(|s| s.seconds).sum();
-    println!("stage                   ms/step   share  ns/particle");
-    for s in times.iter().chain([&wgsph::sph::profile::StageTime {
+    println!("stage                   ms/step   share  ns/particle  est. B/particle   GB/s");
+    let all = wgsph::sph::profile::StageTime {
         name: "all stages",
         seconds: total,
-    }]) {
+    };
+    for s in times.iter().chain([&all]) {
         let per_step = s.seconds / steps as f64;
+        let bytes = match s.name {
+            "all stages" => Some(traffic.total().total()),
+            name => traffic.of_stage(name).map(|b| b.total()),
+        };
+        let estimate = match bytes {
+            Some(b) => format!(
+                "{:>15.1} {:>6.1}",
+                b,
+                b * particles as f64 / per_step.max(f64::MIN_POSITIVE) * 1e-9
+            ),
+            None => format!("{:>15} {:>6}", "-", "-"),
+        };
         println!(
-            "{:<22} {:>8.4} {:>6.1} % {:>10.2}",
+            "{:<22} {:>8.4} {:>6.1} % {:>10.2} {estimate}",
             s.name,
             1e3 * per_step,
             100.0 * s.seconds / total.max(f64::MIN_POSITIVE),

@@ -584,14 +584,19 @@ fn bench_reports_throughput_and_the_stages() {
         .count()
         - 2;
     assert!(dispatches >= n_stages as f64, "{stdout}");
-    // Rows after the table's header: name, ms/step, share, "%", ns/particle.
+    // Rows after the table's header: name, ms/step, share, "%", ns/particle, the estimated
+    // bytes per particle-step and the GB/s they imply.
     let rows: Vec<Vec<&str>> = stdout
         .lines()
         .skip_while(|l| !l.starts_with("stage "))
         .skip(1)
         .map(|l| l.split_whitespace().collect())
         .collect();
-    let share = |r: &Vec<&str>| -> f64 { r[r.len() - 3].parse().unwrap() };
+    let column = |r: &Vec<&str>, after_percent: isize| -> f64 {
+        let percent = r.iter().position(|t| *t == "%").unwrap() as isize;
+        r[(percent + after_percent) as usize].parse().unwrap()
+    };
+    let share = |r: &Vec<&str>| column(r, -1);
     let (all, stages) = rows.split_last().expect("a stage table");
     assert_eq!(all[..2], ["all", "stages"], "{stdout}");
     for name in ["predict", "sort_key", "interaction", "correct"] {
@@ -600,6 +605,20 @@ fn bench_reports_throughput_and_the_stages() {
     let sum: f64 = stages.iter().map(share).sum();
     assert!((sum - 100.0).abs() < 0.05 * stages.len() as f64, "{stdout}");
     assert_eq!(share(all), 100.0, "{stdout}");
+    // The estimated bytes: the stages' add up to the step's, which the line above the table
+    // gives read and written; the interaction loads at least a position per candidate.
+    let estimate = |r: &Vec<&str>| column(r, 2);
+    let stage_sum: f64 = stages.iter().map(estimate).sum();
+    assert!((stage_sum / estimate(all) - 1.0).abs() < 1e-3, "{stdout}");
+    let line = (stdout.lines())
+        .find(|l| l.starts_with("bytes/particle-step"))
+        .unwrap();
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let (read, written): (f64, f64) = (words[1].parse().unwrap(), words[3].parse().unwrap());
+    assert!((read + written - estimate(all)).abs() <= 1.0, "{stdout}");
+    let interaction = stages.iter().find(|r| r[0] == "interaction").unwrap();
+    assert!(estimate(interaction) > 16.0 * candidates, "{stdout}");
+    assert!(column(interaction, 3) > 0.0, "GB/s: {stdout}");
 }
 
 /// A wave gauge in a domain tall compared with h, at 10× finer dx than the shipped

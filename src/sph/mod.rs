@@ -30,6 +30,7 @@ pub mod shader;
 pub mod state;
 pub mod subdomain;
 pub mod total_lagrangian;
+pub mod traffic;
 
 use anyhow::{bail, Result};
 
@@ -421,6 +422,14 @@ impl Solver {
         // The step was not taken: the parity stays.
         self.parity = 1 - self.parity;
         crate::gpu::kernel::dispatches_recorded() - before
+    }
+
+    /// The names of a step's stages, in order (`Passes::record_step`); records nothing.
+    pub fn stage_names(&self) -> Vec<&'static str> {
+        let mut names = Vec::new();
+        self.passes
+            .record_step(Recorder::Names(&mut names), self.parity);
+        names
     }
 
     /// The stages of one step (`Passes::record_step`); flips the parity.

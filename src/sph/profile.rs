@@ -27,6 +27,8 @@ pub(super) enum Recorder<'e> {
         encoder: &'e mut wgpu::CommandEncoder,
         profiler: &'e mut Profiler,
     },
+    /// Only the stages' names, in order (the bytes each moves: `traffic`); records nothing.
+    Names(&'e mut Vec<&'static str>),
 }
 
 impl Recorder<'_> {
@@ -38,6 +40,7 @@ impl Recorder<'_> {
     ) {
         match self {
             Recorder::Shared(pass) => record(pass),
+            Recorder::Names(names) => names.push(name),
             Recorder::Timed { encoder, profiler } => {
                 let first = profiler.open(name);
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
