@@ -5,6 +5,8 @@
 // with a neighbour is packed as that neighbour's halo. The host reads the records, swaps them
 // with the neighbours and writes what it received after `tail`, the first entry of the last
 // sort's excluded slot (free ever since: excluded particles stay excluded).
+// A record carries what the receiver's passes read and, for a migrant, what it goes on
+// integrating (its last rates, and its energy with the energy equation).
 // A migrant stays in the sender's arrays for this step, as a halo copy: it is within one layer
 // of the cut it crossed, and the sender's particles there need it; the receiver's halo for the
 // sender was packed before it arrived.
@@ -47,19 +49,21 @@ struct HaloRecord {
     rate: vec4<f32>,
     code: u32,
     dest: u32,          // DEST_UPPER | DEST_MIGRANT bits
-    pad0: u32,
-    pad1: u32,
+    energy: vec2<f32>,  // (e, de/dt of the last evaluation) when ENERGY, else zeros
 }
 
 const DEST_UPPER: u32 = 1u;
 const DEST_MIGRANT: u32 = 2u;
 
-@group(0) @binding(6) var<storage, read> halo_ctl: HaloCtl;
+// A uniform: the packing binds the eight storage buffers every adapter allows.
+@group(0) @binding(6) var<uniform> halo_ctl: HaloCtl;
 @group(0) @binding(7) var<storage, read_write> halo_counts: HaloCounts;
 @group(0) @binding(8) var<storage, read_write> halo_out: array<HaloRecord>;
 // Weighted own particles per cell layer along the axis (`count_layers`): 2 for a particle that
 // moves, 1 for a boundary particle (decomposition.rs's weights, doubled to be whole).
 @group(0) @binding(9) var<storage, read_write> layer_load: array<atomic<u32>>;
+// (e, de/dt of the last evaluation); one unused entry without the energy equation.
+@group(0) @binding(10) var<storage, read> energy: array<vec2<f32>>;
 
 fn layer_of(p: Pos) -> u32 {
     return u32(cell_of(p)[halo_ctl.axis]);
@@ -71,7 +75,11 @@ fn pack_record(i: u32, dest: u32) {
         atomicAdd(&halo_counts.overflow, 1u);
         return;
     }
-    halo_out[k] = HaloRecord(pos[i], velrho[i], rate[i], code[i], dest, 0u, 0u);
+    var e = vec2<f32>(0.0);
+    if (ENERGY) {
+        e = energy[i];
+    }
+    halo_out[k] = HaloRecord(pos[i], velrho[i], rate[i], code[i], dest, e);
 }
 
 @compute @workgroup_size(WG)

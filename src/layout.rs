@@ -338,8 +338,9 @@ pub struct HaloRecord {
     pub rate: [f32; 4],
     pub code: u32,
     pub dest: u32,
-    pub pad0: u32,
-    pub pad1: u32,
+    /// (e, de/dt of the last evaluation) with the energy equation on (a migrant goes on
+    /// integrating it), else zeros.
+    pub energy: [f32; 2],
 }
 
 /// `HaloRecord::dest`: to the neighbour above (else below); a migrant (else a halo copy).
@@ -713,7 +714,7 @@ mod tests {
             &halo::SHADER,
             "HaloRecord",
             HaloRecord,
-            [pos, velrho, rate, code, dest]
+            [pos, velrho, rate, code, dest, energy]
         );
         assert_eq!(wgsl_u32(&halo::SHADER, "DEST_UPPER"), DEST_UPPER);
         assert_eq!(wgsl_u32(&halo::SHADER, "DEST_MIGRANT"), DEST_MIGRANT);

@@ -179,8 +179,9 @@ fn a_failing_rank_ends_the_job_and_says_which() {
     unreachable!("rank 0 received from a rank that aborted");
 }
 
-/// (id, position words, (v, ρ) bits) of every live particle, sorted by id.
-type Live = Vec<(u32, [u32; 4], [u32; 4])>;
+/// (id, position words, (v, ρ, e) bits) of every live particle, sorted by id (e = 0 without
+/// the energy equation).
+type Live = Vec<(u32, [u32; 4], [u32; 5])>;
 
 fn live_particles(solver: &Solver) -> Live {
     let (pos, velrho, code) = solver.read_raw().unwrap();
@@ -194,10 +195,21 @@ fn live_particles(solver: &Solver) -> Live {
                 p.off[2].to_bits(),
                 p.block,
             ];
-            (code[k] & ID_MASK, words, velrho[k].map(f32::to_bits))
+            let [vx, vy, vz, rho] = velrho[k].map(f32::to_bits);
+            (code[k] & ID_MASK, words, [vx, vy, vz, rho, 0])
         })
         .collect();
     live.sort_by_key(|l| l.0);
+    // The energies, in id order too.
+    let read = solver.read_particles().unwrap();
+    if let Some(energy) = &read.energy {
+        let live_energy = (0..read.id.len())
+            .filter(|&k| read.kind[k] != KIND_EXCLUDED)
+            .map(|k| energy[k]);
+        for (l, e) in live.iter_mut().zip(live_energy) {
+            l.2[4] = e.to_bits();
+        }
+    }
     live
 }
 
@@ -278,11 +290,13 @@ impl Comparison {
             println!("rank {r}: {halo} halo copies and {migrants} migrants sent, {rebalances} rebalances");
             assert!(halo > 0, "rank {r} sent no halo");
             assert!(!self.uneven || rebalances > 0, "the cuts never moved");
-            merged.extend(
-                words[4..]
-                    .chunks(9)
-                    .map(|c| (c[0], [c[1], c[2], c[3], c[4]], [c[5], c[6], c[7], c[8]])),
-            );
+            merged.extend(words[4..].chunks(10).map(|c| {
+                (
+                    c[0],
+                    [c[1], c[2], c[3], c[4]],
+                    [c[5], c[6], c[7], c[8], c[9]],
+                )
+            }));
         }
         merged.sort_by_key(|l| l.0);
         assert_eq!(merged.len(), expected.len(), "particle counts differ");
@@ -624,6 +638,25 @@ fn killing_a_rank_ends_the_job_and_its_last_checkpoint_resumes() {
     on_two_ranks(resume(&two, "0.03"));
     on_one_rank(dam_break("time.end_s=0.03", &one));
     assert_same_outputs(&one, &two);
+}
+
+/// The 2D dam break with the energy equation on: the migrants carry their specific internal
+/// energy and its last rate to their new owner, which goes on integrating it; every live
+/// particle's energy equals one whole run's bit for bit after 300 steps, with the cuts moved at
+/// step 100.
+#[test]
+fn ranks_integrate_the_energy_equation_as_one_run() {
+    Comparison {
+        test: "ranks_integrate_the_energy_equation_as_one_run",
+        case: "cases/dam_break_2d.toml",
+        set: &["particles.dx_m=0.0073", "physics.energy=true"],
+        ranks: 2,
+        steps: 300,
+        uneven: true,
+        restore_at: None,
+        outlet: None,
+    }
+    .check();
 }
 
 /// The 2D dam break with an outlet just beyond the foot of the water column, which the column's

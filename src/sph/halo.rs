@@ -6,7 +6,7 @@ use anyhow::{bail, Result};
 
 use super::buffers::ParticleBuffers;
 use crate::decomposition::Slabs;
-use crate::gpu::buffers::{map_read, read, readback_buffer, storage, storage_init};
+use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
 use crate::layout::{HaloCounts, HaloCtl, HaloRecord, DEST_MIGRANT, DEST_UPPER};
@@ -81,7 +81,7 @@ impl Halo {
             capacity: RECORDS_PER_PARTICLE * b.n,
             ..ctl
         };
-        let ctl_buffer = storage_init(device, "halo ctl", std::slice::from_ref(&ctl));
+        let ctl_buffer = uniform_init(device, "halo ctl", &ctl);
         let layer_load = storage(device, "layer load", 4 * layers as u64);
         let counts = storage(
             device,

@@ -122,7 +122,6 @@ fn unsupported(sc: &Scenario) -> Vec<&'static str> {
             sc.physics.density_filter != DensityFilter::None,
             "the density filter (it needs a second exchange a step)",
         ),
-        (sc.physics.energy, "the energy equation"),
         (!sc.points.is_empty(), "tracked points"),
         (
             sc.time.output_boundary == OutputBoundary::First,
@@ -525,6 +524,10 @@ impl Solver {
         write(&b.velrho[p], 16, bytemuck::cast_slice(&velrho));
         write(&b.code[p], 4, bytemuck::cast_slice(&code));
         write(&b.rate, 16, bytemuck::cast_slice(&rate));
+        if self.energy {
+            let energy: Vec<[f32; 2]> = incoming.iter().map(|r| r.energy).collect();
+            write(&b.energy[p], 8, bytemuck::cast_slice(&energy));
+        }
         Ok(())
     }
 
