@@ -829,14 +829,14 @@ fn attached_body(
     ))
 }
 
-/// `physics.delta_sph_form` (default Molteni & Colagrossi; only with δ-SPH on).
+/// `physics.delta_sph_form` (default Fourtakas et al. 2019; only with δ-SPH on).
 fn delta_sph_form(
     ctx: &Ctx<'_>,
     ph: &RawPhysics,
     delta_sph: f64,
 ) -> Result<DeltaSphForm, CaseError> {
     let Some(name) = ph.delta_sph_form else {
-        return Ok(DeltaSphForm::MolteniColagrossi);
+        return Ok(DeltaSphForm::default());
     };
     if delta_sph == 0.0 {
         return Err(ctx.err(
