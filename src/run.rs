@@ -16,7 +16,9 @@ use crate::checkpoint::{
 };
 use crate::decomposition::slabs_for;
 use crate::gpu::GpuContext;
-use crate::output::{OutputDir, ParticleFile, Piece, ProbeWriter, RunSummary, SNAPSHOTS_DIR};
+use crate::output::{
+    FirstPositions, OutputDir, ParticleFile, Piece, ProbeWriter, RunSummary, SNAPSHOTS_DIR,
+};
 use crate::plot::snapshot::{SnapshotField, SnapshotPainter};
 use crate::progress::{Progress, RunStatus};
 use crate::ranks::Ranks;
@@ -141,9 +143,10 @@ fn completed_run(dir: &Path, sc: &Scenario) -> Option<RunSummary> {
 struct ParticleOutputs {
     out: OutputDir,
     png: Option<SnapshotPainter>,
-    /// With `time.output_boundary = "first"`: the positions of that first output (every
-    /// particle, in id order); the later outputs leave out the boundary particles still there.
-    first_pos: Option<Vec<[f64; 3]>>,
+    /// With `time.output_boundary = "first"`: the ids and positions of that first output (of
+    /// this process's particles); the later outputs leave out the boundary particles still
+    /// there.
+    first_pos: Option<FirstPositions>,
     boundary_first: bool,
     /// A subdomain's piece holds its own particles only (not the halo copies it keeps
     /// excluded).
@@ -167,7 +170,7 @@ impl ParticleOutputs {
         self.out
             .write_snapshot(&written.snapshot(solver.time(), &extra))?;
         if self.boundary_first && self.first_pos.is_none() {
-            self.first_pos = Some(p.pos.clone());
+            self.first_pos = Some(FirstPositions::of(&p));
         }
         // The picture is of every particle.
         let snap = p.snapshot(solver.time(), &[]);
@@ -504,9 +507,15 @@ fn resume_with(
     let o = ck.outputs;
     runner.outputs.out.resume_series(o.snapshots)?;
     if runner.outputs.boundary_first {
-        // The later outputs leave out what the first one holds: read it back.
-        let first = crate::output::particle_file_path(dir, 0);
-        runner.outputs.first_pos = Some(ParticleFile::read(&first)?.particles.pos);
+        // The later outputs leave out what the first one holds: read it back (over ranks,
+        // every rank's piece of it, through its `.pvtu`).
+        let first = match runner.ranks {
+            Some(_) => dir
+                .join(crate::output::PARTICLES_DIR)
+                .join(crate::output::pieces_file_name(0)),
+            None => crate::output::particle_file_path(dir, 0),
+        };
+        runner.outputs.first_pos = Some(FirstPositions::of(&ParticleFile::read(&first)?.particles));
     }
     runner.probes.restore(&o.probe_tables)?;
     runner.bodies.csv.restore(&o.body_tables)?;

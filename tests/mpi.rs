@@ -514,6 +514,45 @@ fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
     assert!(ranks.iter().all(|r| r.adapter.contains("llvmpipe")));
 }
 
+/// `time.output_boundary = "first"` over two ranks: each rank's later pieces leave out the
+/// unmoved walls its first piece holds, and every output, completed from the first
+/// (`Particles::completed_from`, as `plot` reads it), equals one whole run's bit for bit, also
+/// after `resume` (which reads the first output's pieces back).
+#[test]
+fn ranks_write_the_unmoved_walls_once_as_one_run_does() {
+    let (one, two) = (
+        common::Scratch::new("mpi-walls-one"),
+        common::Scratch::new("mpi-walls-two"),
+    );
+    let walls_once = |end: &str, out: &std::path::Path| {
+        let mut args = dam_break(end, out);
+        args.extend(["--set".into(), "time.output_boundary=\"first\"".into()]);
+        args
+    };
+    on_one_rank(walls_once("time.end_s=0.05", &one));
+    on_two_ranks(walls_once("time.end_s=0.03", &two));
+    on_two_ranks(resume(&two, "0.05"));
+    let (a, b) = (particle_files(&one).unwrap(), particle_files(&two).unwrap());
+    assert_eq!(a.len(), b.len());
+    let read = |f: &std::path::Path| ParticleFile::read(f).unwrap();
+    let (first_a, first_b) = (read(&a[0].1).particles, read(&b[0].1).particles);
+    assert!(first_a.without_kind(KIND_EXCLUDED) == first_b);
+    for ((_, fa), (_, fb)) in a.iter().zip(&b).skip(1) {
+        let (ra, rb) = (read(fa), read(fb));
+        assert!(
+            rb.particles.id.len() < first_b.id.len(),
+            "{}: the walls were written again",
+            fb.display()
+        );
+        let whole = (ra.particles.completed_from(&first_a)).without_kind(KIND_EXCLUDED);
+        assert!(
+            whole == rb.particles.completed_from(&first_b),
+            "the particles differ at t = {}",
+            ra.time_s
+        );
+    }
+}
+
 /// Three slabs of the 3D SPHERIC dam break at a coarse dx (36 k particles; 3D halos, a middle
 /// rank with two neighbours, the box obstacle): the same, after 40 steps.
 #[test]

@@ -34,7 +34,7 @@ use std::path::{Path, PathBuf};
 
 pub use atomic::write_atomic;
 pub use lock::{DirLock, LOCK_FILE};
-pub use particle_file::{particle_files, ParticleFile, Particles};
+pub use particle_file::{particle_files, FirstPositions, ParticleFile, Particles};
 pub use probes_csv::ProbeWriter;
 pub use run_summary::{RankSummary, RunSummary};
 

@@ -29,6 +29,24 @@ pub struct Particles {
 const STRESS_NAMES: [&str; 6] = ["tau_xx", "tau_yy", "tau_zz", "tau_xy", "tau_xz", "tau_yz"];
 const ENERGY_NAME: &str = "energy";
 
+/// The ids and positions of a run's first particle output, in id order (a subdomain's own
+/// particles, or the whole run's): what `time.output_boundary = "first"` leaves out of the
+/// later ones ([`Particles::without_unmoved_boundary`]).
+#[derive(Clone, Debug, Default)]
+pub struct FirstPositions {
+    pub id: Vec<u32>,
+    pub pos: Vec<[f64; 3]>,
+}
+
+impl FirstPositions {
+    pub fn of(p: &Particles) -> Self {
+        Self {
+            id: p.id.clone(),
+            pos: p.pos.clone(),
+        }
+    }
+}
+
 impl Particles {
     /// The per-particle scalars beyond the fixed arrays, named as in the particle files: the
     /// energy, then the stress components, where the run has them.
@@ -46,14 +64,18 @@ impl Particles {
     }
 
     /// These particles less the boundary particles (walls, obstacles and bodies, of any wall
-    /// treatment) that stand where they stood in the first output, `first_pos` (a run's every
-    /// particle in id order, as these are): what a later output holds with
-    /// `time.output_boundary = "first"`.
-    pub fn without_unmoved_boundary(&self, first_pos: &[[f64; 3]]) -> Particles {
-        let unmoved = |i: usize| {
+    /// treatment) that stand where they stood in the first output, `first` (ids and positions,
+    /// in id order as these are; a subdomain's own particles then): what a later output holds
+    /// with `time.output_boundary = "first"`. A particle `first` lacks is kept.
+    pub fn without_unmoved_boundary(&self, first: &FirstPositions) -> Particles {
+        let mut k = 0;
+        let mut unmoved = |i: usize| {
+            while k < first.id.len() && first.id[k] < self.id[i] {
+                k += 1;
+            }
             Kind::from_code(self.kind[i]).is_some_and(Kind::is_boundary)
-                && first_pos.get(i).map(|x| x.map(f64::to_bits))
-                    == Some(self.pos[i].map(f64::to_bits))
+                && first.id.get(k) == Some(&self.id[i])
+                && first.pos[k].map(f64::to_bits) == self.pos[i].map(f64::to_bits)
         };
         let picks: Vec<(&Particles, usize)> = (0..self.id.len())
             .filter(|&i| !unmoved(i))
@@ -307,7 +329,7 @@ mod tests {
         for (i, v) in later.vel.iter_mut().enumerate() {
             v[1] = -(i as f32);
         }
-        let fewer = later.without_unmoved_boundary(&first.pos);
+        let fewer = later.without_unmoved_boundary(&FirstPositions::of(&first));
         let kept: Vec<u32> = fewer.kind.clone();
         assert_eq!(kept, [1, 0, 5, 7, 15, 0], "{fewer:?}");
         assert_eq!(fewer.id, [1, 2, 6, 7, 8, 10]);
@@ -330,7 +352,7 @@ mod tests {
             assert_eq!(back.vel[i], want, "particle {i}");
         }
         // Nothing left out: the same particles back.
-        let all = later.without_unmoved_boundary(&[]);
+        let all = later.without_unmoved_boundary(&FirstPositions::default());
         assert_eq!(all, later);
         assert_eq!(all.completed_from(&first_with_kinds), later);
     }

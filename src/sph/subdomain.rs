@@ -23,7 +23,7 @@ use crate::grid::Grid;
 use crate::layout::{unpack_block, HaloCtl, HaloRecord, Pos, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
 use crate::output::RankSummary;
 use crate::ranks::Ranks;
-use crate::scenario::{DensityFilter, Kind, OutputBoundary, Scenario};
+use crate::scenario::{DensityFilter, Kind, Scenario};
 
 /// A subdomain's counts, over all ranks where they say so (a checkpoint keeps them).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -123,10 +123,6 @@ fn unsupported(sc: &Scenario) -> Vec<&'static str> {
             "the density filter (it needs a second exchange a step)",
         ),
         (!sc.points.is_empty(), "tracked points"),
-        (
-            sc.time.output_boundary == OutputBoundary::First,
-            "time.output_boundary = \"first\"",
-        ),
     ]
     .into_iter()
     .filter_map(|(yes, what)| yes.then_some(what))
@@ -587,6 +583,11 @@ mod tests {
         assert!(unsupported(&load("cases/dam_break_2d.toml", &[])).is_empty());
         let energy = load("cases/dam_break_2d.toml", &["physics.energy=true"]);
         assert!(unsupported(&energy).is_empty());
+        let walls_once = load(
+            "cases/dam_break_2d.toml",
+            &["time.output_boundary=\"first\""],
+        );
+        assert!(unsupported(&walls_once).is_empty());
         let cases: [(&str, &[&str], &str); 4] = [
             ("cases/floating_box_2d.toml", &[], "moving bodies"),
             ("cases/oscillating_plate_2d.toml", &[], "elastic solids"),
