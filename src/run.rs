@@ -19,7 +19,7 @@ use crate::gpu::GpuContext;
 use crate::output::{
     FirstPositions, OutputDir, ParticleFile, Piece, ProbeWriter, RunSummary, SNAPSHOTS_DIR,
 };
-use crate::plot::snapshot::{SnapshotField, SnapshotPainter};
+use crate::plot::snapshot::{draw_particle_file, SnapshotField, SnapshotPainter};
 use crate::progress::{Progress, RunStatus};
 use crate::ranks::Ranks;
 use crate::scenario::{Kind, OutputBoundary, ProbeKind, Scenario};
@@ -151,6 +151,9 @@ struct ParticleOutputs {
     /// A subdomain's piece holds its own particles only (not the halo copies it keeps
     /// excluded).
     own_only: bool,
+    /// Over several ranks with `time.output_boundary = "first"` and pictures: the first
+    /// output, joined, that the later ones are completed from to be drawn.
+    first_drawn: Option<crate::output::Particles>,
 }
 
 impl ParticleOutputs {
@@ -172,15 +175,36 @@ impl ParticleOutputs {
         if self.boundary_first && self.first_pos.is_none() {
             self.first_pos = Some(FirstPositions::of(&p));
         }
-        // The picture is of every particle.
-        let snap = p.snapshot(solver.time(), &[]);
-        if let Some(view) = &self.png {
-            let path = self
-                .out
-                .path()
-                .join(SNAPSHOTS_DIR)
-                .join(format!("{index:06}.png"));
-            view.write_png(&path, &snap)?;
+        // The picture is of every particle (over ranks, drawn from the joined pieces:
+        // `draw_published`).
+        if let Some(view) = self.png.as_ref().filter(|_| !self.own_only) {
+            view.write_png(&self.png_path(index), &p.snapshot(solver.time(), &[]))?;
+        }
+        Ok(())
+    }
+
+    /// DIR/snapshots/NNNNNN.png of output `index`.
+    fn png_path(&self, index: usize) -> std::path::PathBuf {
+        (self.out.path().join(SNAPSHOTS_DIR)).join(format!("{index:06}.png"))
+    }
+
+    /// Over several ranks, on rank 0 (which alone holds the painter): the output just
+    /// published, every rank's piece read back through its `.pvtu`, drawn as one whole run
+    /// draws it (completed from the first output with `time.output_boundary = "first"`).
+    fn draw_published(&mut self, sc: &Scenario) -> Result<()> {
+        let (Some(view), Some(file)) = (&self.png, self.out.last_snapshot()) else {
+            return Ok(());
+        };
+        let index = self.out.snapshot_count() - 1;
+        let read = draw_particle_file(
+            &file,
+            self.first_drawn.as_ref(),
+            sc,
+            view,
+            &self.png_path(index),
+        )?;
+        if self.boundary_first && self.first_drawn.is_none() {
+            self.first_drawn = Some(read.particles);
         }
         Ok(())
     }
@@ -330,12 +354,6 @@ pub fn run_on_ranks(
     progress: &mut dyn Progress,
     ranks: &dyn Ranks,
 ) -> Result<RunReport> {
-    if options.snapshot_png.is_some() {
-        bail!(
-            "--snapshots draws one device's particles, and a run over several ranks holds them \
-             on each: draw them after the run with `wgsph plot DIR --snapshots`"
-        );
-    }
     start(ctx, sc, dir, options, progress, Some(ranks))
 }
 
@@ -515,7 +533,11 @@ fn resume_with(
                 .join(crate::output::pieces_file_name(0)),
             None => crate::output::particle_file_path(dir, 0),
         };
-        runner.outputs.first_pos = Some(FirstPositions::of(&ParticleFile::read(&first)?.particles));
+        let first = ParticleFile::read(&first)?.particles;
+        runner.outputs.first_pos = Some(FirstPositions::of(&first));
+        if runner.ranks.is_some() && runner.outputs.png.is_some() {
+            runner.outputs.first_drawn = Some(first);
+        }
     }
     runner.probes.restore(&o.probe_tables)?;
     runner.bodies.csv.restore(&o.body_tables)?;
@@ -690,13 +712,14 @@ impl<'a> Runner<'a> {
         };
         let first = ranks.is_none_or(|r| r.rank() == 0);
         let png = match options.snapshot_png {
-            Some(field) => {
+            // Over several ranks rank 0 draws (`ParticleOutputs::draw_published`).
+            Some(field) if first => {
                 let pngs = dir.join(SNAPSHOTS_DIR);
                 std::fs::create_dir_all(&pngs)
                     .with_context(|| format!("cannot create {}", pngs.display()))?;
                 Some(SnapshotPainter::for_scenario(Some(ctx), sc, field, false)?)
             }
-            None => None,
+            _ => None,
         };
         // Rank 0 writes the tables.
         let names: Vec<(String, String)> = (sc.probes.iter())
@@ -742,6 +765,7 @@ impl<'a> Runner<'a> {
                 first_pos: None,
                 boundary_first: sc.time.output_boundary == OutputBoundary::First,
                 own_only: ranks.is_some(),
+                first_drawn: None,
             },
             next_output: sc.time.output_every_s.min(sc.time.end_s),
             next_checkpoint_sim: options.checkpoint.every_sim_s,
@@ -767,6 +791,7 @@ impl<'a> Runner<'a> {
         if let Some(r) = self.ranks {
             r.barrier();
             self.outputs.out.publish_pieces()?;
+            self.outputs.draw_published(self.sc)?;
         }
         Ok(())
     }

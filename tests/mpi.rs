@@ -514,12 +514,13 @@ fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
     assert!(ranks.iter().all(|r| r.adapter.contains("llvmpipe")));
 }
 
-/// `time.output_boundary = "first"` over two ranks: each rank's later pieces leave out the
-/// unmoved walls its first piece holds, and every output, completed from the first
-/// (`Particles::completed_from`, as `plot` reads it), equals one whole run's bit for bit, also
-/// after `resume` (which reads the first output's pieces back).
+/// `time.output_boundary = "first"` and `--snapshots` over two ranks: each rank's later
+/// pieces leave out the unmoved walls its first piece holds, and every output, completed from
+/// the first (`Particles::completed_from`, as `plot` reads it), equals one whole run's bit for
+/// bit, also after `resume` (which reads the first output's pieces back); rank 0 draws each
+/// output from the joined pieces, the whole run's pictures byte for byte.
 #[test]
-fn ranks_write_the_unmoved_walls_once_as_one_run_does() {
+fn ranks_write_the_walls_once_and_draw_what_one_run_draws() {
     let (one, two) = (
         common::Scratch::new("mpi-walls-one"),
         common::Scratch::new("mpi-walls-two"),
@@ -527,6 +528,7 @@ fn ranks_write_the_unmoved_walls_once_as_one_run_does() {
     let walls_once = |end: &str, out: &std::path::Path| {
         let mut args = dam_break(end, out);
         args.extend(["--set".into(), "time.output_boundary=\"first\"".into()]);
+        args.push("--snapshots".into());
         args
     };
     on_one_rank(walls_once("time.end_s=0.05", &one));
@@ -550,6 +552,12 @@ fn ranks_write_the_unmoved_walls_once_as_one_run_does() {
             "the particles differ at t = {}",
             ra.time_s
         );
+    }
+    for (index, _) in &a {
+        let png = |dir: &std::path::Path| {
+            std::fs::read(dir.join(format!("snapshots/{index:06}.png"))).unwrap()
+        };
+        assert!(png(&one) == png(&two), "snapshot {index} differs");
     }
 }
 

@@ -365,6 +365,11 @@ impl OutputDir {
         self.snapshots.len()
     }
 
+    /// The last particle output's file (of a run over several ranks, its `.pvtu`).
+    pub fn last_snapshot(&self) -> Option<PathBuf> {
+        (self.snapshots.last()).map(|(_, rel)| self.dir.join(rel))
+    }
+
     /// Writes DIR/particles/particles_NNNNNN.vtu (NNNNNN = index, 6 digits, starting at 0)
     /// atomically, then rewrites DIR/particles.pvd atomically listing every snapshot written so
     /// far (time + relative file). The .vtu is fully written and renamed before the .pvd that

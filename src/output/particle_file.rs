@@ -85,7 +85,8 @@ impl Particles {
     }
 
     /// A later output that left out unmoved boundary particles, completed with those of
-    /// `first` (every id `first` has and `self` lacks), in id order: the inverse of
+    /// `first` (every boundary particle `first` has and `self` lacks; not the particles that
+    /// left the domain, which a subdomain's piece leaves out too), in id order: the inverse of
     /// [`Particles::without_unmoved_boundary`].
     pub fn completed_from(&self, first: &Particles) -> Particles {
         let mut picks = Vec::with_capacity(first.id.len().max(self.id.len()));
@@ -98,7 +99,7 @@ impl Particles {
             if k < self.id.len() && self.id[k] == first.id[i] {
                 picks.push((self, k));
                 k += 1;
-            } else {
+            } else if Kind::from_code(first.kind[i]).is_some_and(Kind::is_boundary) {
                 picks.push((first, i));
             }
         }

@@ -21,8 +21,8 @@ use plotters::prelude::*;
 use super::perspective::PerspectiveView;
 use super::{register_font, write_png};
 use crate::gpu::GpuContext;
-use crate::output::{particle_files, ParticleFile, Snapshot, SNAPSHOTS_DIR};
-use crate::scenario::{Domain, Kind, Scenario};
+use crate::output::{particle_files, ParticleFile, Particles, Snapshot, SNAPSHOTS_DIR};
+use crate::scenario::{Domain, Kind, OutputBoundary, Scenario};
 use crate::sph::EXCLUDED;
 
 /// The per-particle value that sets a fluid particle's colour.
@@ -199,29 +199,54 @@ pub fn draw_particle_files(
     let mut first: Option<ParticleFile> = None;
     let mut written = Vec::with_capacity(files.len());
     for (index, file) in &files {
-        let read = ParticleFile::read(file)?;
-        let partial = read.particles.id.len() < sc.particles.len();
-        let particles = match (&first, partial) {
-            (_, false) => &read.particles,
-            (Some(f), true) => &read.particles.completed_from(&f.particles),
-            (None, true) => bail!(
-                "{} holds {} of the run's {} particles (time.output_boundary = \"first\" left \
-                 out the unmoved walls), and the first output, which holds them, is missing",
-                file.display(),
-                read.particles.id.len(),
-                sc.particles.len()
-            ),
-        };
         let png = pngs.join(format!("{index:06}.png"));
-        painter
-            .write_png(&png, &particles.snapshot(read.time_s, &[]))
-            .with_context(|| format!("drawing {}", file.display()))?;
+        let read = draw_particle_file(
+            file,
+            first.as_ref().map(|f| &f.particles),
+            sc,
+            painter,
+            &png,
+        )?;
         written.push(png);
         if *index == 0 {
             first = Some(read);
         }
     }
     Ok(written)
+}
+
+/// Draws the particle file `file` of the run of `sc` as `png` with `painter`; a file that left
+/// out the unmoved boundary particles (`time.output_boundary = "first"`) is completed with
+/// those of `first`, the run's first output. Returns what was read.
+pub fn draw_particle_file(
+    file: &Path,
+    first: Option<&Particles>,
+    sc: &Scenario,
+    painter: &SnapshotPainter,
+    png: &Path,
+) -> Result<ParticleFile> {
+    let read = ParticleFile::read(file)?;
+    let partial = sc.time.output_boundary == OutputBoundary::First
+        && read.particles.id.len() < sc.particles.len();
+    let completed;
+    let particles = match (first, partial) {
+        (_, false) => &read.particles,
+        (Some(f), true) => {
+            completed = read.particles.completed_from(f);
+            &completed
+        }
+        (None, true) => bail!(
+            "{} holds {} of the run's {} particles (time.output_boundary = \"first\" left \
+             out the unmoved walls), and the first output, which holds them, is missing",
+            file.display(),
+            read.particles.id.len(),
+            sc.particles.len()
+        ),
+    };
+    painter
+        .write_png(png, &particles.snapshot(read.time_s, &[]))
+        .with_context(|| format!("drawing {}", file.display()))?;
+    Ok(read)
 }
 
 /// Pixels of the layout (see [`SnapshotView::render`]).
