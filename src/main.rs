@@ -204,6 +204,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    wgsph::gpu::context::without_mesa_device_select();
     let cli = Cli::parse();
     let quiet = matches!(
         cli.command,

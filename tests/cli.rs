@@ -91,6 +91,27 @@ fn run_hydrostatic(
     (o, out)
 }
 
+/// A headless run prints no Wayland complaint: Mesa's device-select layer, which connects to a
+/// display to choose a default device and printed "error: XDG_RUNTIME_DIR is invalid or not
+/// set in the environment." twice on every command, is off (`without_mesa_device_select`).
+#[test]
+fn a_headless_run_prints_no_display_errors() {
+    let out = temp_dir("headless");
+    let o = wgsph()
+        .args(["run", "cases/hydrostatic_2d.toml", "--quiet"])
+        .args(["--set", "time.end_s=0.002", "--out"])
+        .arg(&out)
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("NODEVICE_SELECT")
+        .env_remove("MESA_VK_DEVICE_SELECT")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(!stderr.contains("XDG_RUNTIME_DIR"), "{stderr}");
+}
+
 #[test]
 fn snapshots_are_pngs_and_log_lines_go_to_stderr_off_a_terminal() {
     let (o, out) = run_hydrostatic("pngs", "wgsph=debug", &["--snapshots"]);

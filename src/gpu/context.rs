@@ -156,6 +156,21 @@ pub struct GpuFailure(pub String);
 /// supports gives (tests/shader_backends.rs checks every entry point of every shipped variant).
 pub const STORAGE_BUFFERS_PER_STAGE: u32 = 8;
 
+/// Switches off Mesa's implicit Vulkan layer `VK_LAYER_MESA_device_select` for this process,
+/// unless the user steers it (`MESA_VK_DEVICE_SELECT`) or set `NODEVICE_SELECT` already. The
+/// layer only moves the default device first for programs that take the first one; wgsph
+/// chooses its adapter itself (`--adapter`), and to pick a default the layer connects to a
+/// Wayland display, which on a headless machine prints "error: XDG_RUNTIME_DIR is invalid or
+/// not set in the environment." twice on every command. Call at the start of `main`, before
+/// any thread starts (it sets an environment variable).
+pub fn without_mesa_device_select() {
+    if std::env::var_os("MESA_VK_DEVICE_SELECT").is_none()
+        && std::env::var_os("NODEVICE_SELECT").is_none()
+    {
+        std::env::set_var("NODEVICE_SELECT", "1");
+    }
+}
+
 fn instance() -> wgpu::Instance {
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
     desc.backends = wgpu::Backends::PRIMARY;
