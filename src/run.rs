@@ -192,10 +192,10 @@ impl ParticleOutputs {
     /// published, every rank's piece read back through its `.pvtu`, drawn as one whole run
     /// draws it (completed from the first output with `time.output_boundary = "first"`).
     fn draw_published(&mut self, sc: &Scenario) -> Result<()> {
-        let (Some(view), Some(file)) = (&self.png, self.out.last_snapshot()) else {
+        let index = self.out.snapshot_count().saturating_sub(1);
+        let (Some(view), Some(file)) = (&self.png, self.out.snapshot_file(index)) else {
             return Ok(());
         };
-        let index = self.out.snapshot_count() - 1;
         let read = draw_particle_file(
             &file,
             self.first_drawn.as_ref(),
@@ -527,12 +527,8 @@ fn resume_with(
     if runner.outputs.boundary_first {
         // The later outputs leave out what the first one holds: read it back (over ranks,
         // every rank's piece of it, through its `.pvtu`).
-        let first = match runner.ranks {
-            Some(_) => dir
-                .join(crate::output::PARTICLES_DIR)
-                .join(crate::output::pieces_file_name(0)),
-            None => crate::output::particle_file_path(dir, 0),
-        };
+        let first = (runner.outputs.out.snapshot_file(0))
+            .context("the run's first particle output is not in its series")?;
         let first = ParticleFile::read(&first)?.particles;
         runner.outputs.first_pos = Some(FirstPositions::of(&first));
         if runner.ranks.is_some() && runner.outputs.png.is_some() {

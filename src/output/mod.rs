@@ -365,9 +365,9 @@ impl OutputDir {
         self.snapshots.len()
     }
 
-    /// The last particle output's file (of a run over several ranks, its `.pvtu`).
-    pub fn last_snapshot(&self) -> Option<PathBuf> {
-        (self.snapshots.last()).map(|(_, rel)| self.dir.join(rel))
+    /// Particle output `index`'s file (of a run over several ranks, its `.pvtu`), if written.
+    pub fn snapshot_file(&self, index: usize) -> Option<PathBuf> {
+        (self.snapshots.get(index)).map(|(_, rel)| self.dir.join(rel))
     }
 
     /// Writes DIR/particles/particles_NNNNNN.vtu (NNNNNN = index, 6 digits, starting at 0)
