@@ -351,16 +351,19 @@ fn probe_front_continuous(
 }
 
 // Tracked points (`kind = "point"` probes): the position of each followed particle. `tracked`
-// holds their ids in ascending order; the one invocation whose particle carries such an id
-// (the arrays are re-sorted every step, the ids are stable) copies its position. A binary
-// search keeps the cost O(log P) per particle for P tracked points.
+// holds their ids in ascending order; the one invocation whose live particle carries such an id
+// (the arrays are re-sorted every step, the ids are stable) copies its position and marks it
+// held (`tracked_held`, cleared before: a particle that left the domain, or over ranks one
+// another rank holds, is not held). A binary search keeps the cost O(log P) per particle for P
+// tracked points.
 @group(0) @binding(7) var<storage, read> tracked: array<u32>;
 @group(0) @binding(8) var<storage, read_write> tracked_pos: array<Pos>;
+@group(0) @binding(9) var<storage, read_write> tracked_held: array<u32>;
 
 @compute @workgroup_size(WG)
 fn track_points(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let k = linear_index(gid, nwg);
-    if (k >= params.n_particles) {
+    if (k >= params.n_particles || code_kind(code[k]) == KIND_EXCLUDED) {
         return;
     }
     let id = code[k] & ID_MASK;
@@ -376,5 +379,6 @@ fn track_points(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     }
     if (lo < arrayLength(&tracked) && tracked[lo] == id) {
         tracked_pos[lo] = pos[k];
+        tracked_held[lo] = 1u;
     }
 }

@@ -214,6 +214,9 @@ impl ParticleOutputs {
 /// (`probes/point_<name>.csv`: position and displacement from t = 0), one row per probe time.
 struct BodyOutputs {
     csv: ProbeWriter,
+    /// Whether this process writes them: one whole run, or rank 0 of several (every rank
+    /// holds the same bodies).
+    writes: bool,
     dim: u32,
     /// Initial position of every tracked point.
     point_starts: Vec<[f64; 3]>,
@@ -228,7 +231,7 @@ fn point_columns(dim: u32) -> Vec<String> {
 }
 
 impl BodyOutputs {
-    fn new(out: &OutputDir, sc: &Scenario) -> Result<Self> {
+    fn new(out: &OutputDir, sc: &Scenario, writes: bool) -> Result<Self> {
         let dim = sc.physics.dim;
         let bodies = sc
             .bodies
@@ -238,9 +241,10 @@ impl BodyOutputs {
             .points
             .iter()
             .map(|p| (format!("point_{}", p.name), point_columns(dim)));
-        let tables: Vec<(String, Vec<String>)> = bodies.chain(points).collect();
+        let tables: Vec<(String, Vec<String>)> = bodies.chain(points).filter(|_| writes).collect();
         Ok(Self {
             csv: out.table_writer(&tables)?,
+            writes,
             dim,
             // The case's positions: the GPU holds them to f32 offsets in their blocks (and
             // places body particles from the body's pose), so a point at rest reports a
@@ -253,7 +257,12 @@ impl BodyOutputs {
         })
     }
 
-    fn record(&mut self, solver: &Solver) -> Result<()> {
+    /// Every rank together: the points are sampled where their particles are.
+    fn record(&mut self, solver: &Solver, ranks: Option<&dyn Ranks>) -> Result<()> {
+        let points = solver.sample_points(ranks)?;
+        if !self.writes {
+            return Ok(());
+        }
         let mut rows: Vec<Vec<f64>> = Vec::new();
         if let Some(set) = solver.bodies() {
             rows.extend(
@@ -261,7 +270,7 @@ impl BodyOutputs {
             );
         }
         let d = self.dim as usize;
-        for (x, x0) in solver.sample_points()?.iter().zip(&self.point_starts) {
+        for (x, x0) in points.iter().zip(&self.point_starts) {
             let moved = (0..d).map(|a| x[a] - x0[a]);
             rows.push(x[..d].iter().copied().chain(moved).collect());
         }
@@ -385,7 +394,7 @@ fn start(
     let mut runner = Runner::create(ctx, sc, dir, options, ranks)?;
     runner.write_particles()?;
     runner.record_probes()?;
-    runner.bodies.record(&runner.solver)?;
+    runner.bodies.record(&runner.solver, runner.ranks)?;
     runner.go(progress)
 }
 
@@ -728,7 +737,7 @@ impl<'a> Runner<'a> {
             None => Solver::new(ctx, sc),
         }
         .context("setting up the GPU solver")?;
-        let bodies = BodyOutputs::new(&out, sc)?;
+        let bodies = BodyOutputs::new(&out, sc, first)?;
         let some = |n: usize, what: &str| match n {
             0 => String::new(),
             n => format!(", {n} {what}"),
@@ -1009,7 +1018,7 @@ impl<'a> Runner<'a> {
                 .record_max(self.solver.density_variation(), self.solver.time());
         }
         self.record_probes()?;
-        self.bodies.record(&self.solver)?;
+        self.bodies.record(&self.solver, self.ranks)?;
         if self.solver.time() >= self.next_output - 1e-9 * every_out {
             self.write_particles()?;
             self.probes.flush()?;

@@ -412,6 +412,15 @@ fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind, pair: bool) {
     let cpu_rates: Vec<[f64; 4]> = gpu_rates.iter().map(|g| g.map(|x| x as f64)).collect();
     let want = reference::bodies::body_force(&sc.physics, &parts, &cpu_rates, &centers);
     let got = solver.rerun_body_loads().unwrap();
+    // A subdomain of a run over ranks sums the GPU's per-particle loads on the host, with the
+    // GPU's tree: the same bits.
+    let bits = |l: &wgsph::body::Load| [l.force, l.torque].map(|v| v.to_array().map(f64::to_bits));
+    let on_host = solver.rerun_body_loads_summed_on_host().unwrap();
+    assert_eq!(
+        got.iter().map(bits).collect::<Vec<_>>(),
+        on_host.iter().map(bits).collect::<Vec<_>>(),
+        "the host's sums of the per-particle loads differ from the GPU's"
+    );
     for (k, (w, g)) in want.iter().zip(&got).enumerate() {
         // Scale: the sum of the magnitudes (the force is a sum with cancellation).
         let (mut fs, mut ts) = (0.0, 0.0);
@@ -704,7 +713,7 @@ fn point_follows_its_particle(case: &str, point: &str, end: f64) {
     let id = tracked.particle as usize;
     let x0 = sc.particles[id].pos;
     let mut solver = Solver::new(gpu(), &sc).unwrap();
-    let start = solver.sample_points().unwrap();
+    let start = solver.sample_points(None).unwrap();
     assert!(
         (0..3).all(|a| (start[0][a] - x0[a]).abs() < 1e-6),
         "{case}: the point starts at {:?}, its particle at {x0:?}",
@@ -713,7 +722,7 @@ fn point_follows_its_particle(case: &str, point: &str, end: f64) {
     solver.advance_to(end).unwrap();
     let p = solver.read_particles().unwrap();
     let k = p.id.iter().position(|&i| i as usize == id).unwrap();
-    let got = solver.sample_points().unwrap();
+    let got = solver.sample_points(None).unwrap();
     println!("{case}: {point} from {x0:?} to {:?}", got[0]);
     assert_eq!(got, vec![p.pos[k]], "{case}");
     let moved = (0..2)

@@ -213,6 +213,31 @@ fn live_particles(solver: &Solver) -> Live {
     live
 }
 
+/// Every body's pose (centre, rotation, velocity, spin) as the bits of its f64s.
+fn body_words(solver: &Solver) -> Vec<u32> {
+    let Some(set) = solver.bodies() else {
+        return Vec::new();
+    };
+    (0..set.len())
+        .flat_map(|k| {
+            let p = set.pose(k);
+            let values: Vec<f64> = [
+                p.center.to_array(),
+                p.velocity.to_array(),
+                p.omega.to_array(),
+            ]
+            .concat()
+            .into_iter()
+            .chain(p.rotation.to_array())
+            .collect();
+            values
+                .into_iter()
+                .flat_map(|x| [x.to_bits() as u32, (x.to_bits() >> 32) as u32])
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
 /// A case cut into slabs and stepped on `ranks` ranks under mpirun, against its whole run.
 struct Comparison {
     /// The test function that runs it (what mpirun launches).
@@ -227,9 +252,10 @@ struct Comparison {
     /// Save every rank's state after this many steps and take the rest in a new subdomain
     /// restored from it (as `wgsph resume` does), not in the one that saved it.
     restore_at: Option<u64>,
-    /// The box of an `[[outlet]]` added to the case (written beside the test binary before the
-    /// ranks start), which must have drained particles by the end.
-    outlet: Option<&'static str>,
+    /// Tables added to the case (written beside the test binary before the ranks start): an
+    /// `[[outlet]]` must have drained particles by the end; a `[[body]]` must end with
+    /// particles on every rank, and every rank with the whole run's pose of it, bit for bit.
+    tables: &'static str,
 }
 
 impl Comparison {
@@ -238,20 +264,19 @@ impl Comparison {
         wgsph::case::load(&self.case_path(), &set).unwrap()
     }
 
-    /// The case file: `case`, or with an outlet a copy of it with the outlet added.
+    /// The case file: `case`, or with `tables` a copy of it with them added.
     fn case_path(&self) -> std::path::PathBuf {
-        match self.outlet {
-            None => self.case.into(),
-            Some(_) => std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        match self.tables {
+            "" => self.case.into(),
+            _ => std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
                 .join(format!("{}.toml", self.test)),
         }
     }
 
-    /// Writes the case with its outlet ([`Comparison::case_path`]).
-    fn write_outlet_case(&self, outlet: &str) {
+    /// Writes the case with its added tables ([`Comparison::case_path`]).
+    fn write_case(&self) {
         let case = std::fs::read_to_string(self.case).unwrap();
-        let table = format!("\n[[outlet]]\nname = \"drain\"\n{outlet}\n");
-        std::fs::write(self.case_path(), case + &table).unwrap();
+        std::fs::write(self.case_path(), case + "\n" + self.tables).unwrap();
     }
 
     /// The ranks' live particles, merged, equal the whole run's bit for bit, each on one rank;
@@ -260,8 +285,8 @@ impl Comparison {
         if under_mpirun() {
             return self.rank();
         }
-        if let Some(outlet) = self.outlet {
-            self.write_outlet_case(outlet);
+        if !self.tables.is_empty() {
+            self.write_case();
         }
         let out = common::Scratch::new(&format!("mpi-{}", self.test));
         std::fs::create_dir_all(&*out).unwrap();
@@ -272,16 +297,26 @@ impl Comparison {
         let mut whole = Solver::new(common::gpu(), &self.scenario()).unwrap();
         whole.run_steps(self.steps).unwrap();
         let expected = live_particles(&whole);
+        let sc = self.scenario();
         assert!(
-            self.outlet.is_none() || whole.drained() > 0,
+            sc.outlets.is_empty() || whole.drained() > 0,
             "the outlet drained nothing: the test tests nothing"
         );
         println!("{} particles drained", whole.drained());
+        let poses = body_words(&whole);
         let mut merged: Live = Vec::new();
         for r in 0..self.ranks {
             let bytes = std::fs::read(out.join(format!("rank{r}.bin"))).unwrap();
             let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
             let (halo, migrants, rebalances, drained) = (words[0], words[1], words[2], words[3]);
+            let (held, words) = (words[4], &words[5..]);
+            let (pose, words) = words.split_at(poses.len());
+            assert_eq!(pose, poses, "rank {r}'s bodies differ from the whole run's");
+            println!("rank {r}: {held} body particles");
+            assert!(
+                sc.bodies.is_empty() || held > 0,
+                "rank {r} holds no body particle: the body is not cut"
+            );
             assert_eq!(
                 drained as u64,
                 whole.drained(),
@@ -290,7 +325,7 @@ impl Comparison {
             println!("rank {r}: {halo} halo copies and {migrants} migrants sent, {rebalances} rebalances");
             assert!(halo > 0, "rank {r} sent no halo");
             assert!(!self.uneven || rebalances > 0, "the cuts never moved");
-            merged.extend(words[4..].chunks(10).map(|c| {
+            merged.extend(words.chunks(10).map(|c| {
                 (
                     c[0],
                     [c[1], c[2], c[3], c[4]],
@@ -350,13 +385,18 @@ impl Comparison {
                 );
             }
             let counts = solver.ranked().unwrap();
+            let live = live_particles(&solver);
+            let body_ids = (sc.bodies.iter().map(|b| b.particles.start as u32)).min();
+            let held = live.iter().filter(|l| body_ids.is_some_and(|b| l.0 >= b));
             let mut words = vec![
                 counts.halo_sent as u32,
                 counts.migrants_sent as u32,
                 counts.rebalances,
                 solver.drained() as u32,
+                held.count() as u32,
             ];
-            for (id, p, v) in live_particles(&solver) {
+            words.extend(body_words(&solver));
+            for (id, p, v) in live {
                 words.push(id);
                 words.extend(p);
                 words.extend(v);
@@ -472,6 +512,39 @@ fn assert_same_outputs(whole: &std::path::Path, ranked: &std::path::Path) -> usi
     live
 }
 
+/// `mpirun -np 2 wgsph run` of the floating box (its walls dynamic) writes what one whole run
+/// writes: the particles, the gauges, the box's table (pose and load) and the path of its
+/// corner (a tracked point), each written once, by rank 0. The cut runs through the box.
+#[test]
+fn a_floating_body_over_two_ranks_writes_what_one_run_writes() {
+    let (one, two) = (
+        common::Scratch::new("mpi-body-one"),
+        common::Scratch::new("mpi-body-two"),
+    );
+    let args = |out: &std::path::Path| -> Vec<std::ffi::OsString> {
+        let set = [
+            "particles.dx_m=0.02",
+            "body[0].wall=\"dynamic\"",
+            "time.end_s=0.2",
+            "time.output_every_s=0.05",
+        ];
+        let mut args: Vec<std::ffi::OsString> =
+            vec!["run".into(), "cases/floating_box_2d.toml".into()];
+        for s in set {
+            args.extend(["--set".into(), s.into()]);
+        }
+        args.extend(["--quiet".into(), "--out".into(), out.as_os_str().to_owned()]);
+        args
+    };
+    on_one_rank(args(&one));
+    on_two_ranks(args(&two));
+    assert_same_outputs(&one, &two);
+    for table in ["body_box.csv", "point_corner.csv"] {
+        let text = std::fs::read_to_string(two.join("probes").join(table)).unwrap();
+        assert!(text.lines().count() > 10, "{table}: {text}");
+    }
+}
+
 /// `mpirun -np 2 wgsph run` of the 2D dam break writes what one whole run writes
 /// ([`assert_same_outputs`]: the particles, pressure at the wall, the front and the continuous
 /// front). The 2-rank run goes to t = 0.04 s with checkpoints every 0.015 s (both sets of
@@ -573,7 +646,7 @@ fn three_ranks_of_the_3d_dam_break_equal_one_run() {
         steps: 40,
         uneven: false,
         restore_at: None,
-        outlet: None,
+        tables: "",
     }
     .check();
 }
@@ -593,7 +666,7 @@ fn ranks_that_move_their_cuts_still_equal_one_run() {
         steps: 300,
         uneven: true,
         restore_at: Some(200),
-        outlet: None,
+        tables: "",
     }
     .check();
 }
@@ -701,7 +774,7 @@ fn ranks_integrate_the_energy_equation_as_one_run() {
         steps: 300,
         uneven: true,
         restore_at: None,
-        outlet: None,
+        tables: "",
     }
     .check();
 }
@@ -720,7 +793,7 @@ fn ranks_with_an_outlet_drain_what_one_run_drains() {
         steps: 300,
         uneven: false,
         restore_at: None,
-        outlet: Some("min_m = [0.1465, -0.1]\nmax_m = [0.3, 0.06]"),
+        tables: "[[outlet]]\nname = \"drain\"\nmin_m = [0.1465, -0.1]\nmax_m = [0.3, 0.06]\n",
     }
     .check();
 }
@@ -764,4 +837,27 @@ fn bench_under_mpirun_reports_every_rank() {
     let own: f64 = rows.iter().map(|r| r[1]).sum();
     assert_eq!(own, 4274.0, "every particle is own on one rank");
     assert!(rows.iter().all(|r| r[2] > 0.0 && r[4] > 0.0), "{stdout}");
+}
+
+/// A box pushed down through the 2D dam break's water column (dynamic walls, 0.5 m/s down and
+/// along), from cuts at equal numbers of cell layers (this case is cut along the vertical): the
+/// ranks move the cut into the column at step 100, through the box, whose particles then cross
+/// it, migrating from rank to rank, while the load on the box is combined over the ranks. Its
+/// pose on every rank and every particle equal one whole run's bit for bit after 300 steps, the
+/// last 100 taken by subdomains restored from the state saved at step 200.
+#[test]
+fn a_body_crossing_the_cut_moves_as_in_one_run() {
+    Comparison {
+        test: "a_body_crossing_the_cut_moves_as_in_one_run",
+        case: "cases/dam_break_2d.toml",
+        set: &["particles.dx_m=0.0073"],
+        ranks: 2,
+        steps: 300,
+        uneven: true,
+        restore_at: Some(200),
+        tables: "[[body]]\nname = \"box\"\nshape = \"box\"\nmin_m = [0.04, 0.10]\n\
+                 max_m = [0.10, 0.16]\ndensity_kg_m3 = 500.0\nwall = \"dynamic\"\n\
+                 [body.motion]\nkind = \"free\"\nvelocity_m_s = [0.5, -0.5]\n",
+    }
+    .check();
 }

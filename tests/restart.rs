@@ -152,6 +152,24 @@ fn resume_is_bit_identical_for_a_body_held_across_the_halt() {
     split_run_matches("held-box", &sc, 0.07);
 }
 
+/// A cylinder falling into water, halted while it moves through the cells: every particle
+/// changes place in the sorted arrays between the start and the halt, so the resumed run must
+/// find its body particles in the restored arrays, not where the warm-up's sort left them.
+#[test]
+fn resume_is_bit_identical_for_a_body_moving_through_the_cells() {
+    let sc = load(
+        "cases/water_entry_cylinder_2d.toml",
+        &[
+            "particles.dx_m=0.02",
+            "body[0].wall=\"dynamic\"",
+            "time.end_s=0.12",
+            "time.output_every_s=0.03",
+            "time.probe_every_s=0.01",
+        ],
+    );
+    split_run_matches("falling-cylinder", &sc, 0.05);
+}
+
 /// Elastic plates of both formulations in one case (tests/common `both_plates_case`): the
 /// updated-Lagrangian plate's τ and ρ come from the checkpoint; the total-Lagrangian plate's
 /// reference lattice and lists come from the case, not the checkpoint, and F, T, P are

@@ -1,6 +1,9 @@
 //! Moving bodies on the GPU (shaders/bodies.wgsl): places body particles from the poses the
 //! host computes (src/body/), tracks where the sort puts them, and sums their force and torque
-//! per workgroup for the host to finish in f64.
+//! per workgroup for the host to finish in f64. A subdomain of a run over ranks reads back the
+//! per-particle loads instead: the ranks combine them ([`owners_values`]) and each sums them
+//! with the GPU's own tree ([`workgroup_sums`]), so that every rank moves the bodies as one
+//! whole run does.
 
 use anyhow::Result;
 use glam::{DMat3, DVec3};
@@ -8,7 +11,7 @@ use glam::{DMat3, DVec3};
 use super::buffers::ParticleBuffers;
 use super::shader::WORKGROUP_MAX;
 use crate::body::{Load, Pose};
-use crate::gpu::buffers::{storage, storage_init};
+use crate::gpu::buffers::storage;
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::{Shader, WORKGROUP_SIZE};
 use crate::grid::Grid;
@@ -69,50 +72,63 @@ pub struct Bodies {
     /// the bodies with).
     poses: Vec<Pose>,
     accels: Vec<[DVec3; 2]>,
+    /// Per body particle (force, torque) of `body_load`.
+    pub particle_loads: wgpu::Buffer,
+    /// Per workgroup (force, torque) of `body_force`.
     pub partials: wgpu::Buffer,
     /// Workgroups of `body_force` (each covers particles of one body).
     groups: u32,
+    /// A subdomain's bodies: the host sums the per-particle loads of every rank.
+    over_ranks: bool,
     body_move: ParityKernel,
+    body_forget: ParityKernel,
     body_index: ParityKernel,
+    body_load: ParityKernel,
     body_force: ParityKernel,
     n_body: u32,
     n: u32,
 }
 
 impl Bodies {
-    /// `motions` is the table the buffers were made with ([`initial_motions`]).
+    /// `motions` is the table the buffers were made with ([`initial_motions`]); `over_ranks`:
+    /// of a subdomain ([`Bodies::loads_buffer`]). The slots are unknown until
+    /// [`Bodies::encode_index`] runs.
     pub fn new(
         device: &wgpu::Device,
         module: &ShaderModule,
         b: &ParticleBuffers,
         motions: Vec<BodyMotion>,
-        first_id: u32,
+        over_ranks: bool,
     ) -> Result<Self> {
         let groups = motions.last().map_or(0, |m| {
             m.first_group + m.count.div_ceil(WORKGROUP_SIZE).max(1)
         });
-        let n_body = b.n - first_id;
-        // The particles start in id order.
-        let slots: Vec<u32> = (first_id..first_id + n_body).collect();
-        let body_slot = storage_init(device, "body slots", &slots);
+        let n_body = motions.iter().map(|m| m.count).sum::<u32>();
+        let body_slot = storage(device, "body slots", 4 * n_body as u64);
+        let particle_loads = storage(device, "body particle loads", 32 * n_body as u64);
         let partials = storage(device, "body partials", Self::partials_bytes_for(groups));
         let bound = |entry: &str| {
             ParityKernel::new(device, module, entry, |p| {
                 b.at(p)
                     .with("body_slot", &body_slot)
+                    .with("body_loads", &particle_loads)
                     .with("body_partials", &partials)
             })
         };
         Ok(Self {
             body_move: bound("body_move")?,
+            body_forget: bound("body_forget")?,
             body_index: bound("body_index")?,
+            body_load: bound("body_load")?,
             body_force: bound("body_force")?,
             poses: vec![Pose::default(); motions.len()],
             accels: vec![[DVec3::ZERO; 2]; motions.len()],
             motions,
             motion_buf: b.tables.clone(),
+            particle_loads,
             partials,
             groups,
+            over_ranks,
             n_body,
             n: b.n,
         })
@@ -122,9 +138,18 @@ impl Bodies {
         32 * groups as u64
     }
 
-    /// Size of the per-workgroup (force, torque) array, the only per-step readback.
+    /// Size of the per-workgroup (force, torque) array.
     pub fn partials_bytes(&self) -> u64 {
         Self::partials_bytes_for(self.groups)
+    }
+
+    /// What the host reads back after every step, and its size: the per-workgroup sums, or
+    /// in a subdomain the per-particle loads.
+    pub fn loads_buffer(&self) -> (&wgpu::Buffer, u64) {
+        match self.over_ranks {
+            true => (&self.particle_loads, 32 * self.n_body as u64),
+            false => (&self.partials, self.partials_bytes()),
+        }
     }
 
     /// Uploads the poses and accelerations of the step about to be taken (one per body, in
@@ -173,13 +198,23 @@ impl Bodies {
         self.body_move.dispatch(pass, p, self.n_body);
     }
 
-    /// Records where the sort put each body particle (parity `p`, after the sort).
+    /// Records where the sort put each live body particle (parity `p`, after the sort).
     pub fn encode_index(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.body_forget.dispatch(pass, p, self.n_body);
         self.body_index.dispatch(pass, p, self.n);
     }
 
-    /// Per-workgroup force and torque sums of parity `p` (after the interaction).
+    /// The body particles' loads of parity `p` (after the interaction), and their sums per
+    /// workgroup unless the host sums them ([`Bodies::loads_buffer`]).
     pub fn encode_force(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.body_load.dispatch(pass, p, self.n_body);
+        if !self.over_ranks {
+            self.encode_workgroup_sums(pass, p);
+        }
+    }
+
+    /// `body_force` alone: the per-workgroup sums of the loads `body_load` left.
+    pub fn encode_workgroup_sums(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.body_force.dispatch_groups(pass, p, self.groups);
     }
 
@@ -212,4 +247,67 @@ impl Bodies {
         }
         out
     }
+
+    /// Each body's force and torque from its particles' loads (`body_load`'s array), summed
+    /// as the GPU sums them.
+    pub fn loads_of_particles(&self, particle_loads: &[[f32; 4]]) -> Vec<Load> {
+        self.loads(&workgroup_sums(&self.motions, self.groups, particle_loads))
+    }
+}
+
+/// `body_force` on the host: per workgroup of 64 body particles, the same tree of f32 additions
+/// (stride 32, 16, …, 1; zeros past a body's last particle), so the same loads give the same
+/// bits. IEEE additions only: the products are the GPU's own (`body_load`).
+pub fn workgroup_sums(
+    motions: &[BodyMotion],
+    groups: u32,
+    particle_loads: &[[f32; 4]],
+) -> Vec<[f32; 4]> {
+    let wg = WORKGROUP_SIZE as usize;
+    let mut out = vec![[0.0; 4]; 2 * groups as usize];
+    for (b, m) in motions.iter().enumerate() {
+        let end = motions.get(b + 1).map_or(groups, |next| next.first_group);
+        for g in m.first_group..end {
+            // Per lane (force, torque).
+            let mut lanes = vec![[[0.0f32; 3]; 2]; wg];
+            for (li, lane) in lanes.iter_mut().enumerate() {
+                let local = (g - m.first_group) as usize * wg + li;
+                if local < m.count as usize {
+                    let k = m.first as usize + local;
+                    for (part, load) in lane.iter_mut().zip(&particle_loads[2 * k..2 * k + 2]) {
+                        *part = [load[0], load[1], load[2]];
+                    }
+                }
+            }
+            let mut stride = wg / 2;
+            while stride > 0 {
+                for li in 0..stride {
+                    let upper = lanes[li + stride];
+                    for (part, add) in lanes[li].iter_mut().zip(upper) {
+                        for (x, y) in part.iter_mut().zip(add) {
+                            *x += y;
+                        }
+                    }
+                }
+                stride /= 2;
+            }
+            for (part, [x, y, z]) in lanes[0].iter().enumerate() {
+                out[2 * g as usize + part] = [*x, *y, *z, 0.0];
+            }
+        }
+    }
+    out
+}
+
+/// Every rank's per-particle loads combined: each entry is the one rank's that holds the
+/// particle, or +0 where none does (as one whole run leaves an excluded particle's). Exact:
+/// the ranks add the values' bit patterns as whole numbers, which the others' zeros leave
+/// unchanged (adding the values themselves would turn a held −0 into +0).
+pub fn owners_values(ranks: &dyn crate::ranks::Ranks, mine: &[[f32; 4]]) -> Vec<[f32; 4]> {
+    let bits: Vec<f64> = mine.iter().flatten().map(|x| x.to_bits() as f64).collect();
+    let summed = ranks.sum_in_rank_order(&bits);
+    summed
+        .chunks(4)
+        .map(|c| [0, 1, 2, 3].map(|a| f32::from_bits(c[a] as u32)))
+        .collect()
 }

@@ -74,6 +74,23 @@ impl Solver {
         Ok(gpu.loads(&partials))
     }
 
+    /// Test hook: as [`Solver::rerun_body_loads`], but with the per-workgroup sums taken on
+    /// the host from the GPU's per-particle loads (`bodies::workgroup_sums`), as a subdomain
+    /// takes them.
+    pub fn rerun_body_loads_summed_on_host(&self) -> Result<Vec<crate::body::Load>> {
+        let Some(gpu) = &self.passes.bodies else {
+            bail!("the case has no bodies");
+        };
+        self.submit_pass("body loads", |pass| {
+            self.passes.interaction.encode(pass, self.parity);
+            gpu.encode_force(pass, self.parity);
+        });
+        let loads = &gpu.particle_loads;
+        let particle_loads: Vec<[f32; 4]> =
+            read(&self.device, &self.queue, loads, loads.size() as usize / 16)?;
+        Ok(gpu.loads_of_particles(&particle_loads))
+    }
+
     /// Test hook: applies the density filter of the case once to the current arrays (whatever
     /// the step count). With `poison`, the filter's output buffer is first filled with NaN, so a
     /// fluid particle the filter skips gets a NaN density.
@@ -118,19 +135,5 @@ impl Solver {
         let nan = vec![f32::NAN; floats];
         self.queue
             .write_buffer(buffer, 0, bytemuck::cast_slice(&nan));
-    }
-
-    /// Records one compute pass with `record` and submits it.
-    fn submit_pass(&self, label: &str, record: impl FnOnce(&mut wgpu::ComputePass<'_>)) {
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
-        record(
-            &mut encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(label),
-                timestamp_writes: None,
-            }),
-        );
-        self.queue.submit([encoder.finish()]);
     }
 }

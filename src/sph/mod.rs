@@ -206,18 +206,22 @@ impl Solver {
             cfg.tables,
             ph.energy,
         );
-        let mut passes = Passes::new(&device, sc, cfg, &grid, &buffers, &defs, body_motions)?;
-        if let Some(ctl) = subdomain {
-            let module = shader::module(&device, &halo::SHADER, cfg)?;
-            let layers = grid.cells[ctl.axis as usize];
-            passes.halo = Some(halo::Halo::new(&device, &module, &buffers, ctl, layers)?);
-        }
+        let passes = Passes::new(
+            &device,
+            sc,
+            cfg,
+            &grid,
+            &buffers,
+            &defs,
+            body_motions,
+            subdomain,
+        )?;
         let bodies = passes.bodies.as_ref().map(|gpu| HostBodies {
             set: BodySet::new(&sc.bodies, ph.gravity, ph.dim),
             staging: readback_buffer(
                 &device,
                 "state and body loads",
-                std::mem::size_of::<SimState>() as u64 + gpu.partials_bytes(),
+                std::mem::size_of::<SimState>() as u64 + gpu.loads_buffer().1,
             ),
         });
         if let Some(e) = pollster::block_on(oom.pop()) {
@@ -229,7 +233,7 @@ impl Solver {
                 buffers.bytes() as f64 / n as f64
             );
         }
-        Ok(Self {
+        let solver = Self {
             device,
             queue: ctx.queue.clone(),
             faults: ctx.faults.clone(),
@@ -262,7 +266,10 @@ impl Solver {
             n_fluid_at_start: sc.count(Kind::Fluid) as u64,
             profiler: None,
             ranked,
-        })
+        };
+        // The first step's `body_move` finds the body particles where the case put them.
+        solver.index_bodies();
+        Ok(solver)
     }
 
     /// The bodies' host state (poses and last loads), if the case has bodies.
@@ -356,6 +363,20 @@ impl Solver {
     /// GPU steps and sums the loads, the host reads back the state and the loads (the only
     /// per-step readback) and corrects the bodies.
     fn step_with_bodies(&mut self) -> Result<()> {
+        let dt = self.predict_bodies();
+        let encoder = self.encode_steps(1);
+        let (state, partials) = self.submit_reading_loads(encoder)?;
+        self.state = state;
+        let gpu = self.passes.bodies.as_ref().expect("a run with bodies");
+        let loads = gpu.loads(&partials);
+        let host = &mut self.bodies.as_mut().expect("a run with bodies").set;
+        host.correct(dt, &loads);
+        Ok(())
+    }
+
+    /// The host's part of a step with bodies before the GPU's: every body predicted to
+    /// t + dt and its pose uploaded; dt.
+    fn predict_bodies(&mut self) -> f64 {
         let dt = self.state.dt as f64;
         let t_next = self.time() + dt;
         let host = &mut self.bodies.as_mut().expect("a run with bodies").set;
@@ -363,20 +384,53 @@ impl Solver {
         let accelerations = host.accelerations(t_next);
         let gpu = self.passes.bodies.as_mut().expect("a run with bodies");
         gpu.upload(&self.queue, &self.grid, &poses, &accelerations);
-        let mut encoder = self.encode_steps(1);
+        dt
+    }
+
+    /// Submits `encoder` with the state and the bodies' loads copied after it, and reads both
+    /// back (the loads as `Bodies::loads_buffer` says: per workgroup, or per particle).
+    fn submit_reading_loads(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+    ) -> Result<(SimState, Vec<[f32; 4]>)> {
         let gpu = self.passes.bodies.as_ref().expect("a run with bodies");
         let staging = &self.bodies.as_ref().expect("a run with bodies").staging;
         let state_bytes = std::mem::size_of::<SimState>() as u64;
+        let (loads, loads_bytes) = gpu.loads_buffer();
         encoder.copy_buffer_to_buffer(&self.buffers.state, 0, staging, 0, state_bytes);
-        encoder.copy_buffer_to_buffer(&gpu.partials, 0, staging, state_bytes, gpu.partials_bytes());
+        encoder.copy_buffer_to_buffer(loads, 0, staging, state_bytes, loads_bytes);
         self.queue.submit([encoder.finish()]);
-        let bytes = map_read(&self.device, staging)?;
-        self.state = bytemuck::pod_read_unaligned(&bytes[..state_bytes as usize]);
-        let partials: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes[state_bytes as usize..]);
-        let loads = gpu.loads(&partials);
-        let host = &mut self.bodies.as_mut().expect("a run with bodies").set;
-        host.correct(dt, &loads);
-        self.faults.check()
+        let bytes = map_read(&self.device, staging);
+        // A lost device fails the wait; say why rather than how.
+        self.faults.check()?;
+        let bytes = bytes?;
+        let state = bytemuck::pod_read_unaligned(&bytes[..state_bytes as usize]);
+        Ok((
+            state,
+            bytemuck::pod_collect_to_vec(&bytes[state_bytes as usize..]),
+        ))
+    }
+
+    /// Records one compute pass with `record` and submits it.
+    fn submit_pass(&self, label: &str, record: impl FnOnce(&mut wgpu::ComputePass<'_>)) {
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        record(
+            &mut encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(label),
+                timestamp_writes: None,
+            }),
+        );
+        self.queue.submit([encoder.finish()]);
+    }
+
+    /// Records where the arrays of the present parity hold each live body particle, after
+    /// they were written or sorted outside a step (the next step's `body_move` reads it).
+    fn index_bodies(&self) {
+        if let Some(b) = &self.passes.bodies {
+            self.submit_pass("body index", |pass| b.encode_index(pass, self.parity));
+        }
     }
 
     /// Records `count` steps into one command encoder (with the profiler on, each stage in a
@@ -675,8 +729,9 @@ impl Solver {
     }
 
     /// World positions of the tracked points (`Scenario::points`, in order) at the current
-    /// time; empty without points.
-    pub fn sample_points(&self) -> Result<Vec<[f64; 3]>> {
+    /// time, NaN for a particle that left the domain; empty without points. A subdomain
+    /// samples with every rank of `ranks` together.
+    pub fn sample_points(&self, ranks: Option<&dyn crate::ranks::Ranks>) -> Result<Vec<[f64; 3]>> {
         let Some(tracker) = &self.passes.points else {
             return Ok(Vec::new());
         };
@@ -687,11 +742,14 @@ impl Solver {
             });
         tracker.encode(&mut encoder, self.parity);
         self.queue.submit([encoder.finish()]);
-        let pos = tracker.read(&self.device, &self.queue)?;
+        let pos = tracker.read(&self.device, &self.queue, ranks)?;
         self.faults.check()?;
         Ok(pos
             .iter()
-            .map(|p| self.grid.to_world(p.off, unpack_block(p.block)))
+            .map(|p| match p {
+                Some(p) => self.grid.to_world(p.off, unpack_block(p.block)),
+                None => [f64::NAN; 3],
+            })
             .collect())
     }
 

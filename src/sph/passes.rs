@@ -20,7 +20,7 @@ use super::shader::{module, ShaderConfig};
 use super::total_lagrangian::{self, TotalLagrangian};
 use crate::gpu::shader::Shader;
 use crate::grid::Grid;
-use crate::layout::{BodyMotion, ProbeDef};
+use crate::layout::{BodyMotion, HaloCtl, ProbeDef};
 use crate::scenario::{Kind, Scenario, SolidFormulation};
 
 /// Every pass's shader, for the checks that compose them all.
@@ -64,7 +64,9 @@ pub struct Passes {
 
 impl Passes {
     /// The passes `sc` needs, compiled for `cfg`, over `b`; `defs` are the probes' GPU
-    /// definitions and `motions` the bodies' table the buffers were made with.
+    /// definitions and `motions` the bodies' table the buffers were made with; with
+    /// `subdomain`, those of one rank's subdomain (its halo pass).
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         device: &wgpu::Device,
         sc: &Scenario,
@@ -73,6 +75,7 @@ impl Passes {
         b: &ParticleBuffers,
         defs: &[ProbeDef],
         motions: Vec<BodyMotion>,
+        subdomain: Option<HaloCtl>,
     ) -> Result<Self> {
         let ph = &sc.physics;
         let shader = |s: &Shader| module(device, s, cfg);
@@ -113,9 +116,13 @@ impl Passes {
                 .transpose()?,
             bodies: (!sc.bodies.is_empty())
                 .then(|| {
-                    // The bodies' particles are the last ones (`initial::body_id_base`).
-                    let base = b.n - motions.iter().map(|m| m.count).sum::<u32>();
-                    Bodies::new(device, &shader(&bodies::SHADER)?, b, motions, base)
+                    Bodies::new(
+                        device,
+                        &shader(&bodies::SHADER)?,
+                        b,
+                        motions,
+                        subdomain.is_some(),
+                    )
                 })
                 .transpose()?,
             probes: Probes::new(
@@ -130,7 +137,12 @@ impl Passes {
                     .collect(),
             )?,
             points: PointTracker::new(device, &probe_module, b, &sc.points)?,
-            halo: None,
+            halo: subdomain
+                .map(|ctl| {
+                    let layers = grid.cells[ctl.axis as usize];
+                    Halo::new(device, &shader(&halo::SHADER)?, b, ctl, layers)
+                })
+                .transpose()?,
         })
     }
 
@@ -192,11 +204,12 @@ impl Passes {
         if let Some(t) = &self.total_lagrangian {
             r.stage("total_lagrangian_rates", |pass| t.encode_rates(pass, q));
         }
-        if let Some(b) = bodies {
-            r.stage("body_force", |pass| b.encode_force(pass, q));
-        }
+        // A subdomain drops its halo copies first: a body's load is its own particles'.
         if let Some(h) = &self.halo {
             r.stage("halo_drop", |pass| h.encode_drop(pass, q));
+        }
+        if let Some(b) = bodies {
+            r.stage("body_force", |pass| b.encode_force(pass, q));
         }
         r.stage("correct", |pass| self.integrate.encode_correct(pass, q));
         if let Some(f) = &self.density_filter {

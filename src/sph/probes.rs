@@ -1,7 +1,7 @@
 //! Probes sampled on the GPU (shaders/probes.wgsl); only one f32 per probe, and one position
 //! per tracked point, is read back.
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 
 use super::buffers::ParticleBuffers;
 use super::shader::{NEIGHBOURS, WALL_PATCH, WORKGROUP_MAX};
@@ -16,6 +16,7 @@ pub const SHADER: Shader = Shader {
     libs: &[NEIGHBOURS, WORKGROUP_MAX, WALL_PATCH],
 };
 use crate::layout::{Pos, ProbeDef, NO_FACE};
+use crate::ranks::Ranks;
 use crate::scenario::{Probe, ProbeKind, TrackedPoint, WallParams, WallPatch};
 use glam::DVec3;
 
@@ -359,6 +360,8 @@ impl Probes {
 pub struct PointTracker {
     kernel: ParityKernel,
     out: wgpu::Buffer,
+    /// 1 where the arrays hold the point's particle live.
+    held: wgpu::Buffer,
     slot_of_point: Vec<usize>,
     slots: usize,
     n: u32,
@@ -391,12 +394,17 @@ impl PointTracker {
             "tracked positions",
             (ids.len() * std::mem::size_of::<Pos>()) as u64,
         );
+        let held = storage(device, "tracked held", 4 * ids.len() as u64);
         let kernel = ParityKernel::new(device, module, "track_points", |p| {
-            b.at(p).with("tracked", &tracked).with("tracked_pos", &out)
+            b.at(p)
+                .with("tracked", &tracked)
+                .with("tracked_pos", &out)
+                .with("tracked_held", &held)
         })?;
         Ok(Some(Self {
             kernel,
             out,
+            held,
             slot_of_point,
             slots: ids.len(),
             n: b.n,
@@ -405,6 +413,7 @@ impl PointTracker {
 
     /// Copies the followed particles' positions (arrays of parity `p`) into the output buffer.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, p: usize) {
+        encoder.clear_buffer(&self.held, 0, None);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("track points"),
             timestamp_writes: None,
@@ -413,9 +422,43 @@ impl PointTracker {
     }
 
     /// The positions, in the scenario's point order (after [`encode`](Self::encode) was
-    /// submitted).
-    pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<Pos>> {
+    /// submitted); None where the arrays do not hold the particle live. Over `ranks`, every
+    /// rank together, each from the rank that holds it (the position's words, exact).
+    pub fn read(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        ranks: Option<&dyn Ranks>,
+    ) -> Result<Vec<Option<Pos>>> {
         let raw: Vec<Pos> = read(device, queue, &self.out, self.slots)?;
-        Ok(self.slot_of_point.iter().map(|&s| raw[s]).collect())
+        let held: Vec<u32> = read(device, queue, &self.held, self.slots)?;
+        // Per slot (held, the position's four words), zeros where not held.
+        let mut words: Vec<f64> = (raw.iter().zip(&held))
+            .flat_map(|(p, &h)| {
+                let w = [
+                    h,
+                    p.off[0].to_bits(),
+                    p.off[1].to_bits(),
+                    p.off[2].to_bits(),
+                    p.block,
+                ];
+                w.map(|x| if h == 0 { 0.0 } else { x as f64 })
+            })
+            .collect();
+        if let Some(ranks) = ranks {
+            words = ranks.sum_in_rank_order(&words);
+        }
+        let slots: Vec<Option<Pos>> = words
+            .chunks(5)
+            .map(|w| match w[0] as u32 {
+                0 => Ok(None),
+                1 => Ok(Some(Pos {
+                    off: [1, 2, 3].map(|a| f32::from_bits(w[a] as u32)),
+                    block: w[4] as u32,
+                })),
+                n => bail!("a tracked particle is held by {n} ranks"),
+            })
+            .collect::<Result<_>>()?;
+        Ok(self.slot_of_point.iter().map(|&s| slots[s]).collect())
     }
 }

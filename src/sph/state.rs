@@ -140,6 +140,8 @@ impl Solver {
             None => {}
         }
         self.parity = p;
+        // The restored arrays are in the saved order, not the warm-up's.
+        self.index_bodies();
         self.t_base = s.t_base;
         self.steps = s.steps;
         self.initial_dt = s.initial_dt;

@@ -13,10 +13,10 @@ use std::ops::Range;
 
 use anyhow::{bail, ensure, Context, Result};
 
-use super::halo;
 use super::initial::Packed;
 use super::profile::Recorder;
 use super::Solver;
+use super::{bodies, halo};
 use crate::decomposition::{probe_layers, Slabs};
 use crate::gpu::GpuContext;
 use crate::grid::Grid;
@@ -108,7 +108,10 @@ pub fn capacity(own: u32, n: u32) -> u32 {
 fn unsupported(sc: &Scenario) -> Vec<&'static str> {
     let has = |kinds: &[Kind]| sc.particles.iter().any(|p| kinds.contains(&p.kind));
     [
-        (!sc.bodies.is_empty(), "moving bodies"),
+        (
+            sc.probes.iter().any(|p| p.body.is_some()),
+            "probes that move with a body",
+        ),
         (sc.solids.is_some(), "elastic solids"),
         (
             !sc.inlets.is_empty(),
@@ -122,7 +125,6 @@ fn unsupported(sc: &Scenario) -> Vec<&'static str> {
             sc.physics.density_filter != DensityFilter::None,
             "the density filter (it needs a second exchange a step)",
         ),
-        (!sc.points.is_empty(), "tracked points"),
     ]
     .into_iter()
     .filter_map(|(yes, what)| yes.then_some(what))
@@ -312,6 +314,9 @@ impl Solver {
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             self.passes.cell_list.encode(&mut pass, self.parity);
+            if let Some(b) = &self.passes.bodies {
+                b.encode_index(&mut pass, 1 - self.parity);
+            }
         }
         // The sort gathered the last rates into `rate_sorted`; the next predictor reads `rate`.
         let b = &self.buffers;
@@ -425,6 +430,7 @@ impl Solver {
     /// of the step; then the ranks' smallest time step and their summed counts.
     fn ranked_step(&mut self, ranks: &dyn Ranks) -> Result<()> {
         let start = std::time::Instant::now();
+        let body_dt = self.bodies.is_some().then(|| self.predict_bodies());
         let p = self.parity;
         let halo = self
             .passes
@@ -479,11 +485,22 @@ impl Solver {
             let mut r = Recorder::Shared(encoder.begin_compute_pass(&Default::default()));
             self.passes.record_from_exchange(&mut r, p);
         }
-        self.queue.submit([encoder.finish()]);
+        let (local, particle_loads) = match body_dt {
+            Some(_) => {
+                let (state, loads) = self.submit_reading_loads(encoder)?;
+                (state, Some(loads))
+            }
+            None => {
+                self.queue.submit([encoder.finish()]);
+                (self.read_state()?, None)
+            }
+        };
         self.parity = 1 - p;
-        let local = self.read_state()?;
         let computed_at = std::time::Instant::now();
         self.agree(local, packed.owned + packed.migrants, ranks);
+        if let (Some(dt), Some(mine)) = (body_dt, particle_loads) {
+            self.correct_bodies(dt, &mine, ranks);
+        }
         let split = &mut self.ranked.as_mut().expect("a subdomain").split;
         split.pack += (packed_at - start).as_secs_f64();
         split.exchange += (swapped_at - packed_at).as_secs_f64();
@@ -525,6 +542,17 @@ impl Solver {
             write(&b.energy[p], 8, bytemuck::cast_slice(&energy));
         }
         Ok(())
+    }
+
+    /// Corrects the bodies over dt with the loads of every rank's body particles (`mine`:
+    /// this rank's, zero where it holds none), summed as one whole run sums them: every rank
+    /// then moves the bodies alike.
+    fn correct_bodies(&mut self, dt: f64, mine: &[[f32; 4]], ranks: &dyn Ranks) {
+        let all = bodies::owners_values(ranks, mine);
+        let gpu = self.passes.bodies.as_ref().expect("a run with bodies");
+        let loads = gpu.loads_of_particles(&all);
+        let host = &mut self.bodies.as_mut().expect("a run with bodies").set;
+        host.correct(dt, &loads);
     }
 
     /// The ranks' common view after a step: the smallest time step (the GPU's choice
@@ -577,7 +605,8 @@ mod tests {
     }
 
     /// What a subdomain cannot run yet is named, case by case; a fluid with dynamic walls has
-    /// nothing to refuse, nor has it with the energy equation on.
+    /// nothing to refuse, nor has it with the energy equation on, nor a floating body with
+    /// dynamic walls.
     #[test]
     fn what_ranks_cannot_run_yet_is_named() {
         assert!(unsupported(&load("cases/dam_break_2d.toml", &[])).is_empty());
@@ -588,8 +617,15 @@ mod tests {
             &["time.output_boundary=\"first\""],
         );
         assert!(unsupported(&walls_once).is_empty());
-        let cases: [(&str, &[&str], &str); 4] = [
-            ("cases/floating_box_2d.toml", &[], "moving bodies"),
+        let dynamic_box = load("cases/floating_box_2d.toml", &["body[0].wall=\"dynamic\""]);
+        assert!(unsupported(&dynamic_box).is_empty());
+        let cases: [(&str, &[&str], &str); 5] = [
+            ("cases/floating_box_2d.toml", &[], "fixed ghost walls"),
+            (
+                "cases/sloshing_2d.toml",
+                &[],
+                "probes that move with a body",
+            ),
             ("cases/oscillating_plate_2d.toml", &[], "elastic solids"),
             ("cases/water_injection_2d.toml", &[], "inlets ("),
             (

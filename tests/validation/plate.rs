@@ -370,7 +370,7 @@ fn plates_of_both_formulations_in_one_case_move_as_alone() {
         (1..=4)
             .map(|k| {
                 solver.advance_to(0.01 * k as f64).unwrap();
-                let x = solver.sample_points().unwrap();
+                let x = solver.sample_points(None).unwrap();
                 x.iter().zip(&x0).map(|(x, x0)| x[1] - x0[1]).collect()
             })
             .collect()

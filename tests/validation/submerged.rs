@@ -101,7 +101,7 @@ fn column_in_still_water(case: &str, stress_bands: bool) {
         }
     }
     let x0 = sc.particles[sc.points[0].particle as usize].pos;
-    let top = solver.sample_points().unwrap()[0];
+    let top = solver.sample_points(None).unwrap()[0];
     let p = solver.read_particles().unwrap();
     let rho_g = 1000.0 * 9.81;
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
