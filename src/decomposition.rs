@@ -12,7 +12,7 @@ use anyhow::{bail, Result};
 
 use crate::grid::Grid;
 use crate::scenario::{Kind, Particle, ProbeKind, Scenario};
-use crate::sph::halo::HALO_LAYERS;
+use crate::sph::halo::halo_layers;
 
 /// A step's work of a particle that moves (fluid, solid, inlet), the unit of the balance.
 pub const MOVING_WEIGHT: f64 = 1.0;
@@ -71,7 +71,7 @@ pub fn slabs_for(sc: &Scenario, ranks: usize) -> Result<Slabs> {
         axis,
         &layer_load(&grid, axis, &sc.particles),
         ranks,
-        HALO_LAYERS,
+        halo_layers(sc),
         whole,
     )
 }

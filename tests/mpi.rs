@@ -512,9 +512,9 @@ fn assert_same_outputs(whole: &std::path::Path, ranked: &std::path::Path) -> usi
     live
 }
 
-/// `mpirun -np 2 wgsph run` of the floating box (its walls dynamic) writes what one whole run
-/// writes: the particles, the gauges, the box's table (pose and load) and the path of its
-/// corner (a tracked point), each written once, by rank 0. The cut runs through the box.
+/// `mpirun -np 2 wgsph run` of the floating box (as shipped: fixed ghost walls) writes what one
+/// whole run writes: the particles, the gauges, the box's table (pose and load) and the path of
+/// its corner (a tracked point), each written once, by rank 0. The cut runs through the box.
 #[test]
 fn a_floating_body_over_two_ranks_writes_what_one_run_writes() {
     let (one, two) = (
@@ -524,7 +524,6 @@ fn a_floating_body_over_two_ranks_writes_what_one_run_writes() {
     let args = |out: &std::path::Path| -> Vec<std::ffi::OsString> {
         let set = [
             "particles.dx_m=0.02",
-            "body[0].wall=\"dynamic\"",
             "time.end_s=0.2",
             "time.output_every_s=0.05",
         ];
@@ -858,6 +857,25 @@ fn a_body_crossing_the_cut_moves_as_in_one_run() {
         tables: "[[body]]\nname = \"box\"\nshape = \"box\"\nmin_m = [0.04, 0.10]\n\
                  max_m = [0.10, 0.16]\ndensity_kg_m3 = 500.0\nwall = \"dynamic\"\n\
                  [body.motion]\nkind = \"free\"\nvelocity_m_s = [0.5, -0.5]\n",
+    }
+    .check();
+}
+
+/// The 2D dam break in a tank of fixed ghost walls (the seed's interface, MLS ghosts): a ghost
+/// takes its values from the fluid around it earlier in the step, so the halo is two cell layers
+/// thick (`halo::halo_layers`). From cuts at equal numbers of layers, moved at step 100, every
+/// particle equals one whole run's bit for bit after 300 steps.
+#[test]
+fn ranks_with_fixed_ghost_walls_equal_one_run() {
+    Comparison {
+        test: "ranks_with_fixed_ghost_walls_equal_one_run",
+        case: "cases/dam_break_2d.toml",
+        set: &["particles.dx_m=0.0073", "tank.wall=\"fixed_ghost\""],
+        ranks: 2,
+        steps: 300,
+        uneven: true,
+        restore_at: None,
+        tables: "",
     }
     .check();
 }

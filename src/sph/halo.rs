@@ -10,6 +10,7 @@ use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
 use crate::layout::{HaloCounts, HaloCtl, HaloRecord, DEST_MIGRANT, DEST_UPPER};
+use crate::scenario::{Kind, Scenario};
 
 pub const SHADER: Shader = Shader {
     name: "halo",
@@ -17,24 +18,33 @@ pub const SHADER: Shader = Shader {
     libs: &[],
 };
 
-/// Cell layers of halo: cells are the kernel support 2h, so one layer holds every particle a
-/// neighbour's particle reaches in the passes a subdomain runs (`Solver::subdomain` refuses
-/// the passes that reach further: fixed ghosts, the density filter).
-pub const HALO_LAYERS: u32 = 1;
+/// Cell layers of halo `sc` needs. Cells are the kernel support 2h, so one layer holds every
+/// particle a neighbour's particle reaches. Fixed ghosts take their pressure and velocity from
+/// the fluid within a support of them (`fluid_at`) earlier in the same step, so a ghost copy
+/// next to the cut needs the fluid one layer further: two layers, of which the outer one's
+/// copies (wrong values, read by no own particle) only serve the inner one's. (The passes that
+/// reach further still, the density filter, are refused: `subdomain::unsupported`.)
+pub fn halo_layers(sc: &Scenario) -> u32 {
+    let ghosts = [Kind::GhostNoSlip, Kind::GhostFreeSlip];
+    match sc.particles.iter().any(|p| ghosts.contains(&p.kind)) {
+        true => 2,
+        false => 1,
+    }
+}
 
 /// Records the packing buffer holds per particle of the arrays: a particle packs at most two
-/// (a halo copy each way from a slab one layer thick, or one migrant).
+/// (a halo copy each way from a slab as thin as its halo, or one migrant).
 pub const RECORDS_PER_PARTICLE: u32 = 2;
 
-/// Rank `rank`'s part of `slabs`: what `halo_pack` needs to know (the records' capacity is
-/// the pass's own, set by [`Halo::new`]).
-pub fn control(slabs: &Slabs, rank: usize) -> HaloCtl {
+/// Rank `rank`'s part of `slabs` with a halo of `layers` ([`halo_layers`]): what `halo_pack`
+/// needs to know (the records' capacity is the pass's own, set by [`Halo::new`]).
+pub fn control(slabs: &Slabs, rank: usize, layers: u32) -> HaloCtl {
     let own = slabs.range(rank);
     HaloCtl {
         axis: slabs.axis as u32,
         own_lo: own.start,
         own_hi: own.end,
-        layers: HALO_LAYERS,
+        layers,
         lower: (rank > 0) as u32,
         upper: (rank + 1 < slabs.ranks()) as u32,
         capacity: 0,
@@ -54,6 +64,8 @@ pub struct Halo {
     layer_load: wgpu::Buffer,
     /// Cell layers along the cut axis.
     layers: u32,
+    /// Cell layers of halo.
+    pub thickness: u32,
     n: u32,
 }
 
@@ -114,6 +126,7 @@ impl Halo {
             records,
             layer_load,
             layers,
+            thickness: ctl.layers,
             n: b.n,
         })
     }
@@ -123,7 +136,7 @@ impl Halo {
     pub fn set_cuts(&self, queue: &wgpu::Queue, slabs: &Slabs, rank: usize, halos: bool) {
         let mut ctl = HaloCtl {
             capacity: RECORDS_PER_PARTICLE * self.n,
-            ..control(slabs, rank)
+            ..control(slabs, rank, self.thickness)
         };
         if !halos {
             (ctl.lower, ctl.upper) = (0, 0);

@@ -23,7 +23,7 @@ use crate::grid::Grid;
 use crate::layout::{unpack_block, HaloCtl, HaloRecord, Pos, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
 use crate::output::RankSummary;
 use crate::ranks::Ranks;
-use crate::scenario::{DensityFilter, Kind, Scenario};
+use crate::scenario::{DensityFilter, Scenario};
 
 /// A subdomain's counts, over all ranks where they say so (a checkpoint keeps them).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -106,7 +106,6 @@ pub fn capacity(own: u32, n: u32) -> u32 {
 
 /// What a run split over ranks cannot do yet, named for the refusal.
 fn unsupported(sc: &Scenario) -> Vec<&'static str> {
-    let has = |kinds: &[Kind]| sc.particles.iter().any(|p| kinds.contains(&p.kind));
     [
         (
             sc.probes.iter().any(|p| p.body.is_some()),
@@ -116,10 +115,6 @@ fn unsupported(sc: &Scenario) -> Vec<&'static str> {
         (
             !sc.inlets.is_empty(),
             "inlets (their waiting particles share the slot the arrivals are written into)",
-        ),
-        (
-            has(&[Kind::GhostNoSlip, Kind::GhostFreeSlip]),
-            "fixed ghost walls (their interpolation reaches past one cell layer)",
         ),
         (
             sc.physics.density_filter != DensityFilter::None,
@@ -192,7 +187,13 @@ impl Solver {
             slabs.ranks(),
             ranks.size()
         );
-        let ctl = halo::control(slabs, ranks.rank());
+        let ctl = halo::control(slabs, ranks.rank(), halo::halo_layers(sc));
+        ensure!(
+            (0..slabs.ranks()).all(|r| slabs.range(r).len() as u32 >= ctl.layers),
+            "the cuts {slabs:?} leave a slab thinner than the {} cell layers of halo this case \
+             needs",
+            ctl.layers
+        );
         let mut solver = Self::build(ctx, sc, Some(ctl))?;
         let probes = probe_layers(sc, &solver.grid, slabs.axis)?;
         for (p, layers) in sc.probes.iter().zip(&probes) {
@@ -265,7 +266,7 @@ impl Solver {
         let load = ranks.sum_in_rank_order(&mine);
         let ranked = self.ranked.as_ref().expect("a subdomain");
         let slabs = ranked.slabs.as_ref().expect("a subdomain's cuts");
-        let Some(next) = slabs.rebalanced(&load, halo::HALO_LAYERS) else {
+        let Some(next) = slabs.rebalanced(&load, halo.thickness) else {
             return Ok(false);
         };
         log::info!(
@@ -619,8 +620,7 @@ mod tests {
         assert!(unsupported(&walls_once).is_empty());
         let dynamic_box = load("cases/floating_box_2d.toml", &["body[0].wall=\"dynamic\""]);
         assert!(unsupported(&dynamic_box).is_empty());
-        let cases: [(&str, &[&str], &str); 5] = [
-            ("cases/floating_box_2d.toml", &[], "fixed ghost walls"),
+        let cases: [(&str, &[&str], &str); 4] = [
             (
                 "cases/sloshing_2d.toml",
                 &[],
