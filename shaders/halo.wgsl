@@ -15,9 +15,14 @@
 // the rank's own particles only.
 // `count_layers`: the rank's load per cell layer, from which the ranks move their cuts
 // (`Solver::rebalance`: the same packing without halos, then a sort).
+// `halo_restore`, on the density filter's steps (which read the neighbours' corrected
+// densities): after the corrector the ranks pack their own halo particles again and swap them;
+// each copy the sort put in a cell and `halo_drop` excluded gets back its owner's code word
+// and corrected (v, ρ), found by id among the records received (sorted by id, in `halo_out`),
+// until `halo_drop` excludes it again after the filter.
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
-@group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> code: array<u32>;
 @group(0) @binding(4) var<storage, read> rate: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> cell_start: array<u32>;
@@ -130,4 +135,28 @@ fn count_layers(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     }
     let moves = kind == KIND_FLUID || kind == KIND_SOLID || kind == KIND_INLET;
     atomicAdd(&layer_load[layer_of(pos[i])], select(1u, 2u, moves));
+}
+
+@compute @workgroup_size(WG)
+fn halo_restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i >= cell_start[params.hash_mask + 1u] || code_kind(code[i]) != KIND_EXCLUDED) {
+        return;
+    }
+    let id = code[i] & ID_MASK;
+    var lo = 0u;
+    var hi = atomicLoad(&halo_counts.records);
+    let n = hi;
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        if ((halo_out[mid].code & ID_MASK) < id) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    if (lo < n && (halo_out[lo].code & ID_MASK) == id) {
+        code[i] = halo_out[lo].code;
+        velrho[i] = halo_out[lo].velrho;
+    }
 }

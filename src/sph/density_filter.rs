@@ -30,6 +30,8 @@ struct FilterCtl {
 }
 
 pub struct DensityFilter {
+    /// Filter every `every` steps.
+    every: u32,
     gate: Kernel,
     filter: ParityKernel,
     apply: ParityKernel,
@@ -91,6 +93,7 @@ impl DensityFilter {
             )?,
             filter: ParityKernel::new(device, module, entry, bufs)?,
             apply: ParityKernel::new(device, module, "apply_density", bufs)?,
+            every,
             gate,
             args,
             ctl,
@@ -108,6 +111,14 @@ impl DensityFilter {
             pass.set_bind_group(0, bind, &[]);
             pass.dispatch_workgroups_indirect(&self.args, 0);
         }
+    }
+
+    /// Whether the step that took the GPU's step count from `before` to `after` is one the
+    /// gate (`filter_gate`) opens for: a step taken (a step of dt = 0 does not count) whose
+    /// count is a multiple of `every` (a count never seen before, so not the last filtered).
+    /// A subdomain must know it beforehand, to swap the corrected halo first.
+    pub fn fires_after(&self, before: u32, after: u32) -> bool {
+        after != before && after.is_multiple_of(self.every)
     }
 
     /// The GPU step count of the last filtering (0: none yet). Waits for the GPU.

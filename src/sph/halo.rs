@@ -9,7 +9,7 @@ use crate::decomposition::Slabs;
 use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
-use crate::layout::{HaloCounts, HaloCtl, HaloRecord, DEST_MIGRANT, DEST_UPPER};
+use crate::layout::{HaloCounts, HaloCtl, HaloRecord, DEST_MIGRANT, DEST_UPPER, ID_MASK};
 use crate::scenario::{Kind, Scenario};
 
 pub const SHADER: Shader = Shader {
@@ -22,8 +22,8 @@ pub const SHADER: Shader = Shader {
 /// particle a neighbour's particle reaches. Fixed ghosts take their pressure and velocity from
 /// the fluid within a support of them (`fluid_at`) earlier in the same step, so a ghost copy
 /// next to the cut needs the fluid one layer further: two layers, of which the outer one's
-/// copies (wrong values, read by no own particle) only serve the inner one's. (The passes that
-/// reach further still, the density filter, are refused: `subdomain::unsupported`.)
+/// copies (wrong values, read by no own particle) only serve the inner one's. (The density
+/// filter, which reads corrected neighbours, swaps them again: `Solver::filter_over_ranks`.)
 pub fn halo_layers(sc: &Scenario) -> u32 {
     let ghosts = [Kind::GhostNoSlip, Kind::GhostFreeSlip];
     match sc.particles.iter().any(|p| ghosts.contains(&p.kind)) {
@@ -55,6 +55,7 @@ pub fn control(slabs: &Slabs, rank: usize, layers: u32) -> HaloCtl {
 pub struct Halo {
     pack: ParityKernel,
     drop: ParityKernel,
+    restore: ParityKernel,
     count_layers: ParityKernel,
     ctl: wgpu::Buffer,
     counts: wgpu::Buffer,
@@ -115,6 +116,7 @@ impl Halo {
         Ok(Self {
             pack: ParityKernel::new(device, module, "halo_pack", bufs)?,
             drop: ParityKernel::new(device, module, "halo_drop", bufs)?,
+            restore: ParityKernel::new(device, module, "halo_restore", bufs)?,
             count_layers: ParityKernel::new(device, module, "count_layers", bufs)?,
             ctl: ctl_buffer,
             counts_staging: readback_buffer(
@@ -185,6 +187,23 @@ impl Halo {
     /// interaction).
     pub fn encode_drop(&self, pass: &mut wgpu::ComputePass<'_>, q: usize) {
         self.drop.dispatch(pass, q, self.n);
+    }
+
+    /// Gives the halo copies of the arrays of parity `q`, excluded by `encode_drop`, their
+    /// owners' values in `received` again (for the density filter; [`Halo::encode_restore`]).
+    pub fn upload_restored(&self, queue: &wgpu::Queue, received: &mut [HaloRecord]) {
+        received.sort_unstable_by_key(|r| r.code & ID_MASK);
+        queue.write_buffer(&self.records, 0, bytemuck::cast_slice(received));
+        let counts = HaloCounts {
+            records: received.len() as u32,
+            ..Default::default()
+        };
+        queue.write_buffer(&self.counts, 0, bytemuck::bytes_of(&counts));
+    }
+
+    /// Restores the copies [`Halo::upload_restored`] gave, in the arrays of parity `q`.
+    pub fn encode_restore(&self, pass: &mut wgpu::ComputePass<'_>, q: usize) {
+        self.restore.dispatch(pass, q, self.n);
     }
 
     /// Reads what the last `halo_pack` packed, once its submission (with `copy_counts`) is

@@ -212,7 +212,8 @@ impl Passes {
             r.stage("body_force", |pass| b.encode_force(pass, q));
         }
         r.stage("correct", |pass| self.integrate.encode_correct(pass, q));
-        if let Some(f) = &self.density_filter {
+        // A subdomain filters after a second exchange (`Solver::filter_over_ranks`).
+        if let (Some(f), None) = (&self.density_filter, &self.halo) {
             r.stage("density_filter", |pass| f.encode(pass, q));
         }
     }
