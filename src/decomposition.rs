@@ -9,9 +9,10 @@
 use std::ops::Range;
 
 use anyhow::{bail, Result};
+use glam::DVec3;
 
 use crate::grid::Grid;
-use crate::scenario::{Kind, Particle, ProbeKind, Scenario};
+use crate::scenario::{Kind, Motion, Particle, Probe, ProbeKind, Scenario};
 use crate::sph::halo::halo_layers;
 
 /// A step's work of a particle that moves (fluid, solid, inlet), the unit of the balance.
@@ -83,37 +84,69 @@ pub fn slabs_for(sc: &Scenario, ranks: usize) -> Result<Slabs> {
 /// A point probe reads the 3^d cells around its point (probes.wgsl `fluid_sums`), a gauge
 /// those around its vertical line, a wall patch the cells of its box (`probe_wall_force`);
 /// each range has one layer more on each side against the GPU's f32 rounding of the point.
+/// A probe attached to a body of prescribed motion (a moving tank) reads, over the run, the
+/// layers of every place the motion takes it to at the probe times: their union. One attached
+/// to a free body is refused (its path is not known before the run).
 pub fn probe_layers(sc: &Scenario, grid: &Grid, axis: usize) -> Result<Vec<Option<Range<u32>>>> {
-    let layers = grid.cells[axis] as i64;
     let up = sc.physics.dim as usize - 1;
+    sc.probes
+        .iter()
+        .map(|p| {
+            if matches!(p.kind, ProbeKind::Height { .. }) && axis == up {
+                bail!(
+                    "probe '{}' is a wave gauge, but a run over several ranks cuts this case \
+                     along the vertical (its longest axis): the gauge would read water on \
+                     every rank; run it on one rank",
+                    p.name
+                );
+            }
+            let Some(b) = p.body else {
+                return Ok(layers_read(p, sc.physics.h, grid, axis));
+            };
+            let body = &sc.bodies[b];
+            let Motion::Prescribed(motion) = &body.motion else {
+                bail!(
+                    "probe '{}' moves with body '{}', which moves freely: a run over several \
+                     ranks needs to know beforehand which cell layers a probe reads; run it \
+                     on one rank",
+                    p.name,
+                    body.name
+                );
+            };
+            let center0 = DVec3::from_array(body.center);
+            let every = sc.time.probe_every_s;
+            let times = (0..=(sc.time.end_s / every).ceil() as u64)
+                .map(|k| (k as f64 * every).min(sc.time.end_s));
+            Ok(times
+                .filter_map(|t| {
+                    let placed =
+                        crate::sph::probes::moved(p, body.center, &motion.pose(center0, t));
+                    layers_read(&placed, sc.physics.h, grid, axis)
+                })
+                .reduce(|a, b| a.start.min(b.start)..a.end.max(b.end)))
+        })
+        .collect()
+}
+
+/// The cell layers along `axis` probe `p` reads where it stands ([`probe_layers`]; `h` the
+/// smoothing length).
+pub fn layers_read(p: &Probe, h: f64, grid: &Grid, axis: usize) -> Option<Range<u32>> {
+    let layers = grid.cells[axis] as i64;
     let layer_of = |x: f64| ((x - grid.origin[axis]) / grid.cell_size[axis]).floor() as i64;
     let span =
         |lo: i64, hi: i64| Some((lo - 1).clamp(0, layers) as u32..(hi + 2).clamp(0, layers) as u32);
-    sc.probes
-        .iter()
-        .map(|p| match &p.kind {
-            ProbeKind::Pressure { point } => {
-                Ok(span(layer_of(point[axis]) - 1, layer_of(point[axis]) + 1))
-            }
-            ProbeKind::Height { .. } if axis == up => bail!(
-                "probe '{}' is a wave gauge, but a run over several ranks cuts this case \
-                 along the vertical (its longest axis): the gauge would read water on \
-                 every rank; run it on one rank",
-                p.name
-            ),
-            ProbeKind::Height { base } => {
-                Ok(span(layer_of(base[axis]) - 1, layer_of(base[axis]) + 1))
-            }
-            ProbeKind::WallPressure(patch) => {
-                let e = patch.radius + 4.0 * sc.physics.h;
-                Ok(span(
-                    layer_of(patch.point[axis] - e),
-                    layer_of(patch.point[axis] + e),
-                ))
-            }
-            ProbeKind::Front { .. } => Ok(None),
-        })
-        .collect()
+    match &p.kind {
+        ProbeKind::Pressure { point } => span(layer_of(point[axis]) - 1, layer_of(point[axis]) + 1),
+        ProbeKind::Height { base } => span(layer_of(base[axis]) - 1, layer_of(base[axis]) + 1),
+        ProbeKind::WallPressure(patch) => {
+            let e = patch.radius + 4.0 * h;
+            span(
+                layer_of(patch.point[axis] - e),
+                layer_of(patch.point[axis] + e),
+            )
+        }
+        ProbeKind::Front { .. } => None,
+    }
 }
 
 /// Slabs along one axis of the global grid: rank r owns the cell layers `bounds[r] ..
@@ -439,5 +472,55 @@ mod tests {
         )
         .unwrap();
         assert_eq!(cut_axis(&g, 2).unwrap(), 1);
+    }
+
+    fn load(case: &str, set: &[&str]) -> Scenario {
+        let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        crate::case::load(std::path::Path::new(case), &set).unwrap()
+    }
+
+    /// A probe on the rolling sloshing tank reads, over the run, the layers of its whole path
+    /// (which the cuts then keep whole): more than where it stands at t = 0, and they hold it at
+    /// every probe time. One on a free body is refused, naming it.
+    #[test]
+    fn a_probe_on_a_moving_tank_reads_the_layers_of_its_path() {
+        let sc = load("cases/sloshing_2d.toml", &["time.end_s=2.0"]);
+        let ph = &sc.physics;
+        let g = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic).unwrap();
+        let axis = cut_axis(&g, ph.dim).unwrap();
+        let path = probe_layers(&sc, &g, axis).unwrap();
+        let mut wider = 0;
+        for (p, layers) in sc.probes.iter().zip(&path) {
+            let (Some(b), Some(layers)) = (p.body, layers) else {
+                continue;
+            };
+            let Motion::Prescribed(motion) = &sc.bodies[b].motion else {
+                panic!("the tank moves as prescribed");
+            };
+            let c0 = DVec3::from_array(sc.bodies[b].center);
+            let at_start = layers_read(p, ph.h, &g, axis).unwrap();
+            wider += (layers.len() > at_start.len()) as u32;
+            for k in 0..=200 {
+                let t = k as f64 * 0.01;
+                let placed = crate::sph::probes::moved(p, sc.bodies[b].center, &motion.pose(c0, t));
+                let here = layers_read(&placed, ph.h, &g, axis).unwrap();
+                assert!(
+                    layers.start <= here.start && here.end <= layers.end,
+                    "{}: {here:?} at t = {t} outside {layers:?}",
+                    p.name
+                );
+            }
+        }
+        assert!(
+            wider > 0,
+            "no probe moved across a layer: the test tests nothing"
+        );
+        let mut free = load("cases/floating_box_2d.toml", &[]);
+        free.probes[0].body = Some(0);
+        let e = probe_layers(&free, &g, axis).unwrap_err().to_string();
+        assert!(
+            e.contains("'gauge_left'") && e.contains("'box'") && e.contains("freely"),
+            "{e}"
+        );
     }
 }

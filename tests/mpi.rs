@@ -519,19 +519,37 @@ fn assert_same_outputs(whole: &std::path::Path, ranked: &std::path::Path) -> usi
 /// its corner (a tracked point), each written once, by rank 0. The cut runs through the box.
 #[test]
 fn a_floating_body_over_two_ranks_writes_what_one_run_writes() {
+    two_ranks_write_what_one_run_writes(
+        "body",
+        "cases/floating_box_2d.toml",
+        "time.end_s=0.2",
+        &["body_box.csv", "point_corner.csv"],
+    );
+}
+
+/// `mpirun -np 2 wgsph run` of the sloshing tank (a body of prescribed motion, its walls
+/// dynamic) writes what one whole run writes, the pressure probes and wall sensors that roll
+/// with the tank included: no cut goes through the layers of their paths.
+#[test]
+fn a_rolling_tank_over_two_ranks_writes_what_one_run_writes() {
+    two_ranks_write_what_one_run_writes(
+        "tank",
+        "cases/sloshing_2d.toml",
+        "time.end_s=0.3",
+        &["body_tank.csv", "p2.csv", "w8.csv"],
+    );
+}
+
+/// `case` at dx = 0.02 m to `end`, outputs every 0.05 s, on one rank and on two: the same
+/// outputs ([`assert_same_outputs`]); each of `tables` (in probes/) has rows.
+fn two_ranks_write_what_one_run_writes(tag: &str, case: &str, end: &str, tables: &[&str]) {
     let (one, two) = (
-        common::Scratch::new("mpi-body-one"),
-        common::Scratch::new("mpi-body-two"),
+        common::Scratch::new(&format!("mpi-{tag}-one")),
+        common::Scratch::new(&format!("mpi-{tag}-two")),
     );
     let args = |out: &std::path::Path| -> Vec<std::ffi::OsString> {
-        let set = [
-            "particles.dx_m=0.02",
-            "time.end_s=0.2",
-            "time.output_every_s=0.05",
-        ];
-        let mut args: Vec<std::ffi::OsString> =
-            vec!["run".into(), "cases/floating_box_2d.toml".into()];
-        for s in set {
+        let mut args: Vec<std::ffi::OsString> = vec!["run".into(), case.into()];
+        for s in ["particles.dx_m=0.02", end, "time.output_every_s=0.05"] {
             args.extend(["--set".into(), s.into()]);
         }
         args.extend(["--quiet".into(), "--out".into(), out.as_os_str().to_owned()]);
@@ -540,7 +558,7 @@ fn a_floating_body_over_two_ranks_writes_what_one_run_writes() {
     on_one_rank(args(&one));
     on_two_ranks(args(&two));
     assert_same_outputs(&one, &two);
-    for table in ["body_box.csv", "point_corner.csv"] {
+    for table in tables {
         let text = std::fs::read_to_string(two.join("probes").join(table)).unwrap();
         assert!(text.lines().count() > 10, "{table}: {text}");
     }

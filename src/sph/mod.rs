@@ -697,6 +697,18 @@ impl Solver {
         if self.passes.probes.is_empty() {
             return Ok(Vec::new());
         }
+        self.place_attached_probes();
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.passes
+            .probes
+            .encode(&mut encoder, &self.buffers, self.parity);
+        self.queue.submit([encoder.finish()]);
+        Ok(self.passes.probes.decode(&self.probe_words()?))
+    }
+
+    /// Moves the probes attached to bodies to where their bodies are now; returns them, all
+    /// probes in order (None without attached probes).
+    fn place_attached_probes(&self) -> Option<Vec<crate::scenario::Probe>> {
         if let (Some((list, centers)), Some(set)) = (&self.attached_probes, self.bodies()) {
             let placed: Vec<_> = list
                 .iter()
@@ -713,13 +725,9 @@ impl Solver {
             );
             self.queue
                 .write_buffer(&self.buffers.probes, 0, bytemuck::cast_slice(&defs));
+            return Some(placed);
         }
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        self.passes
-            .probes
-            .encode(&mut encoder, &self.buffers, self.parity);
-        self.queue.submit([encoder.finish()]);
-        Ok(self.passes.probes.decode(&self.probe_words()?))
+        None
     }
 
     /// The probes' raw words (`probe_out`) as the last encoding left them.

@@ -3,12 +3,14 @@
 //! A point probe, a gauge or a wall patch reads only the cell layers `probe_layers` names, and
 //! the cuts never split them (`Slabs::balanced_keeping`): the rank that owns those layers holds
 //! every particle the probe reads, in the order one whole run holds them, and gives its value
-//! bit for bit. A front is the largest reach over the fluid: the ranks' words combine by their
+//! bit for bit (a probe on a moving tank: the layers of its whole path). A front is the
+//! largest reach over the fluid: the ranks' words combine by their
 //! maximum, and a continuous front's wet bins by their union before the walk — exact too.
 
-use anyhow::Result;
+use anyhow::{ensure, Result};
 
 use super::Solver;
+use crate::decomposition::layers_read;
 use crate::gpu::buffers::read;
 use crate::ranks::Ranks;
 
@@ -19,6 +21,25 @@ impl Solver {
         let probes = &self.passes.probes;
         if probes.is_empty() {
             return Ok(Vec::new());
+        }
+        let ranked = self.ranked.as_ref().expect("a subdomain");
+        let slabs = ranked.slabs.as_ref().expect("a subdomain's cuts");
+        if let Some(placed) = self.place_attached_probes() {
+            // A probe on a moving tank stays within the layers of its path the cuts keep whole
+            // (`probe_layers`), unless the run goes on past the end they were planned for.
+            for (p, planned) in placed.iter().zip(&ranked.probe_layers) {
+                let here = layers_read(p, self.params.h as f64, &self.grid, slabs.axis);
+                if let (Some(here), Some(planned)) = (here, planned) {
+                    ensure!(
+                        planned.start <= here.start && here.end <= planned.end,
+                        "probe '{}' reads cell layers {here:?} at t = {:.4} s, outside the \
+                         layers {planned:?} its path was planned to read when the run \
+                         started (did a resume extend time.end_s?); resume it on one rank",
+                        p.name,
+                        self.time()
+                    );
+                }
+            }
         }
         let mut encoder = self.device.create_command_encoder(&Default::default());
         probes.encode_particles(&mut encoder, &self.buffers, self.parity);
@@ -31,8 +52,6 @@ impl Solver {
         }
         let mine: Vec<f64> = self.probe_words()?.iter().map(|&w| w as f64).collect();
         let all = ranks.gather(&mine);
-        let ranked = self.ranked.as_ref().expect("a subdomain");
-        let slabs = ranked.slabs.as_ref().expect("a subdomain's cuts");
         let words: Vec<u32> = (0..mine.len())
             .map(|k| match &ranked.probe_layers[k] {
                 _ if probes.is_front(k) => all.iter().map(|w| w[k] as u32).max().unwrap_or(0),

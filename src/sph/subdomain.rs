@@ -107,10 +107,6 @@ pub fn capacity(own: u32, n: u32) -> u32 {
 /// What a run split over ranks cannot do yet, named for the refusal.
 fn unsupported(sc: &Scenario) -> Vec<&'static str> {
     [
-        (
-            sc.probes.iter().any(|p| p.body.is_some()),
-            "probes that move with a body",
-        ),
         (sc.solids.is_some(), "elastic solids"),
         (
             !sc.inlets.is_empty(),
@@ -660,11 +656,12 @@ mod tests {
 
     /// What a subdomain cannot run yet is named, case by case; a fluid with dynamic walls has
     /// nothing to refuse, nor has it with the energy equation on, a density filter, or the
-    /// walls written once; nor has the floating box.
+    /// walls written once; nor have the floating box and the sloshing tank.
     #[test]
     fn what_ranks_cannot_run_yet_is_named() {
-        let runs: [(&str, &[&str]); 5] = [
+        let runs: [(&str, &[&str]); 6] = [
             ("cases/dam_break_2d.toml", &[]),
+            ("cases/sloshing_2d.toml", &[]),
             ("cases/dam_break_2d.toml", &["physics.energy=true"]),
             (
                 "cases/dam_break_2d.toml",
@@ -679,12 +676,7 @@ mod tests {
         for (case, set) in runs {
             assert!(unsupported(&load(case, set)).is_empty(), "{case} {set:?}");
         }
-        let cases: [(&str, &[&str], &str); 3] = [
-            (
-                "cases/sloshing_2d.toml",
-                &[],
-                "probes that move with a body",
-            ),
+        let cases: [(&str, &[&str], &str); 2] = [
             ("cases/oscillating_plate_2d.toml", &[], "elastic solids"),
             ("cases/water_injection_2d.toml", &[], "inlets ("),
         ];
