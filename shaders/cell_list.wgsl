@@ -25,8 +25,9 @@
 @group(0) @binding(18) var<storage, read> energy_in: array<vec2<f32>>;
 @group(0) @binding(19) var<storage, read_write> energy_out: array<vec2<f32>>;
 
-// Slot of each particle (excluded particles go to the extra slot `hash_mask + 1`) and its
-// provisional place in that slot.
+// Slot of each particle (excluded particles go to the extra slot `hash_mask + 1`, a
+// subdomain's free entries, of id ID_MASK, to the last one, `hash_mask + 2`:
+// sph::subdomain::FREE_ID) and its provisional place in that slot.
 @compute @workgroup_size(WG)
 fn cell_key(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
@@ -36,6 +37,8 @@ fn cell_key(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     var key = params.hash_mask + 1u;
     if (code_kind(code[i]) != KIND_EXCLUDED) {
         key = slot_of_cell(cell_of(pos[i]));
+    } else if ((code[i] & ID_MASK) == ID_MASK) {
+        key = params.hash_mask + 2u;
     }
     keys[i] = key;
     local_rank[i] = atomicAdd(&counts[key], 1u);
@@ -51,8 +54,8 @@ fn scatter(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
 }
 
 // Final place = slot start + number of particles of the same slot with a smaller id (ids are
-// unique). O(n_slot) per particle; the excluded slot keeps its provisional order (its
-// particles never interact, and outputs are written in id order).
+// unique). O(n_slot) per particle; the excluded and free slots keep their provisional order
+// (their particles never interact, and outputs are written in id order).
 @compute @workgroup_size(WG)
 fn rank_in_cell(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let p = linear_index(gid, nwg);

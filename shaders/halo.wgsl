@@ -4,7 +4,10 @@
 // cut and migrates (packed with its last rates); every own particle within `layers` of a cut
 // with a neighbour is packed as that neighbour's halo. The host reads the records, swaps them
 // with the neighbours and writes what it received after `tail`, the first entry of the last
-// sort's excluded slot (free ever since: excluded particles stay excluded).
+// sort's free slot. Free entries: `halo_forget` gives every entry excluded during a step (the
+// halo copies and migrants sent, the particles that left) the free id at the step's end, so
+// the next sort puts them in the free slot, apart from the excluded slot, where the inlet
+// particles waiting behind their buffers keep their ids (`inlet_flow` wakes them by id).
 // A record carries what the receiver's passes read and, for a migrant, what it goes on
 // integrating (its last rates, and its energy with the energy equation).
 // A migrant stays in the sender's arrays for this step, as a halo copy: it is within one layer
@@ -92,7 +95,7 @@ fn halo_pack(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let i = linear_index(gid, nwg);
     if (i == 0u) {
         // The last sort's excluded slot starts here; this step's sort has not run yet.
-        halo_counts.tail = cell_start[params.hash_mask + 1u];
+        halo_counts.tail = cell_start[params.hash_mask + 2u];
     }
     if (i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
         return;
@@ -158,5 +161,13 @@ fn halo_restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     if (lo < n && (halo_out[lo].code & ID_MASK) == id) {
         code[i] = halo_out[lo].code;
         velrho[i] = halo_out[lo].velrho;
+    }
+}
+
+@compute @workgroup_size(WG)
+fn halo_forget(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i < cell_start[params.hash_mask + 1u] && code_kind(code[i]) == KIND_EXCLUDED) {
+        code[i] = with_kind(ID_MASK, KIND_EXCLUDED);
     }
 }

@@ -218,7 +218,7 @@ pub fn step_counts(
     StepCounts {
         dim: sc.physics.dim,
         dense_grid: grid.dense(),
-        slots_per_particle: (grid.slots as f64 + 2.0) / live.max(1) as f64,
+        slots_per_particle: (grid.slots as f64 + 3.0) / live.max(1) as f64,
         fluid_fraction: share(&[Kind::Fluid]),
         ghost_fraction: share(&[Kind::GhostNoSlip, Kind::GhostFreeSlip]),
         energy: sc.physics.energy,

@@ -2,7 +2,8 @@
 
 use crate::grid::Grid;
 
-/// Slot of each particle (given as GPU block + offset), `slots` for excluded ones.
+/// Slot of each particle (given as GPU block + offset), `slots` for excluded ones (a
+/// subdomain's free entries, which go to `slots + 1`, are not among a twin's particles).
 pub fn cell_key(grid: &Grid, pos: &[([f32; 3], [u32; 3])], excluded: &[bool]) -> Vec<u32> {
     pos.iter()
         .zip(excluded)
@@ -17,12 +18,12 @@ pub fn cell_key(grid: &Grid, pos: &[([f32; 3], [u32; 3])], excluded: &[bool]) ->
 }
 
 /// The order the GPU sort must produce: by slot, ties by particle id (`ids[i]` of the particle
-/// stored at i); and the slot starts (slots + 2 entries). Excluded particles (the last slot)
+/// stored at i); and the slot starts (slots + 3 entries). Excluded particles (the extra slots)
 /// are not ordered by the GPU, so callers compare them as a set.
 pub fn sorted_order(grid: &Grid, keys: &[u32], ids: &[u32]) -> (Vec<usize>, Vec<u32>) {
     let mut order: Vec<usize> = (0..keys.len()).collect();
     order.sort_by_key(|&i| (keys[i], ids[i]));
-    let mut counts = vec![0u32; grid.slots as usize + 2];
+    let mut counts = vec![0u32; grid.slots as usize + 3];
     for &k in keys {
         counts[k as usize] += 1;
     }

@@ -26,8 +26,8 @@ pub struct ParticleBuffers {
     /// Atomic rank within the slot, then (reused) the final permutation.
     pub local_perm: wgpu::Buffer,
     pub provisional: wgpu::Buffer,
-    /// Slot histogram, scanned in place into slot starts: slots + 2 entries (the extra slot
-    /// holds excluded particles, the last entry ends up = n).
+    /// Slot histogram, scanned in place into slot starts: slots + 3 entries (the extra slots
+    /// hold the excluded particles and a subdomain's free entries; the last entry ends up = n).
     pub cell_start: wgpu::Buffer,
     /// Block sums of the prefix scan, one buffer per level (the last has one element).
     pub scan_levels: Vec<wgpu::Buffer>,
@@ -183,7 +183,7 @@ impl ParticleBuffers {
         let n = init.pos.len() as u32;
         let vec4 = 16 * n as u64;
         let words = 4 * n as u64;
-        let mut scan_sizes = vec![slots + 2];
+        let mut scan_sizes = vec![slots + 3];
         let block = 2 * crate::gpu::shader::WORKGROUP_SIZE;
         while *scan_sizes.last().unwrap() > block {
             let last = *scan_sizes.last().unwrap();
@@ -217,7 +217,7 @@ impl ParticleBuffers {
             keys: storage(device, "keys", words),
             local_perm: storage(device, "local rank / perm", words),
             provisional: storage(device, "provisional", words),
-            cell_start: storage(device, "cell start", 4 * (slots as u64 + 2)),
+            cell_start: storage(device, "cell start", 4 * (slots as u64 + 3)),
             scan_levels,
             scan_sizes,
             probes: storage_init(

@@ -10,7 +10,7 @@ use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
 use crate::layout::{HaloCounts, HaloCtl, HaloRecord, DEST_MIGRANT, DEST_UPPER, ID_MASK};
-use crate::scenario::{Kind, Scenario};
+use crate::scenario::{InletPressure, Kind, Scenario};
 
 pub const SHADER: Shader = Shader {
     name: "halo",
@@ -24,12 +24,25 @@ pub const SHADER: Shader = Shader {
 /// next to the cut needs the fluid one layer further: two layers, of which the outer one's
 /// copies (wrong values, read by no own particle) only serve the inner one's. (The density
 /// filter, which reads corrected neighbours, swaps them again: `Solver::filter_over_ranks`.)
+///
+/// An extrapolated inlet buffer (`inlet_pressure`) takes its pressure from the fluid around its
+/// mirror image across the inlet's plane, up to twice the buffer's depth away, plus a support:
+/// the halo then reaches that far past the layer next to the cut.
 pub fn halo_layers(sc: &Scenario) -> u32 {
     let ghosts = [Kind::GhostNoSlip, Kind::GhostFreeSlip];
-    match sc.particles.iter().any(|p| ghosts.contains(&p.kind)) {
+    let ghost_layers = match sc.particles.iter().any(|p| ghosts.contains(&p.kind)) {
         true => 2,
         false => 1,
-    }
+    };
+    let cell = 2.0 * sc.physics.h;
+    let mirror_layers = sc
+        .inlets
+        .iter()
+        .filter(|i| i.pressure == InletPressure::Extrapolated)
+        .map(|i| 1 + ((2.0 * i.thickness + cell) / cell).ceil() as u32)
+        .max()
+        .unwrap_or(1);
+    ghost_layers.max(mirror_layers)
 }
 
 /// Records the packing buffer holds per particle of the arrays: a particle packs at most two
@@ -56,6 +69,7 @@ pub struct Halo {
     pack: ParityKernel,
     drop: ParityKernel,
     restore: ParityKernel,
+    forget: ParityKernel,
     count_layers: ParityKernel,
     ctl: wgpu::Buffer,
     counts: wgpu::Buffer,
@@ -117,6 +131,7 @@ impl Halo {
             pack: ParityKernel::new(device, module, "halo_pack", bufs)?,
             drop: ParityKernel::new(device, module, "halo_drop", bufs)?,
             restore: ParityKernel::new(device, module, "halo_restore", bufs)?,
+            forget: ParityKernel::new(device, module, "halo_forget", bufs)?,
             count_layers: ParityKernel::new(device, module, "count_layers", bufs)?,
             ctl: ctl_buffer,
             counts_staging: readback_buffer(
@@ -204,6 +219,12 @@ impl Halo {
     /// Restores the copies [`Halo::upload_restored`] gave, in the arrays of parity `q`.
     pub fn encode_restore(&self, pass: &mut wgpu::ComputePass<'_>, q: usize) {
         self.restore.dispatch(pass, q, self.n);
+    }
+
+    /// Frees the entries of the arrays of parity `q` excluded since the last sort (at the end
+    /// of a step, after the last pass that reads them by id).
+    pub fn encode_forget(&self, pass: &mut wgpu::ComputePass<'_>, q: usize) {
+        self.forget.dispatch(pass, q, self.n);
     }
 
     /// Reads what the last `halo_pack` packed, once its submission (with `copy_counts`) is

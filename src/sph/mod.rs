@@ -178,11 +178,11 @@ impl Solver {
         let defs = probes::probe_defs(&sc.probes, grid.origin, &probe_faces, front_bins);
         let mut packed = initial::pack(sc, &grid);
         let ranked = subdomain.as_ref().map(|ctl| {
-            let own = subdomain::exclude_others(&mut packed, &grid, ctl);
-            let capacity = subdomain::capacity(own, n as u32);
+            let (own, waiting) = subdomain::exclude_others(&mut packed, &grid, ctl, sc);
+            let capacity = subdomain::capacity(own, waiting, n as u32);
             subdomain::resize(&mut packed, capacity as usize);
             params.n_particles = capacity;
-            subdomain::Ranked::new(n as u64, own)
+            subdomain::Ranked::new((n - sc.dormant_count()) as u64, own, waiting)
         });
         let body_motions = bodies::initial_motions(sc, params.body_id_base);
         let solid = initial::solid_states(sc)?;
@@ -293,7 +293,11 @@ impl Solver {
     /// [`advance_to`](Self::advance_to) (or `run_steps`).
     pub fn density_variation(&self) -> DensityVariation {
         let s = &self.state;
-        let fluid = (self.n_fluid_at_start + s.inlet_joined as u64).saturating_sub(self.drained());
+        let joined = match &self.ranked {
+            Some(ranked) => ranked.joined,
+            None => s.inlet_joined as u64,
+        };
+        let fluid = (self.n_fluid_at_start + joined).saturating_sub(self.drained());
         let share = |count: u32| count as f64 / fluid.max(1) as f64;
         DensityVariation {
             max: s.density_variation_peak as f64,

@@ -33,13 +33,13 @@ impl Solver {
         )
     }
 
-    /// Slot starts of the last sort (slots + 2 entries).
+    /// Slot starts of the last sort (slots + 3 entries).
     pub fn read_cell_start(&self) -> Result<Vec<u32>> {
         read(
             &self.device,
             &self.queue,
             &self.buffers.cell_start,
-            self.grid.slots as usize + 2,
+            self.grid.slots as usize + 3,
         )
     }
 

@@ -34,6 +34,9 @@ pub struct Ranked {
     pub(super) excluded: u64,
     /// Fluid particles of the whole run the outlets removed (each rank's GPU counts its own).
     pub(super) drained: u64,
+    /// Inlet particles of the whole run that joined (each rank's GPU counts its own).
+    #[serde(default)]
+    pub(super) joined: u64,
     /// Where the first step unpacks (no sort has run yet): after the own particles.
     first_tail: Option<u32>,
     /// This rank's totals: halo copies and migrants sent, and their bytes.
@@ -49,6 +52,11 @@ pub struct Ranked {
     pub rebalances: u32,
     /// The whole run's steps when these counts were taken.
     pub steps: u64,
+    /// Each cell layer where inlet particles join (the back of a buffer) and the rank that
+    /// holds the particles waiting to join there (its owner under the starting cuts:
+    /// [`exclude_others`]).
+    #[serde(default)]
+    pub(super) joining: Vec<(u32, u32)>,
     /// The cell layers each probe reads (`decomposition::probe_layers`; none for fronts): the
     /// rank that owns them samples it.
     pub(super) probe_layers: Vec<Option<Range<u32>>>,
@@ -83,11 +91,12 @@ impl std::ops::Sub for Split {
 }
 
 impl Ranked {
-    /// A subdomain of a run of `live` particles, with `own` of them first in its arrays.
-    pub(super) fn new(live: u64, own: u32) -> Self {
+    /// A subdomain of a run of `live` particles, with `own` of them first in its arrays and
+    /// then `waiting` inlet particles.
+    pub(super) fn new(live: u64, own: u32, waiting: u32) -> Self {
         Self {
             live_at_start: live,
-            first_tail: Some(own),
+            first_tail: Some(own + waiting),
             ..Default::default()
         }
     }
@@ -97,64 +106,110 @@ impl Ranked {
 /// water that flows in before the cuts move, and the entries the last step's halo copies
 /// still take until the next sort), with room for a small slab's halo; never more than twice
 /// the whole run's `n` (a rank that owns almost everything still takes its halo and
-/// migrants). A rank that receives more than fits stops with a message saying so.
-pub fn capacity(own: u32, n: u32) -> u32 {
+/// migrants); and the `waiting` inlet particles it holds. A rank that receives more than fits
+/// stops with a message saying so.
+pub fn capacity(own: u32, waiting: u32, n: u32) -> u32 {
     own.saturating_mul(2)
         .saturating_add(4096)
         .min(n.saturating_mul(2))
+        .saturating_add(waiting)
 }
 
 /// What a run split over ranks cannot do yet, named for the refusal.
 fn unsupported(sc: &Scenario) -> Vec<&'static str> {
-    [
-        (sc.solids.is_some(), "elastic solids"),
-        (
-            !sc.inlets.is_empty(),
-            "inlets (their waiting particles share the slot the arrivals are written into)",
-        ),
-    ]
-    .into_iter()
-    .filter_map(|(yes, what)| yes.then_some(what))
-    .collect()
+    [(sc.solids.is_some(), "elastic solids")]
+        .into_iter()
+        .filter_map(|(yes, what)| yes.then_some(what))
+        .collect()
 }
 
-/// Excludes the particles outside `ctl`'s own layers and puts the own ones first (the arrays'
-/// order is free: the sort orders them); returns how many are own.
-pub fn exclude_others(packed: &mut Packed, grid: &Grid, ctl: &HaloCtl) -> u32 {
+/// Which entries of `packed` are `ctl`'s subdomain's at the start: its own live particles, and
+/// the inlet particles waiting behind their buffers (`Inlet::dormant`) whose joining place, at
+/// the back of the buffer, lies in its own layers (a rank holds a waiting particle until
+/// `inlet_flow` wakes it, then sends it on if it stands beyond a cut, as any migrant). The own
+/// come first, then the waiting; every other entry is free: excluded, its id [`FREE_ID`] (the
+/// sort puts free entries after the waiting ones, which keep theirs). Returns (own, waiting).
+pub fn exclude_others(
+    packed: &mut Packed,
+    grid: &Grid,
+    ctl: &HaloCtl,
+    sc: &Scenario,
+) -> (u32, u32) {
+    let axis = ctl.axis as usize;
+    let mine = |layer: i64| {
+        let layer = layer.clamp(0, grid.cells[axis] as i64 - 1) as u32;
+        (ctl.own_lo..ctl.own_hi).contains(&layer)
+    };
     let own = |k: usize| {
         let p = packed.pos[k];
-        let layer = grid.cell_of(p.off, unpack_block(p.block))[ctl.axis as usize] as u32;
-        packed.code[k] >> KIND_SHIFT != KIND_EXCLUDED && (ctl.own_lo..ctl.own_hi).contains(&layer)
+        packed.code[k] >> KIND_SHIFT != KIND_EXCLUDED
+            && mine(grid.cell_of(p.off, unpack_block(p.block))[axis])
     };
-    let (mine, others): (Vec<usize>, Vec<usize>) = (0..packed.pos.len()).partition(|&k| own(k));
-    let order: Vec<usize> = mine.iter().chain(&others).copied().collect();
+    let joining_here = |id: usize| {
+        sc.inlets.iter().any(|inlet| {
+            let k = id.wrapping_sub(inlet.particles.start);
+            inlet.particles.contains(&id)
+                && inlet.dormant(k)
+                && mine(joining_layer(inlet, k % inlet.columns.len(), grid, axis) as i64)
+        })
+    };
+    let ids: Vec<usize> = packed.code.iter().map(|c| (c & ID_MASK) as usize).collect();
+    let first: Vec<usize> = (0..ids.len()).filter(|&k| own(k)).collect();
+    let waiting: Vec<usize> = (0..ids.len())
+        .filter(|&k| packed.code[k] >> KIND_SHIFT == KIND_EXCLUDED && joining_here(ids[k]))
+        .collect();
+    let taken: std::collections::HashSet<usize> = first.iter().chain(&waiting).copied().collect();
+    let free = (0..ids.len()).filter(|k| !taken.contains(k));
+    let order: Vec<usize> = first.iter().chain(&waiting).copied().chain(free).collect();
+    let kept = first.len() + waiting.len();
     packed.pos = order.iter().map(|&k| packed.pos[k]).collect();
     packed.velrho = order.iter().map(|&k| packed.velrho[k]).collect();
     packed.code = order
         .iter()
         .enumerate()
-        .map(|(at, &k)| {
-            let c = packed.code[k];
-            if at < mine.len() {
-                c
-            } else {
-                (KIND_EXCLUDED << KIND_SHIFT) | (c & ID_MASK)
-            }
+        .map(|(at, &k)| match at < kept {
+            true => packed.code[k],
+            false => FREE,
         })
         .collect();
-    mine.len() as u32
+    (first.len() as u32, waiting.len() as u32)
 }
 
-/// `packed` cut or padded to `capacity` entries, the padding excluded (ids repeat there, as
-/// among excluded particles anywhere: no pass reads them).
+/// The cell layers along `axis` where `sc`'s inlet particles join (the backs of the buffers,
+/// where [`exclude_others`] assigns their holders), each once.
+fn joining_layers(sc: &Scenario, grid: &Grid, axis: usize) -> Vec<u32> {
+    let mut layers: Vec<u32> = sc
+        .inlets
+        .iter()
+        .flat_map(|inlet| (0..inlet.columns.len()).map(|c| joining_layer(inlet, c, grid, axis)))
+        .collect();
+    layers.sort_unstable();
+    layers.dedup();
+    layers
+}
+
+/// The cell layer along `axis` where the particles of `inlet`'s column `c` join: the back of
+/// its buffer.
+fn joining_layer(inlet: &crate::scenario::Inlet, c: usize, grid: &Grid, axis: usize) -> u32 {
+    let p = inlet.columns[c];
+    let back = [0, 1, 2].map(|a| p[a] - inlet.thickness * inlet.normal[a]);
+    let (off, block) = grid.to_block(back);
+    grid.cell_of(off, block)[axis].clamp(0, grid.cells[axis] as i64 - 1) as u32
+}
+
+/// The id of a free entry of a subdomain's arrays: the largest, so that the sort puts the free
+/// entries last in the excluded slot, after the inlet particles still waiting (`halo_pack`
+/// finds the free tail there). No particle has it (the run's ids stay below it).
+pub const FREE_ID: u32 = ID_MASK;
+
+/// The code word of a free entry.
+const FREE: u32 = (KIND_EXCLUDED << KIND_SHIFT) | FREE_ID;
+
+/// `packed` cut or padded to `capacity` entries, the padding free.
 pub fn resize(packed: &mut Packed, capacity: usize) {
-    let n = packed.code.len();
     packed.pos.resize(capacity, Pos::default());
     packed.velrho.resize(capacity, [0.0; 4]);
-    packed.code.truncate(capacity);
-    packed
-        .code
-        .extend((n..capacity).map(|k| (KIND_EXCLUDED << KIND_SHIFT) | (k % n.max(1)) as u32));
+    packed.code.resize(capacity, FREE);
 }
 
 impl Solver {
@@ -200,6 +255,10 @@ impl Solver {
         let ranked = solver.ranked.as_mut().expect("a subdomain");
         ranked.slabs = Some(slabs.clone());
         ranked.probe_layers = probes;
+        ranked.joining = joining_layers(sc, &solver.grid, slabs.axis)
+            .into_iter()
+            .map(|layer| (layer, slabs.owner(layer) as u32))
+            .collect();
         solver.ranked_step(ranks)?;
         solver.initial_dt = solver.state.dt_cfl;
         Ok(solver)
@@ -261,6 +320,16 @@ impl Solver {
         let Some(next) = slabs.rebalanced(&load, halo.thickness) else {
             return Ok(false);
         };
+        // A rank wakes the inlet particles it holds and sends them on one rank at most.
+        let far = |&(layer, holder): &(u32, u32)| next.owner(layer).abs_diff(holder as usize) > 1;
+        if let Some((layer, holder)) = ranked.joining.iter().find(|j| far(j)) {
+            log::debug!(
+                "rank {}: cuts kept: under {next:?} the inlet particles rank {holder} holds \
+                 would join in layer {layer}, beyond its neighbours",
+                ranks.rank()
+            );
+            return Ok(false);
+        }
         log::info!(
             "rank {}: cuts moved, imbalance {:.1} % -> {:.1} %",
             ranks.rank(),
@@ -335,6 +404,7 @@ impl Solver {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             halo.encode_pack(&mut pass, p);
             halo.encode_drop(&mut pass, p);
+            halo.encode_forget(&mut pass, p);
         }
         halo.copy_counts(&mut encoder);
         self.queue.submit([encoder.finish()]);
@@ -476,6 +546,12 @@ impl Solver {
             self.correct_bodies(dt, &mine, ranks);
         }
         self.filter_over_ranks(steps_before, ranks)?;
+        let halo = self
+            .passes
+            .halo
+            .as_ref()
+            .expect("a subdomain has a halo pass");
+        self.submit_pass("halo forget", |pass| halo.encode_forget(pass, self.parity));
         let split = &mut self.ranked.as_mut().expect("a subdomain").split;
         split.pack += (packed_at - start).as_secs_f64();
         split.exchange += (swapped_at - packed_at).as_secs_f64();
@@ -609,7 +685,8 @@ impl Solver {
     /// (integrate.wgsl `timestep`) repeated with it, so every rank takes the step one whole run
     /// would), and the counts the stop rules read, summed; `live`: this rank's own particles
     /// and migrants sent at packing. The host's state keeps this rank's drained count (it
-    /// goes back to the GPU with a checkpoint), `Ranked::drained` the run's.
+    /// goes back to the GPU with a checkpoint), `Ranked::drained` the run's; so with the
+    /// inlet particles that joined.
     fn agree(&mut self, local: crate::layout::SimState, live: u32, ranks: &dyn Ranks) {
         let dt = ranks.min(local.dt_cfl as f64) as f32;
         let mut gpu = local;
@@ -628,13 +705,16 @@ impl Solver {
             local.beyond_warn_peak as f64,
             local.beyond_stop_peak as f64,
             local.drained as f64,
+            local.inlet_joined as f64,
         ]);
         let peak = -ranks.min(-(local.density_variation_peak as f64));
         let ranked = self.ranked.as_mut().expect("a subdomain");
         ranked.drained = sums[4] as u64;
+        ranked.joined = sums[5] as u64;
         // What is neither live on a rank nor drained left the domain (the drained are
-        // excluded too, but counted apart, as one whole run counts them).
-        ranked.excluded = (ranked.live_at_start)
+        // excluded too, but counted apart, as one whole run counts them); the inlet particles
+        // that joined add to the live.
+        ranked.excluded = (ranked.live_at_start + ranked.joined)
             .saturating_sub(sums[0] as u64)
             .saturating_sub(ranked.drained);
         self.state = gpu;
@@ -656,11 +736,12 @@ mod tests {
 
     /// What a subdomain cannot run yet is named, case by case; a fluid with dynamic walls has
     /// nothing to refuse, nor has it with the energy equation on, a density filter, or the
-    /// walls written once; nor have the floating box and the sloshing tank.
+    /// walls written once; nor have the floating box, the sloshing tank and the injection.
     #[test]
     fn what_ranks_cannot_run_yet_is_named() {
-        let runs: [(&str, &[&str]); 6] = [
+        let runs: [(&str, &[&str]); 7] = [
             ("cases/dam_break_2d.toml", &[]),
+            ("cases/water_injection_2d.toml", &[]),
             ("cases/sloshing_2d.toml", &[]),
             ("cases/dam_break_2d.toml", &["physics.energy=true"]),
             (
@@ -676,50 +757,68 @@ mod tests {
         for (case, set) in runs {
             assert!(unsupported(&load(case, set)).is_empty(), "{case} {set:?}");
         }
-        let cases: [(&str, &[&str], &str); 2] = [
-            ("cases/oscillating_plate_2d.toml", &[], "elastic solids"),
-            ("cases/water_injection_2d.toml", &[], "inlets ("),
-        ];
-        for (case, set, what) in cases {
-            let missing = unsupported(&load(case, set));
-            assert!(
-                missing.iter().any(|m| m.starts_with(what)),
-                "{case}: {missing:?}"
-            );
-        }
+        let missing = unsupported(&load("cases/oscillating_plate_2d.toml", &[]));
+        assert_eq!(missing, ["elastic solids"]);
     }
 
-    /// The own particles come first, unchanged; every other one is excluded with its id kept.
+    /// Three subdomains of the water injection: each holds its own live particles first,
+    /// unchanged, then the inlet particles waiting to join in its layers, ids kept, then free
+    /// entries; together they hold every live particle and every waiting one exactly once.
     #[test]
-    fn a_subdomain_keeps_its_own_layers_first() {
-        let sc = load("cases/dam_break_2d.toml", &[]);
+    fn subdomains_hold_their_own_and_their_waiting_inlet_particles() {
+        let sc = load("cases/water_injection_2d.toml", &[]);
         let ph = &sc.physics;
         let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic).unwrap();
+        let axis = crate::decomposition::cut_axis(&grid, ph.dim).unwrap();
         let whole = super::super::initial::pack(&sc, &grid);
-        let mut packed = super::super::initial::pack(&sc, &grid);
-        let ctl = HaloCtl {
-            axis: 1,
-            own_lo: 0,
-            own_hi: grid.cells[1] / 3,
-            ..Default::default()
-        };
-        let own = exclude_others(&mut packed, &grid, &ctl) as usize;
-        assert!(own > 0 && own < whole.code.len());
-        let mut ids: Vec<u32> = packed.code.iter().map(|c| c & ID_MASK).collect();
-        ids.sort();
-        assert_eq!(ids, (0..whole.code.len() as u32).collect::<Vec<_>>());
-        for (k, &c) in packed.code.iter().enumerate() {
-            let id = (c & ID_MASK) as usize;
-            let excluded = c >> KIND_SHIFT == KIND_EXCLUDED;
-            assert_eq!(excluded, k >= own, "entry {k}");
-            if !excluded {
-                assert_eq!(
-                    (c, packed.pos[k], packed.velrho[k]),
-                    (whole.code[id], whole.pos[id], whole.velrho[id])
-                );
-                let p = packed.pos[k];
-                assert!(grid.cell_of(p.off, unpack_block(p.block))[1] < ctl.own_hi as i64);
+        let layers = grid.cells[axis];
+        let (mut live, mut waiting) = (Vec::new(), Vec::new());
+        for r in 0..3 {
+            let mut packed = super::super::initial::pack(&sc, &grid);
+            let ctl = HaloCtl {
+                axis: axis as u32,
+                own_lo: r * layers / 3,
+                own_hi: (r + 1) * layers / 3,
+                ..Default::default()
+            };
+            let (own, held) = exclude_others(&mut packed, &grid, &ctl, &sc);
+            let (own, held) = (own as usize, held as usize);
+            for (k, &c) in packed.code.iter().enumerate() {
+                let id = (c & ID_MASK) as usize;
+                let excluded = c >> KIND_SHIFT == KIND_EXCLUDED;
+                assert_eq!(excluded, k >= own, "entry {k}");
+                if k < own {
+                    assert_eq!(
+                        (c, packed.pos[k], packed.velrho[k]),
+                        (whole.code[id], whole.pos[id], whole.velrho[id])
+                    );
+                    let p = packed.pos[k];
+                    let layer = grid.cell_of(p.off, unpack_block(p.block))[axis];
+                    assert!((ctl.own_lo..ctl.own_hi).contains(&(layer as u32)));
+                    live.push(id);
+                } else if k < own + held {
+                    assert_eq!(c, whole.code[id], "a waiting particle keeps its code");
+                    waiting.push(id);
+                } else {
+                    assert_eq!(c, FREE);
+                }
             }
         }
+        live.sort();
+        waiting.sort();
+        let kind = |id: &usize| whole.code[*id] >> KIND_SHIFT;
+        let all_live: Vec<usize> = (0..whole.code.len())
+            .filter(|id| kind(id) != KIND_EXCLUDED)
+            .collect();
+        let dormant: Vec<usize> = (0..whole.code.len())
+            .filter(|id| kind(id) == KIND_EXCLUDED)
+            .collect();
+        assert_eq!(live, all_live);
+        assert_eq!(waiting, dormant);
+        assert_eq!(dormant.len(), sc.dormant_count());
+        assert!(
+            !dormant.is_empty(),
+            "no waiting particle: the test tests nothing"
+        );
     }
 }

@@ -60,7 +60,7 @@ pub struct StepCounts {
     pub dim: u32,
     /// A slot per cell (`Grid::dense`): a neighbour loop reads one range per row of cells.
     pub dense_grid: bool,
-    /// Entries of the slot table (slots + 2) per particle.
+    /// Entries of the slot table (slots + 3) per particle.
     pub slots_per_particle: f64,
     pub fluid_fraction: f64,
     /// Fixed ghost particles, which `ghost` interpolates.
