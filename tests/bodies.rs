@@ -411,11 +411,10 @@ fn body_rates_and_loads(dim: u32, seed: u64, kind: Kind, pair: bool) {
         .collect();
     let cpu_rates: Vec<[f64; 4]> = gpu_rates.iter().map(|g| g.map(|x| x as f64)).collect();
     let want = reference::bodies::body_force(&sc.physics, &parts, &cpu_rates, &centers);
-    let got = solver.rerun_body_loads().unwrap();
+    let [got, on_host] = solver.rerun_body_loads().unwrap();
     // A subdomain of a run over ranks sums the GPU's per-particle loads on the host, with the
     // GPU's tree: the same bits.
     let bits = |l: &wgsph::body::Load| [l.force, l.torque].map(|v| v.to_array().map(f64::to_bits));
-    let on_host = solver.rerun_body_loads_summed_on_host().unwrap();
     assert_eq!(
         got.iter().map(bits).collect::<Vec<_>>(),
         on_host.iter().map(bits).collect::<Vec<_>>(),

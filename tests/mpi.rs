@@ -239,6 +239,7 @@ fn body_words(solver: &Solver) -> Vec<u32> {
 }
 
 /// A case cut into slabs and stepped on `ranks` ranks under mpirun, against its whole run.
+#[derive(Default)]
 struct Comparison {
     /// The test function that runs it (what mpirun launches).
     test: &'static str,
@@ -674,11 +675,10 @@ fn three_ranks_of_the_3d_dam_break_equal_one_run() {
         set: &["particles.dx_m=0.04"],
         ranks: 3,
         steps: 40,
-        uneven: false,
-        restore_at: None,
         tables: "[[body]]\nname = \"beam\"\nshape = \"box\"\nmin_m = [1.6, 0.3, 0.35]\n\
                  max_m = [3.0, 0.7, 0.55]\ndensity_kg_m3 = 500.0\nwall = \"dynamic\"\n\
                  [body.motion]\nkind = \"free\"\nvelocity_m_s = [0.0, 0.5, 0.3]\n",
+        ..Default::default()
     }
     .check();
 }
@@ -698,7 +698,7 @@ fn ranks_that_move_their_cuts_still_equal_one_run() {
         steps: 300,
         uneven: true,
         restore_at: Some(200),
-        tables: "",
+        ..Default::default()
     }
     .check();
 }
@@ -805,8 +805,7 @@ fn ranks_integrate_the_energy_equation_as_one_run() {
         ranks: 2,
         steps: 300,
         uneven: true,
-        restore_at: None,
-        tables: "",
+        ..Default::default()
     }
     .check();
 }
@@ -823,9 +822,8 @@ fn ranks_with_an_outlet_drain_what_one_run_drains() {
         set: &["particles.dx_m=0.0073"],
         ranks: 2,
         steps: 300,
-        uneven: false,
-        restore_at: None,
         tables: "[[outlet]]\nname = \"drain\"\nmin_m = [0.1465, -0.1]\nmax_m = [0.3, 0.06]\n",
+        ..Default::default()
     }
     .check();
 }
@@ -907,8 +905,7 @@ fn ranks_with_fixed_ghost_walls_equal_one_run() {
         ranks: 2,
         steps: 300,
         uneven: true,
-        restore_at: None,
-        tables: "",
+        ..Default::default()
     }
     .check();
 }
@@ -932,7 +929,7 @@ fn ranks_filter_the_density_as_one_run() {
         steps: 300,
         uneven: true,
         restore_at: Some(200),
-        tables: "",
+        ..Default::default()
     }
     .check();
 }

@@ -56,8 +56,10 @@ impl Solver {
     }
 
     /// Test hook: re-runs the interaction and the body sums on the current arrays and returns
-    /// each body's force and torque (about the centre of mass of the last uploaded pose).
-    pub fn rerun_body_loads(&self) -> Result<Vec<crate::body::Load>> {
+    /// each body's force and torque (about the centre of mass of the last uploaded pose): as
+    /// the GPU sums them per workgroup, and as the host sums the GPU's per-particle loads
+    /// (`bodies::workgroup_sums`, what a subdomain does).
+    pub fn rerun_body_loads(&self) -> Result<[Vec<crate::body::Load>; 2]> {
         let Some(gpu) = &self.passes.bodies else {
             bail!("the case has no bodies");
         };
@@ -65,30 +67,18 @@ impl Solver {
             self.passes.interaction.encode(pass, self.parity);
             gpu.encode_force(pass, self.parity);
         });
-        let partials: Vec<[f32; 4]> = read(
-            &self.device,
-            &self.queue,
-            &gpu.partials,
-            gpu.partials_bytes() as usize / 16,
-        )?;
-        Ok(gpu.loads(&partials))
-    }
-
-    /// Test hook: as [`Solver::rerun_body_loads`], but with the per-workgroup sums taken on
-    /// the host from the GPU's per-particle loads (`bodies::workgroup_sums`), as a subdomain
-    /// takes them.
-    pub fn rerun_body_loads_summed_on_host(&self) -> Result<Vec<crate::body::Load>> {
-        let Some(gpu) = &self.passes.bodies else {
-            bail!("the case has no bodies");
+        let read_all = |buffer: &wgpu::Buffer| -> Result<Vec<[f32; 4]>> {
+            read(
+                &self.device,
+                &self.queue,
+                buffer,
+                buffer.size() as usize / 16,
+            )
         };
-        self.submit_pass("body loads", |pass| {
-            self.passes.interaction.encode(pass, self.parity);
-            gpu.encode_force(pass, self.parity);
-        });
-        let loads = &gpu.particle_loads;
-        let particle_loads: Vec<[f32; 4]> =
-            read(&self.device, &self.queue, loads, loads.size() as usize / 16)?;
-        Ok(gpu.loads_of_particles(&particle_loads))
+        Ok([
+            gpu.loads(&read_all(&gpu.partials)?),
+            gpu.loads_of_particles(&read_all(&gpu.particle_loads)?),
+        ])
     }
 
     /// Test hook: applies the density filter of the case once to the current arrays (whatever

@@ -398,17 +398,11 @@ impl Solver {
             .expect("a subdomain has a halo pass");
         // Migrants only: no halo this time.
         halo.set_cuts(&self.queue, &next, rank, false);
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        halo.clear(&mut encoder);
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
+        let packed = self.pack(|mut pass| {
             halo.encode_pack(&mut pass, p);
             halo.encode_drop(&mut pass, p);
             halo.encode_forget(&mut pass, p);
-        }
-        halo.copy_counts(&mut encoder);
-        self.queue.submit([encoder.finish()]);
-        let packed = halo.read(&self.device, &self.queue)?;
+        })?;
         let mut to: Vec<Vec<HaloRecord>> = vec![Vec::new(); size];
         for r in packed.lower.into_iter().chain(packed.upper) {
             let layer = self.grid.cell_of(r.pos.off, unpack_block(r.pos.block))[next.axis];
@@ -495,21 +489,10 @@ impl Solver {
         let start = std::time::Instant::now();
         let body_dt = self.bodies.is_some().then(|| self.predict_bodies());
         let p = self.parity;
-        let halo = self
-            .passes
-            .halo
-            .as_ref()
-            .expect("a subdomain has a halo pass");
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        halo.clear(&mut encoder);
-        {
-            let mut r = Recorder::Shared(encoder.begin_compute_pass(&Default::default()));
+        let packed = self.pack(|pass| {
+            let mut r = Recorder::Shared(pass);
             self.passes.record_to_exchange(&mut r, p);
-        }
-        halo.copy_counts(&mut encoder);
-        self.queue.submit([encoder.finish()]);
-        let packed = halo.read(&self.device, &self.queue)?;
-        self.faults.check()?;
+        })?;
         let packed_at = std::time::Instant::now();
 
         let incoming = self.swap(&packed, ranks)?;
@@ -560,6 +543,24 @@ impl Solver {
         Ok(())
     }
 
+    /// Submits the passes `record` records (one of them `halo_pack`) and reads back what they
+    /// packed. Waits for the GPU.
+    fn pack(&self, record: impl FnOnce(wgpu::ComputePass<'_>)) -> Result<halo::Packed> {
+        let halo = self
+            .passes
+            .halo
+            .as_ref()
+            .expect("a subdomain has a halo pass");
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        halo.clear(&mut encoder);
+        record(encoder.begin_compute_pass(&Default::default()));
+        halo.copy_counts(&mut encoder);
+        self.queue.submit([encoder.finish()]);
+        let packed = halo.read(&self.device, &self.queue);
+        self.faults.check()?;
+        packed
+    }
+
     /// Sends the records `packed` holds for each neighbour and returns what the neighbours
     /// sent this rank (every rank together); counts the bytes sent.
     fn swap(&mut self, packed: &halo::Packed, ranks: &dyn Ranks) -> Result<Vec<HaloRecord>> {
@@ -604,15 +605,7 @@ impl Solver {
             .halo
             .as_ref()
             .expect("a subdomain has a halo pass");
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        halo.clear(&mut encoder);
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            halo.encode_pack(&mut pass, q);
-        }
-        halo.copy_counts(&mut encoder);
-        self.queue.submit([encoder.finish()]);
-        let packed = halo.read(&self.device, &self.queue)?;
+        let packed = self.pack(|mut pass| halo.encode_pack(&mut pass, q))?;
         ensure!(
             packed.migrants == 0,
             "{} particles outside the subdomain after the corrector",
