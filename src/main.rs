@@ -313,7 +313,6 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                     overrides: set,
                 }),
                 interrupt: Some(interrupt_flag()?),
-                halt_at_s: None,
                 ..Default::default()
             };
             #[cfg(feature = "mpi")]
