@@ -86,7 +86,7 @@ pub fn slabs_for(sc: &Scenario, ranks: usize) -> Result<Slabs> {
 /// each range has one layer more on each side against the GPU's f32 rounding of the point.
 /// A probe attached to a body of prescribed motion (a moving tank) reads, over the run, the
 /// layers of every place the motion takes it to at the probe times: their union. One attached
-/// to a free body is refused (its path is not known before the run).
+/// to a free body is refused (its path is not known before the run), unless it is a front.
 pub fn probe_layers(sc: &Scenario, grid: &Grid, axis: usize) -> Result<Vec<Option<Range<u32>>>> {
     let up = sc.physics.dim as usize - 1;
     sc.probes
@@ -100,7 +100,11 @@ pub fn probe_layers(sc: &Scenario, grid: &Grid, axis: usize) -> Result<Vec<Optio
                     p.name
                 );
             }
-            let Some(b) = p.body else {
+            let Some(b) = p
+                .body
+                .filter(|_| !matches!(p.kind, ProbeKind::Front { .. }))
+            else {
+                // A front reads no layers, wherever it stands.
                 return Ok(layers_read(p, sc.physics.h, grid, axis));
             };
             let body = &sc.bodies[b];
@@ -522,5 +526,12 @@ mod tests {
             e.contains("'gauge_left'") && e.contains("'box'") && e.contains("freely"),
             "{e}"
         );
+        // A front on it reads no layers (the ranks take the largest reach).
+        free.probes[0].kind = ProbeKind::Front {
+            origin: [0.0; 3],
+            axis: [1.0, 0.0, 0.0],
+            continuous: false,
+        };
+        assert_eq!(probe_layers(&free, &g, axis).unwrap()[0], None);
     }
 }
