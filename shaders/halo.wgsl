@@ -62,6 +62,11 @@ struct HaloRecord {
 
 const DEST_UPPER: u32 = 1u;
 const DEST_MIGRANT: u32 = 2u;
+// The record after a solid particle's: its stress state, which the receiver writes into its
+// solid arrays (τ in velrho and pos.off, dτ/dt in rate and energy; the code word names the
+// particle; body, material and interface pressure are not sent: the first two never change,
+// the ghost pass recomputes the third).
+const DEST_SOLID_STATE: u32 = 4u;
 
 // A uniform: the packing binds the eight storage buffers every adapter allows.
 @group(0) @binding(6) var<uniform> halo_ctl: HaloCtl;
@@ -72,15 +77,19 @@ const DEST_MIGRANT: u32 = 2u;
 @group(0) @binding(9) var<storage, read_write> layer_load: array<atomic<u32>>;
 // (e, de/dt of the last evaluation); one unused entry without the energy equation.
 @group(0) @binding(10) var<storage, read> energy: array<vec2<f32>>;
+// The solid particles' stress state, by id − solid_id_base (one unused entry without solids).
+@group(0) @binding(11) var<storage, read> solid: array<SolidState>;
 
 fn layer_of(p: Pos) -> u32 {
     return u32(cell_of(p)[halo_ctl.axis]);
 }
 
 fn pack_record(i: u32, dest: u32) {
-    let k = atomicAdd(&halo_counts.records, 1u);
-    if (k >= halo_ctl.capacity) {
-        atomicAdd(&halo_counts.overflow, 1u);
+    let solid_state = is_solid(code_kind(code[i]));
+    let n = select(1u, 2u, solid_state);
+    let k = atomicAdd(&halo_counts.records, n);
+    if (k + n > halo_ctl.capacity) {
+        atomicAdd(&halo_counts.overflow, n);
         return;
     }
     var e = vec2<f32>(0.0);
@@ -88,15 +97,22 @@ fn pack_record(i: u32, dest: u32) {
         e = energy[i];
     }
     halo_out[k] = HaloRecord(pos[i], velrho[i], rate[i], code[i], dest, e);
+    if (solid_state) {
+        let s = solid[solid_slot(code[i])];
+        halo_out[k + 1u] = HaloRecord(
+            Pos(s.tau_b, 0u), s.tau_a, s.rate_a, code[i], dest | DEST_SOLID_STATE, s.rate_b);
+    }
+}
+
+// The free tail for the host (`halo_pack`'s records go after it): the last sort's free slot.
+@compute @workgroup_size(1)
+fn halo_tail() {
+    halo_counts.tail = cell_start[params.hash_mask + 2u];
 }
 
 @compute @workgroup_size(WG)
 fn halo_pack(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
-    if (i == 0u) {
-        // The last sort's excluded slot starts here; this step's sort has not run yet.
-        halo_counts.tail = cell_start[params.hash_mask + 2u];
-    }
     if (i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
         return;
     }

@@ -346,6 +346,8 @@ pub struct HaloRecord {
 /// `HaloRecord::dest`: to the neighbour above (else below); a migrant (else a halo copy).
 pub const DEST_UPPER: u32 = 1;
 pub const DEST_MIGRANT: u32 = 2;
+/// A record that carries the stress state of the solid particle of the record before it.
+pub const DEST_SOLID_STATE: u32 = 4;
 
 /// Mirrors `TlParams` in shaders/total_lagrangian.wgsl: the total-Lagrangian solid's
 /// particle count and first particle id (its particles have consecutive ids) and the cell
@@ -718,6 +720,10 @@ mod tests {
         );
         assert_eq!(wgsl_u32(&halo::SHADER, "DEST_UPPER"), DEST_UPPER);
         assert_eq!(wgsl_u32(&halo::SHADER, "DEST_MIGRANT"), DEST_MIGRANT);
+        assert_eq!(
+            wgsl_u32(&halo::SHADER, "DEST_SOLID_STATE"),
+            DEST_SOLID_STATE
+        );
     }
 
     #[test]

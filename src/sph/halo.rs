@@ -9,7 +9,9 @@ use crate::decomposition::Slabs;
 use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
-use crate::layout::{HaloCounts, HaloCtl, HaloRecord, DEST_MIGRANT, DEST_UPPER, ID_MASK};
+use crate::layout::{
+    HaloCounts, HaloCtl, HaloRecord, DEST_MIGRANT, DEST_SOLID_STATE, DEST_UPPER, ID_MASK,
+};
 use crate::scenario::{InletPressure, Kind, Scenario};
 
 pub const SHADER: Shader = Shader {
@@ -19,7 +21,8 @@ pub const SHADER: Shader = Shader {
 };
 
 /// Cell layers of halo `sc` needs. Cells are the kernel support 2h, so one layer holds every
-/// particle a neighbour's particle reaches. Fixed ghosts take their pressure and velocity from
+/// particle a neighbour's particle reaches. Fixed ghosts (and elastic solid particles, for
+/// their interface pressure) take their pressure and velocity from
 /// the fluid within a support of them (`fluid_at`) earlier in the same step, so a ghost copy
 /// next to the cut needs the fluid one layer further: two layers, of which the outer one's
 /// copies (wrong values, read by no own particle) only serve the inner one's. (The density
@@ -34,6 +37,11 @@ pub fn halo_layers(sc: &Scenario) -> u32 {
         true => 2,
         false => 1,
     };
+    // An elastic solid's interface pressure comes from the fluid around it as a ghost's does.
+    let ghost_layers = match sc.solids.is_some() {
+        true => 2,
+        false => ghost_layers,
+    };
     let cell = 2.0 * sc.physics.h;
     let mirror_layers = sc
         .inlets
@@ -45,9 +53,15 @@ pub fn halo_layers(sc: &Scenario) -> u32 {
     ghost_layers.max(mirror_layers)
 }
 
-/// Records the packing buffer holds per particle of the arrays: a particle packs at most two
-/// (a halo copy each way from a slab as thin as its halo, or one migrant).
-pub const RECORDS_PER_PARTICLE: u32 = 2;
+/// Records the packing buffer of `sc`'s subdomains holds per particle of the arrays: a
+/// particle packs at most two (a halo copy each way from a slab as thin as its halo, or one
+/// migrant), a solid particle twice as many (each with its stress state).
+pub fn records_per_particle(sc: &Scenario) -> u32 {
+    match sc.solids.is_some() {
+        true => 4,
+        false => 2,
+    }
+}
 
 /// Rank `rank`'s part of `slabs` with a halo of `layers` ([`halo_layers`]): what `halo_pack`
 /// needs to know (the records' capacity is the pass's own, set by [`Halo::new`]).
@@ -66,6 +80,7 @@ pub fn control(slabs: &Slabs, rank: usize, layers: u32) -> HaloCtl {
 }
 
 pub struct Halo {
+    tail: ParityKernel,
     pack: ParityKernel,
     drop: ParityKernel,
     restore: ParityKernel,
@@ -81,6 +96,8 @@ pub struct Halo {
     layers: u32,
     /// Cell layers of halo.
     pub thickness: u32,
+    /// Records `halo_out` holds.
+    capacity: u32,
     n: u32,
 }
 
@@ -103,9 +120,10 @@ impl Halo {
         b: &ParticleBuffers,
         ctl: HaloCtl,
         layers: u32,
+        records_per_particle: u32,
     ) -> Result<Self> {
         let ctl = HaloCtl {
-            capacity: RECORDS_PER_PARTICLE * b.n,
+            capacity: records_per_particle * b.n,
             ..ctl
         };
         let ctl_buffer = uniform_init(device, "halo ctl", &ctl);
@@ -128,6 +146,7 @@ impl Halo {
                 .with("layer_load", &layer_load)
         };
         Ok(Self {
+            tail: ParityKernel::new(device, module, "halo_tail", bufs)?,
             pack: ParityKernel::new(device, module, "halo_pack", bufs)?,
             drop: ParityKernel::new(device, module, "halo_drop", bufs)?,
             restore: ParityKernel::new(device, module, "halo_restore", bufs)?,
@@ -144,6 +163,7 @@ impl Halo {
             layer_load,
             layers,
             thickness: ctl.layers,
+            capacity: ctl.capacity,
             n: b.n,
         })
     }
@@ -152,7 +172,7 @@ impl Halo {
     /// packs migrants only.
     pub fn set_cuts(&self, queue: &wgpu::Queue, slabs: &Slabs, rank: usize, halos: bool) {
         let mut ctl = HaloCtl {
-            capacity: RECORDS_PER_PARTICLE * self.n,
+            capacity: self.capacity,
             ..control(slabs, rank, self.thickness)
         };
         if !halos {
@@ -195,6 +215,7 @@ impl Halo {
     /// Packs the migrants and the halo copies of the arrays of parity `p` (after the predictor,
     /// before the sort); the migrants stay until `encode_drop`, as halo copies.
     pub fn encode_pack(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
+        self.tail.dispatch_groups(pass, p, 1);
         self.pack.dispatch(pass, p, self.n);
     }
 
@@ -243,7 +264,7 @@ impl Halo {
         let records = read::<HaloRecord>(device, queue, &self.records, counts.records as usize)?;
         let migrants = records
             .iter()
-            .filter(|r| r.dest & DEST_MIGRANT != 0)
+            .filter(|r| r.dest & (DEST_MIGRANT | DEST_SOLID_STATE) == DEST_MIGRANT)
             .count() as u32;
         let (upper, lower) = records.into_iter().partition(|r| r.dest & DEST_UPPER != 0);
         Ok(Packed {

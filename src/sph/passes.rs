@@ -140,7 +140,8 @@ impl Passes {
             halo: subdomain
                 .map(|ctl| {
                     let layers = grid.cells[ctl.axis as usize];
-                    Halo::new(device, &shader(&halo::SHADER)?, b, ctl, layers)
+                    let records = halo::records_per_particle(sc);
+                    Halo::new(device, &shader(&halo::SHADER)?, b, ctl, layers, records)
                 })
                 .transpose()?,
         })
