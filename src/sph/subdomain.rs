@@ -520,13 +520,27 @@ impl Solver {
         ranked.owned = packed.owned;
         self.unpack(&incoming, tail, p)?;
 
+        // The GPU counts a step of dt > 0 (integrate.wgsl `timestep`): whether the density
+        // filter fires is known now. Its submission frees the entries this step excluded, or
+        // this one does.
+        let steps_before = self.state.steps;
+        let filters = self.passes.density_filter.as_ref().is_some_and(|f| {
+            f.fires_after(steps_before, steps_before + (self.state.dt > 0.0) as u32)
+        });
         let mut encoder = self.device.create_command_encoder(&Default::default());
         self.passes.cell_list.clear(&mut encoder, &self.buffers);
         {
             let mut r = Recorder::Shared(encoder.begin_compute_pass(&Default::default()));
             self.passes.record_from_exchange(&mut r, p);
+            if !filters {
+                let halo = self
+                    .passes
+                    .halo
+                    .as_ref()
+                    .expect("a subdomain has a halo pass");
+                r.stage("halo_forget", |pass| halo.encode_forget(pass, 1 - p));
+            }
         }
-        let steps_before = self.state.steps;
         let (local, particle_loads) = match body_dt {
             Some(_) => {
                 let (state, loads) = self.submit_reading_loads(encoder)?;
@@ -543,13 +557,13 @@ impl Solver {
         if let (Some(dt), Some(mine)) = (body_dt, particle_loads) {
             self.correct_bodies(dt, &mine, ranks);
         }
-        self.filter_over_ranks(steps_before, ranks)?;
-        let halo = self
-            .passes
-            .halo
-            .as_ref()
-            .expect("a subdomain has a halo pass");
-        self.submit_pass("halo forget", |pass| halo.encode_forget(pass, self.parity));
+        if filters {
+            ensure!(
+                self.state.steps == steps_before + 1,
+                "the GPU took no step where the density filter was to fire"
+            );
+            self.filter_over_ranks(ranks)?;
+        }
         let split = &mut self.ranked.as_mut().expect("a subdomain").split;
         split.pack += (packed_at - start).as_secs_f64();
         split.exchange += (swapped_at - packed_at).as_secs_f64();
@@ -603,17 +617,13 @@ impl Solver {
             .collect())
     }
 
-    /// The density filter of a step over ranks, if the step that took the step count from
-    /// `steps_before` is one it filters (`DensityFilter::fires_after`): it reads the corrected
-    /// densities of the neighbours, the halo copies' included, which `halo_drop` excluded
-    /// before the corrector. So the ranks pack their own halo particles again, corrected, and
-    /// swap them; each rank gives its copies their owners' values back (`halo_restore`),
-    /// filters, and excludes them again (every rank together).
-    fn filter_over_ranks(&mut self, steps_before: u32, ranks: &dyn Ranks) -> Result<()> {
-        let filter = self.passes.density_filter.as_ref();
-        if !filter.is_some_and(|f| f.fires_after(steps_before, self.state.steps)) {
-            return Ok(());
-        }
+    /// The density filter of a step it fires on (`DensityFilter::fires_after`), over ranks: it
+    /// reads the corrected densities of the neighbours, the halo copies' included, which
+    /// `halo_drop` excluded before the corrector. So the ranks pack their own halo particles
+    /// again, corrected, and swap them; each rank gives its copies their owners' values back
+    /// (`halo_restore`), filters, excludes them again and frees the step's excluded entries
+    /// (every rank together).
+    fn filter_over_ranks(&mut self, ranks: &dyn Ranks) -> Result<()> {
         let q = self.parity;
         let halo = self
             .passes
@@ -641,6 +651,7 @@ impl Solver {
             halo.encode_restore(pass, q);
             filter.encode(pass, q);
             halo.encode_drop(pass, q);
+            halo.encode_forget(pass, q);
         });
         self.faults.check()
     }
