@@ -45,8 +45,8 @@ fn filter_density(i: u32, mls: bool) -> f32 {
     var sum_wv = 0.0;  // Σ W_ij V_j
     var a = mls_zero();
     var m_mw = vec4<f32>(0.0);  // Σ m_j W_ij [1, x_ij/h]: Σ m_j W^MLS_ij = β·m_mw
-    var ranges: array<vec2<u32>, 27>;
-    let n_ranges = neighbour_ranges(cell_of(p_i), &ranges);
+    var ranges: NeighbourRanges;
+    let n_ranges = neighbour_ranges(p_i, &ranges);
     // One pass: the Shepard sums, the MLS moment matrix and the first moments of m W.
     for (var s = 0u; s < n_ranges; s++) {
         for (var j = ranges[s].x; j < ranges[s].y; j++) {

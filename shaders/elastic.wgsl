@@ -186,8 +186,8 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     var acc = vec3<f32>(0.0);
     var drho = 0.0;
     var grad_v = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
-    var ranges: array<vec2<u32>, 27>;
-    let n_ranges = neighbour_ranges(cell_of(p_i), &ranges);
+    var ranges: NeighbourRanges;
+    let n_ranges = neighbour_ranges(p_i, &ranges);
     for (var s = 0u; s < n_ranges; s++) {
         for (var j = ranges[s].x; j < ranges[s].y; j++) {
             let code_j = code[j];

@@ -176,8 +176,8 @@ fn solid_loads(i: u32) -> vec3<f32> {
     let group_i = params.friction_first_solid + body_i;
     let support2 = 4.0 * params.h * params.h;
     var r = vec3<f32>(0.0);
-    var ranges: array<vec2<u32>, 27>;
-    let n_ranges = neighbour_ranges(cell_of(p_i), &ranges);
+    var ranges: NeighbourRanges;
+    let n_ranges = neighbour_ranges(p_i, &ranges);
     for (var s = 0u; s < n_ranges; s++) {
         for (var j = ranges[s].x; j < ranges[s].y; j++) {
             let kind_j = code_kind(code[j]);
@@ -345,8 +345,8 @@ fn image_rates(pi: Particle, p_i: Pos, image: vec3<f32>, chain: vec3<u32>, n: u3
     var out = PairRates(vec4<f32>(0.0), 0.0);
     let support2 = 4.0 * params.h * params.h;
     let at = pos_of_point(image);
-    var ranges: array<vec2<u32>, 27>;
-    let n_ranges = neighbour_ranges(cell_of(at), &ranges);
+    var ranges: NeighbourRanges;
+    let n_ranges = neighbour_ranges(at, &ranges);
     for (var s = 0u; s < n_ranges; s++) {
         for (var j = ranges[s].x; j < ranges[s].y; j++) {
             if (code_kind(code[j]) != KIND_FLUID) {
@@ -414,7 +414,7 @@ fn mirror_rates(i: u32, pi: Particle) -> PairRates {
 // body's particle of any wall treatment, a fixed wall's with WALL_REACTIONS): a dynamic wall's
 // dρ/dt from the fluid (eq. 22), the reaction to the fluid's force (for bodies.wgsl's load and
 // the wall sensors) and a body particle's contact with walls, other bodies and solids (eq. 24).
-fn boundary_rates(i: u32, kind_i: u32, reacts: bool, on_body: bool, ranges: ptr<function, array<vec2<u32>, 27>>, n_ranges: u32) -> vec4<f32> {
+fn boundary_rates(i: u32, kind_i: u32, reacts: bool, on_body: bool, ranges: ptr<function, NeighbourRanges>, n_ranges: u32) -> vec4<f32> {
     let id_i = code[i] & ID_MASK;
     var body_i = NO_BODY;
     var kinematic_i = false;
@@ -488,7 +488,7 @@ fn boundary_rates(i: u32, kind_i: u32, reacts: bool, on_body: bool, ranges: ptr<
 // The rates of fluid particle i: continuity and momentum from every pressure-carrying neighbour
 // (`pair_rates`), repulsive walls (eq. 23), elastic solids (eq. 28) and mirror images (eq. 12),
 // gravity, and with ENERGY de/dt (written here).
-fn fluid_rates(i: u32, ranges: ptr<function, array<vec2<u32>, 27>>, n_ranges: u32) -> vec4<f32> {
+fn fluid_rates(i: u32, ranges: ptr<function, NeighbourRanges>, n_ranges: u32) -> vec4<f32> {
     let p_i = pos[i];
     let vr_i = velrho[i];
     let pi = Particle(vr_i.xyz, vr_i.w, pressure_of(vr_i.w) / (vr_i.w * vr_i.w));
@@ -572,9 +572,9 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         return;
     }
     // One neighbour list, for fluid and boundary particles alike.
-    var ranges: array<vec2<u32>, 27>;
+    var ranges: NeighbourRanges;
     if (kind_i == KIND_FLUID) {
-        let n_ranges = neighbour_ranges(cell_of(pos[i]), &ranges);
+        let n_ranges = neighbour_ranges(pos[i], &ranges);
         rate[i] = fluid_rates(i, &ranges, n_ranges);
         return;
     }
@@ -585,6 +585,6 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         rate[i] = vec4<f32>(0.0);
         return;
     }
-    let n_ranges = neighbour_ranges(cell_of(pos[i]), &ranges);
+    let n_ranges = neighbour_ranges(pos[i], &ranges);
     rate[i] = boundary_rates(i, kind_i, reacts, on_body, &ranges, n_ranges);
 }

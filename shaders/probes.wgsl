@@ -40,8 +40,8 @@ fn fluid_sums(x: vec3<f32>) -> KernelSums {
     let p = pos_of_point(x);
     let support2 = 4.0 * params.h * params.h;
     var sums = KernelSums(0.0, 0.0);
-    var ranges: array<vec2<u32>, 27>;
-    let n_ranges = neighbour_ranges(cell_of(p), &ranges);
+    var ranges: NeighbourRanges;
+    let n_ranges = neighbour_ranges(p, &ranges);
     for (var s = 0u; s < n_ranges; s++) {
         for (var j = ranges[s].x; j < ranges[s].y; j++) {
             if (code_kind(code[j]) != KIND_FLUID) {

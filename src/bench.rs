@@ -28,34 +28,34 @@ pub struct NeighbourWork {
 }
 
 /// The candidates and neighbours of `particles` on `grid`, counted on the host as the GPU's
-/// `neighbour_ranges` (shaders/lib/neighbours.wgsl) visits them: on a dense grid the three
-/// cells of a row along x around each particle's cell (the rows inside the grid), otherwise
-/// the distinct hash slots of the 3^d cells around it, with every particle a slot holds.
-/// Excluded particles are in no cell.
+/// `neighbour_ranges` (shaders/lib/neighbours.wgsl) visits them: where rows are contiguous
+/// the slots of the cells of each row around a particle's cell that its support reaches,
+/// inside the grid, otherwise the distinct slots of the 3^d cells around, with every particle
+/// a slot holds. Excluded particles are in no cell.
 pub fn neighbour_work(grid: &Grid, dim: u32, h: f64, particles: &Particles) -> NeighbourWork {
     let live: Vec<usize> = (0..particles.pos.len())
         .filter(|&i| particles.kind[i] != KIND_EXCLUDED)
         .collect();
-    let cells: Vec<[i64; 3]> = live
+    let cells: Vec<([i64; 3], [f32; 3])> = live
         .iter()
         .map(|&i| {
             let (off, b) = grid.to_block(particles.pos[i]);
-            grid.cell_of(off, b)
+            (grid.cell_of(off, b), grid.place_in_cell(off))
         })
         .collect();
     // The particles of each slot (indices into `live`).
     let mut by_slot: std::collections::HashMap<u32, Vec<usize>> = Default::default();
-    for (k, c) in cells.iter().enumerate() {
+    for (k, (c, _)) in cells.iter().enumerate() {
         by_slot.entry(grid.slot_of_cell(*c)).or_default().push(k);
     }
     let support2 = (2.0 * h) * (2.0 * h);
     // (candidates, neighbours, particles) of all and of the fluid.
     let mut all = [0u64; 3];
     let mut fluid = [0u64; 3];
-    for (k, c) in cells.iter().enumerate() {
+    for (k, (c, f)) in cells.iter().enumerate() {
         let x = particles.pos[live[k]];
         let mut mine = [0u64, 0, 1];
-        for slot in slots_around(grid, dim, *c) {
+        for slot in slots_around(grid, dim, *c, *f) {
             let Some(list) = by_slot.get(&slot) else {
                 continue;
             };
@@ -83,25 +83,40 @@ pub fn neighbour_work(grid: &Grid, dim: u32, h: f64, particles: &Particles) -> N
     }
 }
 
-/// The slots whose particles the GPU tests around cell `c` (each once).
-fn slots_around(grid: &Grid, dim: u32, c: [i64; 3]) -> Vec<u32> {
+/// The slots whose particles the GPU tests around cell `c` (each once), from a point at `f`
+/// in it (`Grid::place_in_cell`).
+fn slots_around(grid: &Grid, dim: u32, c: [i64; 3], f: [f32; 3]) -> Vec<u32> {
     let g = grid.cells.map(|n| n as i64);
+    let mut slots = Vec::new();
+    if grid.contiguous_rows() {
+        let r = grid.reach as i64;
+        let zr = if dim == 3 { r } else { 0 };
+        let reach2 = (r * r) as f32;
+        for dz in -zr..=zr {
+            for dy in -r..=r {
+                let (y, z) = (c[1] + dy, c[2] + dz);
+                let gap2 = cell_gap(f[1], dy).powi(2) + cell_gap(f[2], dz).powi(2);
+                if y < 0 || y >= g[1] || z < 0 || z >= g[2] || gap2 >= reach2 {
+                    continue;
+                }
+                let w = (reach2 - gap2).sqrt();
+                let from = ((f[0] - w).floor() as i64).max(-r);
+                let to = ((f[0] + w).floor() as i64).min(r);
+                for x in (c[0] + from).max(0)..=(c[0] + to).min(g[0] - 1) {
+                    slots.push(grid.slot_of_cell([x, y, z]));
+                }
+            }
+        }
+        return slots;
+    }
     let zr = if dim == 3 { 1 } else { 0 };
-    let mut slots = Vec::with_capacity(27);
     for dz in -zr..=zr {
         for dy in -1..=1 {
             for dx in -1..=1 {
                 let mut n = [c[0] + dx, c[1] + dy, c[2] + dz];
-                if grid.dense() {
-                    // Rows inside the grid only, each clamped to it.
-                    if (0..3).any(|a| n[a] < 0 || n[a] >= g[a]) {
-                        continue;
-                    }
-                } else {
-                    for a in 0..3 {
-                        if grid.periodic[a] {
-                            n[a] = n[a].rem_euclid(g[a]);
-                        }
+                for a in 0..3 {
+                    if grid.periodic[a] {
+                        n[a] = n[a].rem_euclid(g[a]);
                     }
                 }
                 let s = grid.slot_of_cell(n);
@@ -112,6 +127,16 @@ fn slots_around(grid: &Grid, dim: u32, c: [i64; 3]) -> Vec<u32> {
         }
     }
     slots
+}
+
+/// `cell_gap` of shaders/lib/neighbours.wgsl: the distance in cells from `f` in a cell to the
+/// cells `d` away.
+fn cell_gap(f: f32, d: i64) -> f32 {
+    match d {
+        0 => 0.0,
+        d if d > 0 => (d as f32 - f).max(0.0),
+        d => (f - (d + 1) as f32).max(0.0),
+    }
 }
 
 /// What `wgsph bench` measures: `steps` steps of a case after `warmup`, on one adapter.
@@ -217,7 +242,8 @@ pub fn step_counts(
     };
     StepCounts {
         dim: sc.physics.dim,
-        dense_grid: grid.dense(),
+        contiguous_rows: grid.contiguous_rows(),
+        reach: grid.reach,
         slots_per_particle: (grid.slots as f64 + 3.0) / live.max(1) as f64,
         fluid_fraction: share(&[Kind::Fluid]),
         ghost_fraction: share(&[Kind::GhostNoSlip, Kind::GhostFreeSlip]),
@@ -287,6 +313,7 @@ pub fn measure_ranked(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::grid::CellEdge;
     use crate::scenario::Domain;
 
     /// A 2D square lattice of spacing dx on a dense grid of cells 2h = 2.6 dx: away from the
@@ -318,8 +345,8 @@ mod tests {
             energy: None,
             stress: None,
         };
-        let grid = Grid::new(&domain, h, 2, count, [false; 3]).unwrap();
-        assert!(grid.dense());
+        let grid = Grid::new(&domain, h, 2, count, [false; 3], Some(CellEdge::Support)).unwrap();
+        assert!(grid.contiguous_rows());
         let w = neighbour_work(&grid, 2, h, &p);
         // Interior: 21 lattice points within 2.6 dx; the edges have fewer.
         assert!(w.neighbours < 21.0 && w.neighbours > 19.0, "{w:?}");

@@ -11,7 +11,7 @@ use std::ops::Range;
 use anyhow::{bail, Result};
 use glam::DVec3;
 
-use crate::grid::Grid;
+use crate::grid::{CellEdge, Grid};
 use crate::scenario::{Kind, Motion, Particle, Probe, ProbeKind, Scenario};
 use crate::sph::halo::halo_layers;
 
@@ -58,11 +58,27 @@ pub fn layer_load(grid: &Grid, axis: usize, particles: &[Particle]) -> Vec<f64> 
     load
 }
 
+/// The grid of a run over several ranks: cells of 2h, also where one run takes cells of h by
+/// default (halos, cuts and probes' reach are counted in cell layers one support thick).
+pub fn ranks_grid(sc: &Scenario) -> Result<Grid> {
+    let ph = &sc.physics;
+    if ph.cell == Some(CellEdge::Half) {
+        bail!(
+            "particles.cell = \"h\": a run over several ranks takes cells of 2h (its halos and \
+             cuts are whole cell layers one support thick); set particles.cell = \"2h\" or \
+             leave it out"
+        );
+    }
+    let n = sc.particles.len();
+    let two_h = Some(CellEdge::Support);
+    Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic, two_h)
+}
+
 /// `sc` cut into `ranks` slabs of its grid (as the solver makes it) along [`cut_axis`], balanced
 /// over its particles' [`layer_load`], no cut through a probe's [`probe_layers`].
 pub fn slabs_for(sc: &Scenario, ranks: usize) -> Result<Slabs> {
     let ph = &sc.physics;
-    let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic)?;
+    let grid = ranks_grid(sc)?;
     let axis = cut_axis(&grid, ph.dim)?;
     let whole = probe_layers(sc, &grid, axis)?
         .into_iter()
@@ -329,7 +345,15 @@ mod tests {
         let h = 0.05;
         let support = 2.0 * h * (1.0 + 1e-4);
         let max = cells.map(|c| c * support * 0.99999);
-        Grid::new(&Domain { min: [0.0; 3], max }, h, dim, 100_000, [false; 3]).unwrap()
+        Grid::new(
+            &Domain { min: [0.0; 3], max },
+            h,
+            dim,
+            100_000,
+            [false; 3],
+            TWO_H,
+        )
+        .unwrap()
     }
 
     #[test]
@@ -461,6 +485,8 @@ mod tests {
         assert!(crossing > 0, "no pair across a cut: the test tests nothing");
     }
 
+    const TWO_H: Option<CellEdge> = Some(CellEdge::Support);
+
     #[test]
     fn a_periodic_axis_is_not_cut() {
         let h = 0.05;
@@ -473,6 +499,7 @@ mod tests {
             2,
             1000,
             [true, false, false],
+            TWO_H,
         )
         .unwrap();
         assert_eq!(cut_axis(&g, 2).unwrap(), 1);
@@ -490,7 +517,7 @@ mod tests {
     fn a_probe_on_a_moving_tank_reads_the_layers_of_its_path() {
         let sc = load("cases/sloshing_2d.toml", &["time.end_s=2.0"]);
         let ph = &sc.physics;
-        let g = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic).unwrap();
+        let g = ranks_grid(&sc).unwrap();
         let axis = cut_axis(&g, ph.dim).unwrap();
         let path = probe_layers(&sc, &g, axis).unwrap();
         let mut wider = 0;

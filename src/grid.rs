@@ -1,6 +1,7 @@
 //! Geometry of the neighbour grid and of the position blocks, chosen once per run.
 //!
-//! Cells are the kernel support 2h (with a tiny margin against f32 rounding at cell faces).
+//! Cells are h or the kernel support 2h (with a tiny margin against f32 rounding at cell
+//! faces): [`CellEdge`].
 //! Positions are stored as f32 offsets inside blocks of `cells_per_block` cells, with block
 //! coordinates packed in 11/11/10 bits; the block is as small as the domain allows, so offsets
 //! keep ~7 significant digits relative to the block, not to the whole domain. The slot table is
@@ -10,7 +11,28 @@
 use anyhow::{bail, Result};
 
 use crate::layout::MAX_BLOCK;
-use crate::scenario::Domain;
+use crate::scenario::{Domain, Scenario};
+
+/// The edge of the neighbour grid's cells (`[particles] cell` of a case).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CellEdge {
+    /// The kernel support 2h: a particle's neighbours are in the 3^d cells around its own.
+    Support,
+    /// h: the 5^d cells around, whose union hugs the support's sphere closer. A particle tests
+    /// the particles of 125 h³ for a sphere of 33.5 h³ in 3D, against 216 h³ with cells of 2h
+    /// (25 h² against 36 h² for a disc of 12.6 h² in 2D).
+    Half,
+}
+
+impl CellEdge {
+    /// The name a case file gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            CellEdge::Support => "2h",
+            CellEdge::Half => "h",
+        }
+    }
+}
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Grid {
@@ -26,18 +48,65 @@ pub struct Grid {
     pub blocks: [u32; 3],
     /// Hash slots (power of two).
     pub slots: u32,
+    /// Cells per kernel support along an axis (1: cells of 2h, 2: cells of h): how many cells
+    /// on each side of its own a particle's neighbours can be in.
+    pub reach: u32,
 }
 
 impl Grid {
+    /// The grid of `sc` (its domain, h, particle count and cell edge).
+    pub fn of(sc: &Scenario) -> Result<Self> {
+        let ph = &sc.physics;
+        let n = sc.particles.len();
+        Self::new(&sc.domain, ph.h, ph.dim, n, sc.periodic, ph.cell)
+    }
+
+    /// The grid of cells `cell` (by default h where its rows are contiguous, otherwise 2h:
+    /// [`Grid::contiguous_rows`]).
     pub fn new(
         domain: &Domain,
         h: f64,
         dim: u32,
         n_particles: usize,
         periodic: [bool; 3],
+        cell: Option<CellEdge>,
+    ) -> Result<Self> {
+        let of = |reach| Self::with_reach(domain, h, dim, n_particles, periodic, reach);
+        match cell {
+            Some(CellEdge::Support) => of(1),
+            Some(CellEdge::Half) => {
+                let g = of(2)?;
+                if !g.contiguous_rows() {
+                    bail!(
+                        "particles.cell = \"h\" needs a grid without periodic axes whose cells \
+                         around any cell have hash slots of their own; this one has {} × {} \
+                         cells in a plane for {} slots: set particles.cell = \"2h\" (or leave \
+                         it out)",
+                        g.cells[0],
+                        g.cells[1],
+                        g.slots
+                    );
+                }
+                Ok(g)
+            }
+            None => match of(2) {
+                Ok(g) if g.contiguous_rows() => Ok(g),
+                _ => of(1),
+            },
+        }
+    }
+
+    fn with_reach(
+        domain: &Domain,
+        h: f64,
+        dim: u32,
+        n_particles: usize,
+        periodic: [bool; 3],
+        reach: u32,
     ) -> Result<Self> {
         let support = 2.0 * h * (1.0 + 1e-4);
-        let mut cell_size = [support; 3];
+        let edge = support / reach as f64;
+        let mut cell_size = [edge; 3];
         let mut extent = [0.0; 3];
         let mut cells = [1u32; 3];
         for a in 0..dim as usize {
@@ -45,11 +114,11 @@ impl Grid {
             if extent[a].is_nan() || extent[a] <= 0.0 || !extent[a].is_finite() {
                 bail!("the domain has no extent along axis {a}");
             }
-            let mut n = (extent[a] / support).ceil();
+            let mut n = (extent[a] / edge).ceil();
             if periodic[a] {
                 // Whole cells tile the period, so neighbour cells wrap exactly.
-                n = (extent[a] / support).floor();
-                if n < 3.0 {
+                n = (extent[a] / edge).floor();
+                if n < (2 * reach + 1) as f64 {
                     bail!("the periodic axis {a} is {} m long: at least 3 kernel supports (3 × 2h = {} m) are needed", extent[a], 3.0 * support);
                 }
                 cell_size[a] = extent[a] / n;
@@ -85,6 +154,7 @@ impl Grid {
             periodic,
             blocks,
             slots: slots as u32,
+            reach,
         })
     }
 
@@ -107,12 +177,17 @@ impl Grid {
         [0, 1, 2].map(|a| self.origin[a] + b[a] as f64 * self.block_size[a] as f64 + off[a] as f64)
     }
 
-    /// Whether every cell has a slot of its own (its linear index) and no axis is periodic: the
-    /// cells of a row along x then have consecutive slots (`neighbour_ranges` in
-    /// shaders/lib/neighbours.wgsl).
-    pub fn dense(&self) -> bool {
-        let total: u64 = self.cells.iter().map(|&c| c as u64).product();
-        !self.periodic.iter().any(|&p| p) && total <= self.slots as u64
+    /// Whether no axis is periodic and no two cells of any neighbourhood (the (2 reach + 1)^d
+    /// cells around a cell) share a slot: the cells of a row along x then have consecutive
+    /// slots (modulo the table's size), so `neighbour_ranges` (shaders/lib/neighbours.wgsl)
+    /// takes a row as one range and needs no check for repeated slots. Two cells share a slot
+    /// when their linear indices differ by a multiple of the slot count; within a
+    /// neighbourhood they differ by at most `span`.
+    pub fn contiguous_rows(&self) -> bool {
+        let r = self.reach as u64;
+        let [gx, gy, gz] = self.cells.map(|c| c as u64);
+        let span = 2 * r * (1 + if gy > 1 { gx } else { 0 } + if gz > 1 { gx * gy } else { 0 });
+        !self.periodic.iter().any(|&p| p) && span < self.slots as u64
     }
 
     /// The slot of a world position, as `slot_of_cell(cell_of(..))` computes it on the GPU.
@@ -137,6 +212,17 @@ impl Grid {
         })
     }
 
+    /// Where a position of block offset `off` is in its cell (`cell_of`'s cell within the
+    /// block), in cells per axis, in f32 as `neighbour_ranges` computes it: 0 ≤ f < 1 but for
+    /// rounding.
+    pub fn place_in_cell(&self, off: [f32; 3]) -> [f32; 3] {
+        let k = (self.cells_per_block - 1) as f32;
+        [0, 1, 2].map(|a| {
+            let cells = off[a] * (1.0 / self.cell_size[a]) as f32;
+            cells - cells.floor().clamp(0.0, k)
+        })
+    }
+
     /// The hash slot of cell `c` (which may lie outside the grid), as `slot_of_cell` in
     /// shaders/lib/common.wgsl: its linear index in wrapping u32 arithmetic, masked.
     pub fn slot_of_cell(&self, c: [i64; 3]) -> u32 {
@@ -156,28 +242,89 @@ mod tests {
         Domain { min: [0.0; 3], max }
     }
 
+    const TWO_H: Option<CellEdge> = Some(CellEdge::Support);
+
     #[test]
     fn small_domain_has_one_cell_blocks_and_no_collisions() {
-        let g = Grid::new(&domain([1.0, 0.5, 0.0]), 0.013, 2, 10_000, [false; 3]).unwrap();
-        assert_eq!(g.cells_per_block, 1);
-        assert_eq!(g.cells[2], 1);
-        assert!(g.slots as u64 >= g.cells.iter().map(|&c| c as u64).product::<u64>());
-        assert!(g.dense());
-        let periodic = Grid::new(
-            &domain([1.0, 0.5, 0.0]),
-            0.013,
+        for cell in [None, TWO_H] {
+            let g = Grid::new(&domain([1.0, 0.5, 0.0]), 0.013, 2, 10_000, [false; 3], cell);
+            let g = g.unwrap();
+            assert_eq!(g.reach, if cell.is_none() { 2 } else { 1 });
+            assert_eq!(g.cells_per_block, 1);
+            assert_eq!(g.cells[2], 1);
+            assert!(g.slots as u64 >= g.cells.iter().map(|&c| c as u64).product::<u64>());
+            assert!(g.contiguous_rows());
+        }
+        let periodic = [true, false, false];
+        let g = Grid::new(&domain([1.0, 0.5, 0.0]), 0.013, 2, 10_000, periodic, None);
+        let g = g.unwrap();
+        assert_eq!(g.reach, 1, "a periodic grid takes cells of 2h by default");
+        assert!(!g.contiguous_rows());
+        let half = Some(CellEdge::Half);
+        let e = Grid::new(&domain([1.0, 0.5, 0.0]), 0.013, 2, 10_000, periodic, half);
+        assert!(e
+            .unwrap_err()
+            .to_string()
+            .contains("particles.cell = \"2h\""));
+    }
+
+    /// A long 2D channel has more cells of h than slots, yet within any neighbourhood no two
+    /// cells share a slot and a row's slots follow each other (wrapping at the table's end):
+    /// what `neighbour_ranges` relies on.
+    #[test]
+    fn a_hashed_grid_keeps_its_rows_contiguous() {
+        let g = Grid::new(
+            &domain([100.0, 1.0, 0.0]),
+            0.01,
             2,
-            10_000,
-            [true, false, false],
+            100_000,
+            [false; 3],
+            None,
         );
-        assert!(!periodic.unwrap().dense());
+        let g = g.unwrap();
+        assert_eq!((g.reach, g.cells[0], g.cells[1]), (2, 10_000, 100));
+        assert!(g.slots < g.cells[0] * g.cells[1] && g.contiguous_rows());
+        let mut wrapped = 0;
+        // The cell whose linear index is the slot count is where the table wraps.
+        let at_end = [(g.slots % g.cells[0]) as i64, (g.slots / g.cells[0]) as i64];
+        for c in [[0, 0], at_end, [1311, 99], [5000, 50], [9999, 99]] {
+            let mut slots = Vec::new();
+            for dy in -2..=2 {
+                let row: Vec<u32> = (-2..=2)
+                    .map(|dx| [c[0] + dx, c[1] + dy, 0])
+                    .filter(|n| (0..2).all(|a| n[a] >= 0 && n[a] < g.cells[a] as i64))
+                    .map(|n| g.slot_of_cell(n))
+                    .collect();
+                for w in row.windows(2) {
+                    assert_eq!(w[1], (w[0] + 1) & (g.slots - 1));
+                    wrapped += (w[1] < w[0]) as u32;
+                }
+                slots.extend(row);
+            }
+            let n = slots.len();
+            slots.sort_unstable();
+            slots.dedup();
+            assert_eq!(slots.len(), n, "cells around {c:?} share a slot");
+        }
+        assert!(
+            wrapped > 0,
+            "no row crossed the table's end: the test tests less"
+        );
     }
 
     #[test]
     fn a_position_past_the_far_face_is_in_the_last_cell() {
         // 5 000 cells along x in blocks of 3: the last block's last cell is beyond the grid,
         // where only a position rounded past the face can fall.
-        let g = Grid::new(&domain([100.0, 100.0, 10.0]), 0.01, 3, 1000, [false; 3]).unwrap();
+        let g = Grid::new(
+            &domain([100.0, 100.0, 10.0]),
+            0.01,
+            3,
+            1000,
+            [false; 3],
+            TWO_H,
+        );
+        let g = g.unwrap();
         assert_eq!((g.cells[0], g.cells_per_block), (5000, 3));
         assert!(g.blocks[0] * g.cells_per_block > g.cells[0]);
         let past = [0.999 * g.block_size[0], 0.0, 0.0];
@@ -187,19 +334,15 @@ mod tests {
 
     #[test]
     fn large_domain_keeps_offsets_small_and_slots_bounded() {
-        // A 100 m × 100 m × 10 m flood at dx = 5 mm, h = 2 dx.
-        let g = Grid::new(
-            &domain([100.0, 100.0, 10.0]),
-            0.01,
-            3,
-            1_000_000,
-            [false; 3],
-        )
-        .unwrap();
+        // A 100 m × 100 m × 10 m flood at dx = 5 mm, h = 2 dx: too many cells in a plane for
+        // rows, so cells of 2h with one range per slot.
+        let d = domain([100.0, 100.0, 10.0]);
+        let g = Grid::new(&d, 0.01, 3, 1_000_000, [false; 3], None).unwrap();
+        assert_eq!(g.reach, 1);
         assert!(g.blocks.iter().zip(MAX_BLOCK).all(|(b, m)| *b <= m + 1));
         assert!(g.block_size[0] < 0.1, "block {:?} m", g.block_size);
         assert_eq!(g.slots, 1 << 20);
-        assert!(!g.dense(), "a sparse domain shares slots");
+        assert!(!g.contiguous_rows(), "a sparse domain shares slots");
         // f32 resolution of an offset is far below the particle spacing.
         let ulp = g.block_size[0] * f32::EPSILON;
         assert!((ulp as f64) < 1e-6 * 0.005 * 2.0);
@@ -207,7 +350,15 @@ mod tests {
 
     #[test]
     fn block_round_trip_is_precise_anywhere() {
-        let g = Grid::new(&domain([100.0, 100.0, 10.0]), 0.01, 3, 1000, [false; 3]).unwrap();
+        let g = Grid::new(
+            &domain([100.0, 100.0, 10.0]),
+            0.01,
+            3,
+            1000,
+            [false; 3],
+            None,
+        );
+        let g = g.unwrap();
         for p in [
             [0.0, 0.0, 0.0],
             [99.99, 50.123456, 9.87654],

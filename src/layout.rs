@@ -50,7 +50,7 @@ pub struct Params {
     pub n_inlets: u32,
     pub n_outlets: u32,
     /// 1 when every cell has a slot of its own and no axis is periodic (`Grid::dense`).
-    pub dense_grid: u32,
+    pub contiguous_rows: u32,
     /// Coulomb μ of contact and its regularisation speed ε [m/s] (`WallParams::friction`).
     pub friction: f32,
     pub friction_slip: f32,
@@ -470,7 +470,7 @@ mod tests {
                 n_inlet_particles,
                 n_inlets,
                 n_outlets,
-                dense_grid,
+                contiguous_rows,
                 friction,
                 friction_slip,
                 friction_groups,

@@ -5,6 +5,8 @@
 //! third component is zero, `y` is up in 2D and `z` is up in 3D (the "vertical axis" is
 //! `dimension - 1`).
 
+use crate::grid::CellEdge;
+
 /// What a particle is. Stored in the top bits of the GPU `code` word (see `shaders/lib/common.wgsl`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u32)]
@@ -99,6 +101,8 @@ pub struct Physics {
     /// Smoothing length [m]; kernel support is 2h.
     pub h: f64,
     pub kernel: KernelKind,
+    /// The neighbour grid's cell edge; by default h where the grid allows (`Grid::new`).
+    pub cell: Option<CellEdge>,
     /// Reference density [kg/m³].
     pub rho0: f64,
     /// Numerical speed of sound [m/s].

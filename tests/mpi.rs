@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use wgsph::decomposition::{cut_axis, layer_load, slabs_for, Slabs};
 use wgsph::gpu::{AdapterChoice, GpuContext};
-use wgsph::grid::Grid;
+use wgsph::grid::{CellEdge, Grid};
 use wgsph::layout::{unpack_block, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
 use wgsph::output::{particle_files, ParticleFile, RunSummary};
 use wgsph::ranks::{Mpi, Ranks};
@@ -67,7 +67,7 @@ fn particles_and_grid() -> (Vec<Particle>, Grid) {
         min: [0.0; 3],
         max: [3.0, 0.8, 0.6],
     };
-    let grid = Grid::new(&domain, h, 3, 100_000, [false; 3]).unwrap();
+    let grid = Grid::new(&domain, h, 3, 100_000, [false; 3], Some(CellEdge::Support)).unwrap();
     let mut rng = common::Rng(7);
     let mut uniform = |scale: f64| rng.range(0.0, scale);
     let particles = (0..4000)
@@ -262,7 +262,9 @@ struct Comparison {
 
 impl Comparison {
     fn scenario(&self) -> Scenario {
-        let set: Vec<String> = self.set.iter().map(|s| s.to_string()).collect();
+        let mut set: Vec<String> = self.set.iter().map(|s| s.to_string()).collect();
+        // The cells a run over ranks takes (`decomposition::ranks_grid`), for the whole run.
+        set.push("particles.cell=2h".into());
         wgsph::case::load(&self.case_path(), &set).unwrap()
     }
 
@@ -397,8 +399,7 @@ impl Comparison {
             solver.run_steps_ranked(left, &ranks)?;
             // Every rank holds the particles of its slab (the cuts as the ranks last moved
             // them), give or take those that crossed a cut in the last step.
-            let ph = &sc.physics;
-            let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic)?;
+            let grid = wgsph::decomposition::ranks_grid(&sc)?;
             let slabs = solver.ranked().unwrap().slabs.clone().unwrap();
             let mine = slabs.range(r);
             for (_, p, _) in live_particles(&solver) {
@@ -461,6 +462,8 @@ fn on_one_rank(args: Vec<std::ffi::OsString>) {
     let o = Command::new(env!("CARGO_BIN_EXE_wgsph"))
         .args(args)
         .args(["--adapter", "cpu"])
+        // The cells a run over ranks takes (`decomposition::ranks_grid`).
+        .args(["--set", "particles.cell=2h"])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -24,7 +24,8 @@ fn variants() -> Vec<(String, ShaderConfig)> {
     let mut configs = vec![("all kinds".to_string(), ShaderConfig::default())];
     for file in cases() {
         let sc = wgsph::case::load(&file, &[]).unwrap();
-        let cfg = ShaderConfig::of(&sc).unwrap();
+        let grid = wgsph::grid::Grid::of(&sc).unwrap();
+        let cfg = ShaderConfig::of(&sc, &grid).unwrap();
         if !configs.iter().any(|(_, c)| *c == cfg) {
             configs.push((file.display().to_string(), cfg));
         }

@@ -50,9 +50,9 @@ struct Params {
     n_inlet_particles: u32,
     n_inlets: u32,
     n_outlets: u32,             // open_boundaries.wgsl
-    // 1 when every cell has a slot of its own and no axis is periodic (`Grid::dense`):
-    // neighbour_ranges then takes a row of cells as one range.
-    dense_grid: u32,
+    // 1 when no axis is periodic and no two cells of a neighbourhood share a slot
+    // (`Grid::contiguous_rows`): neighbour_ranges then takes a row of cells as one range.
+    contiguous_rows: u32,
     friction: f32,              // Coulomb μ of contact (interaction.wgsl `contact`); 0: none
     friction_slip: f32,         // its regularisation speed ε [m/s]
     // With [[friction]] pairs: the number G of contact groups (0 without: every pair has
@@ -401,9 +401,27 @@ fn kernel_f(q: f32) -> f32 {
 
 // ---- equation of state -------------------------------------------------------------------
 
+// x^γ: by multiplications where γ is a whole number (TAIT_GAMMA, 7 for water), otherwise
+// pow. Every pair pays for its neighbour's pressure, and on a CPU adapter pow's exp2(γ log2 x)
+// costs several times the 4 multiplications of x^7.
+fn tait_power(x: f32) -> f32 {
+    if (TAIT_GAMMA == 0u) {
+        return pow(x, params.gamma);
+    }
+    var r = 1.0;
+    var b = x;
+    for (var e = TAIT_GAMMA; e != 0u; e >>= 1u) {
+        if ((e & 1u) != 0u) {
+            r *= b;
+        }
+        b *= b;
+    }
+    return r;
+}
+
 // Tait: P = B((ρ/ρ0)^γ − 1) (Monaghan 1994, Batchelor 1967).
 fn pressure_of(rho: f32) -> f32 {
-    return params.tait_b * (pow(rho / params.rho0, params.gamma) - 1.0);
+    return params.tait_b * (tait_power(rho / params.rho0) - 1.0);
 }
 
 // Local sound speed c = c0 (ρ/ρ0)^((γ−1)/2).

@@ -24,8 +24,8 @@ fn fluid_at(pg: Pos, g_eff: vec3<f32>) -> vec4<f32> {
     var m_vx = vec4<f32>(0.0);
     var m_vy = vec4<f32>(0.0);
     var m_vz = vec4<f32>(0.0);
-    var ranges: array<vec2<u32>, 27>;
-    let n_ranges = neighbour_ranges(cell_of(pg), &ranges);
+    var ranges: NeighbourRanges;
+    let n_ranges = neighbour_ranges(pg, &ranges);
     for (var s = 0u; s < n_ranges; s++) {
         for (var j = ranges[s].x; j < ranges[s].y; j++) {
             if (code_kind(code[j]) != KIND_FLUID) {

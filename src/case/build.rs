@@ -1144,6 +1144,7 @@ fn physics(case: &Case, start: &Start, h: f64) -> Physics {
         dx: case.dx,
         h,
         kernel: case.kernel,
+        cell: case.cell,
         rho0: case.rho0,
         c0: start.c0,
         gamma: case.gamma,
@@ -1215,6 +1216,7 @@ pub(super) fn build_solid_case(
         dx,
         h: case.h_over_dx * dx,
         kernel: case.kernel,
+        cell: case.cell,
         rho0: case.rho0,
         // Unused without fluid; the solids' sound speeds enter through their materials.
         c0: materials

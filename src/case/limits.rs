@@ -118,7 +118,7 @@ pub(super) fn grid_fits(
     fluid_parts: &[(String, Aabb)],
     solid: &[(String, Aabb)],
 ) -> Result<(), CaseError> {
-    let Err(e) = Grid::new(domain, h, dim as u32, 0, [false; 3]) else {
+    let Err(e) = Grid::new(domain, h, dim as u32, 0, [false; 3], None) else {
         return Ok(());
     };
     let extent = |a: usize| domain.max[a] - domain.min[a];

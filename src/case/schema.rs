@@ -122,6 +122,16 @@ pub(super) struct RawParticles {
     pub dx_m: f64,
     pub h_over_dx: Option<f64>,
     pub kernel: Option<KernelName>,
+    pub cell: Option<CellName>,
+}
+
+/// The neighbour grid's cell edge (`crate::grid::CellEdge`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub(super) enum CellName {
+    #[serde(rename = "2h")]
+    TwoH,
+    #[serde(rename = "h")]
+    H,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -420,6 +430,11 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "particles.kernel",
         "the kernel name",
         "kernel = \"wendland_c2\"",
+    ),
+    f(
+        "particles.cell",
+        "the neighbour grid's cell edge, \"h\" or \"2h\" (by default h where the grid allows)",
+        "cell = \"2h\"",
     ),
     f(
         "physics",

@@ -2,6 +2,7 @@
 //! options that go together, defaults. Produces a [`Case`] in SI with 3-component vectors.
 //! Geometric checks that need several fields at once live in `build.rs` and `domain.rs`.
 
+use crate::grid::CellEdge;
 use crate::scenario::{
     DeltaSphForm, DensityFilter, FrictionPair, GhostCorrection, KernelKind, OutputBoundary, Probe,
     RepulsiveForm, TimeControl, Viscosity, DEFAULT_FRICTION_SLIP,
@@ -12,8 +13,8 @@ use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::probes::Checked;
 use super::schema::{
-    DeltaSphFormName, DensityFilterName, GhostCorrectionName, KernelName, OutputBoundaryName,
-    RawCase, RawPhysics, RepulsiveFormName, ViscosityName, WallName,
+    CellName, DeltaSphFormName, DensityFilterName, GhostCorrectionName, KernelName,
+    OutputBoundaryName, RawCase, RawPhysics, RepulsiveFormName, ViscosityName, WallName,
 };
 
 #[derive(Debug, Clone, Copy)]
@@ -65,6 +66,7 @@ pub(super) struct Case {
     pub dx: f64,
     pub h_over_dx: f64,
     pub kernel: KernelKind,
+    pub cell: Option<CellEdge>,
     pub rho0: f64,
     pub gravity: [f64; 3],
     pub sound: Sound,
@@ -131,7 +133,7 @@ pub(super) fn validate(
         ));
     }
     let name = case_name(ctx, raw, default_name)?;
-    let (dx, h_over_dx, kernel) = particles(ctx, raw)?;
+    let (dx, h_over_dx, kernel, cell) = particles(ctx, raw)?;
     let physics = physics(ctx, raw, dim)?;
     let time = time(ctx, raw)?;
 
@@ -170,6 +172,7 @@ pub(super) fn validate(
         dx,
         h_over_dx,
         kernel,
+        cell,
         rho0,
         gravity,
         sound,
@@ -233,8 +236,11 @@ fn case_name(ctx: &Ctx<'_>, raw: &RawCase, default_name: &str) -> Result<String,
     })
 }
 
-/// `[particles]`: the spacing dx, h / dx and the kernel.
-fn particles(ctx: &Ctx<'_>, raw: &RawCase) -> Result<(f64, f64, KernelKind), CaseError> {
+/// `[particles]`: the spacing dx, h / dx, the kernel and the grid's cell edge.
+fn particles(
+    ctx: &Ctx<'_>,
+    raw: &RawCase,
+) -> Result<(f64, f64, KernelKind, Option<CellEdge>), CaseError> {
     let p = &raw.particles;
     let dx = number(
         ctx,
@@ -256,7 +262,11 @@ fn particles(ctx: &Ctx<'_>, raw: &RawCase) -> Result<(f64, f64, KernelKind), Cas
         KernelName::CubicSpline => KernelKind::CubicSpline,
         KernelName::WendlandC2 => KernelKind::WendlandC2,
     };
-    Ok((dx, h_over_dx, kernel))
+    let cell = p.cell.map(|c| match c {
+        CellName::TwoH => CellEdge::Support,
+        CellName::H => CellEdge::Half,
+    });
+    Ok((dx, h_over_dx, kernel, cell))
 }
 
 /// The checked `[physics]` table.

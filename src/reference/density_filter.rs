@@ -128,6 +128,7 @@ mod tests {
             dx,
             h: 1.3 * dx,
             kernel,
+            cell: None,
             rho0: 1000.0,
             c0: 20.0,
             gamma: 7.0,

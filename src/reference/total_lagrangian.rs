@@ -243,6 +243,7 @@ mod tests {
             dx,
             h: 1.3 * dx,
             kernel: KernelKind::WendlandC2,
+            cell: None,
             rho0: 1000.0,
             c0: 10.0,
             gamma: 7.0,

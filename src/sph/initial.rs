@@ -212,8 +212,7 @@ mod tests {
     #[test]
     fn packed_particles_keep_kind_id_and_position() {
         let sc = crate::case::load(std::path::Path::new("cases/dam_break_2d.toml"), &[]).unwrap();
-        let ph = &sc.physics;
-        let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic).unwrap();
+        let grid = Grid::of(&sc).unwrap();
         let packed = pack(&sc, &grid);
         for (id, p) in sc.particles.iter().enumerate() {
             assert_eq!(packed.code[id] & crate::layout::ID_MASK, id as u32);

@@ -165,9 +165,12 @@ impl Solver {
             bail!("the case has no particles");
         }
         check_capacity(ctx, n)?;
-        let grid = Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic)?;
+        let grid = match subdomain {
+            Some(_) => crate::decomposition::ranks_grid(sc)?,
+            None => Grid::of(sc)?,
+        };
         let mut params = Params::from_scenario(sc, &grid)?;
-        let cfg = ShaderConfig::of(sc)?;
+        let cfg = ShaderConfig::of(sc, &grid)?;
         probes::check_wall_pressure(sc)?;
         let device = ctx.device.clone();
         // Allocation failures are caught here to name what was being allocated; later ones

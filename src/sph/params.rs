@@ -26,7 +26,7 @@ impl Params {
         let mut params = Params {
             grid_cells: grid.cells,
             hash_mask: grid.slots - 1,
-            dense_grid: grid.dense() as u32,
+            contiguous_rows: grid.contiguous_rows() as u32,
             block_size: grid.block_size,
             cells_per_block: grid.cells_per_block,
             inv_cell_size: grid.cell_size.map(|c| (1.0 / c) as f32),
@@ -186,8 +186,7 @@ mod tests {
 
     fn load(case: &str) -> (Scenario, Grid) {
         let sc = crate::case::load(std::path::Path::new(case), &[]).unwrap();
-        let ph = &sc.physics;
-        let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic).unwrap();
+        let grid = Grid::of(&sc).unwrap();
         (sc, grid)
     }
 

@@ -12,6 +12,7 @@ use super::buffers::TableSizes;
 use super::initial::Present;
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::shader::{compose as compose_shader, Shader, WORKGROUP_SIZE};
+use crate::grid::Grid;
 use crate::scenario::{
     DeltaSphForm, GhostCorrection, KernelKind, RepulsiveForm, Scenario, Viscosity,
 };
@@ -115,6 +116,11 @@ pub struct ShaderConfig {
     pub present: Present,
     /// The sizes of the case's tables (`CaseTables` in common.wgsl).
     pub tables: TableSizes,
+    /// Cells per kernel support (`Grid::reach`): 1 for cells of 2h, 2 for cells of h.
+    pub cell_reach: u32,
+    /// The Tait exponent γ where it is a whole number from 1 to 15 (`tait_power` multiplies),
+    /// otherwise 0 (pow).
+    pub tait_gamma: u32,
 }
 
 impl Default for ShaderConfig {
@@ -132,13 +138,15 @@ impl Default for ShaderConfig {
                 mirror_planes: 1,
                 wall_sensors: 1,
             },
+            cell_reach: 2,
+            tait_gamma: 7,
         }
     }
 }
 
 impl ShaderConfig {
-    /// The choices of `sc`.
-    pub fn of(sc: &Scenario) -> Result<ShaderConfig> {
+    /// The choices of `sc` on `grid`.
+    pub fn of(sc: &Scenario, grid: &Grid) -> Result<ShaderConfig> {
         let ph = &sc.physics;
         Ok(ShaderConfig {
             dim: ph.dim,
@@ -153,6 +161,8 @@ impl ShaderConfig {
             wall_reactions: sc.walls.reactions,
             present: Present::of(sc)?,
             tables: TableSizes::of(sc),
+            cell_reach: grid.reach,
+            tait_gamma: whole_exponent(ph.gamma),
         })
     }
 
@@ -173,7 +183,7 @@ impl ShaderConfig {
              const MIRRORS: bool = {mirrors};\nconst LONE_SOLID: bool = {lone_solid};\n\
              const WG: u32 = {wg}u;\n\
              const N_BODIES: u32 = {bodies_n}u;\nconst N_MIRROR_PLANES: u32 = {planes_n}u;\n\
-             const N_WALL_SENSORS: u32 = {sensors_n}u;\n",
+             const N_WALL_SENSORS: u32 = {sensors_n}u;\nconst CELL_REACH: i32 = {reach};\nconst TAIT_GAMMA: u32 = {gamma}u;\n",
             dim = self.dim,
             kernel = self.kernel.name(),
             visc = self.viscosity.name(),
@@ -190,8 +200,18 @@ impl ShaderConfig {
             bodies_n = self.tables.bodies,
             planes_n = self.tables.mirror_planes,
             sensors_n = self.tables.wall_sensors,
+            reach = self.cell_reach,
+            gamma = self.tait_gamma,
         );
         out
+    }
+}
+
+/// `gamma` as a whole number from 1 to 15, or 0 where it is not one.
+fn whole_exponent(gamma: f64) -> u32 {
+    match gamma.fract() == 0.0 && (1.0..16.0).contains(&gamma) {
+        true => gamma as u32,
+        false => 0,
     }
 }
 

@@ -839,7 +839,7 @@ mod tests {
     fn subdomains_hold_their_own_and_their_waiting_inlet_particles() {
         let sc = load("cases/water_injection_2d.toml", &[]);
         let ph = &sc.physics;
-        let grid = Grid::new(&sc.domain, ph.h, ph.dim, sc.particles.len(), sc.periodic).unwrap();
+        let grid = crate::decomposition::ranks_grid(&sc).unwrap();
         let axis = crate::decomposition::cut_axis(&grid, ph.dim).unwrap();
         let whole = super::super::initial::pack(&sc, &grid);
         let layers = grid.cells[axis];

@@ -58,8 +58,10 @@ impl std::ops::Add for Bytes {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepCounts {
     pub dim: u32,
-    /// A slot per cell (`Grid::dense`): a neighbour loop reads one range per row of cells.
-    pub dense_grid: bool,
+    /// Rows of cells take one range each (`Grid::contiguous_rows`).
+    pub contiguous_rows: bool,
+    /// Cells per support (`Grid::reach`): a neighbourhood is (2 reach + 1)^d cells.
+    pub reach: u32,
     /// Entries of the slot table (slots + 3) per particle.
     pub slots_per_particle: f64,
     pub fluid_fraction: f64,
@@ -73,17 +75,26 @@ pub struct StepCounts {
 }
 
 impl StepCounts {
-    /// The particles of a slot, seen from one of them: the candidates come from the 3^d cells
-    /// around a particle, so a cell holds about candidates / 3^d.
-    fn slot_mates(&self) -> f64 {
-        self.work.candidates / 3f64.powi(self.dim as i32)
+    /// Cells along an axis of a neighbourhood: 2 reach + 1.
+    fn side(&self) -> f64 {
+        (2 * self.reach + 1) as f64
     }
 
-    /// The slot table entries `neighbour_ranges` loads: two per row of 3 cells on a dense
-    /// grid (3^(d-1) rows), two per slot of the 3^d cells otherwise.
+    /// The particles of a slot, seen from one of them: the candidates come from the
+    /// side^d cells around a particle, so a cell holds about candidates / side^d.
+    fn slot_mates(&self) -> f64 {
+        self.work.candidates / self.side().powi(self.dim as i32)
+    }
+
+    /// The slot table entries `neighbour_ranges` loads: two per row of cells where rows are
+    /// contiguous (side^(d-1) rows), two per slot of the side^d cells otherwise.
     fn range_bytes(&self) -> f64 {
-        let cells = 3f64.powi(self.dim as i32);
-        let ranges = if self.dense_grid { cells / 3.0 } else { cells };
+        let cells = self.side().powi(self.dim as i32);
+        let ranges = if self.contiguous_rows {
+            cells / self.side()
+        } else {
+            cells
+        };
         2.0 * WORD * ranges
     }
 
@@ -325,7 +336,8 @@ mod tests {
     fn dam_break_2d() -> StepCounts {
         StepCounts {
             dim: 2,
-            dense_grid: true,
+            contiguous_rows: true,
+            reach: 1,
             slots_per_particle: 1.0,
             fluid_fraction: 0.75,
             ghost_fraction: 0.0,

@@ -209,7 +209,8 @@ pub(crate) fn check_sane(sc: &Scenario) -> Result<(), String> {
             ));
         }
     }
-    Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic).map_err(|e| format!("grid: {e}"))?;
+    Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic, ph.cell)
+        .map_err(|e| format!("grid: {e}"))?;
     Ok(())
 }
 

@@ -82,6 +82,7 @@ pub fn physics(dim: u32, dx: f64, c0: f64) -> Physics {
         dx,
         h,
         kernel: KernelKind::WendlandC2,
+        cell: None,
         rho0: 1000.0,
         c0,
         gamma: 7.0,
