@@ -316,6 +316,64 @@ mod tests {
     use crate::grid::CellEdge;
     use crate::scenario::Domain;
 
+    /// Every particle within the support of another is in a slot `slots_around` visits from
+    /// it (the rows cut to the support's reach, as `neighbour_ranges` cuts them), on grids of
+    /// cells of h with hashed rows that wrap past the table's end and of cells of 2h, in 2D
+    /// and 3D, for particles anywhere in their cells; and the cut rows visit fewer cells.
+    #[test]
+    fn the_cut_rows_keep_every_neighbour() {
+        let mut seed = 12345u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let h = 0.026;
+        // (dim, domain edge, particles, the grid's particle count: 1 024 and 4 096 slots).
+        for (dim, edge, n, slots_for) in [(2, 1.3, 3000, 1000), (3, 0.47, 3000, 3000)] {
+            let mut max = [edge; 3];
+            if dim == 2 {
+                max[2] = 0.0;
+            }
+            let domain = Domain { min: [0.0; 3], max };
+            let pos: Vec<[f64; 3]> = (0..n).map(|_| max.map(|m| m * next())).collect();
+            for cell in [None, Some(CellEdge::Support)] {
+                let grid = Grid::new(&domain, h, dim, slots_for, [false; 3], cell).unwrap();
+                assert!(grid.contiguous_rows());
+                assert_eq!(grid.reach, if cell.is_none() { 2 } else { 1 });
+                let cells: u32 = grid.cells.iter().product();
+                assert_eq!(cells > grid.slots, cell.is_none(), "{dim}D: hashed rows");
+                let placed: Vec<([i64; 3], [f32; 3])> = (pos.iter())
+                    .map(|&p| {
+                        let (off, b) = grid.to_block(p);
+                        (grid.cell_of(off, b), grid.place_in_cell(off))
+                    })
+                    .collect();
+                let mut visited = 0;
+                for (i, x) in pos.iter().enumerate() {
+                    let (c, f) = placed[i];
+                    let slots = slots_around(&grid, dim, c, f);
+                    visited += slots.len();
+                    for (j, y) in pos.iter().enumerate() {
+                        let r2: f64 = (0..3).map(|a| (x[a] - y[a]).powi(2)).sum();
+                        if r2 < 4.0 * h * h {
+                            let slot = grid.slot_of_cell(placed[j].0);
+                            assert!(slots.contains(&slot), "{dim}D {cell:?}: {i} misses {j}");
+                        }
+                    }
+                }
+                let side = (2 * grid.reach + 1) as f64;
+                let full = n as f64 * side.powi(dim as i32);
+                println!("{dim}D reach {}: {visited} cells of {full}", grid.reach);
+                assert!(
+                    (visited as f64) < 0.95 * full,
+                    "{dim}D {cell:?}: rows not cut"
+                );
+            }
+        }
+    }
+
     /// A 2D square lattice of spacing dx on a dense grid of cells 2h = 2.6 dx: away from the
     /// edges a particle has the lattice points within 2.6 dx as neighbours (21, itself
     /// included) and its 3 × 3 cells' particles as candidates; an excluded particle counts in

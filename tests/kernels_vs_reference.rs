@@ -3,6 +3,7 @@
 
 mod common;
 use common::*;
+use wgsph::grid::Grid;
 use wgsph::layout::{unpack_block, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
 use wgsph::reference::{self, RefParticle};
 use wgsph::scenario::*;
@@ -119,6 +120,37 @@ fn setups() -> Vec<Setup> {
     v
 }
 
+/// Domains of more cells of h than slots, but few enough along x (2D) or in a horizontal
+/// plane (3D) that no two cells around a cell share a slot: rows of a hashed grid
+/// (`Grid::contiguous_rows`), some around the water wrapping past the slot table's end (2D:
+/// 50 × 50 cells for 1 024 slots; 3D: 19³ for 4 096).
+fn hashed_row_setups() -> Vec<Setup> {
+    [(2, 1.3, 31), (3, 0.47, 32)]
+        .into_iter()
+        .map(|(dim, domain, seed)| Setup {
+            dim,
+            kernel: KernelKind::WendlandC2,
+            viscosity: Viscosity::Artificial { alpha: 0.05 },
+            delta_sph_form: DeltaSphForm::Fourtakas,
+            domain,
+            seed,
+        })
+        .collect()
+}
+
+/// Whether some particle's row of cells wraps past the slot table's end.
+fn a_row_wraps(grid: &Grid, blocks: &[([f32; 3], [u32; 3])]) -> bool {
+    let r = grid.reach as i64;
+    blocks.iter().any(|(off, b)| {
+        let c = grid.cell_of(*off, *b);
+        let x = |d: i64| c[0] + d >= 0 && c[0] + d < grid.cells[0] as i64;
+        (-r..r).filter(|&d| x(d) && x(d + 1)).any(|d| {
+            let slot = |d: i64| grid.slot_of_cell([c[0] + d, c[1], c[2]]);
+            slot(d + 1) < slot(d)
+        })
+    })
+}
+
 /// max_i |gpu_i − cpu_i| / rms(cpu) over the components `comps`; NaN fails.
 fn rel_err(gpu: &[[f32; 4]], cpu: &[[f64; 4]], comps: std::ops::Range<usize>) -> f64 {
     let mut sq = 0.0;
@@ -144,7 +176,7 @@ fn rel_err(gpu: &[[f32; 4]], cpu: &[[f64; 4]], comps: std::ops::Range<usize>) ->
 
 #[test]
 fn cell_list_sort_matches_reference_exactly() {
-    for s in setups() {
+    for s in setups().into_iter().chain(hashed_row_setups()) {
         let sc = random_scenario(&s);
         let solver = Solver::new(gpu(), &sc).unwrap();
         // The warm-up step sorted the initial (id-ordered) particles once: the GPU order must
@@ -159,11 +191,18 @@ fn cell_list_sort_matches_reference_exactly() {
         let ids: Vec<usize> = code.iter().map(|c| (c & ID_MASK) as usize).collect();
         assert_eq!(ids, order, "dim {} domain {}", s.dim, s.domain);
         assert_eq!(solver.read_cell_start().unwrap(), start);
+        let cells: u64 = grid.cells.iter().map(|&c| c as u64).product();
         if s.domain > 1.0 {
-            let cells: u64 = grid.cells.iter().map(|&c| c as u64).product();
             assert!(
                 cells > grid.slots as u64,
                 "sparse case must exercise hash collisions"
+            );
+        }
+        if hashed_row_setups().iter().any(|h| h.seed == s.seed) {
+            assert!(
+                cells > grid.slots as u64 && grid.contiguous_rows() && a_row_wraps(grid, &init),
+                "dim {}: no wrapping row of a hashed grid",
+                s.dim
             );
         }
     }
@@ -217,7 +256,7 @@ fn interaction_errors(sc: &Scenario) -> (f64, f64) {
 
 #[test]
 fn interaction_matches_reference() {
-    for s in setups() {
+    for s in setups().into_iter().chain(hashed_row_setups()) {
         let (e_acc, e_rho) = interaction_errors(&random_scenario(&s));
         println!(
             "dim {} {:?} {:?} {:?}: accel err {e_acc:.2e}, drho err {e_rho:.2e}",

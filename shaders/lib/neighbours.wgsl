@@ -5,7 +5,7 @@
 
 // Rows of the neighbourhood along x, each at most two ranges (a row that wraps past the slot
 // table's end); or, where rows are not contiguous (cells of 2h only), one range per cell.
-const MAX_RANGES: u32 = 2u * u32(2 * CELL_REACH + 1) * u32(2 * CELL_REACH + 1);
+const MAX_RANGES: u32 = max(2u * u32(2 * CELL_REACH + 1) * u32(2 * CELL_REACH + 1), 27u);
 alias NeighbourRanges = array<vec2<u32>, MAX_RANGES>;
 
 // The distinct slots of the 3^DIM cells around `c` (two neighbour cells can share a slot;

@@ -229,6 +229,16 @@ pub fn module(device: &wgpu::Device, shader: &Shader, cfg: ShaderConfig) -> Resu
 mod tests {
     use super::*;
 
+    /// Water's γ = 7 is raised by multiplications; a fractional or out-of-range γ by pow.
+    #[test]
+    fn only_whole_exponents_are_multiplied_out() {
+        assert_eq!(whole_exponent(7.0), 7);
+        assert_eq!(whole_exponent(1.0), 1);
+        for gamma in [1.4, 0.0, 16.0, f64::NAN] {
+            assert_eq!(whole_exponent(gamma), 0, "{gamma}");
+        }
+    }
+
     /// The codes the uniform carries are the WGSL constants' values, variant for variant.
     #[test]
     fn method_codes_are_the_wgsl_constants() {
@@ -249,6 +259,7 @@ mod tests {
             assert!(src.contains(&decl), "{decl}");
         }
         assert!(src.contains("const KERNEL: u32 = KERNEL_WENDLAND_C2;"));
+        assert!(src.contains("const TAIT_GAMMA: u32 = 7u;"));
         assert!(src.contains("const VISCOSITY: u32 = VISCOSITY_ARTIFICIAL;"));
     }
 }
