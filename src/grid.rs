@@ -51,6 +51,49 @@ pub struct Grid {
     /// Cells per kernel support along an axis (1: cells of 2h, 2: cells of h): how many cells
     /// on each side of its own a particle's neighbours can be in.
     pub reach: u32,
+    /// The slot of cell (x, y, z) is x + stride[0] y + stride[1] z modulo the slots
+    /// ([`Grid::slot_of_cell`]): the cell's linear index, or strides under which no two cells
+    /// of a neighbourhood share a slot ([`hash_strides`]).
+    pub stride: [u32; 2],
+    /// Whether no axis is periodic and no two cells of any neighbourhood share a slot.
+    rows: bool,
+}
+
+/// Whether no two cells of a neighbourhood of (2 reach + 1)^d cells share a slot under the
+/// strides `a`, `b`: two such cells differ by at most 2 reach along each axis (fewer on a
+/// short one), and share a slot when dx + a dy + b dz is a multiple of the slot count.
+fn distinct_around(cells: [u32; 3], slots: u64, reach: u32, [a, b]: [u32; 2]) -> bool {
+    let most = cells.map(|c| (2 * reach as i64).min(c as i64 - 1));
+    (-most[2]..=most[2]).all(|dz| {
+        (-most[1]..=most[1]).all(|dy| {
+            (-most[0]..=most[0]).all(|dx| {
+                let v = dx + a as i64 * dy + b as i64 * dz;
+                (dx, dy, dz) == (0, 0, 0) || v.rem_euclid(slots as i64) != 0
+            })
+        })
+    })
+}
+
+/// The strides of the slot hash (`Grid::stride`): the linear index's (gx, gx gy) where no two
+/// cells of a neighbourhood share a slot under them (always where there are as many slots as
+/// cells), otherwise the first strides from there up that keep the cells of every
+/// neighbourhood in distinct slots (searched for y alone, then for z), so that a row of cells
+/// along x is consecutive slots and no slot needs visiting twice; `None` if none is found
+/// within 4 096 tries each (a table of a few slots).
+fn hash_strides(cells: [u32; 3], slots: u64, reach: u32) -> Option<[u32; 2]> {
+    let linear = [cells[0], cells[0].wrapping_mul(cells[1])];
+    if distinct_around(cells, slots, reach, linear) {
+        return Some(linear);
+    }
+    let flat = [cells[0], cells[1], 1];
+    let a = (0..4096)
+        .map(|k| linear[0].wrapping_add(k))
+        .find(|&a| distinct_around(flat, slots, reach, [a, 0]))?;
+    let b0 = a.wrapping_mul(cells[1]);
+    (0..4096)
+        .map(|k| b0.wrapping_add(k))
+        .find(|&b| distinct_around(cells, slots, reach, [a, b]))
+        .map(|b| [a, b])
 }
 
 impl Grid {
@@ -78,12 +121,9 @@ impl Grid {
                 let g = of(2)?;
                 if !g.contiguous_rows() {
                     bail!(
-                        "particles.cell = \"h\" needs a grid without periodic axes whose cells \
-                         around any cell have hash slots of their own; this one has {} × {} \
-                         cells in a plane for {} slots: set particles.cell = \"2h\" (or leave \
-                         it out)",
-                        g.cells[0],
-                        g.cells[1],
+                        "particles.cell = \"h\" needs a grid without periodic axes whose slot \
+                         table keeps the cells around any cell apart ({} slots here): set \
+                         particles.cell = \"2h\" (or leave it out)",
                         g.slots
                     );
                 }
@@ -144,6 +184,9 @@ impl Grid {
         if slots > (1 << 30) {
             bail!("{slots} hash slots needed: too many particles for one GPU");
         }
+        let strides = hash_strides(cells, slots, reach);
+        let rows = strides.is_some() && !periodic.iter().any(|&p| p);
+        let stride = strides.unwrap_or([cells[0], cells[0].wrapping_mul(cells[1])]);
         Ok(Self {
             origin: domain.min,
             extent,
@@ -155,6 +198,8 @@ impl Grid {
             blocks,
             slots: slots as u32,
             reach,
+            stride,
+            rows,
         })
     }
 
@@ -178,16 +223,12 @@ impl Grid {
     }
 
     /// Whether no axis is periodic and no two cells of any neighbourhood (the (2 reach + 1)^d
-    /// cells around a cell) share a slot: the cells of a row along x then have consecutive
-    /// slots (modulo the table's size), so `neighbour_ranges` (shaders/lib/neighbours.wgsl)
-    /// takes a row as one range and needs no check for repeated slots. Two cells share a slot
-    /// when their linear indices differ by a multiple of the slot count; within a
-    /// neighbourhood they differ by at most `span`.
+    /// cells around a cell) share a slot ([`hash_strides`]): the cells of a row along x then
+    /// have consecutive slots (modulo the table's size), so `neighbour_ranges`
+    /// (shaders/lib/neighbours.wgsl) takes a row as one range and needs no check for repeated
+    /// slots.
     pub fn contiguous_rows(&self) -> bool {
-        let r = self.reach as u64;
-        let [gx, gy, gz] = self.cells.map(|c| c as u64);
-        let span = 2 * r * (1 + if gy > 1 { gx } else { 0 } + if gz > 1 { gx * gy } else { 0 });
-        !self.periodic.iter().any(|&p| p) && span < self.slots as u64
+        self.rows
     }
 
     /// The slot of a world position, as `slot_of_cell(cell_of(..))` computes it on the GPU.
@@ -227,10 +268,11 @@ impl Grid {
     /// shaders/lib/common.wgsl: its linear index in wrapping u32 arithmetic, masked.
     pub fn slot_of_cell(&self, c: [i64; 3]) -> u32 {
         let u = c.map(|x| x as u32);
-        let lin = u[0].wrapping_add(
-            self.cells[0].wrapping_mul(u[1].wrapping_add(self.cells[1].wrapping_mul(u[2]))),
-        );
-        lin & (self.slots - 1)
+        let [a, b] = self.stride;
+        let key = u[0]
+            .wrapping_add(a.wrapping_mul(u[1]))
+            .wrapping_add(b.wrapping_mul(u[2]));
+        key & (self.slots - 1)
     }
 }
 
@@ -334,18 +376,67 @@ mod tests {
 
     #[test]
     fn large_domain_keeps_offsets_small_and_slots_bounded() {
-        // A 100 m × 100 m × 10 m flood at dx = 5 mm, h = 2 dx: too many cells in a plane for
-        // rows, so cells of 2h with one range per slot.
+        // A 100 m × 100 m × 10 m flood at dx = 5 mm, h = 2 dx: far more cells of h than slots,
+        // and more in a plane, yet rows (under these strides no neighbourhood shares a slot).
         let d = domain([100.0, 100.0, 10.0]);
         let g = Grid::new(&d, 0.01, 3, 1_000_000, [false; 3], None).unwrap();
-        assert_eq!(g.reach, 1);
+        assert_eq!(g.reach, 2);
         assert!(g.blocks.iter().zip(MAX_BLOCK).all(|(b, m)| *b <= m + 1));
         assert!(g.block_size[0] < 0.1, "block {:?} m", g.block_size);
         assert_eq!(g.slots, 1 << 20);
-        assert!(!g.contiguous_rows(), "a sparse domain shares slots");
+        assert!(g.contiguous_rows());
         // f32 resolution of an offset is far below the particle spacing.
         let ulp = g.block_size[0] * f32::EPSILON;
         assert!((ulp as f64) < 1e-6 * 0.005 * 2.0);
+    }
+
+    /// On grids whose linear index would put cells of a neighbourhood in one slot, the searched
+    /// strides keep every neighbourhood's cells (brute force over cells along the grid) in
+    /// distinct slots, its rows in consecutive ones; a few slots cannot, and say so.
+    #[test]
+    fn searched_strides_keep_every_neighbourhood_apart() {
+        let cases = [
+            (domain([100.0, 100.0, 10.0]), 3, 1_000_000),
+            (domain([8.0, 8.0, 8.0]), 3, 3000),
+            (domain([300.0, 20.0, 0.0]), 2, 20_000),
+        ];
+        let mut searched = 0;
+        for (d, dim, n) in cases {
+            for cell in [None, TWO_H] {
+                let g = Grid::new(&d, 0.01, dim, n, [false; 3], cell).unwrap();
+                assert!(g.contiguous_rows(), "{d:?} {cell:?}");
+                searched += (g.stride != [g.cells[0], g.cells[0].wrapping_mul(g.cells[1])]) as u32;
+                let r = g.reach as i64;
+                let zr = if dim == 3 { r } else { 0 };
+                for k in 0..50u32 {
+                    let c = [0, 1, 2]
+                        .map(|a| ((k * (7919 + 104_729 * a)) % g.cells[a as usize]) as i64);
+                    let mut slots = Vec::new();
+                    for dz in -zr..=zr {
+                        for dy in -r..=r {
+                            let row: Vec<u32> = (-r..=r)
+                                .map(|dx| [c[0] + dx, c[1] + dy, c[2] + dz])
+                                .filter(|n| (0..3).all(|a| n[a] >= 0 && n[a] < g.cells[a] as i64))
+                                .map(|n| g.slot_of_cell(n))
+                                .collect();
+                            for w in row.windows(2) {
+                                assert_eq!(w[1], (w[0] + 1) & (g.slots - 1));
+                            }
+                            slots.extend(row);
+                        }
+                    }
+                    let len = slots.len();
+                    slots.sort_unstable();
+                    slots.dedup();
+                    assert_eq!(slots.len(), len, "{d:?} {cell:?}: cells around {c:?} share");
+                }
+            }
+        }
+        assert!(
+            searched > 0,
+            "no grid needed its strides searched: the test tests less"
+        );
+        assert_eq!(hash_strides([100, 100, 100], 4, 2), None);
     }
 
     #[test]

@@ -62,8 +62,9 @@ pub struct Params {
     /// which `correct` counts a fluid particle.
     pub density_warn: f32,
     pub density_stop: f32,
-    /// To `solid_materials`' 16-byte alignment in WGSL.
-    pub pad: [u32; 2],
+    /// The slot hash's strides (`Grid::stride`); also brings `solid_materials` to its
+    /// 16-byte alignment in WGSL.
+    pub hash_stride: [u32; 2],
     /// The distinct materials of the elastic solids; a solid particle's is
     /// `SolidState::material`.
     pub solid_materials: [SolidMaterial; MAX_SOLID_MATERIALS],
@@ -477,7 +478,7 @@ mod tests {
                 friction_first_solid,
                 density_warn,
                 density_stop,
-                pad,
+                hash_stride,
                 solid_materials,
                 friction_table
             ]

@@ -25,7 +25,7 @@ budget=${2:-540}
 wgsph=${WGSPH:-target/release/wgsph}
 tests=${VALIDATION_TESTS:-}
 cap=${ITEM_CAP_S:-300}
-all="info bench_spheric2 bench_spheric2_1M bench_spheric2_4M bench_spheric2_13M bench_dam_break_3d bench_dam_break_3d_1M bench_street_flood_3d
+all="info bench_spheric2 bench_spheric2_2h bench_spheric2_1M bench_spheric2_1M_2h bench_spheric2_4M bench_spheric2_13M bench_dam_break_3d bench_dam_break_3d_1M bench_street_flood_3d
 validate:floating_box_2d validate:water_entry_cylinder_2d validate:water_entry_cylinder_2d_rho1000
 validate:sloshing_2d validate:oscillating_plate_2d validate:oscillating_plate_tl_2d
 validate:elastic_gate_2d sloshing_3d street_flood_3d street_flood_3d_open validate:dam_break_3d
@@ -47,6 +47,9 @@ command_of() {
     # DualSPHysics' performance case at its published sizes (docs/performance.md).
     bench_spheric2) echo "$wgsph bench cases/bench_spheric2.toml --steps 500 --stages" ;;
     bench_spheric2_1M) echo "$wgsph bench cases/bench_spheric2.toml --set particles.dx_m=0.0114 --steps 300" ;;
+    # The same with cells of 2h, the default before 2026-12-05: what cells of h gain on a GPU.
+    bench_spheric2_2h) echo "$wgsph bench cases/bench_spheric2.toml --set particles.cell=2h --steps 500 --stages" ;;
+    bench_spheric2_1M_2h) echo "$wgsph bench cases/bench_spheric2.toml --set particles.dx_m=0.0114 --set particles.cell=2h --steps 300" ;;
     bench_spheric2_4M) echo "$wgsph bench cases/bench_spheric2.toml --set particles.dx_m=0.0072 --steps 200" ;;
     bench_spheric2_13M) echo "$wgsph bench cases/bench_spheric2.toml --set particles.dx_m=0.0042 --steps 100" ;;
     bench_dam_break_3d) echo "$wgsph bench cases/dam_break_3d.toml --steps 500 --stages" ;;

@@ -63,7 +63,8 @@ struct Params {
     // |ρ/ρ0 − 1| is beyond each limit are counted (`time.density_variation_warn`, `_stop`).
     density_warn: f32,
     density_stop: f32,
-    pad: vec2<u32>,             // to the 16-byte alignment of the array below
+    // The slot of cell (x, y, z) is x + hash_stride.x y + hash_stride.y z, masked (`Grid::stride`).
+    hash_stride: vec2<u32>,
     // The distinct materials of the solids; a solid particle's is SolidState.material.
     solid_materials: array<SolidMaterial, MAX_SOLID_MATERIALS>,
     // μ between contact groups a and b at a·G + b, four to a vector.
@@ -316,12 +317,13 @@ fn cell_of(p: Pos) -> vec3<i32> {
     return select(min(c, g - 1), c % g, periodic_axes());
 }
 
-// Hash slot of a cell: its linear index in the domain grid, wrapped to the (power of two)
-// slot table. Dense domains get no collisions and x-contiguous cells; sparse ones share slots,
-// which the distance test filters. Wrapping u32 arithmetic is intended.
+// Hash slot of a cell: x + A y + B z wrapped to the (power of two) slot table, (A, B) the
+// linear index's strides or strides under which the cells around any cell have distinct slots
+// (`Grid::stride`). Dense domains get no collisions; sparse ones share slots between distant
+// cells, which the distance test filters. Wrapping u32 arithmetic is intended.
 fn slot_of_cell(c: vec3<i32>) -> u32 {
     let u = vec3<u32>(c);
-    return (u.x + params.grid_cells.x * (u.y + params.grid_cells.y * u.z)) & params.hash_mask;
+    return (u.x + params.hash_stride.x * u.y + params.hash_stride.y * u.z) & params.hash_mask;
 }
 
 // ---- mirror planes ---------------------------------------------------------------------

@@ -4,7 +4,7 @@
 // (CELL_REACH 2): a point's neighbours are in the (2 CELL_REACH + 1)^DIM cells around its own.
 
 // Rows of the neighbourhood along x, each at most two ranges (a row that wraps past the slot
-// table's end); or, where rows are not contiguous (cells of 2h only), one range per cell.
+// table's end); or, on a periodic grid (cells of 2h), one range per cell.
 const MAX_RANGES: u32 = max(2u * u32(2 * CELL_REACH + 1) * u32(2 * CELL_REACH + 1), 27u);
 alias NeighbourRanges = array<vec2<u32>, MAX_RANGES>;
 
@@ -47,8 +47,8 @@ fn cell_gap(f: f32, d: i32) -> f32 {
 
 // The sorted particles within the support of `p`, and others, as index ranges [x, y).
 //
-// Where rows are contiguous (params.contiguous_rows: no periodic axis, and no two cells of a
-// neighbourhood share a slot, Grid::contiguous_rows) the cells of a row along x have
+// Where rows are contiguous (params.contiguous_rows: no periodic axis; the slot hash's strides
+// keep the cells of any neighbourhood in distinct slots, Grid::contiguous_rows) the cells of a row along x have
 // consecutive slots, so a row is one range (two where it wraps past the table's end). A row
 // is cut to the cells the support's sphere reaches from `p` (none, when the row lies beyond
 // it): which cells a particle's neighbours can be in depends only on where it is, so the sum
@@ -57,7 +57,8 @@ fn cell_gap(f: f32, d: i32) -> f32 {
 // (cell_of clamps) and are left out; a slot may hold particles of far cells, which the
 // distance test rejects.
 //
-// Otherwise one range per distinct slot of the 3^DIM cells around (cells of 2h).
+// Otherwise (a periodic axis: cells of 2h) one range per distinct slot of the 3^DIM cells
+// around.
 fn neighbour_ranges(p: Pos, ranges: ptr<function, NeighbourRanges>) -> u32 {
     let c = cell_of(p);
     var n = 0u;

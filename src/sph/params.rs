@@ -27,6 +27,7 @@ impl Params {
             grid_cells: grid.cells,
             hash_mask: grid.slots - 1,
             contiguous_rows: grid.contiguous_rows() as u32,
+            hash_stride: grid.stride,
             block_size: grid.block_size,
             cells_per_block: grid.cells_per_block,
             inv_cell_size: grid.cell_size.map(|c| (1.0 / c) as f32),
