@@ -310,6 +310,33 @@ mod tests {
             .contains("particles.cell = \"2h\""));
     }
 
+    /// Asserts that the cells of `g` around `c` (inside the grid) have distinct slots, each
+    /// row's consecutive; the rows that wrap past the table's end.
+    fn rows_around(g: &Grid, dim: u32, c: [i64; 3]) -> u32 {
+        let r = g.reach as i64;
+        let zr = if dim == 3 { r } else { 0 };
+        let (mut slots, mut wrapped) = (Vec::new(), 0);
+        for dz in -zr..=zr {
+            for dy in -r..=r {
+                let row: Vec<u32> = (-r..=r)
+                    .map(|dx| [c[0] + dx, c[1] + dy, c[2] + dz])
+                    .filter(|n| (0..3).all(|a| n[a] >= 0 && n[a] < g.cells[a] as i64))
+                    .map(|n| g.slot_of_cell(n))
+                    .collect();
+                for w in row.windows(2) {
+                    assert_eq!(w[1], (w[0] + 1) & (g.slots - 1), "row around {c:?}");
+                    wrapped += (w[1] < w[0]) as u32;
+                }
+                slots.extend(row);
+            }
+        }
+        let n = slots.len();
+        slots.sort_unstable();
+        slots.dedup();
+        assert_eq!(slots.len(), n, "cells around {c:?} share a slot");
+        wrapped
+    }
+
     /// A long 2D channel has more cells of h than slots, yet within any neighbourhood no two
     /// cells share a slot and a row's slots follow each other (wrapping at the table's end):
     /// what `neighbour_ranges` relies on.
@@ -330,23 +357,7 @@ mod tests {
         // The cell whose linear index is the slot count is where the table wraps.
         let at_end = [(g.slots % g.cells[0]) as i64, (g.slots / g.cells[0]) as i64];
         for c in [[0, 0], at_end, [1311, 99], [5000, 50], [9999, 99]] {
-            let mut slots = Vec::new();
-            for dy in -2..=2 {
-                let row: Vec<u32> = (-2..=2)
-                    .map(|dx| [c[0] + dx, c[1] + dy, 0])
-                    .filter(|n| (0..2).all(|a| n[a] >= 0 && n[a] < g.cells[a] as i64))
-                    .map(|n| g.slot_of_cell(n))
-                    .collect();
-                for w in row.windows(2) {
-                    assert_eq!(w[1], (w[0] + 1) & (g.slots - 1));
-                    wrapped += (w[1] < w[0]) as u32;
-                }
-                slots.extend(row);
-            }
-            let n = slots.len();
-            slots.sort_unstable();
-            slots.dedup();
-            assert_eq!(slots.len(), n, "cells around {c:?} share a slot");
+            wrapped += rows_around(&g, 2, [c[0], c[1], 0]);
         }
         assert!(
             wrapped > 0,
@@ -406,29 +417,10 @@ mod tests {
                 let g = Grid::new(&d, 0.01, dim, n, [false; 3], cell).unwrap();
                 assert!(g.contiguous_rows(), "{d:?} {cell:?}");
                 searched += (g.stride != [g.cells[0], g.cells[0].wrapping_mul(g.cells[1])]) as u32;
-                let r = g.reach as i64;
-                let zr = if dim == 3 { r } else { 0 };
                 for k in 0..50u32 {
                     let c = [0, 1, 2]
                         .map(|a| ((k * (7919 + 104_729 * a)) % g.cells[a as usize]) as i64);
-                    let mut slots = Vec::new();
-                    for dz in -zr..=zr {
-                        for dy in -r..=r {
-                            let row: Vec<u32> = (-r..=r)
-                                .map(|dx| [c[0] + dx, c[1] + dy, c[2] + dz])
-                                .filter(|n| (0..3).all(|a| n[a] >= 0 && n[a] < g.cells[a] as i64))
-                                .map(|n| g.slot_of_cell(n))
-                                .collect();
-                            for w in row.windows(2) {
-                                assert_eq!(w[1], (w[0] + 1) & (g.slots - 1));
-                            }
-                            slots.extend(row);
-                        }
-                    }
-                    let len = slots.len();
-                    slots.sort_unstable();
-                    slots.dedup();
-                    assert_eq!(slots.len(), len, "{d:?} {cell:?}: cells around {c:?} share");
+                    rows_around(&g, dim, c);
                 }
             }
         }
