@@ -7,7 +7,6 @@
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> code: array<u32>;
-@group(0) @binding(3) var<storage, read_write> keys: array<u32>;
 @group(0) @binding(4) var<storage, read_write> local_rank: array<u32>;
 @group(0) @binding(5) var<storage, read_write> counts: array<atomic<u32>>;
 @group(0) @binding(6) var<storage, read> cell_start: array<u32>;
@@ -25,23 +24,26 @@
 @group(0) @binding(18) var<storage, read> energy_in: array<vec2<f32>>;
 @group(0) @binding(19) var<storage, read_write> energy_out: array<vec2<f32>>;
 
-// Slot of each particle (excluded particles go to the extra slot `hash_mask + 1`, a
+// The slot of particle i (excluded particles go to the extra slot `hash_mask + 1`, a
 // subdomain's free entries, of id ID_MASK, to the last one, `hash_mask + 2`:
-// sph::subdomain::FREE_ID) and its provisional place in that slot.
+// sph::subdomain::FREE_ID). Recomputed by each kernel of the sort rather than stored: a
+// stored key would cost 4 bytes a particle for the few loads of its position it saves.
+fn sort_slot(i: u32) -> u32 {
+    let c = code[i];
+    if (code_kind(c) != KIND_EXCLUDED) {
+        return slot_of_cell(cell_of(pos[i]));
+    }
+    return select(params.hash_mask + 1u, params.hash_mask + 2u, (c & ID_MASK) == ID_MASK);
+}
+
+// Each particle's provisional place in its slot, counted into the slot.
 @compute @workgroup_size(WG)
 fn cell_key(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
     if (i >= params.n_particles) {
         return;
     }
-    var key = params.hash_mask + 1u;
-    if (code_kind(code[i]) != KIND_EXCLUDED) {
-        key = slot_of_cell(cell_of(pos[i]));
-    } else if ((code[i] & ID_MASK) == ID_MASK) {
-        key = params.hash_mask + 2u;
-    }
-    keys[i] = key;
-    local_rank[i] = atomicAdd(&counts[key], 1u);
+    local_rank[i] = atomicAdd(&counts[sort_slot(i)], 1u);
 }
 
 @compute @workgroup_size(WG)
@@ -50,7 +52,7 @@ fn scatter(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if (i >= params.n_particles) {
         return;
     }
-    provisional[cell_start[keys[i]] + local_rank[i]] = i;
+    provisional[cell_start[sort_slot(i)] + local_rank[i]] = i;
 }
 
 // Final place = slot start + number of particles of the same slot with a smaller id (ids are
@@ -63,7 +65,7 @@ fn rank_in_cell(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         return;
     }
     let i = provisional[p];
-    let key = keys[i];
+    let key = sort_slot(i);
     let start = cell_start[key];
     if (key > params.hash_mask) {
         perm[p] = i;

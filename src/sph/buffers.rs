@@ -22,7 +22,6 @@ pub struct ParticleBuffers {
     pub rate: wgpu::Buffer,
     /// The previous rates gathered into the new order by the sort.
     pub rate_sorted: wgpu::Buffer,
-    pub keys: wgpu::Buffer,
     /// Atomic rank within the slot, then (reused) the final permutation.
     pub local_perm: wgpu::Buffer,
     pub provisional: wgpu::Buffer,
@@ -214,7 +213,6 @@ impl ParticleBuffers {
             ],
             rate: storage_init(device, "rate", &zero_rates),
             rate_sorted: storage(device, "rate sorted", vec4),
-            keys: storage(device, "keys", words),
             local_perm: storage(device, "local rank / perm", words),
             provisional: storage(device, "provisional", words),
             cell_start: storage(device, "cell start", 4 * (slots as u64 + 3)),
@@ -277,7 +275,6 @@ impl ParticleBuffers {
             "state" => Some(&self.state),
             // The slot histogram, counted atomically, then scanned into the slots' starts.
             "cell_start" | "counts" => Some(&self.cell_start),
-            "keys" => Some(&self.keys),
             // The rank within the slot, then the permutation it becomes.
             "local_rank" | "perm" => Some(&self.local_perm),
             "provisional" => Some(&self.provisional),
@@ -319,7 +316,6 @@ impl ParticleBuffers {
             &self.state,
             &self.rate,
             &self.rate_sorted,
-            &self.keys,
             &self.local_perm,
             &self.provisional,
             &self.cell_start,

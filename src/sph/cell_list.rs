@@ -39,14 +39,13 @@ impl Resolve for ScanLevel<'_> {
 
 pub struct CellList {
     cell_key: ParityKernel,
-    scatter: Kernel,
+    scatter: ParityKernel,
     rank_in_cell: ParityKernel,
     reorder: ParityKernel,
     reorder_motion: ParityKernel,
     reorder_energy: Option<ParityKernel>,
     scan_blocks: Kernel,
     scan_add: Kernel,
-    bind_scatter: wgpu::BindGroup,
     /// (scan_blocks, scan_add) bind group of each level.
     bind_scan: Vec<(wgpu::BindGroup, Option<wgpu::BindGroup>)>,
     scan_sizes: Vec<u32>,
@@ -63,7 +62,6 @@ impl CellList {
     ) -> Result<Self> {
         let parity = |entry: &str| ParityKernel::new(device, cells, entry, |p| b.at(p));
         let reorder_energy = energy.then(|| parity("reorder_energy")).transpose()?;
-        let scatter = cells.kernel(device, "scatter")?;
         let scan_blocks = scan.kernel(device, "scan_blocks")?;
         let scan_add = scan.kernel(device, "scan_add")?;
         let mut levels: Vec<&wgpu::Buffer> = vec![&b.cell_start];
@@ -83,8 +81,7 @@ impl CellList {
         }
         Ok(Self {
             cell_key: parity("cell_key")?,
-            bind_scatter: scatter.bind(device, &b.unparitied())?,
-            scatter,
+            scatter: parity("scatter")?,
             rank_in_cell: parity("rank_in_cell")?,
             reorder: parity("reorder")?,
             reorder_motion: parity("reorder_motion")?,
@@ -119,7 +116,7 @@ impl CellList {
 
     /// Each particle's place in the sorted order: after the slots, then by id within its slot.
     pub fn encode_scatter(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.scatter.dispatch(pass, &self.bind_scatter, self.n);
+        self.scatter.dispatch(pass, p, self.n);
         self.rank_in_cell.dispatch(pass, p, self.n);
     }
 

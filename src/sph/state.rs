@@ -3,7 +3,7 @@
 //! host clock, the density filter's last step, the elastic solids' stress and the bodies' host
 //! state. Restoring these into
 //! a solver built from the same case continues bit-identically on the same adapter: every other
-//! GPU buffer (keys, cell starts, sorted rates, ghost values, body partials) is rebuilt by the
+//! GPU buffer (cell starts, sorted rates, ghost values, body partials) is rebuilt by the
 //! step before it is read.
 //!
 //! The file format is the checkpoint's business (`crate::checkpoint`); this module only gathers

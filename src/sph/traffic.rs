@@ -21,7 +21,7 @@ use crate::layout::Pos;
 const POS: f64 = size_of::<Pos>() as f64;
 /// A `vec4<f32>`: velrho (v, ρ), rate (dv/dt, dρ/dt), rate_old, the filtered density.
 const VEC4: f64 = size_of::<[f32; 4]>() as f64;
-/// A `u32` or `f32`: code (kind + id), keys, ranks, permutation, a slot's start, one component.
+/// A `u32` or `f32`: code (kind + id), ranks, permutation, a slot's start, one component.
 const WORD: f64 = size_of::<u32>() as f64;
 /// (e, de/dt), with `physics.energy`.
 const ENERGY: f64 = size_of::<[f32; 2]>() as f64;
@@ -178,20 +178,21 @@ pub fn stage_cost(name: &str, c: &StepCounts) -> Option<StageCost> {
             WORD + 2.0 * VEC4 + fluid * (POS + c.energy_bytes(ENERGY)),
             fluid * (POS + VEC4 + c.energy_bytes(WORD)) + boundary * WORD,
         )),
-        // cell_list.wgsl `cell_key`: code, pos; the key and the provisional rank written, the
+        // cell_list.wgsl `cell_key`: code, pos (`sort_slot`); the provisional rank written, the
         // slot's count read and written by the atomic.
-        "sort_key" => StageCost::particles(Bytes::new(WORD + POS + WORD, 3.0 * WORD)),
+        "sort_key" => StageCost::particles(Bytes::new(WORD + POS + WORD, 2.0 * WORD)),
         // prefix_scan.wgsl: `scan_blocks` reads and writes each slot's count, `scan_add` reads
         // it and its block's sum and writes it back (the block sums' levels are 1/512 of that).
         "sort_scan" => StageCost {
             per_slot: Bytes::new(3.0 * WORD, 2.0 * WORD),
             ..StageCost::particles(Bytes::default())
         },
-        // `scatter`: keys, the slot's start and the rank read, `provisional` written;
-        // `rank_in_cell`: provisional, key, the slot's start and end, code read, and per slot-mate
-        // its index and code word (ordering by id); `perm` written.
+        // `scatter`: code and pos (`sort_slot`), the slot's start and the rank read,
+        // `provisional` written; `rank_in_cell`: provisional, code and pos (`sort_slot`), the
+        // slot's start and end, and per slot-mate its index and code word (ordering by id);
+        // `perm` written.
         "sort_scatter" => StageCost::particles(Bytes::new(
-            3.0 * WORD + 5.0 * WORD + 2.0 * WORD * c.slot_mates(),
+            (POS + 3.0 * WORD) + (POS + 4.0 * WORD) + 2.0 * WORD * c.slot_mates(),
             2.0 * WORD,
         )),
         // `reorder` and `reorder_motion` (and `reorder_energy`): the permutation read by each,
