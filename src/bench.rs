@@ -62,10 +62,7 @@ pub fn neighbour_work(grid: &Grid, dim: u32, h: f64, particles: &Particles) -> N
             mine[0] += list.len() as u64;
             mine[1] += list
                 .iter()
-                .filter(|&&j| {
-                    let y = particles.pos[live[j]];
-                    (0..3).map(|a| (x[a] - y[a]).powi(2)).sum::<f64>() < support2
-                })
+                .filter(|&&j| grid.distance2(x, particles.pos[live[j]]) < support2)
                 .count() as u64;
         }
         let is_fluid = particles.kind[live[k]] == Kind::Fluid as u32;
@@ -88,23 +85,34 @@ pub fn neighbour_work(grid: &Grid, dim: u32, h: f64, particles: &Particles) -> N
 fn slots_around(grid: &Grid, dim: u32, c: [i64; 3], f: [f32; 3]) -> Vec<u32> {
     let g = grid.cells.map(|n| n as i64);
     let mut slots = Vec::new();
+    // A cell's index along each axis, wrapped on a periodic one; `None` outside the grid.
+    let inside = |n: [i64; 3]| -> Option<[i64; 3]> {
+        let mut w = n;
+        for a in 0..3 {
+            if grid.periodic[a] {
+                w[a] = n[a].rem_euclid(g[a]);
+            }
+            if w[a] < 0 || w[a] >= g[a] {
+                return None;
+            }
+        }
+        Some(w)
+    };
     if grid.contiguous_rows() {
         let r = grid.reach as i64;
         let zr = if dim == 3 { r } else { 0 };
         let reach2 = (r * r) as f32;
         for dz in -zr..=zr {
             for dy in -r..=r {
-                let (y, z) = (c[1] + dy, c[2] + dz);
                 let gap2 = cell_gap(f[1], dy).powi(2) + cell_gap(f[2], dz).powi(2);
-                if y < 0 || y >= g[1] || z < 0 || z >= g[2] || gap2 >= reach2 {
+                if gap2 >= reach2 {
                     continue;
                 }
                 let w = (reach2 - gap2).sqrt();
                 let from = ((f[0] - w).floor() as i64).max(-r);
                 let to = ((f[0] + w).floor() as i64).min(r);
-                for x in (c[0] + from).max(0)..=(c[0] + to).min(g[0] - 1) {
-                    slots.push(grid.slot_of_cell([x, y, z]));
-                }
+                let row = (from..=to).filter_map(|dx| inside([c[0] + dx, c[1] + dy, c[2] + dz]));
+                slots.extend(row.map(|n| grid.slot_of_cell(n)));
             }
         }
         return slots;
@@ -330,8 +338,15 @@ mod tests {
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
         let h = 0.026;
-        // (dim, domain edge, particles, the grid's particle count: 1 024 and 4 096 slots).
-        for (dim, edge, n, slots_for) in [(2, 1.3, 3000, 1000), (3, 0.47, 3000, 3000)] {
+        // (dim, domain edge, particles, the grid's particle count: 1 024 and 4 096 slots, or
+        // a slot per cell on the periodic grids, periodic along x and the last axis).
+        let periodic = |dim: usize| [true, dim == 2, dim == 3];
+        for (dim, edge, n, slots_for, wraps) in [
+            (2, 1.3, 3000, 1000, [false; 3]),
+            (3, 0.47, 3000, 3000, [false; 3]),
+            (2, 1.3, 3000, 4000, periodic(2)),
+            (3, 0.47, 3000, 60_000, periodic(3)),
+        ] {
             let mut max = [edge; 3];
             if dim == 2 {
                 max[2] = 0.0;
@@ -339,11 +354,13 @@ mod tests {
             let domain = Domain { min: [0.0; 3], max };
             let pos: Vec<[f64; 3]> = (0..n).map(|_| max.map(|m| m * next())).collect();
             for cell in [None, Some(CellEdge::Support)] {
-                let grid = Grid::new(&domain, h, dim, slots_for, [false; 3], cell).unwrap();
-                assert!(grid.contiguous_rows());
+                let grid = Grid::new(&domain, h, dim, slots_for, wraps, cell).unwrap();
+                let hashed = grid.slots < grid.cells.iter().product();
                 assert_eq!(grid.reach, if cell.is_none() { 2 } else { 1 });
-                let cells: u32 = grid.cells.iter().product();
-                assert_eq!(cells > grid.slots, cell.is_none(), "{dim}D: hashed rows");
+                assert!(grid.contiguous_rows() || (cell.is_some() && hashed));
+                if wraps == [false; 3] {
+                    assert_eq!(hashed, cell.is_none(), "{dim}D: hashed rows");
+                }
                 let placed: Vec<([i64; 3], [f32; 3])> = (pos.iter())
                     .map(|&p| {
                         let (off, b) = grid.to_block(p);
@@ -356,8 +373,7 @@ mod tests {
                     let slots = slots_around(&grid, dim, c, f);
                     visited += slots.len();
                     for (j, y) in pos.iter().enumerate() {
-                        let r2: f64 = (0..3).map(|a| (x[a] - y[a]).powi(2)).sum();
-                        if r2 < 4.0 * h * h {
+                        if grid.distance2(*x, *y) < 4.0 * h * h {
                             let slot = grid.slot_of_cell(placed[j].0);
                             assert!(slots.contains(&slot), "{dim}D {cell:?}: {i} misses {j}");
                         }

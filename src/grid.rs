@@ -55,7 +55,8 @@ pub struct Grid {
     /// ([`Grid::slot_of_cell`]): the cell's linear index, or strides under which no two cells
     /// of a neighbourhood share a slot ([`hash_strides`]).
     pub stride: [u32; 2],
-    /// Whether no axis is periodic and no two cells of any neighbourhood share a slot.
+    /// Whether no two cells of any neighbourhood share a slot (on a periodic grid: every
+    /// cell has its own slot).
     rows: bool,
 }
 
@@ -121,10 +122,11 @@ impl Grid {
                 let g = of(2)?;
                 if !g.contiguous_rows() {
                     bail!(
-                        "particles.cell = \"h\" needs a grid without periodic axes whose slot \
-                         table keeps the cells around any cell apart ({} slots here): set \
-                         particles.cell = \"2h\" (or leave it out)",
-                        g.slots
+                        "particles.cell = \"h\" needs a slot table that keeps the cells \
+                         around any cell apart (on a periodic grid, a slot per cell: {} slots \
+                         here for {} cells): set particles.cell = \"2h\" (or leave it out)",
+                        g.slots,
+                        g.cells.iter().map(|&c| c as u64).product::<u64>()
                     );
                 }
                 Ok(g)
@@ -158,8 +160,10 @@ impl Grid {
             if periodic[a] {
                 // Whole cells tile the period, so neighbour cells wrap exactly.
                 n = (extent[a] / edge).floor();
+                // The cells around a cell must be distinct cells (no image counted twice).
                 if n < (2 * reach + 1) as f64 {
-                    bail!("the periodic axis {a} is {} m long: at least 3 kernel supports (3 × 2h = {} m) are needed", extent[a], 3.0 * support);
+                    let least = (2 * reach + 1) as f64 * edge;
+                    bail!("the periodic axis {a} is {} m long: at least {least} m ({} cells of {edge} m) are needed", extent[a], 2 * reach + 1);
                 }
                 cell_size[a] = extent[a] / n;
             }
@@ -185,7 +189,13 @@ impl Grid {
             bail!("{slots} hash slots needed: too many particles for one GPU");
         }
         let strides = hash_strides(cells, slots, reach);
-        let rows = strides.is_some() && !periodic.iter().any(|&p| p);
+        // On a periodic grid the cells around a cell wrap, which `hash_strides` does not
+        // model; with a slot per cell (the linear index) they are distinct all the same.
+        let rows = if periodic.iter().any(|&p| p) {
+            slots >= total_cells
+        } else {
+            strides.is_some()
+        };
         let stride = strides.unwrap_or([cells[0], cells[0].wrapping_mul(cells[1])]);
         Ok(Self {
             origin: domain.min,
@@ -222,10 +232,11 @@ impl Grid {
         [0, 1, 2].map(|a| self.origin[a] + b[a] as f64 * self.block_size[a] as f64 + off[a] as f64)
     }
 
-    /// Whether no axis is periodic and no two cells of any neighbourhood (the (2 reach + 1)^d
-    /// cells around a cell) share a slot ([`hash_strides`]): the cells of a row along x then
-    /// have consecutive slots (modulo the table's size), so `neighbour_ranges`
-    /// (shaders/lib/neighbours.wgsl) takes a row as one range and needs no check for repeated
+    /// Whether no two cells of any neighbourhood (the (2 reach + 1)^d cells around a cell)
+    /// share a slot ([`hash_strides`]; on a periodic grid, whether every cell has its own
+    /// slot): the cells of a row along x then have consecutive slots (modulo the table's size),
+    /// so `neighbour_ranges` (shaders/lib/neighbours.wgsl) takes a row as one range (two where
+    /// it wraps past the table's end or a periodic x axis) and needs no check for repeated
     /// slots.
     pub fn contiguous_rows(&self) -> bool {
         self.rows
@@ -264,6 +275,23 @@ impl Grid {
         })
     }
 
+    /// The squared distance between two world positions, to the nearest image on periodic
+    /// axes (as `rel_pos` in shaders/lib/common.wgsl takes it).
+    pub fn distance2(&self, x: [f64; 3], y: [f64; 3]) -> f64 {
+        (0..3)
+            .map(|a| {
+                let d = x[a] - y[a];
+                let l = self.extent[a];
+                if self.periodic[a] {
+                    d - l * (d / l).round()
+                } else {
+                    d
+                }
+            })
+            .map(|d| d * d)
+            .sum()
+    }
+
     /// The hash slot of cell `c` (which may lie outside the grid), as `slot_of_cell` in
     /// shaders/lib/common.wgsl: its linear index in wrapping u32 arithmetic, masked.
     pub fn slot_of_cell(&self, c: [i64; 3]) -> u32 {
@@ -297,13 +325,33 @@ mod tests {
             assert!(g.slots as u64 >= g.cells.iter().map(|&c| c as u64).product::<u64>());
             assert!(g.contiguous_rows());
         }
+    }
+
+    /// A periodic grid takes cells of h with rows where every cell has its own slot (10 000
+    /// particles: 4 096 slots for 76 × 39 cells of h), otherwise cells of 2h, with rows where
+    /// these have a slot each (1 000 particles: 1 024 slots for 38 × 20 cells of 2h), one range
+    /// per slot where not (a domain 4 times longer); it refuses cells of h asked for there.
+    #[test]
+    fn a_periodic_grid_takes_rows_where_each_cell_has_a_slot() {
         let periodic = [true, false, false];
         let g = Grid::new(&domain([1.0, 0.5, 0.0]), 0.013, 2, 10_000, periodic, None);
         let g = g.unwrap();
-        assert_eq!(g.reach, 1, "a periodic grid takes cells of 2h by default");
+        assert_eq!((g.reach, g.cells, g.slots), (2, [76, 39, 1], 4096));
+        assert!(g.contiguous_rows());
+        let g = Grid::new(&domain([1.0, 0.5, 0.0]), 0.013, 2, 1000, periodic, None);
+        let g = g.unwrap();
+        assert_eq!((g.reach, g.cells, g.slots), (1, [38, 20, 1], 1024));
+        assert!(g.contiguous_rows());
+        let g = Grid::new(&domain([4.0, 0.5, 0.0]), 0.013, 2, 1000, periodic, None);
+        let g = g.unwrap();
+        assert_eq!(
+            (g.reach, g.slots),
+            (1, 1024),
+            "a hashed periodic grid takes cells of 2h"
+        );
         assert!(!g.contiguous_rows());
         let half = Some(CellEdge::Half);
-        let e = Grid::new(&domain([1.0, 0.5, 0.0]), 0.013, 2, 10_000, periodic, half);
+        let e = Grid::new(&domain([4.0, 0.5, 0.0]), 0.013, 2, 1000, periodic, half);
         assert!(e
             .unwrap_err()
             .to_string()

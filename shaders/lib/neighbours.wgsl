@@ -4,7 +4,8 @@
 // (CELL_REACH 2): a point's neighbours are in the (2 CELL_REACH + 1)^DIM cells around its own.
 
 // Rows of the neighbourhood along x, each at most two ranges (a row that wraps past the slot
-// table's end); or, on a periodic grid (cells of 2h), one range per cell.
+// table's end or a periodic x axis); or, on a periodic grid with a hashed table (cells of 2h),
+// one range per cell.
 const MAX_RANGES: u32 = max(2u * u32(2 * CELL_REACH + 1) * u32(2 * CELL_REACH + 1), 27u);
 alias NeighbourRanges = array<vec2<u32>, MAX_RANGES>;
 
@@ -45,10 +46,29 @@ fn cell_gap(f: f32, d: i32) -> f32 {
     return select(0.0, max(f - f32(d + 1), 0.0), d < 0);
 }
 
+// The particles of `len` cells from `first` along x, whose slots follow each other (modulo the
+// table's size), as one range or, where they wrap past the table's end, two; empty ranges are
+// dropped. Returns the new count of ranges.
+fn push_row(ranges: ptr<function, NeighbourRanges>, n: u32, first: vec3<i32>, len: u32) -> u32 {
+    let table_end = params.hash_mask + 1u;
+    let s0 = slot_of_cell(first);
+    let s1 = s0 + len;
+    var m = n;
+    var pieces = array<vec2<u32>, 2>(vec2<u32>(s0, s1), vec2<u32>(0u, 0u));
+    if (s1 > table_end) {
+        pieces = array<vec2<u32>, 2>(vec2<u32>(s0, table_end), vec2<u32>(0u, s1 - table_end));
+    }
+    for (var k = 0; k < 2; k++) {
+        (*ranges)[m] = vec2<u32>(cell_start[pieces[k].x], cell_start[pieces[k].y]);
+        m += select(0u, 1u, (*ranges)[m].y > (*ranges)[m].x);
+    }
+    return m;
+}
+
 // The sorted particles within the support of `p`, and others, as index ranges [x, y).
 //
-// Where rows are contiguous (params.contiguous_rows: no periodic axis; the slot hash's strides
-// keep the cells of any neighbourhood in distinct slots, Grid::contiguous_rows) the cells of a row along x have
+// Where rows are contiguous (params.contiguous_rows: the slot hash's strides keep the cells of
+// any neighbourhood in distinct slots, Grid::contiguous_rows) the cells of a row along x have
 // consecutive slots, so a row is one range (two where it wraps past the table's end). A row
 // is cut to the cells the support's sphere reaches from `p` (none, when the row lies beyond
 // it): which cells a particle's neighbours can be in depends only on where it is, so the sum
@@ -57,44 +77,50 @@ fn cell_gap(f: f32, d: i32) -> f32 {
 // (cell_of clamps) and are left out; a slot may hold particles of far cells, which the
 // distance test rejects.
 //
-// Otherwise (a periodic axis: cells of 2h) one range per distinct slot of the 3^DIM cells
-// around.
+// On a periodic axis the rows wrap: y and z to the period's other side, and a row along a
+// periodic x in two (the cells past the period's end are the first ones). Rows then exist
+// only where every cell has its own slot (the linear index, below the table's end), so a row
+// is still at most two ranges; a period's cells may be wider than the reach's, which only
+// makes the cut keep more.
+//
+// Otherwise (a periodic grid with a hashed table: cells of 2h) one range per distinct slot of
+// the 3^DIM cells around.
 fn neighbour_ranges(p: Pos, ranges: ptr<function, NeighbourRanges>) -> u32 {
     let c = cell_of(p);
     var n = 0u;
     if (params.contiguous_rows != 0u) {
         let g = vec3<i32>(params.grid_cells);
+        let wraps = periodic_axes();
         // Where `p` is in its cell, in cells (`cell_of`'s local cell).
         let cells = p.off * params.inv_cell_size;
         let f = cells - clamp(floor(cells), vec3<f32>(0.0), vec3<f32>(f32(params.cells_per_block - 1u)));
         let reach2 = f32(CELL_REACH * CELL_REACH);
         let zr = select(0, CELL_REACH, DIM == 3u);
-        let table_end = params.hash_mask + 1u;
         for (var dz = -zr; dz <= zr; dz++) {
             let gz = cell_gap(f.z, dz);
             for (var dy = -CELL_REACH; dy <= CELL_REACH; dy++) {
-                let y = c.y + dy;
-                let z = c.z + dz;
                 let gy = cell_gap(f.y, dy);
                 let gap2 = gy * gy + gz * gz;
-                if (y < 0 || y >= g.y || z < 0 || z >= g.z || gap2 >= reach2) {
+                var yz = vec2<i32>(c.y + dy, c.z + dz);
+                yz = select(yz, (yz + g.yz) % g.yz, wraps.yz);
+                if (any(yz < vec2<i32>(0)) || any(yz >= g.yz) || gap2 >= reach2) {
                     continue;
                 }
                 let r = sqrt(reach2 - gap2);
-                let first = max(i32(floor(f.x - r)), -CELL_REACH);
-                let last = min(i32(floor(f.x + r)), CELL_REACH);
-                let x0 = max(c.x + first, 0);
-                let x1 = min(c.x + last, g.x - 1);
-                let s0 = slot_of_cell(vec3<i32>(x0, y, z));
-                let s1 = s0 + u32(x1 - x0) + 1u;
-                if (s1 <= table_end) {
-                    (*ranges)[n] = vec2<u32>(cell_start[s0], cell_start[s1]);
-                    n += select(0u, 1u, (*ranges)[n].y > (*ranges)[n].x);
-                } else {
-                    (*ranges)[n] = vec2<u32>(cell_start[s0], cell_start[table_end]);
-                    n += select(0u, 1u, (*ranges)[n].y > (*ranges)[n].x);
-                    (*ranges)[n] = vec2<u32>(cell_start[0], cell_start[s1 - table_end]);
-                    n += select(0u, 1u, (*ranges)[n].y > (*ranges)[n].x);
+                var x0 = c.x + max(i32(floor(f.x - r)), -CELL_REACH);
+                var x1 = c.x + min(i32(floor(f.x + r)), CELL_REACH);
+                if (wraps.x && x0 < 0) {
+                    n = push_row(ranges, n, vec3<i32>(x0 + g.x, yz), u32(-x0));
+                    x0 = 0;
+                } else if (wraps.x && x1 >= g.x) {
+                    n = push_row(ranges, n, vec3<i32>(0, yz), u32(x1 - g.x + 1));
+                    x1 = g.x - 1;
+                }
+                x0 = max(x0, 0);
+                x1 = min(x1, g.x - 1);
+                // (Empty only for a point past the far face, in the last cell: x0 = g.x.)
+                if (x0 <= x1) {
+                    n = push_row(ranges, n, vec3<i32>(x0, yz), u32(x1 - x0 + 1));
                 }
             }
         }
