@@ -197,6 +197,10 @@ fn assert_no_penetration(o: &Outcome) {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 1 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn fixed_ghost_mls_no_slip() {
     let o = tank_with(FIXED_GHOST_MLS);
     assert_steady(&o);
@@ -205,6 +209,10 @@ fn fixed_ghost_mls_no_slip() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 0.8 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn fixed_ghost_shepard_free_slip() {
     let o = tank_with(FIXED_GHOST_SHEPARD);
     assert_steady(&o);
@@ -214,6 +222,10 @@ fn fixed_ghost_shepard_free_slip() {
 
 /// Mirror planes have no particles for the floor sensor: the bottom probe only.
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 1.2 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn mirror_free_slip() {
     let o = tank_with(MIRROR);
     assert_steady(&o);
@@ -259,6 +271,10 @@ fn repulsive_holds_the_water() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 0.7 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn repulsive_monaghan_kajtar_holds_the_water() {
     let o = hydrostatic(&[
         "tank.wall=\"repulsive\"",
@@ -383,6 +399,10 @@ fn water_at_rest_does_not_sink_with_the_default_diffusion() {
 /// The contrast the test above guards: with the whole density difference diffused, the same
 /// tank sinks by more than five times what the default form may.
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 1.2 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn water_at_rest_sinks_with_whole_difference_diffusion() {
     let fall = sinking(Some("molteni_colagrossi"));
     println!(
@@ -405,6 +425,10 @@ const STILL: f64 = 2e-4;
 /// over (1, 2] s, and the floor sensor within ±1 % of the weight. With the whole density
 /// difference diffused (the default until issue 36) the probe read −12.4 %, falling.
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 3.5 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn a_still_3d_tank_keeps_its_bottom_pressure_with_the_defaults() {
     let set = hydrostatic::overrides_3d(Mode::Quick).unwrap();
     let sc = wgsph::case::load(Path::new("cases/hydrostatic_3d.toml"), &set).unwrap();
@@ -540,6 +564,10 @@ fn a_submerged_inlet_takes_the_pressure_of_the_water_around_it() {
 /// is cut from the kernel sums of the column's particles. Bound 2 %: a sensor within 2h of an
 /// edge is not resolved by the kernel.
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 1.3 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn sensors_by_an_edge_read_the_water_on_their_own_face() {
     let text = r#"dimension = 2
 [particles]

@@ -27,6 +27,10 @@ fn sample(sc: &Scenario, every: f64, end: f64) -> Vec<(f64, Pose)> {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 2.5 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn floating_box_settles_near_the_archimedes_draft_coarse() {
     // dx = 0.02 m: the box is 5 particles high (fixed ghosts; measured −10.6 %, dynamic
     // particles ride higher, −19 %). Mean draft over 1-2 s within 25 % of Archimedes'.
@@ -131,6 +135,10 @@ fn fixed_lift(shape: &str, area: f64, wall: &str, dx: f64) -> f64 {
 /// settled around it (docs/validation.md has boxes and circles, dynamic particles and a finer
 /// resolution).
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 4 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn a_fixed_submerged_diamond_feels_its_buoyancy() {
     let diamond =
         "shape = \"polygon\"\nvertices_m = [[0.2, 0.2], [0.3, 0.12], [0.4, 0.2], [0.3, 0.28]]";
@@ -178,6 +186,10 @@ fn water_entry_penetration_within_10_percent_fine() {
 /// sign, the depth is the same. The particle set is symmetric, so only the order of the f32
 /// sums differs. And the entry slows the cylinder down sideways as well as downwards.
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 2 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn oblique_entry_paths_mirror_each_other() {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/water_entry_oblique_2d.toml");

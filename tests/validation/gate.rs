@@ -13,6 +13,10 @@ use wgsph::validation::Mode;
 /// 40 and 80 ms (bound 10 % of the peak measured) and the published solutions' band (10 %).
 /// About 27 500 steps of 6 400 particles, 4 minutes on lavapipe.
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 20 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn elastic_gate_opens_as_measured_coarse() {
     let (o, _dir) = validate_case("elastic_gate_2d", Mode::Quick, Mode::Quick, "quick");
     assert!(o.passed(), "{}", crate::common::rows(&o));

@@ -19,6 +19,10 @@ fn run(tag: &str, bounds: Mode) -> (CaseOutcome, crate::common::Scratch) {
 /// particle lost (`validation::lobovsky`, quick bounds); sensor 3's impact time and averaged
 /// peak to the same bounds, from its particle probe and from its wall-force sensor.
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 3 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn lobovsky_sensor1_first_impact_matches_experiment() {
     let (o, _dir) = run("impact", Mode::Quick);
     assert!(o.passed(), "{}", crate::common::rows(&o));

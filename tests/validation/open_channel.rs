@@ -86,6 +86,10 @@ fn overfall(dx: f64, end_s: f64) -> (Steady, [f64; 3]) {
 /// what the inlet brings (to the discreteness of the nappe: a layer of the inflow is 1.6 % of
 /// the second's); the depths are reported.
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 2 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn overfall_outlet_drains_what_the_inlet_brings_coarse() {
     let (o, _) = overfall(0.01, 4.0);
     assert_eq!(o.escaped, 0, "no particle escapes the domain");
@@ -258,6 +262,10 @@ fn street_flood_strikes_the_building_coarse() {
 /// The standing contact with the street's floor and wall, which a fixed body no longer takes,
 /// put 2·10⁵ N on it.
 #[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: about 3.5 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
+)]
 fn a_mesh_building_takes_the_flood_load_not_the_streets() {
     let set = ["particles.dx_m=0.04", "time.end_s=1.2"].map(String::from);
     let sc = wgsph::case::load(Path::new("cases/street_flood_mesh_3d.toml"), &set).unwrap();
