@@ -85,19 +85,18 @@ pub fn neighbour_work(grid: &Grid, dim: u32, h: f64, particles: &Particles) -> N
 fn slots_around(grid: &Grid, dim: u32, c: [i64; 3], f: [f32; 3]) -> Vec<u32> {
     let g = grid.cells.map(|n| n as i64);
     let mut slots = Vec::new();
-    // A cell's index along each axis, wrapped on a periodic one; `None` outside the grid.
-    let inside = |n: [i64; 3]| -> Option<[i64; 3]> {
-        let mut w = n;
-        for a in 0..3 {
+    // A cell's index along each axis, wrapped on a periodic one.
+    let wrap = |n: [i64; 3]| -> [i64; 3] {
+        [0, 1, 2].map(|a| {
             if grid.periodic[a] {
-                w[a] = n[a].rem_euclid(g[a]);
+                n[a].rem_euclid(g[a])
+            } else {
+                n[a]
             }
-            if w[a] < 0 || w[a] >= g[a] {
-                return None;
-            }
-        }
-        Some(w)
+        })
     };
+    // The same, `None` outside the grid.
+    let inside = |n: [i64; 3]| Some(wrap(n)).filter(|w| (0..3).all(|a| (0..g[a]).contains(&w[a])));
     if grid.contiguous_rows() {
         let r = grid.reach as i64;
         let zr = if dim == 3 { r } else { 0 };
@@ -121,13 +120,7 @@ fn slots_around(grid: &Grid, dim: u32, c: [i64; 3], f: [f32; 3]) -> Vec<u32> {
     for dz in -zr..=zr {
         for dy in -1..=1 {
             for dx in -1..=1 {
-                let mut n = [c[0] + dx, c[1] + dy, c[2] + dz];
-                for a in 0..3 {
-                    if grid.periodic[a] {
-                        n[a] = n[a].rem_euclid(g[a]);
-                    }
-                }
-                let s = grid.slot_of_cell(n);
+                let s = grid.slot_of_cell(wrap([c[0] + dx, c[1] + dy, c[2] + dz]));
                 if !slots.contains(&s) {
                     slots.push(s);
                 }

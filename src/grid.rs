@@ -163,7 +163,7 @@ impl Grid {
                 // The cells around a cell must be distinct cells (no image counted twice).
                 if n < (2 * reach + 1) as f64 {
                     let least = (2 * reach + 1) as f64 * edge;
-                    bail!("the periodic axis {a} is {} m long: at least {least} m ({} cells of {edge} m) are needed", extent[a], 2 * reach + 1);
+                    bail!("the periodic axis {a} is {} m long: at least {least:.4} m ({} cells of {edge:.4} m) are needed", extent[a], 2 * reach + 1);
                 }
                 cell_size[a] = extent[a] / n;
             }
