@@ -1,9 +1,10 @@
 // Cell-list neighbour search, every step: cell key + atomic histogram, (prefix scan in
 // prefix_scan.wgsl), scatter, deterministic rank within each slot, reorder of particle arrays.
-// The order within a slot is by particle id: it depends neither on the atomics (which only
-// decide a provisional placement) nor on where a particle was in the arrays before, so the
-// same particles give the same order however they were stored (a subdomain's particles with
-// its neighbours' halo among them sum in the same order as in one whole run).
+// The order within a slot is by code word (kind, then particle id: a slot's fluid first): it
+// depends neither on the atomics (which only decide a provisional placement) nor on where a
+// particle was in the arrays before, so the same particles give the same order however they
+// were stored (a subdomain's particles with its neighbours' halo among them sum in the same
+// order as in one whole run).
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> code: array<u32>;
@@ -55,9 +56,11 @@ fn scatter(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     provisional[cell_start[sort_slot(i)] + local_rank[i]] = i;
 }
 
-// Final place = slot start + number of particles of the same slot with a smaller id (ids are
-// unique). O(n_slot) per particle; the excluded and free slots keep their provisional order
-// (their particles never interact, and outputs are written in id order).
+// Final place = slot start + number of particles of the same slot with a smaller code word
+// (kind, then id: ids are unique), so a slot holds its fluid first (shaders/lib/neighbours.wgsl)
+// and the order depends only on which particles there are. O(n_slot) per particle; the excluded
+// and free slots keep their provisional order (their particles never interact, and outputs are
+// written in id order).
 @compute @workgroup_size(WG)
 fn rank_in_cell(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let p = linear_index(gid, nwg);
@@ -72,10 +75,10 @@ fn rank_in_cell(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         return;
     }
     let end = cell_start[key + 1u];
-    let id = code[i] & ID_MASK;
+    let word = code[i];
     var rank = 0u;
     for (var q = start; q < end; q++) {
-        rank += select(0u, 1u, (code[provisional[q]] & ID_MASK) < id);
+        rank += select(0u, 1u, code[provisional[q]] < word);
     }
     perm[start + rank] = i;
 }

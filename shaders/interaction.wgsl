@@ -345,31 +345,34 @@ fn image_rates(pi: Particle, p_i: Pos, image: vec3<f32>, chain: vec3<u32>, n: u3
     var out = PairRates(vec4<f32>(0.0), 0.0);
     let support2 = 4.0 * params.h * params.h;
     let at = pos_of_point(image);
-    var ranges: NeighbourRanges;
-    let n_ranges = neighbour_ranges(at, &ranges);
-    for (var s = 0u; s < n_ranges; s++) {
-        for (var j = ranges[s].x; j < ranges[s].y; j++) {
-            if (code_kind(code[j]) != KIND_FLUID) {
-                continue;
+    // The fluid of each slot around, which comes first in it (shaders/lib/neighbours.wgsl).
+    var rows: NeighbourRanges;
+    let n_rows = neighbour_rows(at, &rows);
+    for (var r = 0u; r < n_rows; r++) {
+        var end = cell_start[rows[r].x];
+        for (var s = rows[r].x; s < rows[r].y; s++) {
+            var j = end;
+            end = cell_start[s + 1u];
+            for (; j < end && code_kind(code[j]) == KIND_FLUID; j++) {
+                let x = rel_pos(at, pos[j]);
+                let r2 = dot(x, x);
+                if (r2 >= support2) {
+                    continue;
+                }
+                var x_ig = x;
+                var v_cont = velrho[j].xyz;
+                var v_visc = v_cont;
+                for (var c = n; c > 0u; c--) {
+                    let plane = tables.mirror_planes[chain[c - 1u]];
+                    x_ig = reflect_vec(x_ig, plane.normal);
+                    v_cont = reflect_vec(v_cont, plane.normal);
+                    v_visc = ghost_velocity(v_visc, plane);
+                }
+                let psi = diffused_density(pi.rho, velrho[j].w, rel_pos(p_i, pos[j]));
+                let pr = pair_rates(pi, x_ig, r2, v_cont, v_visc, velrho[j].w, psi, 1.0);
+                out.rate += pr.rate;
+                out.de += pr.de;
             }
-            let x = rel_pos(at, pos[j]);
-            let r2 = dot(x, x);
-            if (r2 >= support2) {
-                continue;
-            }
-            var x_ig = x;
-            var v_cont = velrho[j].xyz;
-            var v_visc = v_cont;
-            for (var c = n; c > 0u; c--) {
-                let plane = tables.mirror_planes[chain[c - 1u]];
-                x_ig = reflect_vec(x_ig, plane.normal);
-                v_cont = reflect_vec(v_cont, plane.normal);
-                v_visc = ghost_velocity(v_visc, plane);
-            }
-            let psi = diffused_density(pi.rho, velrho[j].w, rel_pos(p_i, pos[j]));
-            let pr = pair_rates(pi, x_ig, r2, v_cont, v_visc, velrho[j].w, psi, 1.0);
-            out.rate += pr.rate;
-            out.de += pr.de;
         }
     }
     return out;
@@ -410,11 +413,38 @@ fn mirror_rates(i: u32, pi: Particle) -> PairRates {
     return out;
 }
 
-// The rates of a boundary particle i (dynamic wall, or one that takes the fluid's force: a
-// body's particle of any wall treatment, a fixed wall's with WALL_REACTIONS): a dynamic wall's
-// dρ/dt from the fluid (eq. 22), the reaction to the fluid's force (for bodies.wgsl's load and
-// the wall sensors) and a body particle's contact with walls, other bodies and solids (eq. 24).
-fn boundary_rates(i: u32, kind_i: u32, reacts: bool, on_body: bool, ranges: ptr<function, NeighbourRanges>, n_ranges: u32) -> vec4<f32> {
+// dρ/dt of a fixed dynamic wall particle, eq. 22: continuity from the fluid alone. A slot holds
+// its fluid first (shaders/lib/neighbours.wgsl), so the loop leaves each slot at its first
+// particle of another kind and never tests the walls around.
+fn wall_continuity(i: u32) -> f32 {
+    let p_i = pos[i];
+    let v_i = velrho[i].xyz;
+    let support2 = 4.0 * params.h * params.h;
+    var rows: NeighbourRanges;
+    let n_rows = neighbour_rows(p_i, &rows);
+    var drho = 0.0;
+    for (var r = 0u; r < n_rows; r++) {
+        var end = cell_start[rows[r].x];
+        for (var s = rows[r].x; s < rows[r].y; s++) {
+            var j = end;
+            end = cell_start[s + 1u];
+            for (; j < end && code_kind(code[j]) == KIND_FLUID; j++) {
+                let x_ij = rel_pos(p_i, pos[j]);
+                let r2 = dot(x_ij, x_ij);
+                if (r2 < support2) {
+                    drho += params.mass * dot(v_i - velrho[j].xyz, x_ij * kernel_f(sqrt(r2) / params.h));
+                }
+            }
+        }
+    }
+    return drho;
+}
+
+// The rates of a boundary particle i that takes the fluid's force (a body's particle of any
+// wall treatment, a fixed wall's with WALL_REACTIONS): a dynamic one's dρ/dt from the fluid
+// (eq. 22), the reaction to the fluid's force (for bodies.wgsl's load and the wall
+// sensors) and a body particle's contact with walls, other bodies and solids (eq. 24).
+fn boundary_rates(i: u32, kind_i: u32, on_body: bool, ranges: ptr<function, NeighbourRanges>, n_ranges: u32) -> vec4<f32> {
     let id_i = code[i] & ID_MASK;
     var body_i = NO_BODY;
     var kinematic_i = false;
@@ -434,7 +464,7 @@ fn boundary_rates(i: u32, kind_i: u32, reacts: bool, on_body: bool, ranges: ptr<
     // Under a sensor on a fixed wall, only the fluid over the sensor's face loads i.
     var sensor = NO_SENSOR;
     var x_i = vec3<f32>(0.0);
-    if (WALL_REACTIONS && reacts && !on_body) {
+    if (WALL_REACTIONS && !on_body) {
         x_i = domain_pos(p_i);
         sensor = owning_sensor(x_i);
     }
@@ -455,10 +485,7 @@ fn boundary_rates(i: u32, kind_i: u32, reacts: bool, on_body: bool, ranges: ptr<
             if (kind_j == KIND_FLUID) {
                 let vr_j = velrho[j];
                 let loads = sensor == NO_SENSOR || faces_sensor(tables.wall_sensors[sensor], x_i - x_ij);
-                if (!reacts) {
-                    // Fixed dynamic wall particle: continuity only.
-                    r.w += params.mass * dot(pi.v - vr_j.xyz, x_ij * kernel_f(sqrt(r2) / params.h));
-                } else if (is_repulsive(kind_i)) {
+                if (is_repulsive(kind_i)) {
                     // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
                     if (loads) {
                         r += vec4<f32>(repulsion(x_ij, r2), 0.0);
@@ -581,10 +608,14 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let on_body = kind_i != KIND_EXCLUDED && is_body_particle(code[i] & ID_MASK);
     // Boundary particles that take the fluid's force: bodies', and fixed walls' for probes.
     let reacts = on_body || (WALL_REACTIONS && kind_i != KIND_EXCLUDED && kind_i != KIND_INLET);
-    if (kind_i != KIND_WALL && !reacts) {
-        rate[i] = vec4<f32>(0.0);
+    if (!reacts) {
+        var drho = 0.0;
+        if (kind_i == KIND_WALL) {
+            drho = wall_continuity(i);
+        }
+        rate[i] = vec4<f32>(0.0, 0.0, 0.0, drho);
         return;
     }
     let n_ranges = neighbour_ranges(pos[i], &ranges);
-    rate[i] = boundary_rates(i, kind_i, reacts, on_body, &ranges, n_ranges);
+    rate[i] = boundary_rates(i, kind_i, on_body, &ranges, n_ranges);
 }

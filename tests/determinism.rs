@@ -1,5 +1,5 @@
 //! The same input on the same adapter gives bit-identical results (no float atomics; the sort
-//! orders each slot by particle id).
+//! orders each slot by code word: kind, then particle id).
 
 mod common;
 use common::gpu;

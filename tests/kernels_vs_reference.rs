@@ -180,13 +180,15 @@ fn cell_list_sort_matches_reference_exactly() {
         let sc = random_scenario(&s);
         let solver = Solver::new(gpu(), &sc).unwrap();
         // The warm-up step sorted the initial (id-ordered) particles once: the GPU order must
-        // be the stable sort of the ids by slot.
+        // be the sort of the code words (kind, id) by slot.
         let grid = &solver.grid;
         let init: Vec<([f32; 3], [u32; 3])> =
             sc.particles.iter().map(|p| grid.to_block(p.pos)).collect();
         let keys = reference::cell_list::cell_key(grid, &init, &vec![false; init.len()]);
-        let ids: Vec<u32> = (0..init.len() as u32).collect();
-        let (order, start) = reference::cell_list::sorted_order(grid, &keys, &ids);
+        let codes: Vec<u32> = (sc.particles.iter().enumerate())
+            .map(|(id, p)| (p.kind as u32) << KIND_SHIFT | id as u32)
+            .collect();
+        let (order, start) = reference::cell_list::sorted_order(grid, &keys, &codes);
         let (_, _, code) = solver.read_raw().unwrap();
         let ids: Vec<usize> = code.iter().map(|c| (c & ID_MASK) as usize).collect();
         assert_eq!(ids, order, "dim {} domain {}", s.dim, s.domain);
@@ -209,10 +211,11 @@ fn cell_list_sort_matches_reference_exactly() {
 }
 
 /// After particles have moved for some steps, the arrays' previous order is no longer the ids'
-/// order; the sort still orders each slot by id, whatever order the particles came in (what
-/// makes a subdomain sum its neighbours in the same order as a whole run).
+/// order; the sort still orders each slot by code word (kind, id), whatever order the particles
+/// came in (what makes a subdomain sum its neighbours in the same order as a whole run, and
+/// puts a slot's fluid first).
 #[test]
-fn cell_list_orders_each_slot_by_id_after_motion() {
+fn cell_list_orders_each_slot_by_code_after_motion() {
     for s in setups() {
         let sc = random_scenario(&s);
         let mut solver = Solver::new(gpu(), &sc).unwrap();
@@ -227,13 +230,12 @@ fn cell_list_orders_each_slot_by_id_after_motion() {
             .map(|c| c >> KIND_SHIFT == KIND_EXCLUDED)
             .collect();
         let keys = reference::cell_list::cell_key(grid, &at, &excluded);
-        let ids: Vec<u32> = code.iter().map(|c| c & ID_MASK).collect();
-        let (order, start) = reference::cell_list::sorted_order(grid, &keys, &ids);
+        let (order, start) = reference::cell_list::sorted_order(grid, &keys, &code);
         let active = start[grid.slots as usize] as usize;
         assert_eq!(
             order[..active].to_vec(),
             (0..active).collect::<Vec<_>>(),
-            "dim {} domain {}: not ordered by (slot, id)",
+            "dim {} domain {}: not ordered by (slot, code)",
             s.dim,
             s.domain
         );

@@ -2,6 +2,12 @@
 // around a point. The pass file declares `cell_start` (slot s holds the sorted particles
 // cell_start[s] .. cell_start[s + 1]). Cells are the support 2h (CELL_REACH 1) or h
 // (CELL_REACH 2): a point's neighbours are in the (2 CELL_REACH + 1)^DIM cells around its own.
+//
+// A slot's particles are ordered by code word (cell_list.wgsl's `rank_in_cell`), so its fluid,
+// of kind 0, comes first: a sum over the fluid alone walks the slots of `neighbour_rows` one by
+// one and leaves each at its first particle of another kind, never testing the walls around
+// (most of a wall particle's neighbours, and most particles of a tank are walls), as
+// DualSPHysics' cell lists keep boundary and fluid particles apart.
 
 // Rows of the neighbourhood along x, each at most two ranges (a row that wraps past the slot
 // table's end or a periodic x axis); or, on a periodic grid with a hashed table (cells of 2h),
@@ -46,30 +52,28 @@ fn cell_gap(f: f32, d: i32) -> f32 {
     return select(0.0, max(f - f32(d + 1), 0.0), d < 0);
 }
 
-// The particles of `len` cells from `first` along x, whose slots follow each other (modulo the
-// table's size), as one range or, where they wrap past the table's end, two; empty ranges are
-// dropped. Returns the new count of ranges.
-fn push_row(ranges: ptr<function, NeighbourRanges>, n: u32, first: vec3<i32>, len: u32) -> u32 {
+// The `len` cells from `first` along x, whose slots follow each other (modulo the table's
+// size), as one run of slots or, where they wrap past the table's end, two. Returns the new
+// count of runs.
+fn push_row(rows: ptr<function, NeighbourRanges>, n: u32, first: vec3<i32>, len: u32) -> u32 {
     let table_end = params.hash_mask + 1u;
     let s0 = slot_of_cell(first);
     let s1 = s0 + len;
-    var m = n;
-    var pieces = array<vec2<u32>, 2>(vec2<u32>(s0, s1), vec2<u32>(0u, 0u));
-    if (s1 > table_end) {
-        pieces = array<vec2<u32>, 2>(vec2<u32>(s0, table_end), vec2<u32>(0u, s1 - table_end));
+    if (s1 <= table_end) {
+        (*rows)[n] = vec2<u32>(s0, s1);
+        return n + 1u;
     }
-    for (var k = 0; k < 2; k++) {
-        (*ranges)[m] = vec2<u32>(cell_start[pieces[k].x], cell_start[pieces[k].y]);
-        m += select(0u, 1u, (*ranges)[m].y > (*ranges)[m].x);
-    }
-    return m;
+    (*rows)[n] = vec2<u32>(s0, table_end);
+    (*rows)[n + 1u] = vec2<u32>(0u, s1 - table_end);
+    return n + 2u;
 }
 
-// The sorted particles within the support of `p`, and others, as index ranges [x, y).
+// The slots of the cells around `p` that can hold particles within its support, as runs of
+// consecutive slots [x, y).
 //
 // Where rows are contiguous (params.contiguous_rows: the slot hash's strides keep the cells of
 // any neighbourhood in distinct slots, Grid::contiguous_rows) the cells of a row along x have
-// consecutive slots, so a row is one range (two where it wraps past the table's end). A row
+// consecutive slots, so a row is one run (two where it wraps past the table's end). A row
 // is cut to the cells the support's sphere reaches from `p` (none, when the row lies beyond
 // it): which cells a particle's neighbours can be in depends only on where it is, so the sum
 // over the neighbours keeps its order. The reach is CELL_REACH cells, a support and a margin
@@ -80,12 +84,12 @@ fn push_row(ranges: ptr<function, NeighbourRanges>, n: u32, first: vec3<i32>, le
 // On a periodic axis the rows wrap: y and z to the period's other side, and a row along a
 // periodic x in two (the cells past the period's end are the first ones). Rows then exist
 // only where every cell has its own slot (the linear index, below the table's end), so a row
-// is still at most two ranges; a period's cells may be wider than the reach's, which only
+// is still at most two runs; a period's cells may be wider than the reach's, which only
 // makes the cut keep more.
 //
-// Otherwise (a periodic grid with a hashed table: cells of 2h) one range per distinct slot of
+// Otherwise (a periodic grid with a hashed table: cells of 2h) one run per distinct slot of
 // the 3^DIM cells around.
-fn neighbour_ranges(p: Pos, ranges: ptr<function, NeighbourRanges>) -> u32 {
+fn neighbour_rows(p: Pos, rows: ptr<function, NeighbourRanges>) -> u32 {
     let c = cell_of(p);
     var n = 0u;
     if (params.contiguous_rows != 0u) {
@@ -110,17 +114,17 @@ fn neighbour_ranges(p: Pos, ranges: ptr<function, NeighbourRanges>) -> u32 {
                 var x0 = c.x + max(i32(floor(f.x - r)), -CELL_REACH);
                 var x1 = c.x + min(i32(floor(f.x + r)), CELL_REACH);
                 if (wraps.x && x0 < 0) {
-                    n = push_row(ranges, n, vec3<i32>(x0 + g.x, yz), u32(-x0));
+                    n = push_row(rows, n, vec3<i32>(x0 + g.x, yz), u32(-x0));
                     x0 = 0;
                 } else if (wraps.x && x1 >= g.x) {
-                    n = push_row(ranges, n, vec3<i32>(0, yz), u32(x1 - g.x + 1));
+                    n = push_row(rows, n, vec3<i32>(0, yz), u32(x1 - g.x + 1));
                     x1 = g.x - 1;
                 }
                 x0 = max(x0, 0);
                 x1 = min(x1, g.x - 1);
                 // (Empty only for a point past the far face, in the last cell: x0 = g.x.)
                 if (x0 <= x1) {
-                    n = push_row(ranges, n, vec3<i32>(x0, yz), u32(x1 - x0 + 1));
+                    n = push_row(rows, n, vec3<i32>(x0, yz), u32(x1 - x0 + 1));
                 }
             }
         }
@@ -129,7 +133,20 @@ fn neighbour_ranges(p: Pos, ranges: ptr<function, NeighbourRanges>) -> u32 {
     var slots: array<u32, 27>;
     let n_slots = neighbour_slots(c, &slots);
     for (var s = 0u; s < n_slots; s++) {
-        (*ranges)[s] = vec2<u32>(cell_start[slots[s]], cell_start[slots[s] + 1u]);
+        (*rows)[s] = vec2<u32>(slots[s], slots[s] + 1u);
     }
     return n_slots;
+}
+
+// The sorted particles of the cells around `p` (`neighbour_rows`), as index ranges [x, y): a
+// run of slots is one range of the sorted arrays; empty ones are dropped.
+fn neighbour_ranges(p: Pos, ranges: ptr<function, NeighbourRanges>) -> u32 {
+    let n_rows = neighbour_rows(p, ranges);
+    var n = 0u;
+    for (var r = 0u; r < n_rows; r++) {
+        let run = (*ranges)[r];
+        (*ranges)[n] = vec2<u32>(cell_start[run.x], cell_start[run.y]);
+        n += select(0u, 1u, (*ranges)[n].y > (*ranges)[n].x);
+    }
+    return n;
 }

@@ -17,12 +17,13 @@ pub fn cell_key(grid: &Grid, pos: &[([f32; 3], [u32; 3])], excluded: &[bool]) ->
         .collect()
 }
 
-/// The order the GPU sort must produce: by slot, ties by particle id (`ids[i]` of the particle
-/// stored at i); and the slot starts (slots + 3 entries). Excluded particles (the extra slots)
-/// are not ordered by the GPU, so callers compare them as a set.
-pub fn sorted_order(grid: &Grid, keys: &[u32], ids: &[u32]) -> (Vec<usize>, Vec<u32>) {
+/// The order the GPU sort must produce: by slot, ties by code word (`codes[i]` of the particle
+/// stored at i: kind, then id, so a slot's fluid comes first); and the slot starts (slots + 3
+/// entries). Excluded particles (the extra slots) are not ordered by the GPU, so callers
+/// compare them as a set.
+pub fn sorted_order(grid: &Grid, keys: &[u32], codes: &[u32]) -> (Vec<usize>, Vec<u32>) {
     let mut order: Vec<usize> = (0..keys.len()).collect();
-    order.sort_by_key(|&i| (keys[i], ids[i]));
+    order.sort_by_key(|&i| (keys[i], codes[i]));
     let mut counts = vec![0u32; grid.slots as usize + 3];
     for &k in keys {
         counts[k as usize] += 1;

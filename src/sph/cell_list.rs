@@ -114,7 +114,8 @@ impl CellList {
         self.cell_key.dispatch(pass, p, self.n);
     }
 
-    /// Each particle's place in the sorted order: after the slots, then by id within its slot.
+    /// Each particle's place in the sorted order: after the slots, then by code word (kind,
+    /// then id) within its slot.
     pub fn encode_scatter(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.scatter.dispatch(pass, p, self.n);
         self.rank_in_cell.dispatch(pass, p, self.n);

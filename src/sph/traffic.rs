@@ -221,9 +221,11 @@ pub fn stage_cost(name: &str, c: &StepCounts) -> Option<StageCost> {
         },
         // interaction.wgsl: code, pos, velrho of i, its rate (and de/dt) written; the loop
         // loads each candidate's pos before the distance test, and a neighbour's code and
-        // velrho (a fluid particle's loop: a wall's loads velrho of fluid neighbours only, so
-        // this is the upper figure for walls). Ghosts (and inlets) write a zero rate only; they
-        // are counted with the rest for their code and pos.
+        // velrho (a fluid particle's loop; a fixed dynamic wall's, `wall_continuity`, tests
+        // only the fluid of each slot, loading a candidate's code before its pos and a
+        // neighbour's velrho: 4 B more a candidate and 4 B less a neighbour, and a code word
+        // a slot, left out here). Ghosts (and inlets) write a zero rate only; they are counted
+        // with the rest for their code and pos.
         "interaction" => StageCost {
             per_particle: Bytes::new(WORD + POS + VEC4, VEC4 + c.energy_bytes(WORD)),
             neighbour_loop: Some(NeighbourLoop {
