@@ -443,8 +443,10 @@ fn wall_continuity(i: u32) -> f32 {
 // The rates of a boundary particle i that takes the fluid's force (a body's particle of any
 // wall treatment, a fixed wall's with WALL_REACTIONS): a dynamic one's dρ/dt from the fluid
 // (eq. 22), the reaction to the fluid's force (for bodies.wgsl's load and the wall
-// sensors) and a body particle's contact with walls, other bodies and solids (eq. 24).
-fn boundary_rates(i: u32, kind_i: u32, on_body: bool, ranges: ptr<function, NeighbourRanges>, n_ranges: u32) -> vec4<f32> {
+// sensors) and a body particle's contact with walls, other bodies and solids (eq. 24). A fixed
+// wall's particle has no contact, so it leaves each slot at the slot's last fluid particle,
+// as `wall_continuity` does.
+fn boundary_rates(i: u32, kind_i: u32, on_body: bool) -> vec4<f32> {
     let id_i = code[i] & ID_MASK;
     var body_i = NO_BODY;
     var kinematic_i = false;
@@ -474,38 +476,45 @@ fn boundary_rates(i: u32, kind_i: u32, on_body: bool, ranges: ptr<function, Neig
         v_contact_i = contact_velocity(i);
     }
     var r = vec4<f32>(0.0);
-    for (var s = 0u; s < n_ranges; s++) {
-        for (var j = (*ranges)[s].x; j < (*ranges)[s].y; j++) {
-            let x_ij = rel_pos(p_i, pos[j]);
-            let r2 = dot(x_ij, x_ij);
-            if (r2 >= support2 || j == i) {
-                continue;
-            }
-            let kind_j = code_kind(code[j]);
-            if (kind_j == KIND_FLUID) {
-                let vr_j = velrho[j];
-                let loads = sensor == NO_SENSOR || faces_sensor(tables.wall_sensors[sensor], x_i - x_ij);
-                if (is_repulsive(kind_i)) {
-                    // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
-                    if (loads) {
-                        r += vec4<f32>(repulsion(x_ij, r2), 0.0);
-                    }
-                } else {
-                    // The reaction to the fluid's pressure and viscous force; a dynamic body
-                    // particle also its dρ/dt (ghosts have none).
-                    let pr = pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, 0.0, 1.0).rate;
-                    let force = select(vec3<f32>(0.0), pr.xyz, loads);
-                    r += vec4<f32>(force, select(0.0, pr.w, kind_i == KIND_WALL));
+    var rows: NeighbourRanges;
+    let n_rows = neighbour_rows(p_i, &rows);
+    for (var row = 0u; row < n_rows; row++) {
+        var end = cell_start[rows[row].x];
+        for (var s = rows[row].x; s < rows[row].y; s++) {
+            var j = end;
+            end = cell_start[s + 1u];
+            for (; j < end && (on_body || code_kind(code[j]) == KIND_FLUID); j++) {
+                let x_ij = rel_pos(p_i, pos[j]);
+                let r2 = dot(x_ij, x_ij);
+                if (r2 >= support2 || j == i) {
+                    continue;
                 }
-            } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
-                // Contact with an elastic solid.
-                let s_j = solid[solid_slot(code[j])];
-                let mu = friction_between(1u + body_i, params.friction_first_solid + s_j.body);
-                r += vec4<f32>(contact_weight(params.mass, material_of(s_j).mass) * contact(x_ij, r2, v_contact_i - velrho[j].xyz, mu), 0.0);
-            } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, code[j] & ID_MASK) && contact_counts(kinematic_i, code[j] & ID_MASK)) {
-                // Contact with a fixed wall or another body.
-                let mu = friction_between(1u + body_i, boundary_group(code[j] & ID_MASK));
-                r += vec4<f32>(contact(x_ij, r2, v_contact_i - contact_velocity(j), mu), 0.0);
+                let kind_j = code_kind(code[j]);
+                if (kind_j == KIND_FLUID) {
+                    let vr_j = velrho[j];
+                    let loads = sensor == NO_SENSOR || faces_sensor(tables.wall_sensors[sensor], x_i - x_ij);
+                    if (is_repulsive(kind_i)) {
+                        // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
+                        if (loads) {
+                            r += vec4<f32>(repulsion(x_ij, r2), 0.0);
+                        }
+                    } else {
+                        // The reaction to the fluid's pressure and viscous force; a dynamic
+                        // wall or body particle also its dρ/dt (ghosts have none).
+                        let pr = pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, 0.0, 1.0).rate;
+                        let force = select(vec3<f32>(0.0), pr.xyz, loads);
+                        r += vec4<f32>(force, select(0.0, pr.w, kind_i == KIND_WALL));
+                    }
+                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
+                    // Contact with an elastic solid.
+                    let s_j = solid[solid_slot(code[j])];
+                    let mu = friction_between(1u + body_i, params.friction_first_solid + s_j.body);
+                    r += vec4<f32>(contact_weight(params.mass, material_of(s_j).mass) * contact(x_ij, r2, v_contact_i - velrho[j].xyz, mu), 0.0);
+                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, code[j] & ID_MASK) && contact_counts(kinematic_i, code[j] & ID_MASK)) {
+                    // Contact with a fixed wall or another body.
+                    let mu = friction_between(1u + body_i, boundary_group(code[j] & ID_MASK));
+                    r += vec4<f32>(contact(x_ij, r2, v_contact_i - contact_velocity(j), mu), 0.0);
+                }
             }
         }
     }
@@ -598,9 +607,8 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         rate[i] = vec4<f32>(loads, 0.0);
         return;
     }
-    // One neighbour list, for fluid and boundary particles alike.
-    var ranges: NeighbourRanges;
     if (kind_i == KIND_FLUID) {
+        var ranges: NeighbourRanges;
         let n_ranges = neighbour_ranges(pos[i], &ranges);
         rate[i] = fluid_rates(i, &ranges, n_ranges);
         return;
@@ -616,6 +624,5 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         rate[i] = vec4<f32>(0.0, 0.0, 0.0, drho);
         return;
     }
-    let n_ranges = neighbour_ranges(pos[i], &ranges);
-    rate[i] = boundary_rates(i, kind_i, on_body, &ranges, n_ranges);
+    rate[i] = boundary_rates(i, kind_i, on_body);
 }

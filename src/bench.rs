@@ -32,7 +32,7 @@ pub struct NeighbourWork {
 /// the slots of the cells of each row around a particle's cell that its support reaches,
 /// inside the grid, otherwise the distinct slots of the 3^d cells around, with every particle
 /// a slot holds, or, for a particle whose loop sums the fluid alone (`fluid_only`, by index:
-/// a fixed dynamic wall's), only the slot's fluid (which the sort puts first; the code word
+/// a fixed boundary particle's), only the slot's fluid (which the sort puts first; the code word
 /// that ends the slot's fluid is not counted). Excluded particles are in no cell.
 pub fn neighbour_work(
     grid: &Grid,
@@ -207,10 +207,15 @@ pub fn measure(
     let wall_s = start.elapsed().as_secs_f64();
     let simulated_s = solver.time() - t0;
     let particles = solver.read_particles()?;
-    // interaction.wgsl's `wall_continuity`: a fixed dynamic wall that takes no force.
+    // Every loop of a fixed boundary particle or inlet sums the fluid alone (interaction.wgsl's
+    // `wall_continuity` and `boundary_rates`, ghost.wgsl's `fluid_at`); a body's and a
+    // solid's take every kind.
     let fluid_only: Vec<bool> = (particles.kind.iter().zip(&particles.id))
         .map(|(&k, &id)| {
-            k == Kind::Wall as u32 && !sc.walls.reactions && solver.body_of_id(id).is_none()
+            let takes_every_kind = [Kind::Fluid, Kind::Solid, Kind::SolidClamped]
+                .iter()
+                .any(|&kind| kind as u32 == k);
+            !takes_every_kind && solver.body_of_id(id).is_none()
         })
         .collect();
     let work = neighbour_work(
