@@ -54,9 +54,8 @@ fn cell_gap(f: f32, d: i32) -> f32 {
 
 // The `len` cells from `first` along x, whose slots follow each other (modulo the table's
 // size), as one run of slots or, where they wrap past the table's end, two. Returns the new
-// count of runs. Both entries are written and the count chosen by `select`, without a branch:
-// on lavapipe an early return here, inlined in every neighbour loop, made the 2D step 10×
-// slower.
+// count of runs. Both entries are written and the count chosen by `select`: a branch here,
+// inlined in every neighbour loop, slows them on SIMD adapters (docs/performance.md).
 fn push_row(rows: ptr<function, NeighbourRanges>, n: u32, first: vec3<i32>, len: u32) -> u32 {
     let table_end = params.hash_mask + 1u;
     let s0 = slot_of_cell(first);
