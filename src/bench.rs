@@ -212,10 +212,8 @@ pub fn measure(
     // solid's take every kind.
     let fluid_only: Vec<bool> = (particles.kind.iter().zip(&particles.id))
         .map(|(&k, &id)| {
-            let takes_every_kind = [Kind::Fluid, Kind::Solid, Kind::SolidClamped]
-                .iter()
-                .any(|&kind| kind as u32 == k);
-            !takes_every_kind && solver.body_of_id(id).is_none()
+            let fixed = Kind::from_code(k).is_some_and(|k| !k.is_fluid() && !k.is_solid());
+            fixed && solver.body_of_id(id).is_none()
         })
         .collect();
     let work = neighbour_work(
@@ -459,7 +457,6 @@ mod tests {
         assert!(without.neighbours < w.neighbours);
         // With the left half fixed walls that sum the fluid alone, a wall tests only the fluid
         // of its slots (none, deep in the walls); the fluid's loops are unchanged.
-        p.kind[50 * n + 50] = 0;
         let wall: Vec<bool> = p.pos.iter().map(|x| x[0] < 0.5).collect();
         p.kind = wall.iter().map(|&w| w as u32).collect();
         let all = neighbour_work(&grid, 2, h, &p, &vec![false; count]);

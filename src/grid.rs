@@ -235,9 +235,9 @@ impl Grid {
     /// Whether no two cells of any neighbourhood (the (2 reach + 1)^d cells around a cell)
     /// share a slot ([`hash_strides`]; on a periodic grid, whether every cell has its own
     /// slot): the cells of a row along x then have consecutive slots (modulo the table's size),
-    /// so `neighbour_ranges` (shaders/lib/neighbours.wgsl) takes a row as one range (two where
-    /// it wraps past the table's end or a periodic x axis) and needs no check for repeated
-    /// slots.
+    /// so `neighbour_rows` (shaders/lib/neighbours.wgsl) takes a row as one run of slots (two
+    /// where it wraps past the table's end or a periodic x axis) and needs no check for
+    /// repeated slots.
     pub fn contiguous_rows(&self) -> bool {
         self.rows
     }

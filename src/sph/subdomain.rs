@@ -6,8 +6,9 @@
 //! [`REBALANCE_EVERY`] steps they may move the cuts (`Solver::rebalance`).
 //!
 //! The grid, its slot table and the particle ids are the whole run's, and the sort orders each
-//! slot by code word (kind, then id), so an own particle sums the same neighbours in the same order as in one whole
-//! run: the ranks' particles together are bit-identical to it (tests/mpi.rs).
+//! slot by code word (kind, then id), so an own particle sums the same neighbours in the same
+//! order as in one whole run: the ranks' particles together are bit-identical to it
+//! (tests/mpi.rs).
 
 use std::ops::Range;
 
