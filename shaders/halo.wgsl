@@ -21,8 +21,9 @@
 // `halo_restore`, on the density filter's steps (which read the neighbours' corrected
 // densities): after the corrector the ranks pack their own halo particles again and swap them;
 // each copy the sort put in a cell and `halo_drop` excluded gets back its owner's code word
-// and corrected (v, ρ), found by id among the records received (sorted by id, in `halo_out`),
-// until `halo_drop` excludes it again after the filter.
+// and corrected density (the one field of a neighbour the filter reads besides its place),
+// found by id among the records received (sorted by id, in `halo_out`), until `halo_drop`
+// excludes it again after the filter.
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
@@ -176,7 +177,7 @@ fn halo_restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     }
     if (lo < n && (halo_out[lo].code & ID_MASK) == id) {
         code[i] = halo_out[lo].code;
-        velrho[i] = halo_out[lo].velrho;
+        velrho[i].w = halo_out[lo].velrho.w;
     }
 }
 

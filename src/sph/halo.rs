@@ -13,6 +13,7 @@ use crate::layout::{
     HaloCounts, HaloCtl, HaloRecord, DEST_MIGRANT, DEST_SOLID_STATE, DEST_UPPER, ID_MASK,
 };
 use crate::scenario::{InletPressure, Kind, Scenario};
+use bytemuck::{Pod, Zeroable};
 
 pub const SHADER: Shader = Shader {
     name: "halo",
@@ -99,6 +100,37 @@ pub struct Halo {
     /// Records `halo_out` holds.
     capacity: u32,
     n: u32,
+}
+
+/// What the density filter's exchange sends of a halo copy: its owner's code word and
+/// corrected density, all that `halo_restore` gives the copy back (the filter reads no other
+/// field of a neighbour's): 8 bytes a particle where a record is 64. Only the host and the
+/// ranks' messages hold it; the receiver uploads full records.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct FilterRecord {
+    pub code: u32,
+    pub rho: f32,
+}
+
+impl From<&HaloRecord> for FilterRecord {
+    fn from(r: &HaloRecord) -> Self {
+        Self {
+            code: r.code,
+            rho: r.velrho[3],
+        }
+    }
+}
+
+impl FilterRecord {
+    /// The record `halo_restore` reads: the code word and ρ, the rest zero.
+    pub fn restored(&self) -> HaloRecord {
+        HaloRecord {
+            velrho: [0.0, 0.0, 0.0, self.rho],
+            code: self.code,
+            ..Default::default()
+        }
+    }
 }
 
 /// What one `halo_pack` found: the records for each neighbour, the rank's own live particles,
@@ -274,5 +306,36 @@ impl Halo {
             tail: counts.tail,
             migrants,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::layout::Pos;
+
+    /// The filter's exchange sends an eighth of a record and gives `halo_restore` everything it
+    /// reads: the code word (the id it searches by) and ρ.
+    #[test]
+    fn a_filter_record_carries_what_the_restore_reads() {
+        assert_eq!(std::mem::size_of::<FilterRecord>(), 8);
+        assert_eq!(std::mem::size_of::<HaloRecord>(), 64);
+        let full = HaloRecord {
+            pos: Pos {
+                off: [0.1, 0.2, 0.3],
+                block: 7,
+            },
+            velrho: [1.0, -2.0, 0.5, 1003.25],
+            rate: [4.0; 4],
+            code: 0x1000_0abc,
+            dest: DEST_UPPER,
+            energy: [5.0, 6.0],
+        };
+        let restored = FilterRecord::from(&full).restored();
+        assert_eq!(
+            (restored.code, restored.velrho[3]),
+            (full.code, full.velrho[3])
+        );
+        assert_eq!(restored.dest & DEST_SOLID_STATE, 0);
     }
 }

@@ -14,6 +14,7 @@ use std::ops::Range;
 
 use anyhow::{bail, ensure, Context, Result};
 
+use super::halo::FilterRecord;
 use super::initial::Packed;
 use super::profile::Recorder;
 use super::Solver;
@@ -509,7 +510,7 @@ impl Solver {
         })?;
         let packed_at = std::time::Instant::now();
 
-        let incoming = self.swap(&packed, ranks)?;
+        let incoming = self.swap(&packed.lower, &packed.upper, ranks)?;
         let swapped_at = std::time::Instant::now();
         let ranked = self.ranked.as_mut().expect("a subdomain");
         let tail = ranked.first_tail.take().unwrap_or(packed.tail);
@@ -591,14 +592,19 @@ impl Solver {
         packed
     }
 
-    /// Sends the records `packed` holds for each neighbour and returns what the neighbours
-    /// sent this rank (every rank together); counts the bytes sent.
-    fn swap(&mut self, packed: &halo::Packed, ranks: &dyn Ranks) -> Result<Vec<HaloRecord>> {
+    /// Sends `lower` and `upper` to the neighbour below and above and returns what the
+    /// neighbours sent this rank (every rank together); counts the bytes sent.
+    fn swap<T: bytemuck::Pod>(
+        &mut self,
+        lower: &[T],
+        upper: &[T],
+        ranks: &dyn Ranks,
+    ) -> Result<Vec<T>> {
         let rank = ranks.rank();
         let mut sends = Vec::new();
         for (to, records) in [
-            (rank.checked_sub(1), &packed.lower),
-            ((rank + 1 < ranks.size()).then_some(rank + 1), &packed.upper),
+            (rank.checked_sub(1), lower),
+            ((rank + 1 < ranks.size()).then_some(rank + 1), upper),
         ] {
             match to {
                 Some(to) => sends.push((to, bytemuck::cast_slice(records).to_vec())),
@@ -614,14 +620,15 @@ impl Solver {
         ranked.bytes_sent += sends.iter().map(|(_, b)| b.len() as u64).sum::<u64>();
         Ok(received
             .iter()
-            .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, HaloRecord>(b))
+            .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, T>(b))
             .collect())
     }
 
     /// The density filter of a step it fires on (`DensityFilter::fires_after`), over ranks: it
     /// reads the corrected densities of the neighbours, the halo copies' included, which
     /// `halo_drop` excluded before the corrector. So the ranks pack their own halo particles
-    /// again, corrected, and swap them; each rank gives its copies their owners' values back
+    /// again, corrected, and swap their code words and densities ([`FilterRecord`], 8 bytes
+    /// where a record is 64); each rank gives its copies their owners' values back
     /// (`halo_restore`), filters, excludes them again and frees the step's excluded entries
     /// (every rank together).
     fn filter_over_ranks(&mut self, ranks: &dyn Ranks) -> Result<()> {
@@ -637,7 +644,13 @@ impl Solver {
             "{} particles outside the subdomain after the corrector",
             packed.migrants
         );
-        let mut incoming = self.swap(&packed, ranks)?;
+        let lean = |records: &[HaloRecord]| -> Vec<FilterRecord> {
+            (records.iter())
+                .filter(|r| r.dest & DEST_SOLID_STATE == 0)
+                .map(FilterRecord::from)
+                .collect()
+        };
+        let incoming = self.swap(&lean(&packed.lower), &lean(&packed.upper), ranks)?;
         let (halo, filter) = (
             self.passes
                 .halo
@@ -645,8 +658,7 @@ impl Solver {
                 .expect("a subdomain has a halo pass"),
             self.passes.density_filter.as_ref().expect("a filter"),
         );
-        // The filter reads no stress.
-        incoming.retain(|r| r.dest & DEST_SOLID_STATE == 0);
+        let mut incoming: Vec<HaloRecord> = incoming.iter().map(FilterRecord::restored).collect();
         halo.upload_restored(&self.queue, &mut incoming);
         self.submit_pass("density filter over ranks", |pass| {
             halo.encode_restore(pass, q);
