@@ -3,11 +3,17 @@
 // w_ij fixed at the start (computed on the host in f64 by src/reference/total_lagrangian.rs,
 // also the f64 twin). Per evaluation (k the TL index, i = tl_slot[k] its slot after the sort):
 //   tl_index:    the slot of every TL particle, after the sort;
+//   tl_gather:   the position of every TL particle the arrays hold, by TL index;
 //   tl_deform:   the displacement gradient H = F − I;
 //   tl_gradient: the Green strain E and the cell-quadrature stresses T^k;
 //   tl_stress:   the first Piola–Kirchhoff stress P = F (S + S2), S of St Venant–Kirchhoff;
 //   tl_accel:    ρ0 a_i = Σ_j (P_i w_ij − P_j w_ji), added to rate with g; dρ/dt = 0.
 // Plane strain in 2D. Symplectic with integrate.wgsl's predictor–corrector (eq. 30).
+// A particle's H reads its reference neighbours' positions, and its acceleration their H
+// through T and P: four lists deep, beyond any halo. So the passes read positions by TL index
+// (`tl_pos`), where a subdomain has every TL particle's, its own gathered and the others'
+// shared by the ranks after its predictor (`Solver::share_tl_positions`), and every rank
+// computes the whole solid's stresses alike; `tl_accel` adds to the particles it holds.
 // Design notes: docs/design/total_lagrangian.md.
 
 struct TlParams {
@@ -39,6 +45,10 @@ struct TlPair {
 @group(0) @binding(8) var<storage, read_write> tl_h: array<mat3x3<f32>>;
 @group(0) @binding(9) var<storage, read_write> tl_t: array<mat3x3<f32>>;
 @group(0) @binding(10) var<storage, read_write> tl_p: array<mat3x3<f32>>;
+// The position of every TL particle and whether the arrays hold it, by TL index
+// (`tl_gather`); a subdomain's others are written by the host.
+@group(0) @binding(12) var<storage, read_write> tl_pos: array<Pos>;
+@group(0) @binding(13) var<storage, read_write> tl_held: array<u32>;
 // The solid state, for the material of TL particle k (λ, G and ρ0 of params.solid_materials,
 // per body; `tl_material`): the TL particles are the run of solid slots from
 // tlp.first_id − params.solid_id_base.
@@ -84,18 +94,39 @@ fn tl_index(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     }
 }
 
+// The position of TL particle k where the arrays hold it, live, at the slot `tl_index` last
+// found (a subdomain's slot of a particle it no longer holds is stale: another id is there,
+// or a free or excluded entry).
+@compute @workgroup_size(WG)
+fn tl_gather(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let k = linear_index(gid, nwg);
+    if (k >= tlp.n) {
+        return;
+    }
+    let i = tl_slot[k];
+    var held = false;
+    if (i < params.n_particles) {
+        let c = code[i];
+        held = (c & ID_MASK) == tlp.first_id + k && code_kind(c) != KIND_EXCLUDED;
+    }
+    if (held) {
+        tl_pos[k] = pos[i];
+    }
+    tl_held[k] = select(0u, 1u, held);
+}
+
 @compute @workgroup_size(WG)
 fn tl_deform(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let k = linear_index(gid, nwg);
     if (k >= tlp.n) {
         return;
     }
-    let xi = pos[tl_slot[k]];
+    let xi = tl_pos[k];
     var h = zero3();
     for (var q = tl_start[k]; q < tl_start[k + 1u]; q++) {
         let p = tl_pairs[q];
         // (x_j − x_i) − (X_j − X_i): the displacement difference, small against Δ.
-        let u = rel_pos(pos[tl_slot[p.j]], xi) - p.d0;
+        let u = rel_pos(tl_pos[p.j], xi) - p.d0;
         h += outer(u, p.w_ij);
     }
     tl_h[k] = h;
@@ -156,6 +187,8 @@ fn tl_accel(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
         let p = tl_pairs[q];
         f += p_i * p.w_ij - tl_p[p.j] * p.w_ji;
     }
-    let i = tl_slot[k];
-    rate[i] += vec4<f32>(f / tl_material(k).rho0 + params.gravity, 0.0);
+    if (tl_held[k] != 0u) {
+        let i = tl_slot[k];
+        rate[i] += vec4<f32>(f / tl_material(k).rho0 + params.gravity, 0.0);
+    }
 }

@@ -1006,6 +1006,26 @@ fn ranks_bend_an_elastic_plate_as_one_run() {
     .check();
 }
 
+/// The same plate as a total-Lagrangian solid (`oscillating_plate_tl_2d`), cut across its
+/// length: a particle's acceleration reads positions four reference lists away, beyond the
+/// halo, so the ranks share every TL particle's predicted position each step and each
+/// computes the whole plate's stresses (`Solver::share_tl_positions`). From cuts at equal
+/// numbers of layers, moved at step 100, every particle equals one whole run's bit for bit
+/// after 300 steps, the last 100 taken by subdomains restored at step 200.
+#[test]
+fn ranks_bend_a_total_lagrangian_plate_as_one_run() {
+    Comparison {
+        test: "ranks_bend_a_total_lagrangian_plate_as_one_run",
+        case: "cases/oscillating_plate_tl_2d.toml",
+        ranks: 2,
+        steps: 300,
+        uneven: true,
+        restore_at: Some(200),
+        ..Default::default()
+    }
+    .check();
+}
+
 /// The elastic gate holding back a water column (the talk's fluid–solid case, its gate updated
 /// Lagrangian): the gate's interface pressure comes from the water around it
 /// as a ghost's does (a halo of two layers), and its stress crosses the cut with its halo

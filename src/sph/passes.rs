@@ -174,6 +174,11 @@ impl Passes {
             r.stage("open_boundaries", |pass| o.encode(pass, p));
         }
         if let Some(h) = &self.halo {
+            // The predicted positions of the TL particles this rank holds, which the ranks
+            // share before the sums (`Solver::share_tl_positions`).
+            if let Some(t) = &self.total_lagrangian {
+                r.stage("total_lagrangian_index", |pass| t.encode_index(pass, p));
+            }
             r.stage("halo_pack", |pass| h.encode_pack(pass, p));
         }
     }

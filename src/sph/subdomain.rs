@@ -28,7 +28,7 @@ use crate::layout::{
 };
 use crate::output::RankSummary;
 use crate::ranks::Ranks;
-use crate::scenario::{Scenario, SolidFormulation};
+use crate::scenario::Scenario;
 
 /// A subdomain's counts, over all ranks where they say so (a checkpoint keeps them).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -118,19 +118,6 @@ pub fn capacity(own: u32, waiting: u32, n: u32) -> u32 {
         .saturating_add(4096)
         .min(n.saturating_mul(2))
         .saturating_add(waiting)
-}
-
-/// What a run split over ranks cannot do yet, named for the refusal.
-fn unsupported(sc: &Scenario) -> Vec<&'static str> {
-    [(
-        sc.solids
-            .as_ref()
-            .is_some_and(|s| s.has(SolidFormulation::TotalLagrangian)),
-        "total-Lagrangian solids (their reference neighbour lists)",
-    )]
-    .into_iter()
-    .filter_map(|(yes, what)| yes.then_some(what))
-    .collect()
 }
 
 /// Which entries of `packed` are `ctl`'s subdomain's at the start: its own live particles, and
@@ -231,13 +218,6 @@ impl Solver {
         slabs: &Slabs,
         ranks: &dyn Ranks,
     ) -> Result<Self> {
-        let missing = unsupported(sc);
-        if !missing.is_empty() {
-            bail!(
-                "a run split over ranks does not support {} yet (issue 32)",
-                missing.join(", ")
-            );
-        }
         ensure!(
             slabs.ranks() == ranks.size(),
             "{} slabs for {} ranks",
@@ -511,6 +491,7 @@ impl Solver {
         let packed_at = std::time::Instant::now();
 
         let incoming = self.swap(&packed.lower, &packed.upper, ranks)?;
+        self.share_tl_positions(ranks)?;
         let swapped_at = std::time::Instant::now();
         let ranked = self.ranked.as_mut().expect("a subdomain");
         let tail = ranked.first_tail.take().unwrap_or(packed.tail);
@@ -572,6 +553,51 @@ impl Solver {
         split.compute += (computed_at - swapped_at).as_secs_f64();
         split.agree += computed_at.elapsed().as_secs_f64();
         Ok(())
+    }
+
+    /// Every total-Lagrangian particle's position, shared by the ranks, for the TL passes: a
+    /// particle's acceleration reads the positions four reference lists away, further than
+    /// any halo, so every rank computes the whole solid's stresses. Each rank has gathered
+    /// the positions of the TL particles it holds after its predictor, with the packing
+    /// (`TotalLagrangian::encode_index`); the ranks add them up in rank order as
+    /// integer-valued words, each held by one rank and so added to zeros only (the same
+    /// bits), and every rank writes them back. The corrector moves no particle
+    /// (integrate.wgsl), so these are also the positions an output's stresses read. Stops
+    /// the run where a particle is held by no rank (it left the domain) or by several (every
+    /// rank alike: they see the same sums). Nothing without TL solids.
+    fn share_tl_positions(&self, ranks: &dyn Ranks) -> Result<()> {
+        let Some(t) = &self.passes.total_lagrangian else {
+            return Ok(());
+        };
+        const WORDS: usize = 5;
+        let held = t.read_held(&self.device, &self.queue)?;
+        let mut mine = vec![0.0; WORDS * held.len()];
+        for (w, p) in mine.chunks_exact_mut(WORDS).zip(&held) {
+            if let Some(p) = p {
+                w[0] = 1.0;
+                for d in 0..3 {
+                    w[1 + d] = p.off[d].to_bits() as f64;
+                }
+                w[4] = p.block as f64;
+            }
+        }
+        let all = ranks.sum_in_rank_order(&mine);
+        let mut pos = Vec::with_capacity(held.len());
+        for (k, w) in all.chunks_exact(WORDS).enumerate() {
+            ensure!(
+                w[0] == 1.0,
+                "the total-Lagrangian solid particle of id {} is held by {} ranks, where one \
+                 must hold it (none: it left the domain)",
+                t.first_id() as usize + k,
+                w[0]
+            );
+            pos.push(Pos {
+                off: [0, 1, 2].map(|d| f32::from_bits(w[1 + d] as u32)),
+                block: w[4] as u32,
+            });
+        }
+        t.write_positions(&self.queue, &pos);
+        self.faults.check()
     }
 
     /// Submits the passes `record` records (one of them `halo_pack`) and reads back what they
@@ -811,38 +837,6 @@ mod tests {
     fn load(case: &str, set: &[&str]) -> Scenario {
         let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
         crate::case::load(std::path::Path::new(case), &set).unwrap()
-    }
-
-    /// What a subdomain cannot run yet is named, case by case; a fluid with dynamic walls has
-    /// nothing to refuse, nor has it with the energy equation on, a density filter, or the
-    /// walls written once; nor have the floating box, the sloshing tank, the injection and the
-    /// updated-Lagrangian plate. A total-Lagrangian solid is refused.
-    #[test]
-    fn what_ranks_cannot_run_yet_is_named() {
-        let runs: [(&str, &[&str]); 8] = [
-            ("cases/oscillating_plate_2d.toml", &[]),
-            ("cases/dam_break_2d.toml", &[]),
-            ("cases/water_injection_2d.toml", &[]),
-            ("cases/sloshing_2d.toml", &[]),
-            ("cases/dam_break_2d.toml", &["physics.energy=true"]),
-            (
-                "cases/dam_break_2d.toml",
-                &["physics.density_filter=\"mls\""],
-            ),
-            (
-                "cases/dam_break_2d.toml",
-                &["time.output_boundary=\"first\""],
-            ),
-            ("cases/floating_box_2d.toml", &[]),
-        ];
-        for (case, set) in runs {
-            assert!(unsupported(&load(case, set)).is_empty(), "{case} {set:?}");
-        }
-        let missing = unsupported(&load("cases/oscillating_plate_tl_2d.toml", &[]));
-        assert_eq!(
-            missing,
-            ["total-Lagrangian solids (their reference neighbour lists)"]
-        );
     }
 
     /// Three subdomains of the water injection: each holds its own live particles first,

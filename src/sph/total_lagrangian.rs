@@ -21,11 +21,12 @@ pub const SHADER: Shader = Shader {
     libs: &[],
 };
 use crate::lagrangian::{cauchy_of, TlSetup};
-use crate::layout::{TlPair, TlParams};
+use crate::layout::{Pos, TlPair, TlParams};
 use crate::scenario::{Scenario, SolidFormulation};
 
 pub struct TotalLagrangian {
     index: ParityKernel,
+    gather: ParityKernel,
     deform: ParityKernel,
     gradient: ParityKernel,
     stress: ParityKernel,
@@ -33,6 +34,9 @@ pub struct TotalLagrangian {
     /// H = F − I and the first Piola–Kirchhoff stress P of the last evaluation, by TL index.
     tl_h: wgpu::Buffer,
     tl_p: wgpu::Buffer,
+    /// Every TL particle's position, and whether the arrays hold it (`tl_gather`).
+    tl_pos: wgpu::Buffer,
+    tl_held: wgpu::Buffer,
     /// The first TL particle's id.
     first_id: u32,
     /// Particles (all kinds) and TL particles.
@@ -108,8 +112,10 @@ impl TotalLagrangian {
         let tl_h = storage(device, "tl H", mat * n_tl as u64);
         let tl_t = storage(device, "tl T", 3 * mat * n_tl as u64);
         let tl_p = storage(device, "tl P", mat * n_tl as u64);
+        let tl_pos = storage(device, "tl positions", 16 * n_tl as u64);
+        let tl_held = storage(device, "tl held", 4 * n_tl as u64);
         let bytes = [
-            &tl_params, &tl_start, &tl_pairs, &tl_slot, &tl_h, &tl_t, &tl_p,
+            &tl_params, &tl_start, &tl_pairs, &tl_slot, &tl_h, &tl_t, &tl_p, &tl_pos, &tl_held,
         ]
         .iter()
         .map(|b| b.size())
@@ -123,16 +129,21 @@ impl TotalLagrangian {
                 .with("tl_h", &tl_h)
                 .with("tl_t", &tl_t)
                 .with("tl_p", &tl_p)
+                .with("tl_pos", &tl_pos)
+                .with("tl_held", &tl_held)
         };
         let bound = |entry: &str| ParityKernel::new(device, module, entry, bufs);
         Ok(Self {
             index: bound("tl_index")?,
+            gather: bound("tl_gather")?,
             deform: bound("tl_deform")?,
             gradient: bound("tl_gradient")?,
             stress: bound("tl_stress")?,
             accel: bound("tl_accel")?,
             tl_h,
             tl_p,
+            tl_pos,
+            tl_held,
             first_id: range.start as u32,
             n: b.n,
             n_tl,
@@ -140,14 +151,45 @@ impl TotalLagrangian {
         })
     }
 
+    /// The first TL particle's id (TL index 0).
+    pub fn first_id(&self) -> u32 {
+        self.first_id
+    }
+
     /// GPU memory of the lists and per-particle matrices, in bytes.
     pub fn bytes(&self) -> u64 {
         self.bytes
     }
 
-    /// Records where the sort put every TL particle (arrays of parity `p`, after the sort).
+    /// Records where every TL particle the arrays of parity `p` hold is, and its position
+    /// (after the sort, and in a subdomain after the predictor too, before the ranks share
+    /// the positions).
     pub fn encode_index(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.index.dispatch(pass, p, self.n);
+        self.gather.dispatch(pass, p, self.n_tl);
+    }
+
+    /// The positions of the TL particles this process holds, by TL index (`None` for the
+    /// others), as the last [`TotalLagrangian::encode_index`] found them. Waits for the GPU.
+    pub fn read_held(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> Result<Vec<Option<Pos>>> {
+        let n = self.n_tl as usize;
+        let pos: Vec<Pos> = read(device, queue, &self.tl_pos, n)?;
+        let held: Vec<u32> = read(device, queue, &self.tl_held, n)?;
+        Ok(pos
+            .into_iter()
+            .zip(held)
+            .map(|(p, h)| (h != 0).then_some(p))
+            .collect())
+    }
+
+    /// Every TL particle's position, by TL index (what the ranks shared); `encode_index`
+    /// rewrites those the arrays hold with the same values after the sort.
+    pub fn write_positions(&self, queue: &wgpu::Queue, pos: &[Pos]) {
+        queue.write_buffer(&self.tl_pos, 0, bytemuck::cast_slice(pos));
     }
 
     /// The four passes: dv/dt of the TL particles added to `rate` (after the interaction
@@ -177,6 +219,9 @@ impl TotalLagrangian {
                 label: Some("tl stress output"),
                 timestamp_writes: None,
             });
+            // The positions of the arrays held now (those of the step's evaluation: the
+            // corrector moves no particle).
+            self.gather.dispatch(&mut pass, p, self.n_tl);
             for b in [&self.deform, &self.gradient, &self.stress] {
                 b.dispatch(&mut pass, p, self.n_tl);
             }
