@@ -2,7 +2,7 @@
 //! predictor, `halo_drop` after the interaction. The solver's `ranked_step` swaps the packed
 //! records with the neighbours between the two.
 
-use anyhow::{bail, Result};
+use anyhow::{anyhow, bail, ensure, Result};
 
 use super::buffers::ParticleBuffers;
 use crate::decomposition::Slabs;
@@ -10,7 +10,7 @@ use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
 use crate::layout::{
-    HaloCounts, HaloCtl, HaloRecord, DEST_MIGRANT, DEST_SOLID_STATE, DEST_UPPER, ID_MASK,
+    HaloCounts, HaloCtl, HaloRecord, Pos, DEST_MIGRANT, DEST_SOLID_STATE, DEST_UPPER, ID_MASK,
 };
 use crate::scenario::{InletPressure, Kind, Scenario};
 use bytemuck::{Pod, Zeroable};
@@ -130,6 +130,95 @@ impl FilterRecord {
             code: self.code,
             ..Default::default()
         }
+    }
+}
+
+/// How records travel between neighbours: the bytes of one message and back.
+pub trait Wire: Sized {
+    fn to_wire(records: &[Self]) -> Vec<u8>;
+    fn from_wire(bytes: &[u8]) -> Result<Vec<Self>>;
+}
+
+impl Wire for FilterRecord {
+    fn to_wire(records: &[Self]) -> Vec<u8> {
+        bytemuck::cast_slice(records).to_vec()
+    }
+
+    fn from_wire(bytes: &[u8]) -> Result<Vec<Self>> {
+        ensure!(
+            bytes.len() % std::mem::size_of::<Self>() == 0,
+            "a neighbour's density-filter message of {} bytes is not whole records",
+            bytes.len()
+        );
+        Ok(bytemuck::pod_collect_to_vec(bytes))
+    }
+}
+
+/// What a halo copy carries to the neighbour: what the neighbour's passes read of it (its
+/// place, (v, ρ) and code word) and its `dest`; not the last rates nor the energy, which only a
+/// migrant goes on integrating (a copy is excluded before the corrector): 40 bytes where a
+/// record is 64.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct HaloCopy {
+    pub pos: Pos,
+    pub velrho: [f32; 4],
+    pub code: u32,
+    pub dest: u32,
+}
+
+impl HaloCopy {
+    /// Whether `r` is a halo copy's record (migrants' and solid states' go whole).
+    fn is_copy(r: &HaloRecord) -> bool {
+        r.dest & (DEST_MIGRANT | DEST_SOLID_STATE) == 0
+    }
+}
+
+/// A message to a neighbour: the count of its whole records, those, then its halo copies as
+/// [`HaloCopy`]s; the receiver's copies get zero rates and energy.
+impl Wire for HaloRecord {
+    fn to_wire(records: &[Self]) -> Vec<u8> {
+        let whole: Vec<HaloRecord> = (records.iter())
+            .filter(|r| !HaloCopy::is_copy(r))
+            .copied()
+            .collect();
+        let copies: Vec<HaloCopy> = (records.iter())
+            .filter(|r| HaloCopy::is_copy(r))
+            .map(|r| HaloCopy {
+                pos: r.pos,
+                velrho: r.velrho,
+                code: r.code,
+                dest: r.dest,
+            })
+            .collect();
+        let mut bytes = (whole.len() as u32).to_le_bytes().to_vec();
+        bytes.extend_from_slice(bytemuck::cast_slice(&whole));
+        bytes.extend_from_slice(bytemuck::cast_slice(&copies));
+        bytes
+    }
+
+    fn from_wire(bytes: &[u8]) -> Result<Vec<Self>> {
+        let malformed = || {
+            anyhow!(
+                "a neighbour's halo message of {} bytes is malformed",
+                bytes.len()
+            )
+        };
+        let (count, rest) = bytes.split_first_chunk::<4>().ok_or_else(malformed)?;
+        let whole = u32::from_le_bytes(*count) as usize * std::mem::size_of::<HaloRecord>();
+        if rest.len() < whole || (rest.len() - whole) % std::mem::size_of::<HaloCopy>() != 0 {
+            return Err(malformed());
+        }
+        let mut records: Vec<HaloRecord> = bytemuck::pod_collect_to_vec(&rest[..whole]);
+        let copies: Vec<HaloCopy> = bytemuck::pod_collect_to_vec(&rest[whole..]);
+        records.extend(copies.iter().map(|c| HaloRecord {
+            pos: c.pos,
+            velrho: c.velrho,
+            code: c.code,
+            dest: c.dest,
+            ..Default::default()
+        }));
+        Ok(records)
     }
 }
 
@@ -312,7 +401,6 @@ impl Halo {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::layout::Pos;
 
     /// The filter's exchange sends an eighth of a record and gives `halo_restore` everything it
     /// reads: the code word (the id it searches by) and ρ.
@@ -337,5 +425,45 @@ mod tests {
             (full.code, full.velrho[3])
         );
         assert_eq!(restored.dest & DEST_SOLID_STATE, 0);
+    }
+
+    /// A halo message carries migrants and solid states whole and copies lean (40 bytes), and
+    /// reads back as the same records but for the copies' rates and energy, which no pass
+    /// reads.
+    #[test]
+    fn a_halo_message_sends_copies_lean_and_the_rest_whole() {
+        let record = |k: u32, dest: u32| HaloRecord {
+            pos: Pos {
+                off: [0.1 * k as f32, 0.2, 0.3],
+                block: k,
+            },
+            velrho: [k as f32, -2.0, 0.5, 1000.0 + k as f32],
+            rate: [4.0 + k as f32; 4],
+            code: 0x1000_0000 | k,
+            dest,
+            energy: [5.0, 6.0 + k as f32],
+        };
+        let sent = [
+            record(1, DEST_UPPER),
+            record(2, DEST_UPPER | DEST_MIGRANT),
+            record(3, DEST_UPPER | DEST_SOLID_STATE),
+            record(4, DEST_UPPER),
+            record(5, 0),
+        ];
+        let bytes = HaloRecord::to_wire(&sent);
+        assert_eq!(std::mem::size_of::<HaloCopy>(), 40);
+        assert_eq!(bytes.len(), 4 + 2 * 64 + 3 * 40);
+        let received = HaloRecord::from_wire(&bytes).unwrap();
+        let mut expected = vec![sent[1], sent[2]];
+        for r in [sent[0], sent[3], sent[4]] {
+            expected.push(HaloRecord {
+                rate: [0.0; 4],
+                energy: [0.0; 2],
+                ..r
+            });
+        }
+        assert_eq!(received, expected);
+        assert!(HaloRecord::from_wire(&bytes[..bytes.len() - 1]).is_err());
+        assert!(HaloRecord::from_wire(&[]).is_err());
     }
 }

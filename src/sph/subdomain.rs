@@ -14,7 +14,7 @@ use std::ops::Range;
 
 use anyhow::{bail, ensure, Context, Result};
 
-use super::halo::FilterRecord;
+use super::halo::{FilterRecord, Wire};
 use super::initial::Packed;
 use super::profile::Recorder;
 use super::Solver;
@@ -618,14 +618,10 @@ impl Solver {
         packed
     }
 
-    /// Sends `lower` and `upper` to the neighbour below and above and returns what the
-    /// neighbours sent this rank (every rank together); counts the bytes sent.
-    fn swap<T: bytemuck::Pod>(
-        &mut self,
-        lower: &[T],
-        upper: &[T],
-        ranks: &dyn Ranks,
-    ) -> Result<Vec<T>> {
+    /// Sends `lower` and `upper` to the neighbour below and above, in `T`'s wire format, and
+    /// returns what the neighbours sent this rank (every rank together); counts the bytes
+    /// sent.
+    fn swap<T: Wire>(&mut self, lower: &[T], upper: &[T], ranks: &dyn Ranks) -> Result<Vec<T>> {
         let rank = ranks.rank();
         let mut sends = Vec::new();
         for (to, records) in [
@@ -633,7 +629,7 @@ impl Solver {
             ((rank + 1 < ranks.size()).then_some(rank + 1), upper),
         ] {
             match to {
-                Some(to) => sends.push((to, bytemuck::cast_slice(records).to_vec())),
+                Some(to) => sends.push((to, T::to_wire(records))),
                 None => ensure!(
                     records.is_empty(),
                     "rank {rank} packed records for no neighbour"
@@ -644,10 +640,11 @@ impl Solver {
         let received = ranks.exchange(&sends, &from)?;
         let ranked = self.ranked.as_mut().expect("a subdomain");
         ranked.bytes_sent += sends.iter().map(|(_, b)| b.len() as u64).sum::<u64>();
-        Ok(received
-            .iter()
-            .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, T>(b))
-            .collect())
+        let mut records = Vec::new();
+        for bytes in &received {
+            records.extend(T::from_wire(bytes)?);
+        }
+        Ok(records)
     }
 
     /// The density filter of a step it fires on (`DensityFilter::fires_after`), over ranks: it
