@@ -146,7 +146,7 @@ impl Wire for FilterRecord {
 
     fn from_wire(bytes: &[u8]) -> Result<Vec<Self>> {
         ensure!(
-            bytes.len() % std::mem::size_of::<Self>() == 0,
+            bytes.len().is_multiple_of(std::mem::size_of::<Self>()),
             "a neighbour's density-filter message of {} bytes is not whole records",
             bytes.len()
         );
@@ -206,7 +206,9 @@ impl Wire for HaloRecord {
         };
         let (count, rest) = bytes.split_first_chunk::<4>().ok_or_else(malformed)?;
         let whole = u32::from_le_bytes(*count) as usize * std::mem::size_of::<HaloRecord>();
-        if rest.len() < whole || (rest.len() - whole) % std::mem::size_of::<HaloCopy>() != 0 {
+        if rest.len() < whole
+            || !(rest.len() - whole).is_multiple_of(std::mem::size_of::<HaloCopy>())
+        {
             return Err(malformed());
         }
         let mut records: Vec<HaloRecord> = bytemuck::pod_collect_to_vec(&rest[..whole]);
