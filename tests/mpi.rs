@@ -1047,3 +1047,23 @@ fn ranks_hold_the_water_with_an_elastic_gate_as_one_run() {
     }
     .check();
 }
+
+/// The same gate as the case ships it, total-Lagrangian: the ranks share the gate's predicted
+/// positions each step (`Solver::share_tl_positions`), each computes the whole gate's stresses
+/// and accelerates its own particles. Every particle equals one whole run's bit for bit after
+/// 300 steps.
+#[test]
+#[cfg_attr(
+    not(feature = "long-tests"),
+    ignore = "long: 32 s in a debug build on lavapipe (2 cores, 2026-12-05), kept out of CI (25.8 min of its 30 with the TL plate in); cargo test --release --features long-tests runs it"
+)]
+fn ranks_hold_the_water_with_a_total_lagrangian_gate_as_one_run() {
+    Comparison {
+        test: "ranks_hold_the_water_with_a_total_lagrangian_gate_as_one_run",
+        case: "cases/elastic_gate_2d.toml",
+        ranks: 2,
+        steps: 300,
+        ..Default::default()
+    }
+    .check();
+}
