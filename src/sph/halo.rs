@@ -167,10 +167,32 @@ pub struct HaloCopy {
     pub dest: u32,
 }
 
+impl From<&HaloRecord> for HaloCopy {
+    fn from(r: &HaloRecord) -> Self {
+        Self {
+            pos: r.pos,
+            velrho: r.velrho,
+            code: r.code,
+            dest: r.dest,
+        }
+    }
+}
+
 impl HaloCopy {
     /// Whether `r` is a halo copy's record (migrants' and solid states' go whole).
     fn is_copy(r: &HaloRecord) -> bool {
         r.dest & (DEST_MIGRANT | DEST_SOLID_STATE) == 0
+    }
+
+    /// The copy's record on the receiver, its rates and energy zero.
+    fn record(&self) -> HaloRecord {
+        HaloRecord {
+            pos: self.pos,
+            velrho: self.velrho,
+            code: self.code,
+            dest: self.dest,
+            ..Default::default()
+        }
     }
 }
 
@@ -184,12 +206,7 @@ impl Wire for HaloRecord {
             .collect();
         let copies: Vec<HaloCopy> = (records.iter())
             .filter(|r| HaloCopy::is_copy(r))
-            .map(|r| HaloCopy {
-                pos: r.pos,
-                velrho: r.velrho,
-                code: r.code,
-                dest: r.dest,
-            })
+            .map(HaloCopy::from)
             .collect();
         let mut bytes = (whole.len() as u32).to_le_bytes().to_vec();
         bytes.extend_from_slice(bytemuck::cast_slice(&whole));
@@ -213,13 +230,7 @@ impl Wire for HaloRecord {
         }
         let mut records: Vec<HaloRecord> = bytemuck::pod_collect_to_vec(&rest[..whole]);
         let copies: Vec<HaloCopy> = bytemuck::pod_collect_to_vec(&rest[whole..]);
-        records.extend(copies.iter().map(|c| HaloRecord {
-            pos: c.pos,
-            velrho: c.velrho,
-            code: c.code,
-            dest: c.dest,
-            ..Default::default()
-        }));
+        records.extend(copies.iter().map(HaloCopy::record));
         Ok(records)
     }
 }

@@ -388,7 +388,7 @@ impl Solver {
             .expect("a subdomain has a halo pass");
         // Migrants only: no halo this time.
         halo.set_cuts(&self.queue, &next, rank, false);
-        let packed = self.pack(|mut pass| {
+        let packed = self.pack(false, |mut pass| {
             halo.encode_pack(&mut pass, p);
             halo.encode_drop(&mut pass, p);
             halo.encode_forget(&mut pass, p);
@@ -484,7 +484,7 @@ impl Solver {
         let start = std::time::Instant::now();
         let body_dt = self.bodies.is_some().then(|| self.predict_bodies());
         let p = self.parity;
-        let packed = self.pack(|pass| {
+        let packed = self.pack(true, |pass| {
             let mut r = Recorder::Shared(pass);
             self.passes.record_to_exchange(&mut r, p);
         })?;
@@ -559,7 +559,7 @@ impl Solver {
     /// particle's acceleration reads the positions four reference lists away, further than
     /// any halo, so every rank computes the whole solid's stresses. Each rank has gathered
     /// the positions of the TL particles it holds after its predictor, with the packing
-    /// (`TotalLagrangian::encode_index`); the ranks add them up in rank order as
+    /// (`TotalLagrangian::encode_index`, copied out by `pack`); the ranks add them up in rank order as
     /// integer-valued words, each held by one rank and so added to zeros only (the same
     /// bits), and every rank writes them back. The corrector moves no particle
     /// (integrate.wgsl), so these are also the positions an output's stresses read. Stops
@@ -570,7 +570,7 @@ impl Solver {
             return Ok(());
         };
         const WORDS: usize = 5;
-        let held = t.read_held(&self.device, &self.queue)?;
+        let held = t.read_held(&self.device)?;
         let mut mine = vec![0.0; WORDS * held.len()];
         for (w, p) in mine.chunks_exact_mut(WORDS).zip(&held) {
             if let Some(p) = p {
@@ -601,8 +601,13 @@ impl Solver {
     }
 
     /// Submits the passes `record` records (one of them `halo_pack`) and reads back what they
-    /// packed. Waits for the GPU.
-    fn pack(&self, record: impl FnOnce(wgpu::ComputePass<'_>)) -> Result<halo::Packed> {
+    /// packed; with `tl_positions`, also copies the total-Lagrangian positions they gathered
+    /// for [`Solver::share_tl_positions`]. Waits for the GPU.
+    fn pack(
+        &self,
+        tl_positions: bool,
+        record: impl FnOnce(wgpu::ComputePass<'_>),
+    ) -> Result<halo::Packed> {
         let halo = self
             .passes
             .halo
@@ -612,6 +617,14 @@ impl Solver {
         halo.clear(&mut encoder);
         record(encoder.begin_compute_pass(&Default::default()));
         halo.copy_counts(&mut encoder);
+        if let Some(t) = self
+            .passes
+            .total_lagrangian
+            .as_ref()
+            .filter(|_| tl_positions)
+        {
+            t.copy_held(&mut encoder);
+        }
         self.queue.submit([encoder.finish()]);
         let packed = halo.read(&self.device, &self.queue);
         self.faults.check()?;
@@ -661,7 +674,7 @@ impl Solver {
             .halo
             .as_ref()
             .expect("a subdomain has a halo pass");
-        let packed = self.pack(|mut pass| halo.encode_pack(&mut pass, q))?;
+        let packed = self.pack(false, |mut pass| halo.encode_pack(&mut pass, q))?;
         ensure!(
             packed.migrants == 0,
             "{} particles outside the subdomain after the corrector",

@@ -11,7 +11,7 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
-use crate::gpu::buffers::{read, storage, storage_init, uniform_init};
+use crate::gpu::buffers::{map_read, read, readback_buffer, storage, storage_init, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
 
@@ -37,6 +37,8 @@ pub struct TotalLagrangian {
     /// Every TL particle's position, and whether the arrays hold it (`tl_gather`).
     tl_pos: wgpu::Buffer,
     tl_held: wgpu::Buffer,
+    /// Where a subdomain's step copies `tl_pos` and then `tl_held` for the host (`copy_held`).
+    held_staging: wgpu::Buffer,
     /// The first TL particle's id.
     first_id: u32,
     /// Particles (all kinds) and TL particles.
@@ -114,8 +116,18 @@ impl TotalLagrangian {
         let tl_p = storage(device, "tl P", mat * n_tl as u64);
         let tl_pos = storage(device, "tl positions", 16 * n_tl as u64);
         let tl_held = storage(device, "tl held", 4 * n_tl as u64);
+        let held_staging = readback_buffer(device, "tl held positions", 20 * n_tl as u64);
         let bytes = [
-            &tl_params, &tl_start, &tl_pairs, &tl_slot, &tl_h, &tl_t, &tl_p, &tl_pos, &tl_held,
+            &tl_params,
+            &tl_start,
+            &tl_pairs,
+            &tl_slot,
+            &tl_h,
+            &tl_t,
+            &tl_p,
+            &tl_pos,
+            &tl_held,
+            &held_staging,
         ]
         .iter()
         .map(|b| b.size())
@@ -144,6 +156,7 @@ impl TotalLagrangian {
             tl_p,
             tl_pos,
             tl_held,
+            held_staging,
             first_id: range.start as u32,
             n: b.n,
             n_tl,
@@ -169,16 +182,22 @@ impl TotalLagrangian {
         self.gather.dispatch(pass, p, self.n_tl);
     }
 
+    /// Copies the positions `encode_index` gathered and which of them the arrays hold for
+    /// [`TotalLagrangian::read_held`], in the submission that gathered them.
+    pub fn copy_held(&self, encoder: &mut wgpu::CommandEncoder) {
+        let pos_bytes = 16 * self.n_tl as u64;
+        encoder.copy_buffer_to_buffer(&self.tl_pos, 0, &self.held_staging, 0, pos_bytes);
+        let held_bytes = 4 * self.n_tl as u64;
+        encoder.copy_buffer_to_buffer(&self.tl_held, 0, &self.held_staging, pos_bytes, held_bytes);
+    }
+
     /// The positions of the TL particles this process holds, by TL index (`None` for the
-    /// others), as the last [`TotalLagrangian::encode_index`] found them. Waits for the GPU.
-    pub fn read_held(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-    ) -> Result<Vec<Option<Pos>>> {
-        let n = self.n_tl as usize;
-        let pos: Vec<Pos> = read(device, queue, &self.tl_pos, n)?;
-        let held: Vec<u32> = read(device, queue, &self.tl_held, n)?;
+    /// others), as the last [`TotalLagrangian::copy_held`] copied them. Waits for the GPU.
+    pub fn read_held(&self, device: &wgpu::Device) -> Result<Vec<Option<Pos>>> {
+        let bytes = map_read(device, &self.held_staging)?;
+        let (pos, held) = bytes.split_at(16 * self.n_tl as usize);
+        let pos: Vec<Pos> = bytemuck::pod_collect_to_vec(pos);
+        let held: Vec<u32> = bytemuck::pod_collect_to_vec(&held[..4 * self.n_tl as usize]);
         Ok(pos
             .into_iter()
             .zip(held)
