@@ -75,22 +75,55 @@ pub fn ranks_grid(sc: &Scenario) -> Result<Grid> {
 }
 
 /// `sc` cut into `ranks` slabs of its grid (as the solver makes it) along [`cut_axis`], balanced
-/// over its particles' [`layer_load`], no cut through a probe's [`probe_layers`].
+/// over its particles' [`layer_load`], no cut through a probe's [`probe_layers`] (nor within
+/// [`PROBE_CLEARANCE`] layers of one on a free body).
 pub fn slabs_for(sc: &Scenario, ranks: usize) -> Result<Slabs> {
     let ph = &sc.physics;
     let grid = ranks_grid(sc)?;
     let axis = cut_axis(&grid, ph.dim)?;
-    let whole = probe_layers(sc, &grid, axis)?
-        .into_iter()
-        .flatten()
-        .collect();
+    let mut whole = Vec::new();
+    let mut moving = Vec::new();
+    for (p, layers) in sc.probes.iter().zip(probe_layers(sc, &grid, axis)?) {
+        match (layers, on_free_body(sc, p)) {
+            (Some(l), true) => moving.push(widened(l, PROBE_CLEARANCE, grid.cells[axis])),
+            (Some(l), false) => whole.push(l),
+            (None, _) => {}
+        }
+    }
     Slabs::balanced_keeping(
         axis,
         &layer_load(&grid, axis, &sc.particles),
         ranks,
         halo_layers(sc),
         whole,
+    )?
+    .clear_of_moving(
+        &layer_load(&grid, axis, &sc.particles),
+        halo_layers(sc),
+        &moving,
     )
+}
+
+/// How many cell layers a probe on a free body may move before the run moves the cuts out of
+/// its way (`Solver::keep_probes_whole`): more than a step moves it (the CFL condition keeps a
+/// step's travel under h, half a layer), so the probe is whole at the end of the step the cuts
+/// were looked at before.
+pub const PROBE_MARGIN: u32 = 1;
+
+/// How far the cuts are placed from the layers a probe on a free body reads when they move out
+/// of its way: more than [`PROBE_MARGIN`], so that they do not move again at the next step.
+pub const PROBE_CLEARANCE: u32 = 2;
+
+/// Whether `p` moves with a body that moves freely (and is not a front, which reads no layers):
+/// its layers are known only as the run goes.
+pub fn on_free_body(sc: &Scenario, p: &Probe) -> bool {
+    let free = |b: usize| !matches!(sc.bodies[b].motion, Motion::Prescribed(_));
+    p.body.is_some_and(free) && !matches!(p.kind, ProbeKind::Front { .. })
+}
+
+/// `layers` and `by` more on each side, within the grid's `count` layers.
+pub fn widened(layers: Range<u32>, by: u32, count: u32) -> Range<u32> {
+    layers.start.saturating_sub(by)..(layers.end + by).min(count)
 }
 
 /// The cell layers along `axis` each of `sc`'s probes reads (`None`: a front, which is a
@@ -102,7 +135,8 @@ pub fn slabs_for(sc: &Scenario, ranks: usize) -> Result<Slabs> {
 /// each range has one layer more on each side against the GPU's f32 rounding of the point.
 /// A probe attached to a body of prescribed motion (a moving tank) reads, over the run, the
 /// layers of every place the motion takes it to at the probe times: their union. One attached
-/// to a free body is refused (its path is not known before the run), unless it is a front.
+/// to a free body ([`on_free_body`]): those where it stands at the start (its path is not known
+/// before the run; the run moves the cuts out of its way as it goes).
 pub fn probe_layers(sc: &Scenario, grid: &Grid, axis: usize) -> Result<Vec<Option<Range<u32>>>> {
     let up = sc.physics.dim as usize - 1;
     sc.probes
@@ -125,13 +159,7 @@ pub fn probe_layers(sc: &Scenario, grid: &Grid, axis: usize) -> Result<Vec<Optio
             };
             let body = &sc.bodies[b];
             let Motion::Prescribed(motion) = &body.motion else {
-                bail!(
-                    "probe '{}' moves with body '{}', which moves freely: a run over several \
-                     ranks needs to know beforehand which cell layers a probe reads; run it \
-                     on one rank",
-                    p.name,
-                    body.name
-                );
+                return Ok(layers_read(p, sc.physics.h, grid, axis));
             };
             let center0 = DVec3::from_array(body.center);
             let every = sc.time.probe_every_s;
@@ -260,6 +288,30 @@ impl Slabs {
         })
     }
 
+    /// These cuts, or where one of them lies inside one of the layer ranges `moving` (the
+    /// layers probes on free bodies read now: kept whole now, not remembered), new cuts
+    /// balanced over `load` that keep those whole as well as [`Slabs::balanced_keeping`]'s.
+    pub fn clear_of_moving(
+        self,
+        load: &[f64],
+        min_layers: u32,
+        moving: &[Range<u32>],
+    ) -> Result<Self> {
+        if !moving.iter().any(|m| self.splits(m)) {
+            return Ok(self);
+        }
+        let whole = self.whole.clone();
+        let keep = whole.iter().chain(moving).cloned().collect();
+        let next = Self::balanced_keeping(self.axis, load, self.ranks(), min_layers, keep)?;
+        Ok(Self { whole, ..next })
+    }
+
+    /// Whether a cut lies inside `layers` (one at its start or end does not).
+    pub fn splits(&self, layers: &Range<u32>) -> bool {
+        let inner = &self.bounds[1..self.bounds.len() - 1];
+        inner.iter().any(|&b| layers.start < b && b < layers.end)
+    }
+
     pub fn ranks(&self) -> usize {
         self.bounds.len() - 1
     }
@@ -318,20 +370,20 @@ impl Slabs {
     }
 
     /// New cuts for `load` when the present ones are beyond [`REBALANCE_THRESHOLD`] and the new
-    /// ones are better; `None` keeps the present ones.
-    pub fn rebalanced(&self, load: &[f64], min_layers: u32) -> Option<Self> {
+    /// ones are better; `None` keeps the present ones. The new ones keep the layer ranges
+    /// `moving` whole too (as [`Slabs::clear_of_moving`]).
+    pub fn rebalanced(&self, load: &[f64], min_layers: u32, moving: &[Range<u32>]) -> Option<Self> {
         let now = self.imbalance(load);
         if now <= REBALANCE_THRESHOLD {
             return None;
         }
-        let next = Self::balanced_keeping(
-            self.axis,
-            load,
-            self.ranks(),
-            min_layers,
-            self.whole.clone(),
-        )
-        .ok()?;
+        let keep = self.whole.iter().chain(moving).cloned().collect();
+        let next = Self::balanced_keeping(self.axis, load, self.ranks(), min_layers, keep)
+            .ok()
+            .map(|next| Self {
+                whole: self.whole.clone(),
+                ..next
+            })?;
         (next.imbalance(load) < now && next != *self).then_some(next)
     }
 }
@@ -379,8 +431,8 @@ mod tests {
             whole: Vec::new(),
         };
         assert!(even.imbalance(&load) > 0.5);
-        assert_eq!(even.rebalanced(&load, 1).as_ref(), Some(&s));
-        assert_eq!(s.rebalanced(&load, 1), None);
+        assert_eq!(even.rebalanced(&load, 1, &[]).as_ref(), Some(&s));
+        assert_eq!(s.rebalanced(&load, 1, &[]), None);
     }
 
     #[test]
@@ -393,7 +445,7 @@ mod tests {
         // Moving the cuts keeps the range whole too.
         let mut heavy = load;
         heavy[..10].iter_mut().for_each(|l| *l = 10.0);
-        let next = s.rebalanced(&heavy, 1).expect("imbalanced");
+        let next = s.rebalanced(&heavy, 1, &[]).expect("imbalanced");
         assert!(next.range(0).end <= 17, "{next:?}");
         assert!(!next.whole.is_empty());
         // A range over every place a cut may go leaves none.
@@ -512,7 +564,7 @@ mod tests {
 
     /// A probe on the rolling sloshing tank reads, over the run, the layers of its whole path
     /// (which the cuts then keep whole): more than where it stands at t = 0, and they hold it at
-    /// every probe time. One on a free body is refused, naming it.
+    /// every probe time. One on a free body reads those where it stands at the start.
     #[test]
     fn a_probe_on_a_moving_tank_reads_the_layers_of_its_path() {
         let sc = load("cases/sloshing_2d.toml", &["time.end_s=2.0"]);
@@ -548,11 +600,9 @@ mod tests {
         );
         let mut free = load("cases/floating_box_2d.toml", &[]);
         free.probes[0].body = Some(0);
-        let e = probe_layers(&free, &g, axis).unwrap_err().to_string();
-        assert!(
-            e.contains("'gauge_left'") && e.contains("'box'") && e.contains("freely"),
-            "{e}"
-        );
+        assert!(on_free_body(&free, &free.probes[0]));
+        let at_start = layers_read(&free.probes[0], free.physics.h, &g, axis);
+        assert_eq!(probe_layers(&free, &g, axis).unwrap()[0], at_start);
         // A front on it reads no layers (the ranks take the largest reach).
         free.probes[0].kind = ProbeKind::Front {
             origin: [0.0; 3],
@@ -560,5 +610,6 @@ mod tests {
             continuous: false,
         };
         assert_eq!(probe_layers(&free, &g, axis).unwrap()[0], None);
+        assert!(!on_free_body(&free, &free.probes[0]));
     }
 }

@@ -574,6 +574,48 @@ fn a_rolling_tank_over_two_ranks_writes_what_one_run_writes() {
     );
 }
 
+/// A box sinks through the 2D dam break's water column (a free body, 2 000 kg/m³, pushed down
+/// at 0.8 m/s) with a pressure probe under it, which crosses where the cut first lies:
+/// `mpirun -np 2 wgsph run` to t = 0.1 s, then `resume` from its last checkpoint (0.09 s) to
+/// 0.3 s, moves the cuts out of the probe's way as it comes (after the resume), and writes what
+/// one whole run writes (the particles, the probe's table, the box's).
+#[test]
+fn a_probe_on_a_sinking_box_over_two_ranks_reads_what_one_run_reads() {
+    let case = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("sinker.toml");
+    let tables = "[[body]]\nname = \"sinker\"\nshape = \"box\"\nmin_m = [0.04, 0.30]\n\
+                  max_m = [0.10, 0.34]\ndensity_kg_m3 = 2000.0\nwall = \"dynamic\"\n\
+                  [body.motion]\nkind = \"free\"\nvelocity_m_s = [0.0, -0.8]\n\
+                  [[probe]]\nname = \"under_sinker\"\nkind = \"pressure\"\n\
+                  point_m = [0.07, 0.29]\nbody = \"sinker\"\n";
+    let dam_break = std::fs::read_to_string("cases/dam_break_2d.toml").unwrap();
+    std::fs::write(&case, dam_break + "\n" + tables).unwrap();
+    let (one, two) = (
+        common::Scratch::new("mpi-sinker-one"),
+        common::Scratch::new("mpi-sinker-two"),
+    );
+    let args = |out: &std::path::Path, end: &str| -> Vec<std::ffi::OsString> {
+        let mut args: Vec<std::ffi::OsString> = vec!["run".into(), case.clone().into()];
+        for s in ["particles.dx_m=0.01", end, "time.output_every_s=0.05"] {
+            args.extend(["--set".into(), s.into()]);
+        }
+        args.extend(["--out".into(), out.as_os_str().to_owned()]);
+        args
+    };
+    on_one_rank(args(&one, "time.end_s=0.3"));
+    on_two_ranks(args(&two, "time.end_s=0.1"));
+    let log = on_two_ranks(resume(&two, "0.3"));
+    assert!(log.contains("resuming from t = 0.09"), "{log}");
+    assert!(
+        log.contains("cuts moved out of the way of a probe on a free body"),
+        "the probe never neared a cut: the test tests nothing\n{log}"
+    );
+    assert_same_outputs(&one, &two);
+    for table in ["under_sinker.csv", "body_sinker.csv"] {
+        let text = std::fs::read_to_string(two.join("probes").join(table)).unwrap();
+        assert!(text.lines().count() > 100, "{table}: {text}");
+    }
+}
+
 /// `case` at dx = 0.02 m to `end`, outputs every 0.05 s, on one rank and on two: the same
 /// outputs ([`assert_same_outputs`]); each of `tables` (in probes/) has rows.
 fn two_ranks_write_what_one_run_writes(tag: &str, case: &str, end: &str, tables: &[&str]) {

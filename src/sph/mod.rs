@@ -716,25 +716,29 @@ impl Solver {
     /// Moves the probes attached to bodies to where their bodies are now; returns them, all
     /// probes in order (None without attached probes).
     fn place_attached_probes(&self) -> Option<Vec<crate::scenario::Probe>> {
-        if let (Some((list, centers)), Some(set)) = (&self.attached_probes, self.bodies()) {
-            let placed: Vec<_> = list
-                .iter()
-                .map(|p| match p.body {
-                    Some(k) => probes::moved(p, centers[k], &set.pose(k)),
-                    None => p.clone(),
-                })
-                .collect();
-            let defs = probes::probe_defs(
-                &placed,
-                self.grid.origin,
-                &self.probe_faces,
-                self.front_bins,
-            );
-            self.queue
-                .write_buffer(&self.buffers.probes, 0, bytemuck::cast_slice(&defs));
-            return Some(placed);
-        }
-        None
+        let placed = self.attached_probes_placed()?;
+        let defs = probes::probe_defs(
+            &placed,
+            self.grid.origin,
+            &self.probe_faces,
+            self.front_bins,
+        );
+        self.queue
+            .write_buffer(&self.buffers.probes, 0, bytemuck::cast_slice(&defs));
+        Some(placed)
+    }
+
+    /// Every probe in order, those attached to bodies where their bodies are now (None without
+    /// attached probes).
+    fn attached_probes_placed(&self) -> Option<Vec<crate::scenario::Probe>> {
+        let (Some((list, centers)), Some(set)) = (&self.attached_probes, self.bodies()) else {
+            return None;
+        };
+        let placed = list.iter().map(|p| match p.body {
+            Some(k) => probes::moved(p, centers[k], &set.pose(k)),
+            None => p.clone(),
+        });
+        Some(placed.collect())
     }
 
     /// The probes' raw words (`probe_out`) as the last encoding left them.

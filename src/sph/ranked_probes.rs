@@ -3,11 +3,12 @@
 //! A point probe, a gauge or a wall patch reads only the cell layers `probe_layers` names, and
 //! the cuts never split them (`Slabs::balanced_keeping`): the rank that owns those layers holds
 //! every particle the probe reads, in the order one whole run holds them, and gives its value
-//! bit for bit (a probe on a moving tank: the layers of its whole path). A front is the
+//! bit for bit (a probe on a moving tank: the layers of its whole path; one on a free body: the
+//! layers where it stands, which the cuts move out of the way of). A front is the
 //! largest reach over the fluid: the ranks' words combine by their
 //! maximum, and a continuous front's wet bins by their union before the walk — exact too.
 
-use anyhow::{ensure, Result};
+use anyhow::{bail, ensure, Result};
 
 use super::Solver;
 use crate::decomposition::layers_read;
@@ -24,10 +25,28 @@ impl Solver {
         }
         let ranked = self.ranked.as_ref().expect("a subdomain");
         let slabs = ranked.slabs.as_ref().expect("a subdomain's cuts");
+        // The layers each probe reads: those `probe_layers` planned, or for one on a free body
+        // those where it stands now (which `keep_probes_whole` kept whole).
+        let mut layers = ranked.probe_layers.clone();
         if let Some(placed) = self.place_attached_probes() {
+            for &k in &ranked.moving_probes {
+                let here = layers_read(&placed[k], self.params.h as f64, &self.grid, slabs.axis);
+                if let Some(l) = here.clone().filter(|l| slabs.splits(l)) {
+                    bail!(
+                        "probe '{}' on a free body reads cell layers {l:?} at t = {:.4} s, \
+                         which the cuts {slabs:?} split (it moved further in a step than the \
+                         cuts allow for); run the case on one rank",
+                        placed[k].name,
+                        self.time()
+                    );
+                }
+                layers[k] = here;
+            }
             // A probe on a moving tank stays within the layers of its path the cuts keep whole
             // (`probe_layers`), unless the run goes on past the end they were planned for.
-            for (p, planned) in placed.iter().zip(&ranked.probe_layers) {
+            let planned = (placed.iter().zip(&ranked.probe_layers).enumerate())
+                .filter(|(k, _)| !ranked.moving_probes.contains(k));
+            for (_, (p, planned)) in planned {
                 let here = layers_read(p, self.params.h as f64, &self.grid, slabs.axis);
                 if let (Some(here), Some(planned)) = (here, planned) {
                     ensure!(
@@ -53,7 +72,7 @@ impl Solver {
         let mine: Vec<f64> = self.probe_words()?.iter().map(|&w| w as f64).collect();
         let all = ranks.gather(&mine);
         let words: Vec<u32> = (0..mine.len())
-            .map(|k| match &ranked.probe_layers[k] {
+            .map(|k| match &layers[k] {
                 _ if probes.is_front(k) => all.iter().map(|w| w[k] as u32).max().unwrap_or(0),
                 Some(layers) => all[slabs.owner(layers.start)][k] as u32,
                 None => unreachable!("every probe but a front reads some layers"),

@@ -19,7 +19,9 @@ use super::initial::Packed;
 use super::profile::Recorder;
 use super::Solver;
 use super::{bodies, halo};
-use crate::decomposition::{probe_layers, Slabs};
+use crate::decomposition::{
+    layers_read, on_free_body, probe_layers, widened, Slabs, PROBE_CLEARANCE, PROBE_MARGIN,
+};
 use crate::gpu::GpuContext;
 use crate::grid::Grid;
 use crate::layout::{
@@ -65,6 +67,10 @@ pub struct Ranked {
     /// The cell layers each probe reads (`decomposition::probe_layers`; none for fronts): the
     /// rank that owns them samples it.
     pub(super) probe_layers: Vec<Option<Range<u32>>>,
+    /// The probes on free bodies (`decomposition::on_free_body`): their layers are those where
+    /// they stand, which the cuts keep whole as they go (`Solver::keep_probes_whole`).
+    #[serde(skip)]
+    pub(super) moving_probes: Vec<usize>,
 }
 
 /// Steps between two looks at the ranks' balance (`Solver::rebalance`).
@@ -245,6 +251,9 @@ impl Solver {
         let ranked = solver.ranked.as_mut().expect("a subdomain");
         ranked.slabs = Some(slabs.clone());
         ranked.probe_layers = probes;
+        ranked.moving_probes = (0..sc.probes.len())
+            .filter(|&k| on_free_body(sc, &sc.probes[k]))
+            .collect();
         ranked.joining = joining_layers(sc, &solver.grid, slabs.axis)
             .into_iter()
             .map(|layer| (layer, slabs.owner(layer) as u32))
@@ -283,6 +292,7 @@ impl Solver {
     /// One step of every rank, and the balance looked at every [`REBALANCE_EVERY`] steps
     /// taken (a step of dt = 0 is not one).
     fn step_and_balance(&mut self, ranks: &dyn Ranks) -> Result<()> {
+        self.keep_probes_whole(ranks)?;
         let before = self.state.steps;
         self.ranked_step(ranks)?;
         let taken = (self.state.steps - before) as u64;
@@ -307,7 +317,8 @@ impl Solver {
         let load = ranks.sum_in_rank_order(&mine);
         let ranked = self.ranked.as_ref().expect("a subdomain");
         let slabs = ranked.slabs.as_ref().expect("a subdomain's cuts");
-        let Some(next) = slabs.rebalanced(&load, halo.thickness) else {
+        let moving = self.moving_probe_layers(PROBE_CLEARANCE);
+        let Some(next) = slabs.rebalanced(&load, halo.thickness, &moving) else {
             return Ok(false);
         };
         // A rank wakes the inlet particles it holds and sends them on one rank at most.
@@ -328,6 +339,58 @@ impl Solver {
         );
         self.redistribute(next, ranks)?;
         Ok(true)
+    }
+
+    /// Moves the cuts out of the way of the probes on free bodies before a step, where one
+    /// lies within [`PROBE_MARGIN`] layers of what such a probe reads now: the new cuts balance
+    /// the ranks' present load and stand [`PROBE_CLEARANCE`] layers clear of those probes
+    /// (every rank together: each sees the same bodies, so each decides the same). A probe is
+    /// then read whole by one rank at the end of the step, as one whole run reads it.
+    fn keep_probes_whole(&mut self, ranks: &dyn Ranks) -> Result<()> {
+        let ranked = self.ranked.as_ref().expect("a subdomain");
+        let slabs = ranked.slabs.as_ref().expect("a subdomain's cuts");
+        let near = self.moving_probe_layers(PROBE_MARGIN);
+        if !near.iter().any(|l| slabs.splits(l)) {
+            return Ok(());
+        }
+        let halo = self
+            .passes
+            .halo
+            .as_ref()
+            .expect("a subdomain has a halo pass");
+        let mine = halo.layer_load(&self.device, &self.queue, self.parity)?;
+        let load = ranks.sum_in_rank_order(&mine);
+        let clear = self.moving_probe_layers(PROBE_CLEARANCE);
+        let next = (slabs.clone().clear_of_moving(&load, halo.thickness, &clear))
+            .context("moving the cuts out of the way of a probe on a free body")?;
+        let far = |&(layer, holder): &(u32, u32)| next.owner(layer).abs_diff(holder as usize) > 1;
+        if let Some((layer, holder)) = ranked.joining.iter().find(|j| far(j)) {
+            bail!(
+                "a probe on a free body nears a cut, and the cuts cannot move out of its way: \
+                 under {next:?} the inlet particles rank {holder} holds would join in cell \
+                 layer {layer}, beyond its neighbours; run the case on fewer ranks"
+            );
+        }
+        log::info!(
+            "rank {}: cuts moved out of the way of a probe on a free body at t = {:.4} s",
+            ranks.rank(),
+            self.time()
+        );
+        self.redistribute(next, ranks)
+    }
+
+    /// The cell layers each probe on a free body reads where it stands now, `by` layers more
+    /// on each side.
+    pub(super) fn moving_probe_layers(&self, by: u32) -> Vec<Range<u32>> {
+        let ranked = self.ranked.as_ref().expect("a subdomain");
+        let (Some(slabs), Some(placed)) = (&ranked.slabs, self.attached_probes_placed()) else {
+            return Vec::new();
+        };
+        let count = self.grid.cells[slabs.axis];
+        (ranked.moving_probes.iter())
+            .filter_map(|&k| layers_read(&placed[k], self.params.h as f64, &self.grid, slabs.axis))
+            .map(|l| widened(l, by, count))
+            .collect()
     }
 
     /// Puts a checkpoint's subdomain counts and cuts back, after [`Solver::restore_state`]
@@ -352,6 +415,7 @@ impl Solver {
         let ranked = self.ranked.as_mut().expect("a subdomain");
         *ranked = Ranked {
             first_tail: None,
+            moving_probes: std::mem::take(&mut ranked.moving_probes),
             ..saved.clone()
         };
         self.sort_in_place();
