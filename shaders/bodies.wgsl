@@ -94,7 +94,7 @@ fn body_index(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     if (i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
         return;
     }
-    let id = code[i] & ID_MASK;
+    let id = particle_id(i);
     if (is_body_particle(id)) {
         body_slot[id - params.body_id_base] = i;
     }

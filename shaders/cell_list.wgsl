@@ -26,7 +26,7 @@
 @group(0) @binding(19) var<storage, read_write> energy_out: array<vec2<f32>>;
 
 // The slot of particle i (excluded particles go to the extra slot `hash_mask + 1`, a
-// subdomain's free entries, of id ID_MASK, to the last one, `hash_mask + 2`:
+// subdomain's free entries, of id FREE_ID, to the last one, `hash_mask + 2`:
 // sph::subdomain::FREE_ID). Recomputed by each kernel of the sort rather than stored: a
 // stored key would cost 4 bytes a particle for the few loads of its position it saves.
 fn sort_slot(i: u32) -> u32 {
@@ -34,7 +34,7 @@ fn sort_slot(i: u32) -> u32 {
     if (code_kind(c) != KIND_EXCLUDED) {
         return slot_of_cell(cell_of(pos[i]));
     }
-    return select(params.hash_mask + 1u, params.hash_mask + 2u, (c & ID_MASK) == ID_MASK);
+    return select(params.hash_mask + 1u, params.hash_mask + 2u, particle_id(i) == FREE_ID);
 }
 
 // Each particle's provisional place in its slot, counted into the slot.
@@ -56,8 +56,8 @@ fn scatter(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     provisional[cell_start[sort_slot(i)] + local_rank[i]] = i;
 }
 
-// Final place = slot start + number of particles of the same slot with a smaller code word
-// (kind, then id: ids are unique), so a slot holds its fluid first (shaders/lib/neighbours.wgsl)
+// Final place = slot start + number of particles of the same slot of a smaller (kind, id) (the
+// code word's order with narrow ids; ids are unique), so a slot holds its fluid first (shaders/lib/neighbours.wgsl)
 // and the order depends only on which particles there are. O(n_slot) per particle; the excluded
 // and free slots keep their provisional order (their particles never interact, and outputs are
 // written in id order).
@@ -77,13 +77,25 @@ fn rank_in_cell(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let end = cell_start[key + 1u];
     let word = code[i];
     var rank = 0u;
-    for (var q = start; q < end; q++) {
-        rank += select(0u, 1u, code[provisional[q]] < word);
+    if (WIDE_IDS) {
+        // (kind, id): the code word holds only the id's low bits.
+        let id = particle_id(i);
+        for (var q = start; q < end; q++) {
+            let j = provisional[q];
+            let kind_j = code_kind(code[j]);
+            let before = kind_j < code_kind(word) || (kind_j == code_kind(word) && particle_id(j) < id);
+            rank += select(0u, 1u, before);
+        }
+    } else {
+        for (var q = start; q < end; q++) {
+            rank += select(0u, 1u, code[provisional[q]] < word);
+        }
     }
     perm[start + rank] = i;
 }
 
-// Gathers the positions and code words into cell order. The per-particle arrays go in two
+// Gathers the positions and code words (with wide ids, the ids' high words after them) into
+// cell order. The per-particle arrays go in two
 // dispatches (this and `reorder_motion`) so that neither binds more than WebGPU's 8 storage
 // buffers.
 @compute @workgroup_size(WG)
@@ -95,6 +107,9 @@ fn reorder(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     let i = perm[p];
     pos_out[p] = pos_in[i];
     code_out[p] = code_in[i];
+    if (WIDE_IDS) {
+        code_out[params.n_particles + p] = code_in[params.n_particles + i];
+    }
 }
 
 // Gathers (v, ρ) and the last rates into cell order.

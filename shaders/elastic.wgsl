@@ -129,8 +129,7 @@ struct SolidParticle {
 // Whether particle i is a solid particle of this pass: of an updated-Lagrangian material (a
 // total-Lagrangian solid's forces are total_lagrangian.wgsl's, and it has no τ to integrate).
 fn is_updated_lagrangian(i: u32) -> bool {
-    let c = code[i];
-    return is_solid(code_kind(c)) && material_of(solid[solid_slot(c)]).total_lagrangian == 0u;
+    return is_solid(code_kind(code[i])) && material_of(solid[solid_slot(i)]).total_lagrangian == 0u;
 }
 
 // σ/ρ², R and the body of every solid particle, for elastic_rates (one invocation per
@@ -143,14 +142,14 @@ fn solid_stress_terms(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(nu
     if (i >= params.n_particles || !is_solid(code_kind(code[i]))) {
         return;
     }
-    let s = solid[solid_slot(code[i])];
+    let s = solid[solid_slot(i)];
     let mat = material_of(s);
     let rho = velrho[i].w;
     let p = solid_pressure(mat, rho);
     let sigma = tau_of(s) - mat3x3<f32>(vec3<f32>(p, 0.0, 0.0), vec3<f32>(0.0, p, 0.0), vec3<f32>(0.0, 0.0, p));
     let a = sigma * (1.0 / (rho * rho));
     let r = artificial_stress(mat.eps, sigma, rho);
-    terms[solid_slot(code[i])] = SolidTerms(
+    terms[solid_slot(i)] = SolidTerms(
         vec4<f32>(a[0].x, a[1].y, a[2].z, a[1].x),
         vec4<f32>(r[0].x, r[1].y, r[2].z, r[1].x),
         vec4<f32>(a[2].x, a[2].y, r[2].x, r[2].y),
@@ -173,7 +172,7 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     if (i >= params.n_particles || !is_updated_lagrangian(i)) {
         return;
     }
-    let slot_i = solid_slot(code[i]);
+    let slot_i = solid_slot(i);
     let body_i = solid[slot_i].body;
     // Pairs are within the body, so of one material.
     let mat = material_of(solid[slot_i]);
@@ -199,7 +198,7 @@ fn elastic_rates(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
             if (r2 >= support2) {
                 continue;
             }
-            let t_j = terms[solid_slot(code_j)];
+            let t_j = terms[solid_slot(j)];
             if (t_j.body != body_i) {
                 continue;
             }
@@ -249,7 +248,7 @@ fn stress_predict(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
         return;
     }
     let dt = state.dt;
-    let k = solid_slot(code[i]);
+    let k = solid_slot(i);
     let s = solid[k];
     solid[k].tau_a = s.tau_a + dt * s.rate_a;
     solid[k].tau_b = s.tau_b + dt * vec3<f32>(s.rate_b, 0.0);
@@ -263,7 +262,7 @@ fn stress_correct(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
         return;
     }
     let half_dt = 0.5 * state.dt;
-    let k = solid_slot(code[i]);
+    let k = solid_slot(i);
     let s = solid[k];
     let r = stress_rate[k];
     solid[k].tau_a = s.tau_a + half_dt * (r.a - s.rate_a);

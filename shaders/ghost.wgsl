@@ -22,7 +22,7 @@ fn ghost_interpolate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
         return;
     }
     var g_eff = params.gravity;
-    let id = code[g] & ID_MASK;
+    let id = particle_id(g);
     if (is_body_particle(id)) {
         let bp = tables.body_particles[id - params.body_id_base];
         g_eff -= body_wall_motion(tables.bodies[bp.body], bp.r).accel;
@@ -48,5 +48,5 @@ fn solid_interface_pressure(@builtin(global_invocation_id) gid: vec3<u32>, @buil
         return;
     }
     // (Along g only: the solid's own acceleration is left out of the correction.)
-    solid[solid_slot(code[g])].interface_p = fluid_at(pos[g], params.gravity).w;
+    solid[solid_slot(g)].interface_p = fluid_at(pos[g], params.gravity).w;
 }

@@ -57,7 +57,7 @@ struct HaloRecord {
     velrho: vec4<f32>,
     rate: vec4<f32>,
     code: u32,
-    dest: u32,          // DEST_UPPER | DEST_MIGRANT bits
+    dest: u32,          // DEST_* bits; with wide ids, the id's high bits from DEST_ID_SHIFT on
     energy: vec2<f32>,  // (e, de/dt of the last evaluation) when ENERGY, else zeros
 }
 
@@ -68,6 +68,7 @@ const DEST_MIGRANT: u32 = 2u;
 // particle; body, material and interface pressure are not sent: the first two never change,
 // the ghost pass recomputes the third).
 const DEST_SOLID_STATE: u32 = 4u;
+const DEST_ID_SHIFT: u32 = 3u;
 
 // A uniform: the packing binds the eight storage buffers every adapter allows.
 @group(0) @binding(6) var<uniform> halo_ctl: HaloCtl;
@@ -85,7 +86,19 @@ fn layer_of(p: Pos) -> u32 {
     return u32(cell_of(p)[halo_ctl.axis]);
 }
 
-fn pack_record(i: u32, dest: u32) {
+// The id of the particle a record carries.
+fn record_id(r: HaloRecord) -> u32 {
+    if (WIDE_IDS) {
+        return (r.code & ID_MASK) | ((r.dest >> DEST_ID_SHIFT) << ID_LOW_BITS);
+    }
+    return r.code & ID_MASK;
+}
+
+fn pack_record(i: u32, flags: u32) {
+    var dest = flags;
+    if (WIDE_IDS) {
+        dest |= (particle_id(i) >> ID_LOW_BITS) << DEST_ID_SHIFT;
+    }
     let solid_state = is_solid(code_kind(code[i]));
     let n = select(1u, 2u, solid_state);
     let k = atomicAdd(&halo_counts.records, n);
@@ -99,7 +112,7 @@ fn pack_record(i: u32, dest: u32) {
     }
     halo_out[k] = HaloRecord(pos[i], velrho[i], rate[i], code[i], dest, e);
     if (solid_state) {
-        let s = solid[solid_slot(code[i])];
+        let s = solid[solid_slot(i)];
         halo_out[k + 1u] = HaloRecord(
             Pos(s.tau_b, 0u), s.tau_a, s.rate_a, code[i], dest | DEST_SOLID_STATE, s.rate_b);
     }
@@ -163,19 +176,19 @@ fn halo_restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     if (i >= cell_start[params.hash_mask + 1u] || code_kind(code[i]) != KIND_EXCLUDED) {
         return;
     }
-    let id = code[i] & ID_MASK;
+    let id = particle_id(i);
     var lo = 0u;
     var hi = atomicLoad(&halo_counts.records);
     let n = hi;
     while (lo < hi) {
         let mid = (lo + hi) / 2u;
-        if ((halo_out[mid].code & ID_MASK) < id) {
+        if (record_id(halo_out[mid]) < id) {
             lo = mid + 1u;
         } else {
             hi = mid;
         }
     }
-    if (lo < n && (halo_out[lo].code & ID_MASK) == id) {
+    if (lo < n && record_id(halo_out[lo]) == id) {
         code[i] = halo_out[lo].code;
         velrho[i].w = halo_out[lo].velrho.w;
     }
@@ -185,6 +198,9 @@ fn halo_restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
 fn halo_forget(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
     if (i < cell_start[params.hash_mask + 1u] && code_kind(code[i]) == KIND_EXCLUDED) {
-        code[i] = with_kind(ID_MASK, KIND_EXCLUDED);
+        code[i] = with_kind(FREE_ID & ID_LOW_MASK, KIND_EXCLUDED);
+        if (WIDE_IDS) {
+            code[params.n_particles + i] = FREE_ID >> ID_LOW_BITS;
+        }
     }
 }

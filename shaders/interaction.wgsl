@@ -168,7 +168,7 @@ fn contact_weight(m_self: f32, m_other: f32) -> f32 {
 fn solid_loads(i: u32) -> vec3<f32> {
     let p_i = pos[i];
     let vr_i = velrho[i];
-    let s_i = solid[solid_slot(code[i])];
+    let s_i = solid[solid_slot(i)];
     let m_i = material_of(s_i).mass;
     let v_i = vr_i.xyz;
     let b_i = s_i.interface_p / (vr_i.w * vr_i.w);
@@ -195,13 +195,13 @@ fn solid_loads(i: u32) -> vec3<f32> {
                 r += interface_rates(b_i, vr_i.xyz, vr_i.w, pressure_of(vr_j.w) / (vr_j.w * vr_j.w), vr_j.xyz, vr_j.w, params.mass, x_ij, r2).xyz;
             } else if (!is_solid(kind_j)) {
                 var k = 1.0;
-                if (is_body_particle(code[j] & ID_MASK)) {
+                if (is_body_particle(particle_id(j))) {
                     k = contact_weight(m_i, params.mass);
                 }
-                let mu = friction_between(group_i, boundary_group(code[j] & ID_MASK));
+                let mu = friction_between(group_i, boundary_group(particle_id(j)));
                 r += k * contact(x_ij, r2, v_i - contact_velocity(j), mu);
             } else {
-                let s_j = solid[solid_slot(code[j])];
+                let s_j = solid[solid_slot(j)];
                 if (s_j.body != body_i) {
                     let mu = friction_between(group_i, params.friction_first_solid + s_j.body);
                     r += contact_weight(m_i, material_of(s_j).mass) * contact(x_ij, r2, v_i - velrho[j].xyz, mu);
@@ -256,7 +256,7 @@ fn contact_velocity(j: u32) -> vec3<f32> {
     if (is_solid(code_kind(code[j]))) {
         return velrho[j].xyz;
     }
-    let id = code[j] & ID_MASK;
+    let id = particle_id(j);
     if (is_body_particle(id)) {
         let bp = tables.body_particles[id - params.body_id_base];
         return body_wall_motion(tables.bodies[bp.body], bp.r).velocity;
@@ -447,7 +447,7 @@ fn wall_continuity(i: u32) -> f32 {
 // wall's particle has no contact, so it leaves each slot at the slot's last fluid particle,
 // as `wall_continuity` does.
 fn boundary_rates(i: u32, kind_i: u32, on_body: bool) -> vec4<f32> {
-    let id_i = code[i] & ID_MASK;
+    let id_i = particle_id(i);
     var body_i = NO_BODY;
     var kinematic_i = false;
     if (on_body) {
@@ -507,12 +507,12 @@ fn boundary_rates(i: u32, kind_i: u32, on_body: bool) -> vec4<f32> {
                     }
                 } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
                     // Contact with an elastic solid.
-                    let s_j = solid[solid_slot(code[j])];
+                    let s_j = solid[solid_slot(j)];
                     let mu = friction_between(1u + body_i, params.friction_first_solid + s_j.body);
                     r += vec4<f32>(contact_weight(params.mass, material_of(s_j).mass) * contact(x_ij, r2, v_contact_i - velrho[j].xyz, mu), 0.0);
-                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, code[j] & ID_MASK) && contact_counts(kinematic_i, code[j] & ID_MASK)) {
+                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, particle_id(j)) && contact_counts(kinematic_i, particle_id(j))) {
                     // Contact with a fixed wall or another body.
-                    let mu = friction_between(1u + body_i, boundary_group(code[j] & ID_MASK));
+                    let mu = friction_between(1u + body_i, boundary_group(particle_id(j)));
                     r += vec4<f32>(contact(x_ij, r2, v_contact_i - contact_velocity(j), mu), 0.0);
                 }
             }
@@ -545,7 +545,7 @@ fn fluid_rates(i: u32, ranges: ptr<function, NeighbourRanges>, n_ranges: u32) ->
             }
             if (is_solid(kind_j)) {
                 let vr_j = velrho[j];
-                let s_j = solid[solid_slot(code[j])];
+                let s_j = solid[solid_slot(j)];
                 let b_j = s_j.interface_p / (vr_j.w * vr_j.w);
                 r += interface_rates(pi.p_over_rho2, pi.v, pi.rho, b_j, vr_j.xyz, vr_j.w, material_of(s_j).mass, x_ij, r2);
                 continue;
@@ -557,7 +557,7 @@ fn fluid_rates(i: u32, ranges: ptr<function, NeighbourRanges>, n_ranges: u32) ->
             var v_cont = vr_j.xyz;
             var v_visc = vr_j.xyz;
             if (ghost) {
-                let gv = fixed_ghost_velocity(kind_j, code[j] & ID_MASK, vr_j.xyz);
+                let gv = fixed_ghost_velocity(kind_j, particle_id(j), vr_j.xyz);
                 v_cont = gv.cont;
                 v_visc = gv.visc;
             }
@@ -613,7 +613,7 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         rate[i] = fluid_rates(i, &ranges, n_ranges);
         return;
     }
-    let on_body = kind_i != KIND_EXCLUDED && is_body_particle(code[i] & ID_MASK);
+    let on_body = kind_i != KIND_EXCLUDED && is_body_particle(particle_id(i));
     // Boundary particles that take the fluid's force: bodies', and fixed walls' for probes.
     let reacts = on_body || (WALL_REACTIONS && kind_i != KIND_EXCLUDED && kind_i != KIND_INLET);
     if (!reacts) {

@@ -67,7 +67,7 @@ fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         return;
     }
     let c = code[i];
-    let id = c & ID_MASK;
+    let id = particle_id(i);
     let kind = code_kind(c);
     if (id < params.inlet_id_base || id - params.inlet_id_base >= params.n_inlet_particles
         || (kind != KIND_INLET && kind != KIND_EXCLUDED)) {
@@ -114,7 +114,7 @@ fn inlet_pressure(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
     if (i >= params.n_particles || code_kind(code[i]) != KIND_INLET) {
         return;
     }
-    let id = code[i] & ID_MASK;
+    let id = particle_id(i);
     let inlet = inlets[inlet_of(id)];
     if (inlet.pressure != INLET_EXTRAPOLATED) {
         return;

@@ -199,7 +199,7 @@ fn probe_wall_force(def: ProbeDef) -> f32 {
                         continue;
                     }
                     // A fixed wall's particle that belongs to another face's sensor is its.
-                    if (def.face != NO_FACE && !is_body_particle(code[j] & ID_MASK)) {
+                    if (def.face != NO_FACE && !is_body_particle(particle_id(j))) {
                         let owner = owning_sensor(x);
                         if (owner != NO_SENSOR && tables.wall_sensors[owner].face_id != def.face) {
                             continue;
@@ -369,7 +369,7 @@ fn track_points(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     if (k >= params.n_particles || code_kind(code[k]) == KIND_EXCLUDED) {
         return;
     }
-    let id = code[k] & ID_MASK;
+    let id = particle_id(k);
     var lo = 0u;
     var hi = arrayLength(&tracked);
     while (lo < hi) {

@@ -88,7 +88,7 @@ fn tl_index(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     if (i >= params.n_particles) {
         return;
     }
-    let id = code[i] & ID_MASK;
+    let id = particle_id(i);
     if (id >= tlp.first_id && id - tlp.first_id < tlp.n) {
         tl_slot[id - tlp.first_id] = i;
     }
@@ -106,8 +106,7 @@ fn tl_gather(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let i = tl_slot[k];
     var held = false;
     if (i < params.n_particles) {
-        let c = code[i];
-        held = (c & ID_MASK) == tlp.first_id + k && code_kind(c) != KIND_EXCLUDED;
+        held = particle_id(i) == tlp.first_id + k && code_kind(code[i]) != KIND_EXCLUDED;
     }
     if (held) {
         tl_pos[k] = pos[i];

@@ -256,6 +256,84 @@ pub const BODY_KINEMATIC: u32 = 1;
 pub const KIND_SHIFT: u32 = 28;
 pub const ID_MASK: u32 = 0x0FFF_FFFF;
 pub const KIND_EXCLUDED: u32 = 15;
+
+/// How a run stores its particle ids (issue 32: runs of 2²⁸ particles or more). Narrow: an id
+/// is its code word's low 28 bits. Wide: the code word keeps the id's low `low_bits` bits, and
+/// the rest (`id >> low_bits`) is a second word per particle after the n code words of the same
+/// buffer (which the sort gathers with them), and a halo record's `dest` above its flags
+/// ([`DEST_ID_SHIFT`]). An id is a u32 either way; the free entries' is the largest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct IdSplit {
+    pub wide: bool,
+    pub low_bits: u32,
+}
+
+impl IdSplit {
+    pub const NARROW: Self = Self {
+        wide: false,
+        low_bits: KIND_SHIFT,
+    };
+
+    /// The ids of a run of `particles` (all it may ever hold, inlets' included): wide with
+    /// `forced` low bits (`particles.id_low_bits`), else wide only where narrow ids run out.
+    pub fn for_run(particles: u64, forced: Option<u32>) -> Self {
+        match forced {
+            Some(low_bits) => Self {
+                wide: true,
+                low_bits,
+            },
+            None if particles >= Self::NARROW.free_id() as u64 => Self {
+                wide: true,
+                low_bits: KIND_SHIFT,
+            },
+            None => Self::NARROW,
+        }
+    }
+
+    /// The id of a free entry (`sph::subdomain`), above every particle's.
+    pub fn free_id(self) -> u32 {
+        match self.wide {
+            true => u32::MAX,
+            false => ID_MASK,
+        }
+    }
+
+    /// The words a particle takes in the code buffer.
+    pub fn words(self) -> usize {
+        1 + self.wide as usize
+    }
+
+    /// The code word of a particle of `kind` and `id`.
+    pub fn code_word(self, kind: u32, id: u32) -> u32 {
+        (kind << KIND_SHIFT) | (id & (ID_MASK >> (KIND_SHIFT - self.low_bits)))
+    }
+
+    /// The id bits that do not go in the code word (0 with narrow ids).
+    pub fn high(self, id: u32) -> u32 {
+        match self.wide {
+            true => id >> self.low_bits,
+            false => 0,
+        }
+    }
+
+    /// The id of a code word and its [`IdSplit::high`] bits.
+    pub fn id(self, code_word: u32, high: u32) -> u32 {
+        match self.wide {
+            true => (code_word & ID_MASK) | high << self.low_bits,
+            false => code_word & ID_MASK,
+        }
+    }
+
+    /// The id of particle `i` of the `n` a code buffer's words `code` hold.
+    pub fn id_at(self, code: &[u32], n: usize, i: usize) -> u32 {
+        self.id(code[i], if self.wide { code[n + i] } else { 0 })
+    }
+
+    /// The id of the particle a halo record carries.
+    pub fn record_id(self, r: &HaloRecord) -> u32 {
+        self.id(r.code, r.dest >> DEST_ID_SHIFT)
+    }
+}
 /// Largest block coordinate per axis (11/11/10 bits).
 pub const MAX_BLOCK: [u32; 3] = [2047, 2047, 1023];
 
@@ -349,6 +427,8 @@ pub const DEST_UPPER: u32 = 1;
 pub const DEST_MIGRANT: u32 = 2;
 /// A record that carries the stress state of the solid particle of the record before it.
 pub const DEST_SOLID_STATE: u32 = 4;
+/// With wide ids, the id's high bits ([`IdSplit::high`]) above the flags.
+pub const DEST_ID_SHIFT: u32 = 3;
 
 /// Mirrors `TlParams` in shaders/total_lagrangian.wgsl: the total-Lagrangian solid's
 /// particle count and first particle id (its particles have consecutive ids) and the cell
@@ -793,7 +873,12 @@ mod tests {
                             (true, false, true),
                             (true, true, false),
                         ] {
-                            for present in [Present::ALL, Present::NONE] {
+                            // Narrow ids with every particle, wide with none and all.
+                            for (present, wide) in [
+                                (Present::ALL, false),
+                                (Present::NONE, true),
+                                (Present::ALL, true),
+                            ] {
                                 let cfg = ShaderConfig {
                                     dim,
                                     kernel,
@@ -802,6 +887,7 @@ mod tests {
                                     hydrostatic_diffusion,
                                     wall_reactions,
                                     present,
+                                    ids: IdSplit::for_run(0, wide.then_some(4)),
                                     ..ShaderConfig::default()
                                 };
                                 parse(&compose(pass, cfg), pass.name).unwrap();

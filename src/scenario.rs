@@ -103,6 +103,9 @@ pub struct Physics {
     pub kernel: KernelKind,
     /// The neighbour grid's cell edge; by default h where the grid allows (`Grid::new`).
     pub cell: Option<CellEdge>,
+    /// `particles.id_low_bits`: wide particle ids forced, with this many bits of an id in its
+    /// code word (`layout::IdSplit`); None: wide only where the run needs them.
+    pub id_low_bits: Option<u32>,
     /// Reference density [kg/m³].
     pub rho0: f64,
     /// Numerical speed of sound [m/s].

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use wgsph::decomposition::{cut_axis, layer_load, slabs_for, Slabs};
 use wgsph::gpu::{AdapterChoice, GpuContext};
 use wgsph::grid::{CellEdge, Grid};
-use wgsph::layout::{unpack_block, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
+use wgsph::layout::{unpack_block, KIND_EXCLUDED, KIND_SHIFT};
 use wgsph::output::{particle_files, ParticleFile, RunSummary};
 use wgsph::ranks::{Mpi, Ranks};
 use wgsph::scenario::{Domain, Kind, Particle, Scenario};
@@ -187,13 +187,19 @@ fn a_failing_rank_ends_the_job_and_says_which() {
     unreachable!("rank 0 received from a rank that aborted");
 }
 
+/// Wide particle ids, as runs of 2²⁸ particles or more take them, forced on a small case with
+/// 4 of an id's bits in its code word: most particles share those with others, and only the
+/// second word tells them apart (tests/determinism.rs: the same results as narrow ids).
+const WIDE_IDS: &str = "particles.id_low_bits=4";
+
 /// (id, position words, (v, ρ, e) bits) of every live particle, sorted by id (e = 0 without
 /// the energy equation).
 type Live = Vec<(u32, [u32; 4], [u32; 5])>;
 
 fn live_particles(solver: &Solver) -> Live {
     let (pos, velrho, code) = solver.read_raw().unwrap();
-    let mut live: Live = (0..code.len())
+    let n = pos.len();
+    let mut live: Live = (0..n)
         .filter(|&k| code[k] >> KIND_SHIFT != KIND_EXCLUDED)
         .map(|k| {
             let p = pos[k];
@@ -204,7 +210,8 @@ fn live_particles(solver: &Solver) -> Live {
                 p.block,
             ];
             let [vx, vy, vz, rho] = velrho[k].map(f32::to_bits);
-            (code[k] & ID_MASK, words, [vx, vy, vz, rho, 0])
+            let id = solver.ids().id_at(&code, n, k);
+            (id, words, [vx, vy, vz, rho, 0])
         })
         .collect();
     live.sort_by_key(|l| l.0);
@@ -941,13 +948,14 @@ fn bench_under_mpirun_reports_every_rank() {
 /// ranks move the cut into the column at step 100, through the box, whose particles then cross
 /// it, migrating from rank to rank, while the load on the box is combined over the ranks. Its
 /// pose on every rank and every particle equal one whole run's bit for bit after 300 steps, the
-/// last 100 taken by subdomains restored from the state saved at step 200.
+/// last 100 taken by subdomains restored from the state saved at step 200. With wide ids
+/// ([`WIDE_IDS`]): halo copies and migrants carry the ids' high bits.
 #[test]
 fn a_body_crossing_the_cut_moves_as_in_one_run() {
     Comparison {
         test: "a_body_crossing_the_cut_moves_as_in_one_run",
         case: "cases/dam_break_2d.toml",
-        set: &["particles.dx_m=0.0073"],
+        set: &[WIDE_IDS, "particles.dx_m=0.0073"],
         ranks: 2,
         steps: 300,
         uneven: true,
@@ -981,13 +989,15 @@ fn ranks_with_fixed_ghost_walls_equal_one_run() {
 /// their corrected halo particles again and filter with them (`Solver::filter_over_ranks`).
 /// From cuts at equal numbers of layers, moved at step 100, every particle equals one whole
 /// run's bit for bit after 300 steps, the last 100 taken by subdomains restored at step 200
-/// (the filter's last step restored with them).
+/// (the filter's last step restored with them). With wide ids ([`WIDE_IDS`]): the filter's
+/// records carry the ids' high bits.
 #[test]
 fn ranks_filter_the_density_as_one_run() {
     Comparison {
         test: "ranks_filter_the_density_as_one_run",
         case: "cases/dam_break_2d.toml",
         set: &[
+            WIDE_IDS,
             "particles.dx_m=0.0073",
             "physics.density_filter=\"mls\"",
             "physics.density_filter_every=7",
@@ -1033,12 +1043,14 @@ fn ranks_with_an_inlet_inject_what_one_run_injects() {
 /// layers, moved at step 100 (the particles that change owner go with their stress states),
 /// every particle equals one whole run's bit for bit after 300 steps, the last 100 taken by
 /// subdomains restored at step 200 (with the stresses); without the stress states, 260
-/// particles differ.
+/// particles differ. With wide ids ([`WIDE_IDS`]): a stress state finds its particle's entry
+/// by the whole id.
 #[test]
 fn ranks_bend_an_elastic_plate_as_one_run() {
     Comparison {
         test: "ranks_bend_an_elastic_plate_as_one_run",
         case: "cases/oscillating_plate_2d.toml",
+        set: &[WIDE_IDS],
         ranks: 2,
         steps: 300,
         uneven: true,
@@ -1053,12 +1065,14 @@ fn ranks_bend_an_elastic_plate_as_one_run() {
 /// halo, so the ranks share every TL particle's predicted position each step and each
 /// computes the whole plate's stresses (`Solver::share_tl_positions`). From cuts at equal
 /// numbers of layers, moved at step 100, every particle equals one whole run's bit for bit
-/// after 300 steps, the last 100 taken by subdomains restored at step 200.
+/// after 300 steps, the last 100 taken by subdomains restored at step 200. With wide ids
+/// ([`WIDE_IDS`]).
 #[test]
 fn ranks_bend_a_total_lagrangian_plate_as_one_run() {
     Comparison {
         test: "ranks_bend_a_total_lagrangian_plate_as_one_run",
         case: "cases/oscillating_plate_tl_2d.toml",
+        set: &[WIDE_IDS],
         ranks: 2,
         steps: 300,
         uneven: true,

@@ -219,11 +219,6 @@ fn code_kind(code: u32) -> u32 {
     return code >> KIND_SHIFT;
 }
 
-// Index of a solid particle (its code word) in the solid arrays: id − params.solid_id_base.
-fn solid_slot(code: u32) -> u32 {
-    return (code & ID_MASK) - params.solid_id_base;
-}
-
 // The material of a solid particle.
 fn material_of(s: SolidState) -> SolidMaterial {
     return params.solid_materials[s.material];

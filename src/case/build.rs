@@ -1145,6 +1145,7 @@ fn physics(case: &Case, start: &Start, h: f64) -> Physics {
         h,
         kernel: case.kernel,
         cell: case.cell,
+        id_low_bits: case.id_low_bits,
         rho0: case.rho0,
         c0: start.c0,
         gamma: case.gamma,
@@ -1217,6 +1218,7 @@ pub(super) fn build_solid_case(
         h: case.h_over_dx * dx,
         kernel: case.kernel,
         cell: case.cell,
+        id_low_bits: case.id_low_bits,
         rho0: case.rho0,
         // Unused without fluid; the solids' sound speeds enter through their materials.
         c0: materials

@@ -123,6 +123,7 @@ pub(super) struct RawParticles {
     pub h_over_dx: Option<f64>,
     pub kernel: Option<KernelName>,
     pub cell: Option<CellName>,
+    pub id_low_bits: Option<u32>,
 }
 
 /// The neighbour grid's cell edge (`crate::grid::CellEdge`).
@@ -435,6 +436,13 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "particles.cell",
         "the neighbour grid's cell edge, \"h\" or \"2h\" (by default h where the grid allows)",
         "cell = \"2h\"",
+    ),
+    f(
+        "particles.id_low_bits",
+        "wide particle ids (a second id word per particle, which runs of 2^28 particles or more \
+         take by themselves) with this many of an id's bits in its code word, 1 to 28: fewer \
+         check the wide ids' paths on a small case",
+        "id_low_bits = 4",
     ),
     f(
         "physics",

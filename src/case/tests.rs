@@ -890,6 +890,18 @@ const BAD_NUMBERS: &[(&str, &str, usize, &[&str])] = &[
         5,
         &["particles.h_over_dx", "[1, 3]"],
     ),
+    (
+        "dx_m = 0.1",
+        "dx_m = 0.1\nid_low_bits = 29",
+        5,
+        &["particles.id_low_bits = 29", "between 1 and 28", "leave it out"],
+    ),
+    (
+        "dx_m = 0.1",
+        "dx_m = 0.1\nid_low_bits = 0",
+        5,
+        &["particles.id_low_bits = 0", "between 1 and 28"],
+    ),
     ("end_s = 1.0", "end_s = 0.0", 10, &["time.end_s", "> 0"]),
     ("end_s = 1.0", "end_s = -inf", 10, &["time.end_s", "finite"]),
     (

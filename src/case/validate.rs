@@ -67,6 +67,8 @@ pub(super) struct Case {
     pub h_over_dx: f64,
     pub kernel: KernelKind,
     pub cell: Option<CellEdge>,
+    /// `particles.id_low_bits`: wide ids forced, with this many bits in the code word.
+    pub id_low_bits: Option<u32>,
     pub rho0: f64,
     pub gravity: [f64; 3],
     pub sound: Sound,
@@ -134,6 +136,7 @@ pub(super) fn validate(
     }
     let name = case_name(ctx, raw, default_name)?;
     let (dx, h_over_dx, kernel, cell) = particles(ctx, raw)?;
+    let id_low_bits = id_low_bits(ctx, raw)?;
     let physics = physics(ctx, raw, dim)?;
     let time = time(ctx, raw)?;
 
@@ -173,6 +176,7 @@ pub(super) fn validate(
         h_over_dx,
         kernel,
         cell,
+        id_low_bits,
         rho0,
         gravity,
         sound,
@@ -267,6 +271,21 @@ fn particles(
         CellName::H => CellEdge::Half,
     });
     Ok((dx, h_over_dx, kernel, cell))
+}
+
+/// `particles.id_low_bits`, within 1 to 28 (`crate::layout::IdSplit`).
+fn id_low_bits(ctx: &Ctx<'_>, raw: &RawCase) -> Result<Option<u32>, CaseError> {
+    match raw.particles.id_low_bits {
+        Some(bits) if !(1..=crate::layout::KIND_SHIFT).contains(&bits) => Err(ctx.err(
+            "particles.id_low_bits",
+            Some(bits.to_string()),
+            "must be between 1 and 28 (the bits of a particle id its code word keeps; the rest \
+             go in a second word)",
+            "leave it out (runs of 2^28 particles or more take wide ids with 28 by themselves), \
+             or give a small number such as 4 to check the wide ids on a small case",
+        )),
+        bits => Ok(bits),
+    }
 }
 
 /// The checked `[physics]` table.

@@ -129,6 +129,7 @@ mod tests {
             h: 1.3 * dx,
             kernel,
             cell: None,
+            id_low_bits: None,
             rho0: 1000.0,
             c0: 20.0,
             gamma: 7.0,

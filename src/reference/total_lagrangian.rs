@@ -244,6 +244,7 @@ mod tests {
             h: 1.3 * dx,
             kernel: KernelKind::WendlandC2,
             cell: None,
+            id_low_bits: None,
             rho0: 1000.0,
             c0: 10.0,
             gamma: 7.0,

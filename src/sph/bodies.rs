@@ -9,6 +9,7 @@ use anyhow::Result;
 use glam::{DMat3, DVec3};
 
 use super::buffers::ParticleBuffers;
+use super::shader::PARTICLE_ID;
 use super::shader::WORKGROUP_MAX;
 use crate::body::{Load, Pose};
 use crate::gpu::buffers::storage;
@@ -19,7 +20,7 @@ use crate::grid::Grid;
 pub const SHADER: Shader = Shader {
     name: "bodies",
     source: include_str!("../../shaders/bodies.wgsl"),
-    libs: &[WORKGROUP_MAX],
+    libs: &[PARTICLE_ID, WORKGROUP_MAX],
 };
 use crate::layout::{pack_block, BodyMotion, BodyParticle, BODY_KINEMATIC};
 use crate::scenario::Scenario;

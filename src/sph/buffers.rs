@@ -148,6 +148,7 @@ const NO_SENSOR: WallSensor = WallSensor {
 pub struct InitialParticles<'a> {
     pub pos: &'a [Pos],
     pub velrho: &'a [[f32; 4]],
+    /// The code words, then with wide ids the ids' high words (`Packed::code_words`).
     pub code: &'a [u32],
     pub body_particles: &'a [BodyParticle],
     /// One per body (its particle range and workgroups; the motion comes with each step).
@@ -209,7 +210,7 @@ impl ParticleBuffers {
             ],
             code: [
                 storage_init(device, "code A", init.code),
-                storage(device, "code B", words),
+                storage(device, "code B", 4 * init.code.len() as u64),
             ],
             rate: storage_init(device, "rate", &zero_rates),
             rate_sorted: storage(device, "rate sorted", vec4),

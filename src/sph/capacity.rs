@@ -3,7 +3,7 @@
 use anyhow::{bail, Result};
 
 use crate::gpu::GpuContext;
-use crate::layout::ID_MASK;
+use crate::layout::IdSplit;
 
 /// How many particles fit an adapter, and the limit that binds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -21,7 +21,8 @@ pub struct Capacity {
 const LARGEST_ARRAY_BYTES_PER_PARTICLE: u64 = 16;
 
 /// The most particles a device with `limits` can run: each per-particle array must fit one
-/// storage binding and one buffer, and ids have 28 bits.
+/// storage binding and one buffer, and ids have 32 bits (wide ids, `layout::IdSplit`, past
+/// 2^28).
 pub fn capacity(limits: &wgpu::Limits) -> Capacity {
     let per = LARGEST_ARRAY_BYTES_PER_PARTICLE;
     [
@@ -36,9 +37,9 @@ pub fn capacity(limits: &wgpu::Limits) -> Capacity {
             limit: limits.max_buffer_size,
         },
         Capacity {
-            particles: ID_MASK as u64,
-            bound_by: "the 28-bit particle id",
-            limit: ID_MASK as u64,
+            particles: MAX_PARTICLES,
+            bound_by: "the 32-bit particle id",
+            limit: MAX_PARTICLES,
         },
     ]
     .into_iter()
@@ -46,8 +47,24 @@ pub fn capacity(limits: &wgpu::Limits) -> Capacity {
     .expect("three candidates")
 }
 
+/// The most particles a run can have, over all its ranks: one id is the free entries'.
+pub const MAX_PARTICLES: u64 = u32::MAX as u64 - 1;
+
+/// Fails, naming the limit, when a run of `n` particles (all its ranks') has more than ids
+/// can number.
+pub fn check_ids(n: usize) -> Result<()> {
+    if n as u64 > MAX_PARTICLES {
+        bail!(
+            "the case has {n} particles, more than the {MAX_PARTICLES} that 32-bit particle \
+             ids number: use a coarser particles.dx_m"
+        );
+    }
+    debug_assert!(IdSplit::for_run(n as u64, None).free_id() as u64 > n as u64);
+    Ok(())
+}
+
 /// Fails, saying how many fit and which limit binds, when `n` particles do not fit `ctx`'s
-/// device. Runs call this before they create anything.
+/// device (a whole run's, or a subdomain's arrays). Runs call this before they create anything.
 pub fn check_capacity(ctx: &GpuContext, n: usize) -> Result<()> {
     let cap = capacity(&ctx.limits);
     if n as u64 > cap.particles {

@@ -4,6 +4,7 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
+use super::shader::PARTICLE_ID;
 use crate::gpu::kernel::{ParityKernel, Resolve, ShaderModule};
 use crate::gpu::shader::Shader;
 use crate::gpu::Kernel;
@@ -11,7 +12,7 @@ use crate::gpu::Kernel;
 pub const SHADER: Shader = Shader {
     name: "cell_list",
     source: include_str!("../../shaders/cell_list.wgsl"),
-    libs: &[],
+    libs: &[PARTICLE_ID],
 };
 
 /// The exclusive scan of the slot counts (shaders/prefix_scan.wgsl).

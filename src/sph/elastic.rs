@@ -7,6 +7,7 @@ use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
 use super::shader::NEIGHBOURS;
+use super::shader::PARTICLE_ID;
 use crate::gpu::buffers::storage;
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
@@ -14,7 +15,7 @@ use crate::gpu::shader::Shader;
 pub const SHADER: Shader = Shader {
     name: "elastic",
     source: include_str!("../../shaders/elastic.wgsl"),
-    libs: &[NEIGHBOURS],
+    libs: &[PARTICLE_ID, NEIGHBOURS],
 };
 
 /// Bytes of `SolidTerms` (shaders/elastic.wgsl) per solid particle: σ/ρ², R and the body.

@@ -5,6 +5,7 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
+use super::shader::PARTICLE_ID;
 use super::shader::{FLUID_AT, MLS, NEIGHBOURS};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
@@ -12,7 +13,7 @@ use crate::gpu::shader::Shader;
 pub const SHADER: Shader = Shader {
     name: "ghost",
     source: include_str!("../../shaders/ghost.wgsl"),
-    libs: &[NEIGHBOURS, MLS, FLUID_AT],
+    libs: &[PARTICLE_ID, NEIGHBOURS, MLS, FLUID_AT],
 };
 
 pub struct Ghost {

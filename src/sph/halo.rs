@@ -5,12 +5,14 @@
 use anyhow::{anyhow, bail, ensure, Result};
 
 use super::buffers::ParticleBuffers;
+use super::shader::PARTICLE_ID;
 use crate::decomposition::Slabs;
 use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
 use crate::layout::{
-    HaloCounts, HaloCtl, HaloRecord, Pos, DEST_MIGRANT, DEST_SOLID_STATE, DEST_UPPER, ID_MASK,
+    HaloCounts, HaloCtl, HaloRecord, IdSplit, Pos, DEST_ID_SHIFT, DEST_MIGRANT, DEST_SOLID_STATE,
+    DEST_UPPER,
 };
 use crate::scenario::{InletPressure, Kind, Scenario};
 use bytemuck::{Pod, Zeroable};
@@ -18,7 +20,7 @@ use bytemuck::{Pod, Zeroable};
 pub const SHADER: Shader = Shader {
     name: "halo",
     source: include_str!("../../shaders/halo.wgsl"),
-    libs: &[],
+    libs: &[PARTICLE_ID],
 };
 
 /// Cell layers of halo `sc` needs. Cells are the kernel support 2h, so one layer holds every
@@ -104,13 +106,15 @@ pub struct Halo {
 
 /// What the density filter's exchange sends of a halo copy: its owner's code word and
 /// corrected density, all that `halo_restore` gives the copy back (the filter reads no other
-/// field of a neighbour's): 8 bytes a particle where a record is 64. Only the host and the
-/// ranks' messages hold it; the receiver uploads full records.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+/// field of a neighbour's), and with wide ids the id's high bits: 8 bytes a particle (12 with
+/// wide ids) where a record is 64. Only the host and the ranks' messages hold it; the receiver
+/// uploads full records.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FilterRecord {
     pub code: u32,
     pub rho: f32,
+    /// The id's high bits as `HaloRecord::dest` holds them (0 with narrow ids).
+    pub id_high: u32,
 }
 
 impl From<&HaloRecord> for FilterRecord {
@@ -118,16 +122,18 @@ impl From<&HaloRecord> for FilterRecord {
         Self {
             code: r.code,
             rho: r.velrho[3],
+            id_high: r.dest >> DEST_ID_SHIFT << DEST_ID_SHIFT,
         }
     }
 }
 
 impl FilterRecord {
-    /// The record `halo_restore` reads: the code word and ρ, the rest zero.
+    /// The record `halo_restore` reads: the code word, the id's high bits and ρ, the rest zero.
     pub fn restored(&self) -> HaloRecord {
         HaloRecord {
             velrho: [0.0, 0.0, 0.0, self.rho],
             code: self.code,
+            dest: self.id_high,
             ..Default::default()
         }
     }
@@ -139,18 +145,42 @@ pub trait Wire: Sized {
     fn from_wire(bytes: &[u8]) -> Result<Vec<Self>>;
 }
 
+/// A density-filter message: a word saying whether the ids' high bits follow (only where
+/// some are not 0, so narrow ids never send them), each record's code word and ρ, then the
+/// high bits.
 impl Wire for FilterRecord {
     fn to_wire(records: &[Self]) -> Vec<u8> {
-        bytemuck::cast_slice(records).to_vec()
+        let wide = records.iter().any(|r| r.id_high != 0);
+        let mut words = vec![wide as u32];
+        words.extend(records.iter().flat_map(|r| [r.code, r.rho.to_bits()]));
+        words.extend(records.iter().map(|r| r.id_high).filter(|_| wide));
+        bytemuck::cast_slice(&words).to_vec()
     }
 
     fn from_wire(bytes: &[u8]) -> Result<Vec<Self>> {
+        let words: Vec<u32> = match bytes.len().is_multiple_of(4) {
+            true => bytemuck::pod_collect_to_vec(bytes),
+            false => Vec::new(),
+        };
+        let per = match words.first() {
+            Some(0) => 2,
+            Some(1) => 3,
+            _ => 0,
+        };
         ensure!(
-            bytes.len().is_multiple_of(std::mem::size_of::<Self>()),
+            per > 0 && (words.len() - 1).is_multiple_of(per),
             "a neighbour's density-filter message of {} bytes is not whole records",
             bytes.len()
         );
-        Ok(bytemuck::pod_collect_to_vec(bytes))
+        let n = (words.len() - 1) / per;
+        let (pairs, high) = words[1..].split_at(2 * n);
+        Ok((0..n)
+            .map(|k| Self {
+                code: pairs[2 * k],
+                rho: f32::from_bits(pairs[2 * k + 1]),
+                id_high: high.get(k).copied().unwrap_or(0),
+            })
+            .collect())
     }
 }
 
@@ -361,8 +391,9 @@ impl Halo {
 
     /// Gives the halo copies of the arrays of parity `q`, excluded by `encode_drop`, their
     /// owners' values in `received` again (for the density filter; [`Halo::encode_restore`]).
-    pub fn upload_restored(&self, queue: &wgpu::Queue, received: &mut [HaloRecord]) {
-        received.sort_unstable_by_key(|r| r.code & ID_MASK);
+    /// `received` is sorted by id, which `ids` says how to read.
+    pub fn upload_restored(&self, queue: &wgpu::Queue, received: &mut [HaloRecord], ids: IdSplit) {
+        received.sort_unstable_by_key(|r| ids.record_id(r));
         queue.write_buffer(&self.records, 0, bytemuck::cast_slice(received));
         let counts = HaloCounts {
             records: received.len() as u32,
@@ -415,11 +446,11 @@ impl Halo {
 mod tests {
     use super::*;
 
-    /// The filter's exchange sends an eighth of a record and gives `halo_restore` everything it
-    /// reads: the code word (the id it searches by) and ρ.
+    /// The filter's exchange sends an eighth of a record (with narrow ids) and gives
+    /// `halo_restore` everything it reads: the code word and the id's high bits (the id it
+    /// searches by) and ρ.
     #[test]
     fn a_filter_record_carries_what_the_restore_reads() {
-        assert_eq!(std::mem::size_of::<FilterRecord>(), 8);
         assert_eq!(std::mem::size_of::<HaloRecord>(), 64);
         let full = HaloRecord {
             pos: Pos {
@@ -432,12 +463,30 @@ mod tests {
             dest: DEST_UPPER,
             energy: [5.0, 6.0],
         };
-        let restored = FilterRecord::from(&full).restored();
+        let lean = FilterRecord::from(&full);
+        let restored = lean.restored();
         assert_eq!(
             (restored.code, restored.velrho[3]),
             (full.code, full.velrho[3])
         );
         assert_eq!(restored.dest & DEST_SOLID_STATE, 0);
+        let message = FilterRecord::to_wire(&[lean, lean]);
+        assert_eq!(message.len(), 4 + 2 * 8);
+        assert_eq!(FilterRecord::from_wire(&message).unwrap(), [lean, lean]);
+        // A wide id's high bits travel too, and come back where `halo_restore` reads them.
+        let wide = HaloRecord {
+            dest: DEST_UPPER | 5 << DEST_ID_SHIFT,
+            ..full
+        };
+        let ids = IdSplit::for_run(0, Some(4));
+        let lean = FilterRecord::from(&wide);
+        let message = FilterRecord::to_wire(&[lean, FilterRecord::from(&full)]);
+        assert_eq!(message.len(), 4 + 2 * 12);
+        let back = FilterRecord::from_wire(&message).unwrap();
+        assert_eq!(ids.record_id(&back[0].restored()), ids.record_id(&wide));
+        assert_eq!(ids.record_id(&back[1].restored()), ids.record_id(&full));
+        assert_ne!(ids.record_id(&wide), ids.record_id(&full));
+        assert!(FilterRecord::from_wire(&message[..message.len() - 4]).is_err());
     }
 
     /// A halo message carries migrants and solid states whole and copies lean (40 bytes), and

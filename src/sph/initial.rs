@@ -4,7 +4,7 @@
 use anyhow::{bail, Result};
 
 use crate::grid::Grid;
-use crate::layout::{pack_block, Pos, SolidState, KIND_EXCLUDED, KIND_SHIFT};
+use crate::layout::{pack_block, IdSplit, Pos, SolidState, KIND_EXCLUDED};
 use crate::scenario::{Kind, Scenario};
 
 /// What a case holds, for the branches of the pair sums: the kernels leave out the terms of the
@@ -70,18 +70,39 @@ pub struct Packed {
     pub pos: Vec<Pos>,
     /// (v, ρ)
     pub velrho: Vec<[f32; 4]>,
-    /// kind << 28 | id
+    /// Kind and id (`IdSplit::code_word`).
     pub code: Vec<u32>,
+    /// Each entry's whole id.
+    pub id: Vec<u32>,
+    pub ids: IdSplit,
+}
+
+impl Packed {
+    /// The code buffer's words: the code words, then with wide ids the ids' high words.
+    pub fn code_words(&self) -> Vec<u32> {
+        let high = self.id.iter().map(|&id| self.ids.high(id));
+        let high = high.filter(|_| self.ids.wide);
+        self.code.iter().copied().chain(high).collect()
+    }
+}
+
+/// How `sc`'s particle ids are stored: wide where `particles.id_low_bits` asks for it or
+/// where the run has too many particles for narrow ids.
+pub fn id_split(sc: &Scenario) -> IdSplit {
+    IdSplit::for_run(sc.particles.len() as u64, sc.physics.id_low_bits)
 }
 
 /// `sc`'s particles on `grid`: positions as block offsets, and inlet particles behind their
 /// buffers excluded (in no cell) until they join.
 pub fn pack(sc: &Scenario, grid: &Grid) -> Packed {
     let n = sc.particles.len();
+    let ids = id_split(sc);
     let mut out = Packed {
         pos: Vec::with_capacity(n),
         velrho: Vec::with_capacity(n),
         code: Vec::with_capacity(n),
+        id: (0..n as u32).collect(),
+        ids,
     };
     for (id, p) in sc.particles.iter().enumerate() {
         let (off, b) = grid.to_block(p.pos);
@@ -91,12 +112,12 @@ pub fn pack(sc: &Scenario, grid: &Grid) -> Packed {
         });
         let v = p.vel.map(|x| x as f32);
         out.velrho.push([v[0], v[1], v[2], p.rho as f32]);
-        out.code.push(((p.kind as u32) << KIND_SHIFT) | id as u32);
+        out.code.push(ids.code_word(p.kind as u32, id as u32));
     }
     for inlet in &sc.inlets {
         for (k, id) in inlet.particles.clone().enumerate() {
             if inlet.dormant(k) {
-                out.code[id] = (KIND_EXCLUDED << KIND_SHIFT) | id as u32;
+                out.code[id] = ids.code_word(KIND_EXCLUDED, id as u32);
             }
         }
     }
@@ -184,6 +205,7 @@ pub fn solid_states(sc: &Scenario) -> Result<Vec<SolidState>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::layout::KIND_SHIFT;
 
     fn present_in(case: &str) -> Present {
         let sc = crate::case::load(std::path::Path::new(case), &[]).unwrap();
@@ -214,6 +236,8 @@ mod tests {
         let sc = crate::case::load(std::path::Path::new("cases/dam_break_2d.toml"), &[]).unwrap();
         let grid = Grid::of(&sc).unwrap();
         let packed = pack(&sc, &grid);
+        assert!(!packed.ids.wide);
+        assert_eq!(packed.code_words(), packed.code);
         for (id, p) in sc.particles.iter().enumerate() {
             assert_eq!(packed.code[id] & crate::layout::ID_MASK, id as u32);
             assert_eq!(packed.code[id] >> KIND_SHIFT, p.kind as u32);
@@ -226,5 +250,26 @@ mod tests {
             }
             assert_eq!(packed.velrho[id][3], p.rho as f32);
         }
+    }
+
+    /// With wide ids (forced with 4 low bits) a code word keeps an id's low bits and its kind,
+    /// and the words after the n code words the rest: every id comes back from the two.
+    #[test]
+    fn wide_ids_split_between_the_code_word_and_a_second_word() {
+        let set = ["particles.id_low_bits=4".to_string()];
+        let path = std::path::Path::new("cases/dam_break_2d.toml");
+        let sc = crate::case::load(path, &set).unwrap();
+        let packed = pack(&sc, &Grid::of(&sc).unwrap());
+        let n = sc.particles.len();
+        assert!(packed.ids.wide && n > 1000);
+        let words = packed.code_words();
+        assert_eq!(words.len(), 2 * n);
+        for (id, p) in sc.particles.iter().enumerate() {
+            assert_eq!(packed.code[id] & crate::layout::ID_MASK, id as u32 & 15);
+            assert_eq!(packed.code[id] >> KIND_SHIFT, p.kind as u32);
+            assert_eq!(words[n + id], id as u32 >> 4);
+            assert_eq!(packed.ids.id_at(&words, n, id), id as u32);
+        }
+        assert!(packed.ids.free_id() > n as u32);
     }
 }

@@ -3,6 +3,7 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
+use super::shader::PARTICLE_ID;
 use super::shader::{NEIGHBOURS, WALL_PATCH};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
@@ -10,7 +11,7 @@ use crate::gpu::shader::Shader;
 pub const SHADER: Shader = Shader {
     name: "interaction",
     source: include_str!("../../shaders/interaction.wgsl"),
-    libs: &[NEIGHBOURS, WALL_PATCH],
+    libs: &[PARTICLE_ID, NEIGHBOURS, WALL_PATCH],
 };
 
 pub struct Interaction {

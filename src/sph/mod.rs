@@ -39,7 +39,7 @@ use crate::gpu::buffers::{map_read, read, readback_buffer};
 use crate::gpu::context::GpuFaults;
 use crate::gpu::GpuContext;
 use crate::grid::Grid;
-use crate::layout::{unpack_block, HaloCtl, Params, Pos, SimState, KIND_EXCLUDED};
+use crate::layout::{unpack_block, HaloCtl, IdSplit, Params, Pos, SimState, KIND_EXCLUDED};
 use crate::scenario::{Kind, Scenario};
 use buffers::{CaseTables, InitialParticles, ParticleBuffers};
 pub use capacity::{capacity, check_capacity, Capacity};
@@ -97,7 +97,8 @@ pub struct Unstable {
 
 pub use crate::output::Particles;
 
-/// (positions, (v, ρ), code words) as stored on the GPU.
+/// (positions, (v, ρ), code words) as stored on the GPU; with wide ids the code words are
+/// followed by the ids' high words (`Solver::ids`).
 pub type RawParticles = (Vec<Pos>, Vec<[f32; 4]>, Vec<u32>);
 
 /// Moving bodies' host side: their dynamics, and the buffer the state and the per-workgroup
@@ -117,6 +118,8 @@ pub struct Solver {
     buffers: ParticleBuffers,
     passes: Passes,
     energy: bool,
+    /// How the particles' ids are stored.
+    ids: IdSplit,
     /// Solid particles (the length of the solid arrays).
     n_solid: u32,
     /// The case's probes and the bodies' centres at t = 0, when a probe moves with a body.
@@ -164,7 +167,10 @@ impl Solver {
         if n == 0 {
             bail!("the case has no particles");
         }
-        check_capacity(ctx, n)?;
+        capacity::check_ids(n)?;
+        if subdomain.is_none() {
+            check_capacity(ctx, n)?;
+        }
         let grid = match subdomain {
             Some(_) => crate::decomposition::ranks_grid(sc)?,
             None => Grid::of(sc)?,
@@ -173,20 +179,24 @@ impl Solver {
         let cfg = ShaderConfig::of(sc, &grid)?;
         probes::check_wall_pressure(sc)?;
         let device = ctx.device.clone();
+        let mut packed = initial::pack(sc, &grid);
+        let ranked = (subdomain.as_ref())
+            .map(|ctl| -> Result<_> {
+                let (own, waiting) = subdomain::exclude_others(&mut packed, &grid, ctl, sc);
+                let capacity = subdomain::capacity(own, waiting, n as u32);
+                check_capacity(ctx, capacity as usize)?;
+                subdomain::resize(&mut packed, capacity as usize);
+                params.n_particles = capacity;
+                let live = (n - sc.dormant_count()) as u64;
+                Ok(subdomain::Ranked::new(live, own, waiting))
+            })
+            .transpose()?;
         // Allocation failures are caught here to name what was being allocated; later ones
         // reach `faults`.
         let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let probe_faces = probes::probe_faces(&sc.probes, &sc.walls);
         let front_bins = probes::FrontBins::new(&grid, ph.h, &sc.probes)?;
         let defs = probes::probe_defs(&sc.probes, grid.origin, &probe_faces, front_bins);
-        let mut packed = initial::pack(sc, &grid);
-        let ranked = subdomain.as_ref().map(|ctl| {
-            let (own, waiting) = subdomain::exclude_others(&mut packed, &grid, ctl, sc);
-            let capacity = subdomain::capacity(own, waiting, n as u32);
-            subdomain::resize(&mut packed, capacity as usize);
-            params.n_particles = capacity;
-            subdomain::Ranked::new((n - sc.dormant_count()) as u64, own, waiting)
-        });
         let body_motions = bodies::initial_motions(sc, params.body_id_base);
         let solid = initial::solid_states(sc)?;
         let buffers = ParticleBuffers::new(
@@ -196,7 +206,7 @@ impl Solver {
             &InitialParticles {
                 pos: &packed.pos,
                 velrho: &packed.velrho,
-                code: &packed.code,
+                code: &packed.code_words(),
                 body_particles: &bodies::body_particles(sc),
                 body_motions: &body_motions,
                 solid: &solid,
@@ -245,6 +255,7 @@ impl Solver {
             buffers,
             passes,
             energy: ph.energy,
+            ids: cfg.ids,
             n_solid: solid.len() as u32,
             probe_faces,
             front_bins,

@@ -8,6 +8,7 @@
 use anyhow::{ensure, Result};
 
 use super::buffers::ParticleBuffers;
+use super::shader::PARTICLE_ID;
 use super::shader::{FLUID_AT, MLS, NEIGHBOURS};
 use crate::gpu::buffers::storage_init;
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
@@ -17,7 +18,7 @@ use crate::grid::Grid;
 pub const SHADER: Shader = Shader {
     name: "open_boundaries",
     source: include_str!("../../shaders/open_boundaries.wgsl"),
-    libs: &[NEIGHBOURS, MLS, FLUID_AT],
+    libs: &[PARTICLE_ID, NEIGHBOURS, MLS, FLUID_AT],
 };
 use crate::layout::{
     pack_block, InletDef, OutletDef, Pos, INLET_EXTRAPOLATED, INLET_HYDROSTATIC, INLET_ZERO,

@@ -4,6 +4,7 @@
 use anyhow::{bail, Result};
 
 use super::buffers::ParticleBuffers;
+use super::shader::PARTICLE_ID;
 use super::shader::{NEIGHBOURS, WALL_PATCH, WORKGROUP_MAX};
 use crate::body::Pose;
 use crate::gpu::buffers::{read, storage, storage_init};
@@ -13,7 +14,7 @@ use crate::gpu::shader::Shader;
 pub const SHADER: Shader = Shader {
     name: "probes",
     source: include_str!("../../shaders/probes.wgsl"),
-    libs: &[NEIGHBOURS, WORKGROUP_MAX, WALL_PATCH],
+    libs: &[PARTICLE_ID, NEIGHBOURS, WORKGROUP_MAX, WALL_PATCH],
 };
 use crate::layout::{Pos, ProbeDef, NO_FACE};
 use crate::ranks::Ranks;

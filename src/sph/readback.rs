@@ -6,20 +6,27 @@ use anyhow::{bail, Context, Result};
 use super::{Particles, RawParticles, Solver};
 use crate::eos::{solid_pressure, Tait};
 use crate::gpu::buffers::read;
-use crate::layout::{unpack_block, SolidState, ID_MASK, KIND_SHIFT};
+use crate::layout::{unpack_block, IdSplit, SolidState, KIND_SHIFT};
 use crate::scenario::Kind;
 
 impl Solver {
+    /// How the particles' ids are stored (the code buffer's words: [`Solver::read_raw`]).
+    pub fn ids(&self) -> IdSplit {
+        self.ids
+    }
+
     /// Raw arrays of the current parity, in GPU (cell) order.
     pub fn read_raw(&self) -> Result<RawParticles> {
         let n = self.buffers.n as usize;
+        let words = n * self.ids.words();
         let p = self.parity;
         Ok((
             read(&self.device, &self.queue, &self.buffers.pos[p], n)
                 .context("reading positions")?,
             read(&self.device, &self.queue, &self.buffers.velrho[p], n)
                 .context("reading velocities")?,
-            read(&self.device, &self.queue, &self.buffers.code[p], n).context("reading codes")?,
+            read(&self.device, &self.queue, &self.buffers.code[p], words)
+                .context("reading codes")?,
         ))
     }
 
@@ -81,8 +88,10 @@ impl Solver {
             Some(t) => Some(t.cauchy_stress(&self.device, &self.queue, self.parity)?),
             None => None,
         };
-        let mut order: Vec<usize> = (0..pos.len()).collect();
-        order.sort_unstable_by_key(|&i| code[i] & ID_MASK);
+        let n = pos.len();
+        let id_of = |i: usize| self.ids.id_at(&code, n, i);
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_unstable_by_key(|&i| id_of(i));
         let eos = Tait {
             b: self.params.tait_b as f64,
             rho0: self.params.rho0 as f64,
@@ -96,7 +105,7 @@ impl Solver {
             out.vel.push([v[0], v[1], v[2]]);
             out.rho.push(v[3]);
             let kind = code[i] >> KIND_SHIFT;
-            let id = code[i] & ID_MASK;
+            let id = id_of(i);
             let solid_kind = Kind::code_is_solid(kind);
             // τ and material of the particle (zeros for the others), when the case has solids.
             let state = solid.as_ref().map(|s| {
@@ -133,7 +142,7 @@ impl Solver {
                 out.pressure.push(eos.pressure(v[3] as f64) as f32);
             }
             out.kind.push(kind);
-            out.id.push(code[i] & ID_MASK);
+            out.id.push(id);
             if let Some(e) = &energy {
                 out.energy.get_or_insert_with(Vec::new).push(e[i][0]);
             }

@@ -13,6 +13,7 @@ use super::initial::Present;
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::shader::{compose as compose_shader, Shader, WORKGROUP_SIZE};
 use crate::grid::Grid;
+use crate::layout::IdSplit;
 use crate::scenario::{
     DeltaSphForm, GhostCorrection, KernelKind, RepulsiveForm, Scenario, Viscosity,
 };
@@ -27,6 +28,9 @@ pub const MLS: &str = include_str!("../../shaders/lib/mls.wgsl");
 pub const FLUID_AT: &str = include_str!("../../shaders/lib/fluid_at.wgsl");
 /// A maximum over the workgroup before one atomic (`shaders/lib/workgroup_max.wgsl`).
 pub const WORKGROUP_MAX: &str = include_str!("../../shaders/lib/workgroup_max.wgsl");
+/// A particle's id and the solid arrays' index (`shaders/lib/particle_id.wgsl`; the pass
+/// declares `code`).
+pub const PARTICLE_ID: &str = include_str!("../../shaders/lib/particle_id.wgsl");
 /// A wall-pressure sensor's patch of boundary particles (`shaders/lib/wall_patch.wgsl`).
 pub const WALL_PATCH: &str = include_str!("../../shaders/lib/wall_patch.wgsl");
 
@@ -121,6 +125,8 @@ pub struct ShaderConfig {
     /// The Tait exponent γ where it is a whole number from 1 to 15 (`tait_power` multiplies),
     /// otherwise 0 (pow).
     pub tait_gamma: u32,
+    /// How the particles' ids are stored.
+    pub ids: IdSplit,
 }
 
 impl Default for ShaderConfig {
@@ -140,6 +146,7 @@ impl Default for ShaderConfig {
             },
             cell_reach: 2,
             tait_gamma: 7,
+            ids: IdSplit::NARROW,
         }
     }
 }
@@ -163,6 +170,7 @@ impl ShaderConfig {
             tables: TableSizes::of(sc),
             cell_reach: grid.reach,
             tait_gamma: whole_exponent(ph.gamma),
+            ids: IdSplit::for_run(sc.particles.len() as u64, ph.id_low_bits),
         })
     }
 
@@ -183,7 +191,9 @@ impl ShaderConfig {
              const MIRRORS: bool = {mirrors};\nconst LONE_SOLID: bool = {lone_solid};\n\
              const WG: u32 = {wg}u;\n\
              const N_BODIES: u32 = {bodies_n}u;\nconst N_MIRROR_PLANES: u32 = {planes_n}u;\n\
-             const N_WALL_SENSORS: u32 = {sensors_n}u;\nconst CELL_REACH: i32 = {reach};\nconst TAIT_GAMMA: u32 = {gamma}u;\n",
+             const N_WALL_SENSORS: u32 = {sensors_n}u;\nconst CELL_REACH: i32 = {reach};\nconst TAIT_GAMMA: u32 = {gamma}u;\n\
+             const WIDE_IDS: bool = {wide};\nconst ID_LOW_BITS: u32 = {low_bits}u;\n\
+             const FREE_ID: u32 = {free}u;\nconst ID_LOW_MASK: u32 = {low_mask}u;\n",
             dim = self.dim,
             kernel = self.kernel.name(),
             visc = self.viscosity.name(),
@@ -202,6 +212,10 @@ impl ShaderConfig {
             sensors_n = self.tables.wall_sensors,
             reach = self.cell_reach,
             gamma = self.tait_gamma,
+            wide = self.ids.wide,
+            low_bits = self.ids.low_bits,
+            free = self.ids.free_id(),
+            low_mask = self.ids.code_word(0, u32::MAX),
         );
         out
     }

@@ -91,13 +91,20 @@ impl Solver {
         let lens = [
             ("positions", s.pos.len()),
             ("velocities", s.velrho.len()),
-            ("codes", s.code.len()),
             ("rates", s.rate.len()),
         ];
         for (what, len) in lens {
             if len != n {
                 bail!("the saved state has {len} {what}; this case has {n} particles");
             }
+        }
+        if s.code.len() != n * self.ids.words() {
+            bail!(
+                "the saved state has {} code words for {n} particles; this case takes {} a \
+                 particle (particles.id_low_bits differs?)",
+                s.code.len(),
+                self.ids.words()
+            );
         }
         if s.energy.is_some() != self.energy {
             bail!("the saved state and this case disagree on the energy equation");

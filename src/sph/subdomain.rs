@@ -25,7 +25,7 @@ use crate::decomposition::{
 use crate::gpu::GpuContext;
 use crate::grid::Grid;
 use crate::layout::{
-    unpack_block, HaloCtl, HaloRecord, Pos, SolidState, DEST_SOLID_STATE, ID_MASK, KIND_EXCLUDED,
+    unpack_block, HaloCtl, HaloRecord, IdSplit, Pos, SolidState, DEST_SOLID_STATE, KIND_EXCLUDED,
     KIND_SHIFT,
 };
 use crate::output::RankSummary;
@@ -130,7 +130,7 @@ pub fn capacity(own: u32, waiting: u32, n: u32) -> u32 {
 /// the inlet particles waiting behind their buffers (`Inlet::dormant`) whose joining place, at
 /// the back of the buffer, lies in its own layers (a rank holds a waiting particle until
 /// `inlet_flow` wakes it, then sends it on if it stands beyond a cut, as any migrant). The own
-/// come first, then the waiting; every other entry is free: excluded, its id [`FREE_ID`] (the
+/// come first, then the waiting; every other entry is free: excluded, its id the free one (the
 /// sort puts free entries after the waiting ones, which keep theirs). Returns (own, waiting).
 pub fn exclude_others(
     packed: &mut Packed,
@@ -156,7 +156,7 @@ pub fn exclude_others(
                 && mine(joining_layer(inlet, k % inlet.columns.len(), grid, axis) as i64)
         })
     };
-    let ids: Vec<usize> = packed.code.iter().map(|c| (c & ID_MASK) as usize).collect();
+    let ids: Vec<usize> = packed.id.iter().map(|&id| id as usize).collect();
     let first: Vec<usize> = (0..ids.len()).filter(|&k| own(k)).collect();
     let waiting: Vec<usize> = (0..ids.len())
         .filter(|&k| packed.code[k] >> KIND_SHIFT == KIND_EXCLUDED && joining_here(ids[k]))
@@ -167,13 +167,18 @@ pub fn exclude_others(
     let kept = first.len() + waiting.len();
     packed.pos = order.iter().map(|&k| packed.pos[k]).collect();
     packed.velrho = order.iter().map(|&k| packed.velrho[k]).collect();
+    let free = free_code(packed.ids);
     packed.code = order
         .iter()
         .enumerate()
         .map(|(at, &k)| match at < kept {
             true => packed.code[k],
-            false => FREE,
+            false => free,
         })
+        .collect();
+    let free_id = packed.ids.free_id();
+    packed.id = (order.iter().enumerate())
+        .map(|(at, &k)| if at < kept { packed.id[k] } else { free_id })
         .collect();
     (first.len() as u32, waiting.len() as u32)
 }
@@ -200,19 +205,20 @@ fn joining_layer(inlet: &crate::scenario::Inlet, c: usize, grid: &Grid, axis: us
     grid.cell_of(off, block)[axis].clamp(0, grid.cells[axis] as i64 - 1) as u32
 }
 
-/// The id of a free entry of a subdomain's arrays: the largest, so that the sort puts the free
-/// entries last in the excluded slot, after the inlet particles still waiting (`halo_pack`
-/// finds the free tail there). No particle has it (the run's ids stay below it).
-pub const FREE_ID: u32 = ID_MASK;
-
-/// The code word of a free entry.
-const FREE: u32 = (KIND_EXCLUDED << KIND_SHIFT) | FREE_ID;
+/// The code word of a free entry of a subdomain's arrays: excluded, of the free id
+/// (`IdSplit::free_id`), the largest, so that the sort puts the free entries last in the
+/// excluded slot, after the inlet particles still waiting (`halo_pack` finds the free tail
+/// there). No particle has it (the run's ids stay below it).
+fn free_code(ids: IdSplit) -> u32 {
+    ids.code_word(KIND_EXCLUDED, ids.free_id())
+}
 
 /// `packed` cut or padded to `capacity` entries, the padding free.
 pub fn resize(packed: &mut Packed, capacity: usize) {
     packed.pos.resize(capacity, Pos::default());
     packed.velrho.resize(capacity, [0.0; 4]);
-    packed.code.resize(capacity, FREE);
+    packed.code.resize(capacity, free_code(packed.ids));
+    packed.id.resize(capacity, packed.ids.free_id());
 }
 
 impl Solver {
@@ -759,7 +765,7 @@ impl Solver {
             self.passes.density_filter.as_ref().expect("a filter"),
         );
         let mut incoming: Vec<HaloRecord> = incoming.iter().map(FilterRecord::restored).collect();
-        halo.upload_restored(&self.queue, &mut incoming);
+        halo.upload_restored(&self.queue, &mut incoming, self.ids);
         self.submit_pass("density filter over ranks", |pass| {
             halo.encode_restore(pass, q);
             filter.encode(pass, q);
@@ -801,6 +807,15 @@ impl Solver {
         write(&b.pos[p], 16, bytemuck::cast_slice(&pos));
         write(&b.velrho[p], 16, bytemuck::cast_slice(&velrho));
         write(&b.code[p], 4, bytemuck::cast_slice(&code));
+        if self.ids.wide {
+            // The ids' high words, after the n code words.
+            let high: Vec<u32> = (incoming.iter())
+                .map(|r| self.ids.high(self.ids.record_id(r)))
+                .collect();
+            let at = (b.n as u64 + tail as u64) * 4;
+            self.queue
+                .write_buffer(&b.code[p], at, bytemuck::cast_slice(&high));
+        }
         write(&b.rate, 16, bytemuck::cast_slice(&rate));
         if self.energy {
             let energy: Vec<[f32; 2]> = incoming.iter().map(|r| r.energy).collect();
@@ -816,7 +831,7 @@ impl Solver {
     fn write_solid_states(&self, states: &[HaloRecord]) {
         let size = std::mem::size_of::<SolidState>() as u64;
         for r in states {
-            let at = ((r.code & ID_MASK) - self.params.solid_id_base) as u64 * size;
+            let at = (self.ids.record_id(r) - self.params.solid_id_base) as u64 * size;
             let tau_b = r.pos.off;
             let tau: [f32; 7] = [
                 r.velrho[0],
@@ -907,6 +922,7 @@ impl Solver {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::layout::ID_MASK;
 
     fn load(case: &str, set: &[&str]) -> Scenario {
         let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
@@ -936,7 +952,7 @@ mod tests {
             let (own, held) = exclude_others(&mut packed, &grid, &ctl, &sc);
             let (own, held) = (own as usize, held as usize);
             for (k, &c) in packed.code.iter().enumerate() {
-                let id = (c & ID_MASK) as usize;
+                let id = packed.id[k] as usize;
                 let excluded = c >> KIND_SHIFT == KIND_EXCLUDED;
                 assert_eq!(excluded, k >= own, "entry {k}");
                 if k < own {
@@ -952,7 +968,7 @@ mod tests {
                     assert_eq!(c, whole.code[id], "a waiting particle keeps its code");
                     waiting.push(id);
                 } else {
-                    assert_eq!(c, FREE);
+                    assert_eq!((c, packed.id[k]), (free_code(packed.ids), ID_MASK));
                 }
             }
         }

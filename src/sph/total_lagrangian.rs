@@ -11,6 +11,7 @@
 use anyhow::Result;
 
 use super::buffers::ParticleBuffers;
+use super::shader::PARTICLE_ID;
 use crate::gpu::buffers::{map_read, read, readback_buffer, storage, storage_init, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
@@ -18,7 +19,7 @@ use crate::gpu::shader::Shader;
 pub const SHADER: Shader = Shader {
     name: "total_lagrangian",
     source: include_str!("../../shaders/total_lagrangian.wgsl"),
-    libs: &[],
+    libs: &[PARTICLE_ID],
 };
 use crate::lagrangian::{cauchy_of, TlSetup};
 use crate::layout::{Pos, TlPair, TlParams};

@@ -83,6 +83,7 @@ pub fn physics(dim: u32, dx: f64, c0: f64) -> Physics {
         h,
         kernel: KernelKind::WendlandC2,
         cell: None,
+        id_low_bits: None,
         rho0: 1000.0,
         c0,
         gamma: 7.0,
