@@ -584,7 +584,7 @@ fn a_rolling_tank_over_two_ranks_writes_what_one_run_writes() {
 /// A box sinks through the 2D dam break's water column (a free body, 2 000 kg/m³, pushed down
 /// at 0.8 m/s) with a pressure probe under it, which crosses where the cut first lies:
 /// `mpirun -np 2 wgsph run` to t = 0.1 s, then `resume` from its last checkpoint (0.09 s) to
-/// 0.3 s, moves the cuts out of the probe's way as it comes (after the resume), and writes what
+/// 0.2 s, moves the cuts out of the probe's way as it comes (after the resume), and writes what
 /// one whole run writes (the particles, the probe's table, the box's).
 #[test]
 fn a_probe_on_a_sinking_box_over_two_ranks_reads_what_one_run_reads() {
@@ -608,9 +608,9 @@ fn a_probe_on_a_sinking_box_over_two_ranks_reads_what_one_run_reads() {
         args.extend(["--out".into(), out.as_os_str().to_owned()]);
         args
     };
-    on_one_rank(args(&one, "time.end_s=0.3"));
+    on_one_rank(args(&one, "time.end_s=0.2"));
     on_two_ranks(args(&two, "time.end_s=0.1"));
-    let log = on_two_ranks(resume(&two, "0.3"));
+    let log = on_two_ranks(resume(&two, "0.2"));
     assert!(log.contains("resuming from t = 0.09"), "{log}");
     assert!(
         log.contains("cuts moved out of the way of a probe on a free body"),
@@ -619,7 +619,7 @@ fn a_probe_on_a_sinking_box_over_two_ranks_reads_what_one_run_reads() {
     assert_same_outputs(&one, &two);
     for table in ["under_sinker.csv", "body_sinker.csv"] {
         let text = std::fs::read_to_string(two.join("probes").join(table)).unwrap();
-        assert!(text.lines().count() > 100, "{table}: {text}");
+        assert!(text.lines().count() > 50, "{table}: {text}");
     }
 }
 
