@@ -894,7 +894,11 @@ const BAD_NUMBERS: &[(&str, &str, usize, &[&str])] = &[
         "dx_m = 0.1",
         "dx_m = 0.1\nid_low_bits = 29",
         5,
-        &["particles.id_low_bits = 29", "between 1 and 28", "leave it out"],
+        &[
+            "particles.id_low_bits = 29",
+            "between 1 and 28",
+            "leave it out",
+        ],
     ),
     (
         "dx_m = 0.1",

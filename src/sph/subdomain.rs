@@ -314,22 +314,13 @@ impl Solver {
     /// beyond `decomposition::REBALANCE_THRESHOLD` over the mean (every rank together, between
     /// steps); whether they moved. Particles move exactly, so the run goes on as it would have.
     pub fn rebalance(&mut self, ranks: &dyn Ranks) -> Result<bool> {
-        let halo = self
-            .passes
-            .halo
-            .as_ref()
-            .expect("a subdomain has a halo pass");
-        let mine = halo.layer_load(&self.device, &self.queue, self.parity)?;
-        let load = ranks.sum_in_rank_order(&mine);
-        let ranked = self.ranked.as_ref().expect("a subdomain");
-        let slabs = ranked.slabs.as_ref().expect("a subdomain's cuts");
+        let (load, thickness) = self.layer_loads(ranks)?;
+        let slabs = self.slabs();
         let moving = self.moving_probe_layers(PROBE_CLEARANCE);
-        let Some(next) = slabs.rebalanced(&load, halo.thickness, &moving) else {
+        let Some(next) = slabs.rebalanced(&load, thickness, &moving) else {
             return Ok(false);
         };
-        // A rank wakes the inlet particles it holds and sends them on one rank at most.
-        let far = |&(layer, holder): &(u32, u32)| next.owner(layer).abs_diff(holder as usize) > 1;
-        if let Some((layer, holder)) = ranked.joining.iter().find(|j| far(j)) {
+        if let Some((layer, holder)) = self.joining_beyond_neighbours(&next) {
             log::debug!(
                 "rank {}: cuts kept: under {next:?} the inlet particles rank {holder} holds \
                  would join in layer {layer}, beyond its neighbours",
@@ -353,24 +344,18 @@ impl Solver {
     /// (every rank together: each sees the same bodies, so each decides the same). A probe is
     /// then read whole by one rank at the end of the step, as one whole run reads it.
     fn keep_probes_whole(&mut self, ranks: &dyn Ranks) -> Result<()> {
-        let ranked = self.ranked.as_ref().expect("a subdomain");
-        let slabs = ranked.slabs.as_ref().expect("a subdomain's cuts");
         let near = self.moving_probe_layers(PROBE_MARGIN);
-        if !near.iter().any(|l| slabs.splits(l)) {
+        if !near.iter().any(|l| self.slabs().splits(l)) {
             return Ok(());
         }
-        let halo = self
-            .passes
-            .halo
-            .as_ref()
-            .expect("a subdomain has a halo pass");
-        let mine = halo.layer_load(&self.device, &self.queue, self.parity)?;
-        let load = ranks.sum_in_rank_order(&mine);
+        let (load, thickness) = self.layer_loads(ranks)?;
         let clear = self.moving_probe_layers(PROBE_CLEARANCE);
-        let next = (slabs.clone().clear_of_moving(&load, halo.thickness, &clear))
-            .context("moving the cuts out of the way of a probe on a free body")?;
-        let far = |&(layer, holder): &(u32, u32)| next.owner(layer).abs_diff(holder as usize) > 1;
-        if let Some((layer, holder)) = ranked.joining.iter().find(|j| far(j)) {
+        let next = (self
+            .slabs()
+            .clone()
+            .clear_of_moving(&load, thickness, &clear))
+        .context("moving the cuts out of the way of a probe on a free body")?;
+        if let Some((layer, holder)) = self.joining_beyond_neighbours(&next) {
             bail!(
                 "a probe on a free body nears a cut, and the cuts cannot move out of its way: \
                  under {next:?} the inlet particles rank {holder} holds would join in cell \
@@ -383,6 +368,29 @@ impl Solver {
             self.time()
         );
         self.redistribute(next, ranks)
+    }
+
+    /// The present cuts.
+    fn slabs(&self) -> &Slabs {
+        let ranked = self.ranked.as_ref().expect("a subdomain");
+        ranked.slabs.as_ref().expect("a subdomain's cuts")
+    }
+
+    /// Every rank's own particles per cell layer, summed in rank order (every rank together),
+    /// and the halo's thickness in layers, which a slab may not be thinner than.
+    fn layer_loads(&self, ranks: &dyn Ranks) -> Result<(Vec<f64>, u32)> {
+        let halo = (self.passes.halo.as_ref()).expect("a subdomain has a halo pass");
+        let mine = halo.layer_load(&self.device, &self.queue, self.parity)?;
+        Ok((ranks.sum_in_rank_order(&mine), halo.thickness))
+    }
+
+    /// A place where inlet particles join that `next` puts beyond the neighbours of the rank
+    /// holding them, and that rank: a rank wakes the particles it holds and sends them on one
+    /// rank at most, so such cuts cannot be taken.
+    fn joining_beyond_neighbours(&self, next: &Slabs) -> Option<(u32, u32)> {
+        let ranked = self.ranked.as_ref().expect("a subdomain");
+        let far = |&&(layer, holder): &&(u32, u32)| next.owner(layer).abs_diff(holder as usize) > 1;
+        ranked.joining.iter().find(far).copied()
     }
 
     /// The cell layers each probe on a free body reads where it stands now, `by` layers more
