@@ -744,8 +744,13 @@ impl<'a> Runner<'a> {
         };
         let solid = some(sc.solid_count(), "solid");
         let inlet = some(sc.count(Kind::Inlet), "inlet");
+        let ids = solver.ids();
+        let wide = match ids.wide {
+            true => format!(", wide ids ({} bits in the code word)", ids.low_bits),
+            false => String::new(),
+        };
         log::info!(
-            "{}: {} particles ({} fluid, {} boundary{solid}{inlet}) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
+            "{}: {} particles ({} fluid, {} boundary{solid}{inlet}{wide}) on {}, {:.1} bytes/particle on the GPU, first dt {:.3e} s",
             sc.name,
             sc.particles.len(),
             sc.count(Kind::Fluid),
