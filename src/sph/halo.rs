@@ -66,6 +66,18 @@ pub fn records_per_particle(sc: &Scenario) -> u32 {
     }
 }
 
+/// The records the packing buffer holds for arrays of `n` entries: `per_particle` each, but no
+/// more than one storage binding of `max_binding` bytes holds. Only a slab as thin as its halo
+/// packs every particle; a thicker one packs its layers by the cuts, a small share, so the
+/// cap binds only ranks of millions of particles (128 B an entry would reach an H200's
+/// 2 047 MiB binding at 1.7 × 10⁷ entries), and a step that packs more stops with a message.
+pub fn records_capacity(per_particle: u32, n: u32, max_binding: u64) -> u32 {
+    let fit = max_binding / std::mem::size_of::<HaloRecord>() as u64;
+    (per_particle as u64 * n as u64)
+        .min(fit)
+        .min(u32::MAX as u64) as u32
+}
+
 /// Rank `rank`'s part of `slabs` with a halo of `layers` ([`halo_layers`]): what `halo_pack`
 /// needs to know (the records' capacity is the pass's own, set by [`Halo::new`]).
 pub fn control(slabs: &Slabs, rank: usize, layers: u32) -> HaloCtl {
@@ -286,8 +298,9 @@ impl Halo {
         layers: u32,
         records_per_particle: u32,
     ) -> Result<Self> {
+        let max_binding = device.limits().max_storage_buffer_binding_size;
         let ctl = HaloCtl {
-            capacity: records_per_particle * b.n,
+            capacity: records_capacity(records_per_particle, b.n, max_binding),
             ..ctl
         };
         let ctl_buffer = uniform_init(device, "halo ctl", &ctl);
@@ -392,7 +405,19 @@ impl Halo {
     /// Gives the halo copies of the arrays of parity `q`, excluded by `encode_drop`, their
     /// owners' values in `received` again (for the density filter; [`Halo::encode_restore`]).
     /// `received` is sorted by id, which `ids` says how to read.
-    pub fn upload_restored(&self, queue: &wgpu::Queue, received: &mut [HaloRecord], ids: IdSplit) {
+    pub fn upload_restored(
+        &self,
+        queue: &wgpu::Queue,
+        received: &mut [HaloRecord],
+        ids: IdSplit,
+    ) -> Result<()> {
+        ensure!(
+            received.len() <= self.capacity as usize,
+            "{} halo copies received for the density filter, more than the subdomain's {} \
+             records hold",
+            received.len(),
+            self.capacity
+        );
         received.sort_unstable_by_key(|r| ids.record_id(r));
         queue.write_buffer(&self.records, 0, bytemuck::cast_slice(received));
         let counts = HaloCounts {
@@ -400,6 +425,7 @@ impl Halo {
             ..Default::default()
         };
         queue.write_buffer(&self.counts, 0, bytemuck::bytes_of(&counts));
+        Ok(())
     }
 
     /// Restores the copies [`Halo::upload_restored`] gave, in the arrays of parity `q`.
@@ -487,6 +513,16 @@ mod tests {
         assert_eq!(ids.record_id(&back[1].restored()), ids.record_id(&full));
         assert_ne!(ids.record_id(&wide), ids.record_id(&full));
         assert!(FilterRecord::from_wire(&message[..message.len() - 4]).is_err());
+    }
+
+    /// The packing buffer holds two records an entry (four with solids), but never more than
+    /// one storage binding: on lavapipe's 128 MiB, 2²¹ records of 64 bytes.
+    #[test]
+    fn the_packing_buffer_fits_one_binding() {
+        assert_eq!(records_capacity(2, 1000, 128 << 20), 2000);
+        assert_eq!(records_capacity(4, 1000, 128 << 20), 4000);
+        assert_eq!(records_capacity(2, 10_000_000, 128 << 20), 1 << 21);
+        assert_eq!(records_capacity(2, u32::MAX, u64::MAX), u32::MAX);
     }
 
     /// A halo message carries migrants and solid states whole and copies lean (40 bytes), and

@@ -773,7 +773,7 @@ impl Solver {
             self.passes.density_filter.as_ref().expect("a filter"),
         );
         let mut incoming: Vec<HaloRecord> = incoming.iter().map(FilterRecord::restored).collect();
-        halo.upload_restored(&self.queue, &mut incoming, self.ids);
+        halo.upload_restored(&self.queue, &mut incoming, self.ids)?;
         self.submit_pass("density filter over ranks", |pass| {
             halo.encode_restore(pass, q);
             filter.encode(pass, q);
