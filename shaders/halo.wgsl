@@ -88,10 +88,7 @@ fn layer_of(p: Pos) -> u32 {
 
 // The id of the particle a record carries.
 fn record_id(r: HaloRecord) -> u32 {
-    if (WIDE_IDS) {
-        return (r.code & ID_MASK) | ((r.dest >> DEST_ID_SHIFT) << ID_LOW_BITS);
-    }
-    return r.code & ID_MASK;
+    return whole_id(r.code, r.dest >> DEST_ID_SHIFT);
 }
 
 fn pack_record(i: u32, flags: u32) {

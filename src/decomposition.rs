@@ -90,15 +90,9 @@ pub fn slabs_for(sc: &Scenario, ranks: usize) -> Result<Slabs> {
             (None, _) => {}
         }
     }
-    Slabs::balanced_keeping(
-        axis,
-        &layer_load(&grid, axis, &sc.particles),
-        ranks,
-        halo_layers(sc),
-        whole,
-    )?
-    .clear_of_moving(
-        &layer_load(&grid, axis, &sc.particles),
+    let load = layer_load(&grid, axis, &sc.particles);
+    Slabs::balanced_keeping(axis, &load, ranks, halo_layers(sc), whole)?.clear_of_moving(
+        &load,
         halo_layers(sc),
         &moving,
     )
@@ -300,10 +294,18 @@ impl Slabs {
         if !moving.iter().any(|m| self.splits(m)) {
             return Ok(self);
         }
-        let whole = self.whole.clone();
-        let keep = whole.iter().chain(moving).cloned().collect();
+        self.balanced_now(load, min_layers, moving)
+    }
+
+    /// Cuts balanced over `load` as [`Slabs::balanced_keeping`] with these cuts' ranges kept
+    /// whole and `moving` too, which the result does not remember.
+    fn balanced_now(&self, load: &[f64], min_layers: u32, moving: &[Range<u32>]) -> Result<Self> {
+        let keep = self.whole.iter().chain(moving).cloned().collect();
         let next = Self::balanced_keeping(self.axis, load, self.ranks(), min_layers, keep)?;
-        Ok(Self { whole, ..next })
+        Ok(Self {
+            whole: self.whole.clone(),
+            ..next
+        })
     }
 
     /// Whether a cut lies inside `layers` (one at its start or end does not).
@@ -377,13 +379,7 @@ impl Slabs {
         if now <= REBALANCE_THRESHOLD {
             return None;
         }
-        let keep = self.whole.iter().chain(moving).cloned().collect();
-        let next = Self::balanced_keeping(self.axis, load, self.ranks(), min_layers, keep)
-            .ok()
-            .map(|next| Self {
-                whole: self.whole.clone(),
-                ..next
-            })?;
+        let next = self.balanced_now(load, min_layers, moving).ok()?;
         (next.imbalance(load) < now && next != *self).then_some(next)
     }
 }

@@ -224,6 +224,15 @@ fn material_of(s: SolidState) -> SolidMaterial {
     return params.solid_materials[s.material];
 }
 
+// The id of a code word and its high bits (the word after the code words, or a halo record's
+// `dest` above its flags) with WIDE_IDS; of the code word alone without.
+fn whole_id(code: u32, high: u32) -> u32 {
+    if (WIDE_IDS) {
+        return (code & ID_MASK) | (high << ID_LOW_BITS);
+    }
+    return code & ID_MASK;
+}
+
 fn with_kind(code: u32, kind: u32) -> u32 {
     return (code & ID_MASK) | (kind << KIND_SHIFT);
 }

@@ -4,7 +4,7 @@
 
 fn particle_id(i: u32) -> u32 {
     if (WIDE_IDS) {
-        return (code[i] & ID_MASK) | (code[params.n_particles + i] << ID_LOW_BITS);
+        return whole_id(code[i], code[params.n_particles + i]);
     }
     return code[i] & ID_MASK;
 }

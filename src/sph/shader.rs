@@ -170,7 +170,7 @@ impl ShaderConfig {
             tables: TableSizes::of(sc),
             cell_reach: grid.reach,
             tait_gamma: whole_exponent(ph.gamma),
-            ids: IdSplit::for_run(sc.particles.len() as u64, ph.id_low_bits),
+            ids: super::initial::id_split(sc),
         })
     }
 

@@ -397,6 +397,9 @@ impl Solver {
     /// on each side.
     pub(super) fn moving_probe_layers(&self, by: u32) -> Vec<Range<u32>> {
         let ranked = self.ranked.as_ref().expect("a subdomain");
+        if ranked.moving_probes.is_empty() {
+            return Vec::new();
+        }
         let (Some(slabs), Some(placed)) = (&ranked.slabs, self.attached_probes_placed()) else {
             return Vec::new();
         };
