@@ -6,6 +6,7 @@ mod common;
 use std::process::Command;
 
 fn wgsph() -> Command {
+    common::one_lavapipe_thread_each();
     Command::new(env!("CARGO_BIN_EXE_wgsph"))
 }
 

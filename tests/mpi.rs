@@ -30,6 +30,7 @@ fn mpirun(test: &str, ranks: u32, limit: Duration) -> (bool, String) {
 
 /// As [`mpirun`], with environment variables `env` set for every rank.
 fn mpirun_with(test: &str, ranks: u32, limit: Duration, env: &[(&str, &str)]) -> (bool, String) {
+    common::one_lavapipe_thread_each();
     let exe = std::env::current_exe().unwrap();
     let mut command = Command::new("mpirun");
     command.args(["--oversubscribe", "-np", &ranks.to_string()]);
@@ -474,6 +475,7 @@ fn resume(dir: &std::path::Path, end: &str) -> Vec<std::ffi::OsString> {
 
 /// One whole run of `args` on lavapipe.
 fn on_one_rank(args: Vec<std::ffi::OsString>) {
+    common::one_lavapipe_thread_each();
     let o = Command::new(env!("CARGO_BIN_EXE_wgsph"))
         .args(args)
         .args(["--adapter", "cpu"])
@@ -495,6 +497,7 @@ fn on_two_ranks(args: Vec<std::ffi::OsString>) -> String {
 /// `mpirun -np 2 [EXPORT] wgsph ARGS` as [`on_two_ranks`] runs it, `EXPORT` the variables of
 /// the test's environment to pass on to the ranks (`-x NAME`).
 fn mpirun_wgsph(args: Vec<std::ffi::OsString>, export: &[&str]) -> Command {
+    common::one_lavapipe_thread_each();
     let mut command = Command::new("mpirun");
     command.args(["--oversubscribe", "-np", "2"]);
     for name in export {
@@ -906,6 +909,7 @@ fn ranks_with_an_outlet_drain_what_one_run_drains() {
 /// figures and a line per rank with the halo it sent and where its step time went.
 #[test]
 fn bench_under_mpirun_reports_every_rank() {
+    common::one_lavapipe_thread_each();
     let o = Command::new("mpirun")
         .args(["--oversubscribe", "-np", "2", env!("CARGO_BIN_EXE_wgsph")])
         .args(["bench", "cases/dam_break_2d.toml", "--adapter", "cpu"])

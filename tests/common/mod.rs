@@ -57,12 +57,30 @@ impl Drop for Scratch {
     }
 }
 
+/// One lavapipe thread per device (`LP_NUM_THREADS=1`, unless set already), for this process
+/// and what it starts: the harness runs a test per core side by side, each on a device of its
+/// own ([`gpu`]), and lavapipe gives every device a thread per core, so on 2 cores two tests
+/// kept four threads busy. With one each, `wall_treatments` ran in 90 s instead of 135 s,
+/// `mpi` (two ranks a job) in 182 s instead of 214 s (docs/performance.md, 2026-12-06). A
+/// single run is faster with the threads (`wgsph run` keeps lavapipe's default). Set once,
+/// before this process opens a device (every test opens its own through here or after it
+/// called this), so no thread reads the environment from C while it changes.
+pub fn one_lavapipe_thread_each() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        if std::env::var_os("LP_NUM_THREADS").is_none() {
+            std::env::set_var("LP_NUM_THREADS", "1");
+        }
+    });
+}
+
 /// The adapter for tests: WGSPH_ADAPTER if set, else auto (lavapipe in CI). A missing adapter
 /// is a failure, not a skip. One device per test thread: the harness runs tests side by side,
 /// and one shared device would put them all on its single queue, one after the other (on
 /// lavapipe, two tests on a shared device took 2.8 times as long as on a device each). The
 /// device is leaked, a few MB per test.
 pub fn gpu() -> &'static GpuContext {
+    one_lavapipe_thread_each();
     thread_local! {
         static CTX: &'static GpuContext = Box::leak(Box::new({
             let choice = AdapterChoice::resolve(None).expect("WGSPH_ADAPTER");
