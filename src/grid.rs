@@ -8,6 +8,8 @@
 //! a power of two no larger than the particle count's, so memory scales with particles even
 //! for an almost empty domain.
 
+use std::ops::Range;
+
 use anyhow::{bail, Result};
 
 use crate::layout::MAX_BLOCK;
@@ -211,6 +213,44 @@ impl Grid {
             stride,
             rows,
         })
+    }
+
+    /// This grid as a subdomain takes it (a rank of a run over several, `Solver::build`): the
+    /// same cells and blocks, its slot table sized as a whole run's is, by the smaller of its
+    /// `particles` (its own at the start) and of its cells (the cell layers `layers` along
+    /// `axis`: its own and its halo), and the strides searched for that size
+    /// ([`hash_strides`]); doubled until its rows are contiguous, never past this grid's.
+    ///
+    /// The sums keep the whole run's order, bit for bit: along contiguous rows a particle
+    /// visits the cells around it row by row, x ascending, whatever slots they have, and a
+    /// cell's particles in their (kind, id) order, whichever far cells share their slot (the
+    /// distance test rejects those). Without contiguous rows (a periodic grid with a hashed
+    /// table) a particle visits slots, whose sharing the table decides, so such a grid is kept
+    /// whole, as is a periodic one with rows (it needs a slot per cell).
+    pub fn for_subdomain(&self, particles: usize, axis: usize, layers: Range<u32>) -> Grid {
+        if !self.rows || self.periodic.iter().any(|&p| p) {
+            return self.clone();
+        }
+        let across: u64 = (0..3)
+            .filter(|&a| a != axis)
+            .map(|a| self.cells[a] as u64)
+            .product();
+        let cells = across * layers.len() as u64;
+        let mut slots = (particles.max(1024) as u64)
+            .next_power_of_two()
+            .min(cells.next_power_of_two());
+        while slots < self.slots as u64 {
+            if let Some(stride) = hash_strides(self.cells, slots, self.reach) {
+                let slots = slots as u32;
+                return Grid {
+                    slots,
+                    stride,
+                    ..self.clone()
+                };
+            }
+            slots *= 2;
+        }
+        self.clone()
     }
 
     /// Packs a world position into (block, f32 offset); positions outside the domain are
@@ -477,6 +517,112 @@ mod tests {
             "no grid needed its strides searched: the test tests less"
         );
         assert_eq!(hash_strides([100, 100, 100], 4, 2), None);
+    }
+
+    /// The codes a rows walk (`neighbour_rows`, the whole (2 reach + 1)^d block) visits around
+    /// cell `c` over `cells` (each particle's cell and code word), sorted by slot then code as
+    /// the GPU sort orders them, keeping those of the cells around `c` (what the distance test
+    /// can keep); and how many it passed over (far cells sharing a visited slot).
+    fn rows_walk(g: &Grid, dim: u32, cells: &[([i64; 3], u32)], c: [i64; 3]) -> (Vec<u32>, u32) {
+        let mut sorted: Vec<(u32, u32, [i64; 3])> = cells
+            .iter()
+            .map(|&(cell, code)| (g.slot_of_cell(cell), code, cell))
+            .collect();
+        sorted.sort_unstable_by_key(|&(s, code, _)| (s, code));
+        let r = g.reach as i64;
+        let near = |cell: [i64; 3]| (0..3).all(|a| (cell[a] - c[a]).abs() <= r);
+        let (mut kept, mut passed) = (Vec::new(), 0);
+        let mut visit = |lo: u32, hi: u32| {
+            for &(_, code, cell) in sorted.iter().filter(|e| (lo..hi).contains(&e.0)) {
+                if near(cell) {
+                    kept.push(code);
+                } else {
+                    passed += 1;
+                }
+            }
+        };
+        let zr = if dim == 3 { r } else { 0 };
+        for dz in -zr..=zr {
+            for dy in -r..=r {
+                let (y, z) = (c[1] + dy, c[2] + dz);
+                if y < 0 || z < 0 || y >= g.cells[1] as i64 || z >= g.cells[2] as i64 {
+                    continue;
+                }
+                let x0 = (c[0] - r).max(0);
+                let x1 = (c[0] + r).min(g.cells[0] as i64 - 1);
+                let s0 = g.slot_of_cell([x0, y, z]);
+                let s1 = s0 + (x1 - x0 + 1) as u32;
+                visit(s0, s1.min(g.slots));
+                visit(0, s1.saturating_sub(g.slots));
+            }
+        }
+        (kept, passed)
+    }
+
+    /// A subdomain's smaller table (`Grid::for_subdomain`) shares slots between far cells, yet
+    /// the walk around every particle visits its neighbours in the whole run's order.
+    #[test]
+    fn a_subdomains_table_keeps_the_whole_runs_neighbour_order() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move |n: u64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % n) as i64
+        };
+        let cases = [
+            (domain([300.0, 20.0, 0.0]), 2, [600, 400, 1]),
+            (domain([100.0, 100.0, 10.0]), 3, [60, 60, 20]),
+        ];
+        for (d, dim, region) in cases {
+            let whole = Grid::new(&d, 0.01, dim, 1_000_000, [false; 3], TWO_H).unwrap();
+            let rank = whole.for_subdomain(20_000, 0, 0..whole.cells[0]);
+            assert!(rank.contiguous_rows());
+            assert!(
+                rank.slots < whole.slots / 16,
+                "{} {}",
+                rank.slots,
+                whole.slots
+            );
+            let cells: Vec<([i64; 3], u32)> = (0..20_000u32)
+                .map(|code| (region.map(&mut next), code))
+                .collect();
+            let mut passed = 0;
+            for &(c, _) in cells.iter().step_by(97) {
+                let (order, _) = rows_walk(&whole, dim, &cells, c);
+                let (rank_order, p) = rows_walk(&rank, dim, &cells, c);
+                assert_eq!(order, rank_order, "around {c:?}");
+                assert!(!order.is_empty());
+                passed += p;
+            }
+            assert!(passed > 0, "no slot was shared: the test tests less");
+        }
+    }
+
+    /// A subdomain's table is sized by its particles or by its cells, whichever is fewer, and
+    /// is never larger than the whole run's; a periodic grid keeps its table.
+    #[test]
+    fn a_subdomains_table_follows_its_particles_or_its_cells() {
+        let g = Grid::new(
+            &domain([10.0, 5.0, 0.0]),
+            0.013,
+            2,
+            100_000,
+            [false; 3],
+            TWO_H,
+        )
+        .unwrap();
+        assert_eq!((g.cells, g.slots), ([385, 193, 1], 1 << 17));
+        let all = 0..g.cells[0];
+        assert_eq!(g.for_subdomain(1000, 0, all.clone()).slots, 1024);
+        assert_eq!(g.for_subdomain(1_000_000, 0, all.clone()), g);
+        // 40 layers of 193 cells: 7 720 cells, 8 192 slots for 50 000 particles.
+        let part = g.for_subdomain(50_000, 0, 100..140);
+        assert_eq!(part.slots, 8192);
+        assert!(part.contiguous_rows());
+        let periodic = [true, false, false];
+        let g = Grid::new(&domain([4.0, 0.5, 0.0]), 0.013, 2, 100_000, periodic, TWO_H).unwrap();
+        assert_eq!(g.for_subdomain(1000, 1, 0..2), g);
     }
 
     #[test]

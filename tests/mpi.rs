@@ -690,6 +690,14 @@ fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
         "no particle crossed the cut"
     );
     assert!(ranks.iter().all(|r| r.adapter.contains("llvmpipe")));
+    // Each rank's slot table is sized by its own particles or cells (`Grid::for_subdomain`), smaller
+    // than the whole run's, and the outputs still equal it bit for bit.
+    let sc = wgsph::case::load("cases/dam_break_2d.toml".as_ref(), &[]).unwrap();
+    let whole = wgsph::decomposition::ranks_grid(&sc).unwrap().slots as u64;
+    assert!(
+        ranks.iter().all(|r| r.hash_slots < whole),
+        "{whole} slots in one run"
+    );
 }
 
 /// `time.output_boundary = "first"` and `--snapshots` over two ranks: each rank's later

@@ -76,6 +76,10 @@ pub struct RankSummary {
     pub seconds_per_step: crate::sph::subdomain::Split,
     /// Times the cuts moved.
     pub rebalances: u32,
+    /// Entries of this rank's slot table, sized by its own particles or cells
+    /// (`Grid::for_subdomain`).
+    #[serde(default)]
+    pub hash_slots: u64,
 }
 
 impl RunSummary {

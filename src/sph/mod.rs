@@ -171,26 +171,29 @@ impl Solver {
         if subdomain.is_none() {
             check_capacity(ctx, n)?;
         }
-        let grid = match subdomain {
+        let mut grid = match subdomain {
             Some(_) => crate::decomposition::ranks_grid(sc)?,
             None => Grid::of(sc)?,
         };
-        let mut params = Params::from_scenario(sc, &grid)?;
-        let cfg = ShaderConfig::of(sc, &grid)?;
-        probes::check_wall_pressure(sc)?;
-        let device = ctx.device.clone();
         let mut packed = initial::pack(sc, &grid);
+        let mut capacity = n as u32;
         let ranked = (subdomain.as_ref())
             .map(|ctl| -> Result<_> {
                 let (own, waiting) = subdomain::exclude_others(&mut packed, &grid, ctl, sc);
-                let capacity = subdomain::capacity(own, waiting, n as u32);
+                capacity = subdomain::capacity(own, waiting, n as u32);
                 check_capacity(ctx, capacity as usize)?;
                 subdomain::resize(&mut packed, capacity as usize);
-                params.n_particles = capacity;
+                let window = subdomain::window(ctl, &grid);
+                grid = grid.for_subdomain((own + waiting) as usize, ctl.axis as usize, window);
                 let live = (n - sc.dormant_count()) as u64;
                 Ok(subdomain::Ranked::new(live, own, waiting))
             })
             .transpose()?;
+        let mut params = Params::from_scenario(sc, &grid)?;
+        params.n_particles = capacity;
+        let cfg = ShaderConfig::of(sc, &grid)?;
+        probes::check_wall_pressure(sc)?;
+        let device = ctx.device.clone();
         // Allocation failures are caught here to name what was being allocated; later ones
         // reach `faults`.
         let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);

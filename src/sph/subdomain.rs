@@ -5,10 +5,10 @@
 //! `record_from_exchange`), the ranks agree on the time step and the stop rules, and every
 //! [`REBALANCE_EVERY`] steps they may move the cuts (`Solver::rebalance`).
 //!
-//! The grid, its slot table and the particle ids are the whole run's, and the sort orders each
-//! slot by code word (kind, then id), so an own particle sums the same neighbours in the same
-//! order as in one whole run: the ranks' particles together are bit-identical to it
-//! (tests/mpi.rs).
+//! The grid and the particle ids are the whole run's, the slot table sized by the rank's own
+//! particles (`Grid::for_subdomain`), and the sort orders each slot by code word (kind, then
+//! id), so an own particle sums the same neighbours in the same order as in one whole run: the
+//! ranks' particles together are bit-identical to it (tests/mpi.rs).
 
 use std::ops::Range;
 
@@ -124,6 +124,17 @@ pub fn capacity(own: u32, waiting: u32, n: u32) -> u32 {
         .saturating_add(4096)
         .min(n.saturating_mul(2))
         .saturating_add(waiting)
+}
+
+/// The cell layers `ctl`'s subdomain holds particles of at the start: its own and its halo
+/// layers on each side, within the grid (what its slot table is sized by, with its particles:
+/// `Grid::for_subdomain`).
+pub fn window(ctl: &HaloCtl, grid: &Grid) -> Range<u32> {
+    widened(
+        ctl.own_lo..ctl.own_hi,
+        ctl.layers,
+        grid.cells[ctl.axis as usize],
+    )
 }
 
 /// Which entries of `packed` are `ctl`'s subdomain's at the start: its own live particles, and
@@ -532,6 +543,7 @@ impl Solver {
             split.compute / steps,
             split.agree / steps,
             (now.rebalances - since.rebalances) as f64,
+            self.grid.slots as f64,
         ];
         let mut adapters = ranks.gather_text(adapter)?.into_iter();
         Ok(ranks
@@ -550,6 +562,7 @@ impl Solver {
                     agree: v[7],
                 },
                 rebalances: v[8] as u32,
+                hash_slots: v[9] as u64,
             })
             .collect())
     }
