@@ -181,6 +181,19 @@ impl ParityKernel {
         Ok(Self { kernel, bind })
     }
 
+    /// Binds the kernel to `buffers(p)` again (one of them replaced by a larger one).
+    pub fn rebind<R: Resolve>(
+        &mut self,
+        device: &wgpu::Device,
+        buffers: impl Fn(usize) -> R,
+    ) -> Result<()> {
+        self.bind = [
+            self.kernel.bind(device, &buffers(0))?,
+            self.kernel.bind(device, &buffers(1))?,
+        ];
+        Ok(())
+    }
+
     /// `invocations` invocations on the arrays of parity `p`.
     pub fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, p: usize, invocations: u32) {
         self.kernel.dispatch(pass, &self.bind[p], invocations);

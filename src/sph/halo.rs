@@ -2,9 +2,9 @@
 //! predictor, `halo_drop` after the interaction. The solver's `ranked_step` swaps the packed
 //! records with the neighbours between the two.
 
-use anyhow::{anyhow, bail, ensure, Result};
+use anyhow::{anyhow, ensure, Result};
 
-use super::buffers::ParticleBuffers;
+use super::buffers::{Bindings, ParticleBuffers};
 use super::shader::PARTICLE_ID;
 use crate::decomposition::Slabs;
 use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init};
@@ -66,16 +66,34 @@ pub fn records_per_particle(sc: &Scenario) -> u32 {
     }
 }
 
-/// The records the packing buffer holds for arrays of `n` entries: `per_particle` each, but no
-/// more than one storage binding of `max_binding` bytes holds. Only a slab as thin as its halo
-/// packs every particle; a thicker one packs its layers by the cuts, a small share, so the
-/// cap binds only ranks of millions of particles (128 B an entry would reach an H200's
-/// 2 047 MiB binding at 1.7 × 10⁷ entries), and a step that packs more stops with a message.
+/// The most records the packing buffer can need for arrays of `n` entries: `per_particle`
+/// each, but no more than one storage binding of `max_binding` bytes holds. Only a slab as
+/// thin as its halo, or a rebalance that moves most of a rank's particles, packs every
+/// particle; the cap binds only ranks of millions of particles (128 B an entry would reach an
+/// H200's 2 047 MiB binding at 1.7 × 10⁷ entries), and a step that packs more stops with a
+/// message. The buffer starts far smaller ([`Halo::new`]) and grows to this at most.
 pub fn records_capacity(per_particle: u32, n: u32, max_binding: u64) -> u32 {
     let fit = max_binding / std::mem::size_of::<HaloRecord>() as u64;
     (per_particle as u64 * n as u64)
         .min(fit)
         .min(u32::MAX as u64) as u32
+}
+
+/// A packing buffer of `capacity` records.
+fn records_buffer(device: &wgpu::Device, capacity: u32) -> wgpu::Buffer {
+    let bytes = capacity as u64 * std::mem::size_of::<HaloRecord>() as u64;
+    storage(device, "halo records", bytes)
+}
+
+/// The halo kernels' buffers on the arrays of parity `p`: the particle arrays and the pass's
+/// own (its control, counters, records and layer loads).
+fn bindings<'a>(b: &'a ParticleBuffers, p: usize, own: [&'a wgpu::Buffer; 4]) -> Bindings<'a> {
+    let [ctl, counts, records, layer_load] = own;
+    b.at(p)
+        .with("halo_ctl", ctl)
+        .with("halo_counts", counts)
+        .with("halo_out", records)
+        .with("layer_load", layer_load)
 }
 
 /// Rank `rank`'s part of `slabs` with a halo of `layers` ([`halo_layers`]): what `halo_pack`
@@ -113,6 +131,10 @@ pub struct Halo {
     pub thickness: u32,
     /// Records `halo_out` holds.
     capacity: u32,
+    /// Records it may grow to ([`records_capacity`]).
+    max_capacity: u32,
+    /// Times it grew ([`Halo::reserve`]).
+    pub growths: u32,
     n: u32,
 }
 
@@ -279,6 +301,7 @@ impl Wire for HaloRecord {
 
 /// What one `halo_pack` found: the records for each neighbour, the rank's own live particles,
 /// and where the free tail of the arrays starts.
+#[derive(Default)]
 pub struct Packed {
     /// (to the neighbour below, to the neighbour above): halo copies and migrants.
     pub lower: Vec<HaloRecord>,
@@ -286,10 +309,15 @@ pub struct Packed {
     pub owned: u32,
     pub tail: u32,
     pub migrants: u32,
+    /// The records the packing made where they did not fit the buffer (then no record is
+    /// read): [`Halo::reserve`] them and pack again.
+    pub needed: Option<u32>,
 }
 
 impl Halo {
-    /// The pass of a subdomain `ctl` on a grid of `layers` cell layers along its cut axis.
+    /// The pass of a subdomain `ctl` on a grid of `layers` cell layers along its cut axis, its
+    /// packing buffer of `ctl.capacity` records to start with (`subdomain::starting_records`),
+    /// grown as the steps need ([`Halo::reserve`]) up to [`records_capacity`].
     pub fn new(
         device: &wgpu::Device,
         module: &ShaderModule,
@@ -299,8 +327,9 @@ impl Halo {
         records_per_particle: u32,
     ) -> Result<Self> {
         let max_binding = device.limits().max_storage_buffer_binding_size;
+        let max_capacity = records_capacity(records_per_particle, b.n, max_binding);
         let ctl = HaloCtl {
-            capacity: records_capacity(records_per_particle, b.n, max_binding),
+            capacity: ctl.capacity.clamp(1, max_capacity),
             ..ctl
         };
         let ctl_buffer = uniform_init(device, "halo ctl", &ctl);
@@ -310,18 +339,8 @@ impl Halo {
             "halo counts",
             std::mem::size_of::<HaloCounts>() as u64,
         );
-        let records = storage(
-            device,
-            "halo records",
-            ctl.capacity as u64 * std::mem::size_of::<HaloRecord>() as u64,
-        );
-        let bufs = |p: usize| {
-            b.at(p)
-                .with("halo_ctl", &ctl_buffer)
-                .with("halo_counts", &counts)
-                .with("halo_out", &records)
-                .with("layer_load", &layer_load)
-        };
+        let records = records_buffer(device, ctl.capacity);
+        let bufs = |p: usize| bindings(b, p, [&ctl_buffer, &counts, &records, &layer_load]);
         Ok(Self {
             tail: ParityKernel::new(device, module, "halo_tail", bufs)?,
             pack: ParityKernel::new(device, module, "halo_pack", bufs)?,
@@ -341,8 +360,52 @@ impl Halo {
             layers,
             thickness: ctl.layers,
             capacity: ctl.capacity,
+            max_capacity,
+            growths: 0,
             n: b.n,
         })
+    }
+
+    /// Makes the packing buffer hold at least `needed` records (half as many again, or twice
+    /// its size, whichever is more, up to [`records_capacity`]); an error past that. The
+    /// buffer's records are not kept: call it before packing or uploading.
+    pub fn reserve(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        b: &ParticleBuffers,
+        needed: usize,
+    ) -> Result<()> {
+        if needed <= self.capacity as usize {
+            return Ok(());
+        }
+        ensure!(
+            needed <= self.max_capacity as usize,
+            "{needed} halo and migrant records, more than the subdomain's {} fit (one storage \
+             binding, or two a particle of its arrays): more particles near the cuts than \
+             its buffers were made for",
+            self.max_capacity
+        );
+        let grown = (needed as u64 * 3 / 2).max(2 * self.capacity as u64);
+        self.capacity = grown.min(self.max_capacity as u64) as u32;
+        self.growths += 1;
+        self.records = records_buffer(device, self.capacity);
+        let own = [&self.ctl, &self.counts, &self.records, &self.layer_load];
+        let bufs = |p: usize| bindings(b, p, own);
+        for kernel in [
+            &mut self.tail,
+            &mut self.pack,
+            &mut self.drop,
+            &mut self.restore,
+            &mut self.forget,
+            &mut self.count_layers,
+        ] {
+            kernel.rebind(device, bufs)?;
+        }
+        let at = std::mem::offset_of!(HaloCtl, capacity) as u64;
+        queue.write_buffer(&self.ctl, at, bytemuck::bytes_of(&self.capacity));
+        log::debug!("halo records: room for {} now", self.capacity);
+        Ok(())
     }
 
     /// The subdomain of rank `rank` under `slabs` from now on (its cuts moved); `halos: false`
@@ -414,7 +477,7 @@ impl Halo {
         ensure!(
             received.len() <= self.capacity as usize,
             "{} halo copies received for the density filter, more than the subdomain's {} \
-             records hold",
+             records hold (Halo::reserve first)",
             received.len(),
             self.capacity
         );
@@ -445,12 +508,10 @@ impl Halo {
         let counts: HaloCounts =
             bytemuck::pod_read_unaligned(&map_read(device, &self.counts_staging)?);
         if counts.overflow > 0 {
-            bail!(
-                "{} halo and migrant records did not fit the subdomain's {} (more particles \
-                 near the cuts than the buffers were made for)",
-                counts.overflow,
-                counts.records - counts.overflow
-            );
+            return Ok(Packed {
+                needed: Some(counts.records),
+                ..Default::default()
+            });
         }
         let records = read::<HaloRecord>(device, queue, &self.records, counts.records as usize)?;
         let migrants = records
@@ -464,6 +525,7 @@ impl Halo {
             owned: counts.owned,
             tail: counts.tail,
             migrants,
+            needed: None,
         })
     }
 }

@@ -9,6 +9,11 @@ use crate::gpu::buffers::read;
 use crate::layout::{SimState, SymRate};
 
 impl Solver {
+    /// Test hook: how many times a subdomain's halo packing buffer grew (`Halo::reserve`).
+    pub fn halo_growths(&self) -> u32 {
+        self.passes.halo.as_ref().map_or(0, |h| h.growths)
+    }
+
     /// Test hook: destroys the device, as a driver reset or an unplugged GPU would.
     pub fn lose_device(&self) {
         self.device.destroy();

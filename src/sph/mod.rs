@@ -177,12 +177,14 @@ impl Solver {
         };
         let mut packed = initial::pack(sc, &grid);
         let mut capacity = n as u32;
-        let ranked = (subdomain.as_ref())
+        let mut subdomain = subdomain;
+        let ranked = (subdomain.as_mut())
             .map(|ctl| -> Result<_> {
                 let (own, waiting) = subdomain::exclude_others(&mut packed, &grid, ctl, sc);
                 capacity = subdomain::capacity(own, waiting, n as u32);
                 check_capacity(ctx, capacity as usize)?;
                 subdomain::resize(&mut packed, capacity as usize);
+                ctl.capacity = subdomain::starting_records(&packed, own, &grid, ctl);
                 let window = subdomain::window(ctl, &grid);
                 grid = grid.for_subdomain((own + waiting) as usize, ctl.axis as usize, window);
                 let live = (n - sc.dormant_count()) as u64;

@@ -63,6 +63,11 @@ pub struct Passes {
 }
 
 impl Passes {
+    /// A subdomain's halo pass.
+    pub fn halo(&self) -> &Halo {
+        self.halo.as_ref().expect("a subdomain has a halo pass")
+    }
+
     /// The passes `sc` needs, compiled for `cfg`, over `b`; `defs` are the probes' GPU
     /// definitions and `motions` the bodies' table the buffers were made with; with
     /// `subdomain`, those of one rank's subdomain (its halo pass).

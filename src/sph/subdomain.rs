@@ -16,6 +16,7 @@ use anyhow::{bail, ensure, Context, Result};
 
 use super::halo::{FilterRecord, Wire};
 use super::initial::Packed;
+use super::passes::Passes;
 use super::profile::Recorder;
 use super::Solver;
 use super::{bodies, halo};
@@ -30,7 +31,7 @@ use crate::layout::{
 };
 use crate::output::RankSummary;
 use crate::ranks::Ranks;
-use crate::scenario::Scenario;
+use crate::scenario::{Kind, Scenario};
 
 /// A subdomain's counts, over all ranks where they say so (a checkpoint keeps them).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -124,6 +125,26 @@ pub fn capacity(own: u32, waiting: u32, n: u32) -> u32 {
         .saturating_add(4096)
         .min(n.saturating_mul(2))
         .saturating_add(waiting)
+}
+
+/// The records a subdomain's packing buffer starts with: twice the halo copies the first
+/// `own` entries of `packed` (its own particles at the start) make, each own particle within
+/// `ctl`'s halo layers of a cut with a neighbour one copy (a solid particle two: its stress
+/// state follows), and 64 more. The packing grows it when a step packs more
+/// (`Halo::reserve`: water reaching a cut, cuts moving), up to one binding.
+pub fn starting_records(packed: &Packed, own: u32, grid: &Grid, ctl: &HaloCtl) -> u32 {
+    let axis = ctl.axis as usize;
+    let copies: u64 = (0..own as usize)
+        .map(|k| {
+            let p = packed.pos[k];
+            let layer = grid.cell_of(p.off, unpack_block(p.block))[axis] as u32;
+            let below = ctl.lower != 0 && layer < ctl.own_lo + ctl.layers;
+            let above = ctl.upper != 0 && layer + ctl.layers >= ctl.own_hi;
+            let solid = Kind::from_code(packed.code[k] >> KIND_SHIFT).is_some_and(Kind::is_solid);
+            (below as u64 + above as u64) * (1 + solid as u64)
+        })
+        .sum();
+    (2 * copies + 64).min(u32::MAX as u64) as u32
 }
 
 /// The cell layers `ctl`'s subdomain holds particles of at the start: its own and its halo
@@ -390,7 +411,7 @@ impl Solver {
     /// Every rank's own particles per cell layer, summed in rank order (every rank together),
     /// and the halo's thickness in layers, which a slab may not be thinner than.
     fn layer_loads(&self, ranks: &dyn Ranks) -> Result<(Vec<f64>, u32)> {
-        let halo = (self.passes.halo.as_ref()).expect("a subdomain has a halo pass");
+        let halo = self.passes.halo();
         let mine = halo.layer_load(&self.device, &self.queue, self.parity)?;
         Ok((ranks.sum_in_rank_order(&mine), halo.thickness))
     }
@@ -434,11 +455,7 @@ impl Solver {
             "the checkpoint was written by {} ranks; resume it on as many",
             slabs.ranks()
         );
-        let halo = self
-            .passes
-            .halo
-            .as_ref()
-            .expect("a subdomain has a halo pass");
+        let halo = self.passes.halo();
         halo.set_cuts(&self.queue, &slabs, ranks.rank(), true);
         let ranked = self.ranked.as_mut().expect("a subdomain");
         *ranked = Ranked {
@@ -473,18 +490,16 @@ impl Solver {
     /// step's packing finds the free tail; the last rates follow the sort.
     fn redistribute(&mut self, next: Slabs, ranks: &dyn Ranks) -> Result<()> {
         let (rank, size, p) = (ranks.rank(), ranks.size(), self.parity);
-        let halo = self
-            .passes
-            .halo
-            .as_ref()
-            .expect("a subdomain has a halo pass");
         // Migrants only: no halo this time.
-        halo.set_cuts(&self.queue, &next, rank, false);
-        let packed = self.pack(false, |mut pass| {
-            halo.encode_pack(&mut pass, p);
-            halo.encode_drop(&mut pass, p);
-            halo.encode_forget(&mut pass, p);
+        self.passes.halo().set_cuts(&self.queue, &next, rank, false);
+        let packed = self.pack(false, p, |passes, mut pass| {
+            passes.halo().encode_pack(&mut pass, p)
         })?;
+        let halo = self.passes.halo();
+        self.submit_pass("halo drop", |pass| {
+            halo.encode_drop(pass, p);
+            halo.encode_forget(pass, p);
+        });
         let mut to: Vec<Vec<HaloRecord>> = vec![Vec::new(); size];
         let mut owner = rank;
         for r in packed.lower.into_iter().chain(packed.upper) {
@@ -508,11 +523,7 @@ impl Solver {
             .collect();
         self.unpack(&incoming, packed.tail, p)?;
         self.sort_in_place();
-        let halo = self
-            .passes
-            .halo
-            .as_ref()
-            .expect("a subdomain has a halo pass");
+        let halo = self.passes.halo();
         halo.set_cuts(&self.queue, &next, rank, true);
         let ranked = self.ranked.as_mut().expect("a subdomain");
         ranked.slabs = Some(next);
@@ -578,9 +589,8 @@ impl Solver {
         let start = std::time::Instant::now();
         let body_dt = self.bodies.is_some().then(|| self.predict_bodies());
         let p = self.parity;
-        let packed = self.pack(true, |pass| {
-            let mut r = Recorder::Shared(pass);
-            self.passes.record_to_exchange(&mut r, p);
+        let packed = self.pack(true, p, |passes, pass| {
+            passes.record_to_exchange(&mut Recorder::Shared(pass), p)
         })?;
         let packed_at = std::time::Instant::now();
 
@@ -610,11 +620,7 @@ impl Solver {
             let mut r = Recorder::Shared(encoder.begin_compute_pass(&Default::default()));
             self.passes.record_from_exchange(&mut r, p);
             if !filters {
-                let halo = self
-                    .passes
-                    .halo
-                    .as_ref()
-                    .expect("a subdomain has a halo pass");
+                let halo = self.passes.halo();
                 r.stage("halo_forget", |pass| halo.encode_forget(pass, 1 - p));
             }
         }
@@ -694,22 +700,24 @@ impl Solver {
         self.faults.check()
     }
 
-    /// Submits the passes `record` records (one of them `halo_pack`) and reads back what they
-    /// packed; with `tl_positions`, also copies the total-Lagrangian positions they gathered
-    /// for [`Solver::share_tl_positions`]. Waits for the GPU.
+    /// Submits the passes `record` records (the last of them `halo_pack`, on the arrays of
+    /// parity `p`) and reads back what they packed; with `tl_positions`, also copies the
+    /// total-Lagrangian positions they gathered for [`Solver::share_tl_positions`]. Where the
+    /// records did not fit, grows the packing buffer and packs again (the packing only reads
+    /// the arrays). Waits for the GPU.
     fn pack(
-        &self,
+        &mut self,
         tl_positions: bool,
-        record: impl FnOnce(wgpu::ComputePass<'_>),
+        p: usize,
+        record: impl FnOnce(&Passes, wgpu::ComputePass<'_>),
     ) -> Result<halo::Packed> {
-        let halo = self
-            .passes
-            .halo
-            .as_ref()
-            .expect("a subdomain has a halo pass");
+        let halo = self.passes.halo();
         let mut encoder = self.device.create_command_encoder(&Default::default());
         halo.clear(&mut encoder);
-        record(encoder.begin_compute_pass(&Default::default()));
+        record(
+            &self.passes,
+            encoder.begin_compute_pass(&Default::default()),
+        );
         halo.copy_counts(&mut encoder);
         if let Some(t) = self
             .passes
@@ -720,9 +728,35 @@ impl Solver {
             t.copy_held(&mut encoder);
         }
         self.queue.submit([encoder.finish()]);
-        let packed = halo.read(&self.device, &self.queue);
+        let packed = halo.read(&self.device, &self.queue)?;
         self.faults.check()?;
-        packed
+        let Some(needed) = packed.needed else {
+            return Ok(packed);
+        };
+        self.reserve_records(needed as usize)?;
+        let halo = self.passes.halo();
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        halo.clear(&mut encoder);
+        halo.encode_pack(&mut encoder.begin_compute_pass(&Default::default()), p);
+        halo.copy_counts(&mut encoder);
+        self.queue.submit([encoder.finish()]);
+        let packed = halo.read(&self.device, &self.queue)?;
+        self.faults.check()?;
+        ensure!(
+            packed.needed.is_none(),
+            "the halo records did not fit twice"
+        );
+        Ok(packed)
+    }
+
+    /// Makes the halo's packing buffer hold `needed` records (`Halo::reserve`).
+    fn reserve_records(&mut self, needed: usize) -> Result<()> {
+        let halo = self
+            .passes
+            .halo
+            .as_mut()
+            .expect("a subdomain has a halo pass");
+        halo.reserve(&self.device, &self.queue, &self.buffers, needed)
     }
 
     /// Sends `lower` and `upper` to the neighbour below and above, in `T`'s wire format, and
@@ -763,12 +797,9 @@ impl Solver {
     /// (every rank together).
     fn filter_over_ranks(&mut self, ranks: &dyn Ranks) -> Result<()> {
         let q = self.parity;
-        let halo = self
-            .passes
-            .halo
-            .as_ref()
-            .expect("a subdomain has a halo pass");
-        let packed = self.pack(false, |mut pass| halo.encode_pack(&mut pass, q))?;
+        let packed = self.pack(false, q, |passes, mut pass| {
+            passes.halo().encode_pack(&mut pass, q)
+        })?;
         ensure!(
             packed.migrants == 0,
             "{} particles outside the subdomain after the corrector",
@@ -781,14 +812,10 @@ impl Solver {
                 .collect()
         };
         let incoming = self.swap(&lean(&packed.lower), &lean(&packed.upper), ranks)?;
-        let (halo, filter) = (
-            self.passes
-                .halo
-                .as_ref()
-                .expect("a subdomain has a halo pass"),
-            self.passes.density_filter.as_ref().expect("a filter"),
-        );
         let mut incoming: Vec<HaloRecord> = incoming.iter().map(FilterRecord::restored).collect();
+        self.reserve_records(incoming.len())?;
+        let halo = self.passes.halo();
+        let filter = self.passes.density_filter.as_ref().expect("a filter");
         halo.upload_restored(&self.queue, &mut incoming, self.ids)?;
         self.submit_pass("density filter over ranks", |pass| {
             halo.encode_restore(pass, q);
@@ -951,6 +978,42 @@ mod tests {
     fn load(case: &str, set: &[&str]) -> Scenario {
         let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
         crate::case::load(std::path::Path::new(case), &set).unwrap()
+    }
+
+    /// The middle one of three subdomains of the elastic gate (water on a solid) starts with
+    /// room for twice the halo copies it sends each way, a solid particle's twice (its stress
+    /// state follows), and 64 more; without neighbours, for 64.
+    #[test]
+    fn a_packing_buffer_starts_with_room_for_twice_the_halo() {
+        let sc = load("cases/elastic_gate_2d.toml", &[]);
+        let grid = crate::decomposition::ranks_grid(&sc).unwrap();
+        let axis = crate::decomposition::cut_axis(&grid, sc.physics.dim).unwrap();
+        let layers = grid.cells[axis];
+        let mut ctl = HaloCtl {
+            axis: axis as u32,
+            own_lo: layers / 3,
+            own_hi: 2 * layers / 3,
+            layers: 2,
+            lower: 1,
+            upper: 1,
+            ..Default::default()
+        };
+        let mut packed = super::super::initial::pack(&sc, &grid);
+        let (own, _) = exclude_others(&mut packed, &grid, &ctl, &sc);
+        let near = |lo: u32, hi: u32| -> u32 {
+            (sc.particles.iter())
+                .filter(|p| {
+                    let (off, b) = grid.to_block(p.pos);
+                    (lo..hi).contains(&(grid.cell_of(off, b)[axis] as u32))
+                })
+                .map(|p| 1 + p.kind.is_solid() as u32)
+                .sum()
+        };
+        let halo = near(ctl.own_lo, ctl.own_lo + 2) + near(ctl.own_hi - 2, ctl.own_hi);
+        assert!(halo > 0);
+        assert_eq!(starting_records(&packed, own, &grid, &ctl), 2 * halo + 64);
+        (ctl.lower, ctl.upper) = (0, 0);
+        assert_eq!(starting_records(&packed, own, &grid, &ctl), 64);
     }
 
     /// Three subdomains of the water injection: each holds its own live particles first,
