@@ -48,6 +48,23 @@ pub fn cut_axis(grid: &Grid, dim: u32) -> Result<usize> {
         .ok_or_else(|| anyhow::anyhow!("every axis of the case is periodic: no axis to cut"))
 }
 
+/// The axis to cut `sc` along on `grid`: [`cut_axis`], but where `sc` has a wave gauge (which
+/// reads the cells of a whole vertical line) the longest other axis that is not periodic,
+/// if there is one.
+pub fn case_cut_axis(sc: &Scenario, grid: &Grid) -> Result<usize> {
+    let dim = sc.physics.dim;
+    let axis = cut_axis(grid, dim)?;
+    let up = dim as usize - 1;
+    let gauges = (sc.probes.iter()).any(|p| matches!(p.kind, ProbeKind::Height { .. }));
+    if !gauges || axis != up {
+        return Ok(axis);
+    }
+    Ok((0..up)
+        .filter(|&a| !grid.periodic[a])
+        .max_by_key(|&a| (grid.cells[a], std::cmp::Reverse(a)))
+        .unwrap_or(axis))
+}
+
 /// The weighted particles of each cell layer along `axis`.
 pub fn layer_load(grid: &Grid, axis: usize, particles: &[Particle]) -> Vec<f64> {
     let mut load = vec![0.0; grid.cells[axis] as usize];
@@ -74,13 +91,12 @@ pub fn ranks_grid(sc: &Scenario) -> Result<Grid> {
     Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic, two_h)
 }
 
-/// `sc` cut into `ranks` slabs of its grid (as the solver makes it) along [`cut_axis`], balanced
+/// `sc` cut into `ranks` slabs of its grid (as the solver makes it) along [`case_cut_axis`], balanced
 /// over its particles' [`layer_load`], no cut through a probe's [`probe_layers`] (nor within
 /// [`PROBE_CLEARANCE`] layers of one on a free body).
 pub fn slabs_for(sc: &Scenario, ranks: usize) -> Result<Slabs> {
-    let ph = &sc.physics;
     let grid = ranks_grid(sc)?;
-    let axis = cut_axis(&grid, ph.dim)?;
+    let axis = case_cut_axis(sc, &grid)?;
     let mut whole = Vec::new();
     let mut moving = Vec::new();
     for (p, layers) in sc.probes.iter().zip(probe_layers(sc, &grid, axis)?) {
@@ -138,9 +154,9 @@ pub fn probe_layers(sc: &Scenario, grid: &Grid, axis: usize) -> Result<Vec<Optio
         .map(|p| {
             if matches!(p.kind, ProbeKind::Height { .. }) && axis == up {
                 bail!(
-                    "probe '{}' is a wave gauge, but a run over several ranks cuts this case \
-                     along the vertical (its longest axis): the gauge would read water on \
-                     every rank; run it on one rank",
+                    "probe '{}' is a wave gauge, but a run over several ranks can cut this \
+                     case only along the vertical (its other axes are periodic): the gauge \
+                     would read water on every rank; run it on one rank",
                     p.name
                 );
             }
@@ -556,6 +572,34 @@ mod tests {
     fn load(case: &str, set: &[&str]) -> Scenario {
         let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
         crate::case::load(std::path::Path::new(case), &set).unwrap()
+    }
+
+    /// A tank taller than wide is cut along the vertical, but with a wave gauge along x: the
+    /// gauge then lies whole on one rank. Where x is periodic, the gauge is refused by name.
+    #[test]
+    fn a_tall_tank_with_a_wave_gauge_is_cut_across_the_vertical() {
+        let text = std::fs::read_to_string("cases/hydrostatic_2d.toml").unwrap();
+        let tall = text
+            .replace("max_m = [1.0, 0.6]", "max_m = [0.4, 1.2]")
+            .replace("max_m = [1.0, 0.5]", "max_m = [0.4, 1.0]")
+            .replace("[0.5, 0.05]", "[0.2, 0.05]")
+            .replace("[0.5, 0.0]", "[0.2, 0.0]");
+        let sc = crate::case::load_str(&tall, "tall.toml", &[]).unwrap();
+        let g = ranks_grid(&sc).unwrap();
+        assert_eq!(cut_axis(&g, 2).unwrap(), 1);
+        assert_eq!(case_cut_axis(&sc, &g).unwrap(), 0);
+        let slabs = slabs_for(&sc, 2).unwrap();
+        assert_eq!(slabs.axis, 0);
+        let gauge = sc.probes.iter().position(|p| p.name == "height").unwrap();
+        let layers = probe_layers(&sc, &g, 0).unwrap()[gauge].clone().unwrap();
+        assert!((0..2).any(|r| {
+            let own = slabs.range(r);
+            own.start <= layers.start && layers.end <= own.end
+        }));
+        let mut sc = sc;
+        (sc.periodic, sc.domain.min[0], sc.domain.max[0]) = ([true, false, false], 0.0, 0.4);
+        let e = slabs_for(&sc, 2).unwrap_err().to_string();
+        assert!(e.contains("probe 'height' is a wave gauge"), "{e}");
     }
 
     /// A probe on the rolling sloshing tank reads, over the run, the layers of its whole path
