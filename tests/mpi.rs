@@ -1114,10 +1114,6 @@ fn ranks_bend_a_total_lagrangian_plate_as_one_run() {
 /// copies (325 and 85 of its particles on the two ranks). Every particle equals one whole run's
 /// bit for bit after 300 steps.
 #[test]
-#[cfg_attr(
-    not(feature = "long-tests"),
-    ignore = "long: about 2 min on lavapipe (2 cores, 2026-12-05), beyond CI's 30 minutes; cargo test --release --features long-tests runs it"
-)]
 fn ranks_hold_the_water_with_an_elastic_gate_as_one_run() {
     Comparison {
         test: "ranks_hold_the_water_with_an_elastic_gate_as_one_run",
@@ -1135,10 +1131,6 @@ fn ranks_hold_the_water_with_an_elastic_gate_as_one_run() {
 /// and accelerates its own particles. Every particle equals one whole run's bit for bit after
 /// 300 steps.
 #[test]
-#[cfg_attr(
-    not(feature = "long-tests"),
-    ignore = "long: 32 s in a debug build on lavapipe (2 cores, 2026-12-05), kept out of CI (25.8 min of its 30 with the TL plate in); cargo test --release --features long-tests runs it"
-)]
 fn ranks_hold_the_water_with_a_total_lagrangian_gate_as_one_run() {
     Comparison {
         test: "ranks_hold_the_water_with_a_total_lagrangian_gate_as_one_run",
