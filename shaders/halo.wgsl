@@ -4,10 +4,12 @@
 // cut and migrates (packed with its last rates); every own particle within `layers` of a cut
 // with a neighbour is packed as that neighbour's halo. The host reads the records, swaps them
 // with the neighbours and writes what it received after `tail`, the first entry of the last
-// sort's free slot. Free entries: `halo_forget` gives every entry excluded during a step (the
-// halo copies and migrants sent, the particles that left) the free id at the step's end, so
-// the next sort puts them in the free slot, apart from the excluded slot, where the inlet
-// particles waiting behind their buffers keep their ids (`inlet_flow` wakes them by id).
+// sort's free slot. Free entries: `halo_forget` gives every entry excluded since the sort (the
+// halo copies and migrants sent, a particle the corrector found non-finite) the free id at the
+// step's end, so the next sort puts them in the free slot, apart from the excluded slot, where
+// the inlet particles waiting behind their buffers keep their ids (`inlet_flow` wakes them by
+// id), as do the particles excluded before the sort (drained, or left the domain in the
+// predictor), which the rank writes as one whole run writes them.
 // A record carries what the receiver's passes read and, for a migrant, what it goes on
 // integrating (its last rates, and its energy with the energy equation).
 // A migrant stays in the sender's arrays for this step, as a halo copy: it is within one layer

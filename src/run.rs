@@ -148,8 +148,9 @@ struct ParticleOutputs {
     /// there.
     first_pos: Option<FirstPositions>,
     boundary_first: bool,
-    /// A subdomain's piece holds its own particles only (not the halo copies it keeps
-    /// excluded).
+    /// A subdomain's piece holds its own particles only: its live ones and those excluded on
+    /// it (waiting behind an inlet, drained, left the domain), not its free entries (where
+    /// halo copies and the other ranks' particles were).
     own_only: bool,
     /// Over several ranks with `time.output_boundary = "first"` and pictures: the first
     /// output, joined, that the later ones are completed from to be drawn.
@@ -160,7 +161,7 @@ impl ParticleOutputs {
     fn write(&mut self, solver: &Solver) -> Result<()> {
         let mut p = solver.read_particles()?;
         if self.own_only {
-            p = p.without_kind(crate::sph::EXCLUDED);
+            p = p.without_id(solver.ids().free_id());
         }
         let index = self.out.snapshot_count();
         let fewer = match &self.first_pos {

@@ -524,9 +524,10 @@ fn mpirun_wgsph(args: Vec<std::ffi::OsString>, export: &[&str]) -> Command {
 
 /// The particle outputs and probe tables of the run over ranks in `ranked` equal those of the
 /// whole run in `whole`: every output's pieces, read together through its `.pvtu`, hold bit
-/// for bit the whole run's live particles, each id once; every probe table byte for byte.
-/// Returns the live particles of the last output.
-fn assert_same_outputs(whole: &std::path::Path, ranked: &std::path::Path) -> usize {
+/// for bit the whole run's particles, each id once, the excluded ones too (waiting behind an
+/// inlet, drained, left the domain); every probe table byte for byte. Returns the live
+/// particles of the last output and the excluded ones of all outputs.
+fn assert_same_outputs(whole: &std::path::Path, ranked: &std::path::Path) -> (usize, usize) {
     let (files_one, files_two) = (
         particle_files(whole).unwrap(),
         particle_files(ranked).unwrap(),
@@ -537,13 +538,13 @@ fn assert_same_outputs(whole: &std::path::Path, ranked: &std::path::Path) -> usi
         .all(|(_, f)| f.extension().unwrap() == "pvtu"));
     let pvd = std::fs::read_to_string(ranked.join("particles.pvd")).unwrap();
     assert!(pvd.contains("particles/particles_000001.pvtu"), "{pvd}");
-    let mut live = 0;
+    let (mut live, mut excluded) = (0, 0);
     for ((_, a), (_, b)) in files_one.iter().zip(&files_two) {
         let (a, b) = (
             ParticleFile::read(a).unwrap(),
             ParticleFile::read(b).unwrap(),
         );
-        let whole = a.particles.without_kind(KIND_EXCLUDED);
+        let whole = a.particles;
         assert!(
             b.particles.id.windows(2).all(|w| w[0] < w[1]),
             "an id twice"
@@ -555,7 +556,8 @@ fn assert_same_outputs(whole: &std::path::Path, ranked: &std::path::Path) -> usi
             a.time_s
         );
         assert_eq!(a.time_s.to_bits(), b.time_s.to_bits());
-        live = whole.id.len();
+        let out = whole.kind.iter().filter(|&&k| k == KIND_EXCLUDED).count();
+        (live, excluded) = (whole.id.len() - out, excluded + out);
     }
     for e in std::fs::read_dir(whole.join("probes")).unwrap() {
         let name = e.unwrap().file_name();
@@ -565,7 +567,7 @@ fn assert_same_outputs(whole: &std::path::Path, ranked: &std::path::Path) -> usi
         );
         assert!(a == b, "probes/{name:?} differs");
     }
-    live
+    (live, excluded)
 }
 
 /// `mpirun -np 2 wgsph run` of the floating box (as shipped: fixed ghost walls) writes what one
@@ -575,8 +577,8 @@ fn assert_same_outputs(whole: &std::path::Path, ranked: &std::path::Path) -> usi
 fn a_floating_body_over_two_ranks_writes_what_one_run_writes() {
     two_ranks_write_what_one_run_writes(
         "body",
-        "cases/floating_box_2d.toml",
-        "time.end_s=0.2",
+        ("cases/floating_box_2d.toml", "0.02"),
+        &["time.end_s=0.2"],
         &["body_box.csv", "point_corner.csv"],
     );
 }
@@ -588,9 +590,41 @@ fn a_floating_body_over_two_ranks_writes_what_one_run_writes() {
 fn a_rolling_tank_over_two_ranks_writes_what_one_run_writes() {
     two_ranks_write_what_one_run_writes(
         "tank",
-        "cases/sloshing_2d.toml",
-        "time.end_s=0.3",
+        ("cases/sloshing_2d.toml", "0.02"),
+        &["time.end_s=0.3"],
         &["body_tank.csv", "p2.csv", "w8.csv"],
+    );
+}
+
+/// `mpirun -np 2 wgsph run` of the water injection writes what one whole run writes, its
+/// excluded particles too: the inlet's particles still waiting behind its buffer (20 at the
+/// start), each on the rank that wakes it, as one whole run writes them (kind 15).
+#[test]
+fn ranks_write_the_waiting_inlet_particles_as_one_run() {
+    let excluded = two_ranks_write_what_one_run_writes(
+        "injection",
+        ("cases/water_injection_2d.toml", "0.01"),
+        &["time.end_s=0.2"],
+        &["level_left.csv", "level_right.csv", "p_floor.csv"],
+    );
+    assert!(excluded > 0, "no excluded particle: the test tests less");
+}
+
+/// `mpirun -np 2 wgsph run` of the 2D dam break in an open tank with gravity turned upwards
+/// (the water falls out through the top: 14 particles have left the domain at t = 0.29 s)
+/// writes what one whole run writes: each particle that left, excluded, in the piece of the
+/// rank it left from, as one whole run writes it (kind 15).
+#[test]
+fn ranks_write_the_particles_that_left_the_domain_as_one_run() {
+    let excluded = two_ranks_write_what_one_run_writes(
+        "left",
+        ("cases/dam_break_2d.toml", "0.01"),
+        &["time.end_s=0.29", "physics.gravity_m_s2=[0.0, 9.81]"],
+        &["p_right_wall.csv"],
+    );
+    assert!(
+        excluded > 0,
+        "no particle left the domain: the test tests less"
     );
 }
 
@@ -636,16 +670,23 @@ fn a_probe_on_a_sinking_box_over_two_ranks_reads_what_one_run_reads() {
     }
 }
 
-/// `case` at dx = 0.02 m to `end`, outputs every 0.05 s, on one rank and on two: the same
-/// outputs ([`assert_same_outputs`]); each of `tables` (in probes/) has rows.
-fn two_ranks_write_what_one_run_writes(tag: &str, case: &str, end: &str, tables: &[&str]) {
+/// `case` at dx = `dx` (m) with `sets`, outputs every 0.05 s, on one rank and on two: the same
+/// outputs ([`assert_same_outputs`]); each of `tables` (in probes/) has rows. Returns the
+/// excluded particles the outputs held.
+fn two_ranks_write_what_one_run_writes(
+    tag: &str,
+    (case, dx): (&str, &str),
+    sets: &[&str],
+    tables: &[&str],
+) -> usize {
     let (one, two) = (
         common::Scratch::new(&format!("mpi-{tag}-one")),
         common::Scratch::new(&format!("mpi-{tag}-two")),
     );
     let args = |out: &std::path::Path| -> Vec<std::ffi::OsString> {
         let mut args: Vec<std::ffi::OsString> = vec!["run".into(), case.into()];
-        for s in ["particles.dx_m=0.02", end, "time.output_every_s=0.05"] {
+        let dx = format!("particles.dx_m={dx}");
+        for s in [dx.as_str(), "time.output_every_s=0.05"].iter().chain(sets) {
             args.extend(["--set".into(), s.into()]);
         }
         args.extend(["--quiet".into(), "--out".into(), out.as_os_str().to_owned()]);
@@ -653,11 +694,12 @@ fn two_ranks_write_what_one_run_writes(tag: &str, case: &str, end: &str, tables:
     };
     on_one_rank(args(&one));
     on_two_ranks(args(&two));
-    assert_same_outputs(&one, &two);
+    let (_, excluded) = assert_same_outputs(&one, &two);
     for table in tables {
         let text = std::fs::read_to_string(two.join("probes").join(table)).unwrap();
         assert!(text.lines().count() > 10, "{table}: {text}");
     }
+    excluded
 }
 
 /// `mpirun -np 2 wgsph run` of the 2D dam break writes what one whole run writes
@@ -680,7 +722,7 @@ fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
     }
     let log = on_two_ranks(resume(&two, "0.06"));
     assert!(log.contains("resuming from t = 0.032000 s"), "{log}");
-    let live = assert_same_outputs(&one, &two);
+    let (live, _) = assert_same_outputs(&one, &two);
     let (a, b) = (
         RunSummary::read(&one).unwrap(),
         RunSummary::read(&two).unwrap(),
@@ -734,7 +776,7 @@ fn ranks_write_the_walls_once_and_draw_what_one_run_draws() {
     assert_eq!(a.len(), b.len());
     let read = |f: &std::path::Path| ParticleFile::read(f).unwrap();
     let (first_a, first_b) = (read(&a[0].1).particles, read(&b[0].1).particles);
-    assert!(first_a.without_kind(KIND_EXCLUDED) == first_b);
+    assert!(first_a == first_b);
     for ((_, fa), (_, fb)) in a.iter().zip(&b).skip(1) {
         let (ra, rb) = (read(fa), read(fb));
         assert!(
@@ -742,7 +784,7 @@ fn ranks_write_the_walls_once_and_draw_what_one_run_draws() {
             "{}: the walls were written again",
             fb.display()
         );
-        let whole = (ra.particles.completed_from(&first_a)).without_kind(KIND_EXCLUDED);
+        let whole = ra.particles.completed_from(&first_a);
         assert!(
             whole == rb.particles.completed_from(&first_b),
             "the particles differ at t = {}",

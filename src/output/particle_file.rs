@@ -107,11 +107,11 @@ impl Particles {
         gather(&picks)
     }
 
-    /// These particles less those of `kind` (of a subdomain, its excluded entries: the
-    /// halo copies of other ranks' particles, and its particles that left the domain).
-    pub fn without_kind(&self, kind: u32) -> Particles {
+    /// These particles less those of id `id` (of a subdomain, its free entries, which hold
+    /// no particle: `IdSplit::free_id`).
+    pub fn without_id(&self, id: u32) -> Particles {
         let picks: Vec<(&Particles, usize)> = (0..self.id.len())
-            .filter(|&i| self.kind[i] != kind)
+            .filter(|&i| self.id[i] != id)
             .map(|i| (self, i))
             .collect();
         gather(&picks)
