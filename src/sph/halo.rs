@@ -408,6 +408,12 @@ impl Halo {
         Ok(())
     }
 
+    /// GPU memory of the pass's own buffers, in bytes: the packing buffer's records as it
+    /// stands ([`Halo::reserve`] grows it) and the layer loads.
+    pub fn bytes(&self) -> u64 {
+        self.records.size() + self.layer_load.size()
+    }
+
     /// The subdomain of rank `rank` under `slabs` from now on (its cuts moved); `halos: false`
     /// packs migrants only.
     pub fn set_cuts(&self, queue: &wgpu::Queue, slabs: &Slabs, rank: usize, halos: bool) {

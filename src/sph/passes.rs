@@ -156,6 +156,7 @@ impl Passes {
     pub fn bytes(&self) -> u64 {
         self.total_lagrangian.as_ref().map_or(0, |t| t.bytes())
             + self.elastic.as_ref().map_or(0, |e| e.bytes())
+            + self.halo.as_ref().map_or(0, |h| h.bytes())
     }
 
     /// The stages of one step on the arrays of parity `p`, in order (the sort moves them to
