@@ -42,10 +42,14 @@ pub fn weight(kind: Kind) -> f64 {
 /// The axis to cut: the one with the most cells (slabs across it are the thinnest faces for
 /// the most ranks). A periodic axis is not cut: its halos would wrap around the period.
 pub fn cut_axis(grid: &Grid, dim: u32) -> Result<usize> {
-    (0..dim as usize)
-        .filter(|&a| !grid.periodic[a])
-        .max_by_key(|&a| (grid.cells[a], std::cmp::Reverse(a)))
+    longest_axis(grid, 0..dim as usize)
         .ok_or_else(|| anyhow::anyhow!("every axis of the case is periodic: no axis to cut"))
+}
+
+/// Of `axes`, the one that is not periodic with the most cells (the first of equals).
+fn longest_axis(grid: &Grid, axes: Range<usize>) -> Option<usize> {
+    axes.filter(|&a| !grid.periodic[a])
+        .max_by_key(|&a| (grid.cells[a], std::cmp::Reverse(a)))
 }
 
 /// The axis to cut `sc` along on `grid`: [`cut_axis`], but where `sc` has a wave gauge (which
@@ -59,10 +63,7 @@ pub fn case_cut_axis(sc: &Scenario, grid: &Grid) -> Result<usize> {
     if !gauges || axis != up {
         return Ok(axis);
     }
-    Ok((0..up)
-        .filter(|&a| !grid.periodic[a])
-        .max_by_key(|&a| (grid.cells[a], std::cmp::Reverse(a)))
-        .unwrap_or(axis))
+    Ok(longest_axis(grid, 0..up).unwrap_or(axis))
 }
 
 /// The weighted particles of each cell layer along `axis`.

@@ -77,6 +77,14 @@ fn distinct_around(cells: [u32; 3], slots: u64, reach: u32, [a, b]: [u32; 2]) ->
     })
 }
 
+/// The slots of a table for `cells` cells holding `particles` particles: the smaller of the
+/// next powers of two of the two (at least 1 024 for the particles), so that memory follows
+/// the particles in an almost empty domain and the cells in a full one.
+fn table_slots(cells: u64, particles: usize) -> u64 {
+    let particles = (particles.max(1024) as u64).next_power_of_two();
+    cells.next_power_of_two().min(particles)
+}
+
 /// The strides of the slot hash (`Grid::stride`): the linear index's (gx, gx gy) where no two
 /// cells of a neighbourhood share a slot under them (always where there are as many slots as
 /// cells), otherwise the first strides from there up that keep the cells of every
@@ -184,9 +192,7 @@ impl Grid {
         let blocks = [0, 1, 2].map(|a| cells[a].div_ceil(k));
         let block_size = cell_size.map(|c| (k as f64 * c) as f32);
         let total_cells: u64 = cells.iter().map(|&c| c as u64).product();
-        let slots = total_cells
-            .next_power_of_two()
-            .min((n_particles.max(1024) as u64).next_power_of_two());
+        let slots = table_slots(total_cells, n_particles);
         if slots > (1 << 30) {
             bail!("{slots} hash slots needed: too many particles for one GPU");
         }
@@ -235,10 +241,7 @@ impl Grid {
             .filter(|&a| a != axis)
             .map(|a| self.cells[a] as u64)
             .product();
-        let cells = across * layers.len() as u64;
-        let mut slots = (particles.max(1024) as u64)
-            .next_power_of_two()
-            .min(cells.next_power_of_two());
+        let mut slots = table_slots(across * layers.len() as u64, particles);
         while slots < self.slots as u64 {
             if let Some(stride) = hash_strides(self.cells, slots, self.reach) {
                 let slots = slots as u32;

@@ -161,7 +161,7 @@ impl Solver {
 
     /// The solver of `sc` before its warm-up step: of the whole case, or with `subdomain` of
     /// the particles in its own cell layers (the others excluded) and its halo pass.
-    fn build(ctx: &GpuContext, sc: &Scenario, subdomain: Option<HaloCtl>) -> Result<Self> {
+    fn build(ctx: &GpuContext, sc: &Scenario, mut subdomain: Option<HaloCtl>) -> Result<Self> {
         let ph = &sc.physics;
         let n = sc.particles.len();
         if n == 0 {
@@ -177,7 +177,6 @@ impl Solver {
         };
         let mut packed = initial::pack(sc, &grid);
         let mut capacity = n as u32;
-        let mut subdomain = subdomain;
         let ranked = (subdomain.as_mut())
             .map(|ctl| -> Result<_> {
                 let (own, waiting) = subdomain::exclude_others(&mut packed, &grid, ctl, sc);

@@ -127,6 +127,11 @@ pub fn capacity(own: u32, waiting: u32, n: u32) -> u32 {
         .saturating_add(waiting)
 }
 
+/// The cell layer along `axis` of a particle at `p` (`layer_of` in shaders/halo.wgsl).
+fn layer_of(grid: &Grid, axis: usize, p: Pos) -> i64 {
+    grid.cell_of(p.off, unpack_block(p.block))[axis]
+}
+
 /// The records a subdomain's packing buffer starts with: twice the halo copies the first
 /// `own` entries of `packed` (its own particles at the start) make, each own particle within
 /// `ctl`'s halo layers of a cut with a neighbour one copy (a solid particle two: its stress
@@ -136,8 +141,7 @@ pub fn starting_records(packed: &Packed, own: u32, grid: &Grid, ctl: &HaloCtl) -
     let axis = ctl.axis as usize;
     let copies: u64 = (0..own as usize)
         .map(|k| {
-            let p = packed.pos[k];
-            let layer = grid.cell_of(p.off, unpack_block(p.block))[axis] as u32;
+            let layer = layer_of(grid, axis, packed.pos[k]) as u32;
             let below = ctl.lower != 0 && layer < ctl.own_lo + ctl.layers;
             let above = ctl.upper != 0 && layer + ctl.layers >= ctl.own_hi;
             let solid = Kind::from_code(packed.code[k] >> KIND_SHIFT).is_some_and(Kind::is_solid);
@@ -176,9 +180,7 @@ pub fn exclude_others(
         (ctl.own_lo..ctl.own_hi).contains(&layer)
     };
     let own = |k: usize| {
-        let p = packed.pos[k];
-        packed.code[k] >> KIND_SHIFT != KIND_EXCLUDED
-            && mine(grid.cell_of(p.off, unpack_block(p.block))[axis])
+        packed.code[k] >> KIND_SHIFT != KIND_EXCLUDED && mine(layer_of(grid, axis, packed.pos[k]))
     };
     let joining_here = |id: usize| {
         sc.inlets.iter().any(|inlet| {
@@ -505,7 +507,7 @@ impl Solver {
         for r in packed.lower.into_iter().chain(packed.upper) {
             // A solid's stress state goes where its particle goes, the record before it.
             if r.dest & DEST_SOLID_STATE == 0 {
-                let layer = self.grid.cell_of(r.pos.off, unpack_block(r.pos.block))[next.axis];
+                let layer = layer_of(&self.grid, next.axis, r.pos);
                 owner = next.owner(layer as u32);
             }
             to[owner].push(r);
@@ -711,6 +713,29 @@ impl Solver {
         p: usize,
         record: impl FnOnce(&Passes, wgpu::ComputePass<'_>),
     ) -> Result<halo::Packed> {
+        let packed = self.submit_packing(tl_positions, record)?;
+        let Some(needed) = packed.needed else {
+            return Ok(packed);
+        };
+        self.reserve_records(needed as usize)?;
+        let packed = self.submit_packing(false, |passes, mut pass| {
+            passes.halo().encode_pack(&mut pass, p)
+        })?;
+        ensure!(
+            packed.needed.is_none(),
+            "the halo records did not fit twice"
+        );
+        Ok(packed)
+    }
+
+    /// One submission of [`Solver::pack`]: the counters cleared, the passes `record` records,
+    /// the counters (and with `tl_positions` the total-Lagrangian positions) copied; then what
+    /// was packed, read back.
+    fn submit_packing(
+        &self,
+        tl_positions: bool,
+        record: impl FnOnce(&Passes, wgpu::ComputePass<'_>),
+    ) -> Result<halo::Packed> {
         let halo = self.passes.halo();
         let mut encoder = self.device.create_command_encoder(&Default::default());
         halo.clear(&mut encoder);
@@ -730,22 +755,6 @@ impl Solver {
         self.queue.submit([encoder.finish()]);
         let packed = halo.read(&self.device, &self.queue)?;
         self.faults.check()?;
-        let Some(needed) = packed.needed else {
-            return Ok(packed);
-        };
-        self.reserve_records(needed as usize)?;
-        let halo = self.passes.halo();
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        halo.clear(&mut encoder);
-        halo.encode_pack(&mut encoder.begin_compute_pass(&Default::default()), p);
-        halo.copy_counts(&mut encoder);
-        self.queue.submit([encoder.finish()]);
-        let packed = halo.read(&self.device, &self.queue)?;
-        self.faults.check()?;
-        ensure!(
-            packed.needed.is_none(),
-            "the halo records did not fit twice"
-        );
         Ok(packed)
     }
 
