@@ -33,18 +33,6 @@
 @group(0) @binding(4) var<storage, read> rate: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> cell_start: array<u32>;
 
-// Mirrored by `sph::halo::HaloCtl`.
-struct HaloCtl {
-    axis: u32,
-    own_lo: u32,
-    own_hi: u32,
-    layers: u32,        // halo thickness in cell layers
-    lower: u32,         // 1: a neighbour owns the layers below own_lo
-    upper: u32,         // 1: a neighbour owns the layers from own_hi on
-    capacity: u32,      // records `halo_out` holds
-    pad: u32,
-}
-
 // Mirrored by `sph::halo::HaloCounts`.
 struct HaloCounts {
     records: atomic<u32>,
@@ -85,7 +73,7 @@ const DEST_ID_SHIFT: u32 = 3u;
 @group(0) @binding(11) var<storage, read> solid: array<SolidState>;
 
 fn layer_of(p: Pos) -> u32 {
-    return u32(cell_of(p)[halo_ctl.axis]);
+    return slab_layer(p, halo_ctl.axis);
 }
 
 // The id of the particle a record carries.

@@ -582,15 +582,10 @@ fn fluid_rates(i: u32, ranges: ptr<function, NeighbourRanges>, n_ranges: u32) ->
     return r;
 }
 
-// One invocation per particle, by the kind of i: solids (their loads from outside their body;
-// their own stress in elastic.wgsl), fluid, and boundary particles that take rates; every other
-// particle gets zero.
-@compute @workgroup_size(WG)
-fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = linear_index(gid, nwg);
-    if (i >= params.n_particles) {
-        return;
-    }
+// The rates of particle i, by its kind: solids (their loads from outside their body; their own
+// stress in elastic.wgsl), fluid, and boundary particles that take rates; every other particle
+// gets zero.
+fn interact(i: u32) {
     let kind_i = code_kind(code[i]);
     if (ENERGY) {
         energy_rate[i] = 0.0;
@@ -625,4 +620,56 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         return;
     }
     rate[i] = boundary_rates(i, kind_i, on_body);
+}
+
+@compute @workgroup_size(WG)
+fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i < params.n_particles) {
+        interact(i);
+    }
+}
+
+// A subdomain's slab, for the overlapped step's two halves (docs/scaling.md): the particles
+// that read nothing the exchange brings, summed while it travels, and the rest after it.
+@group(0) @binding(10) var<uniform> halo_ctl: HaloCtl;
+
+// What the first half leaves to the second in `rate`: a NaN of its own (a NaN rate the sums
+// make is summed again the same).
+const LEFT_FOR_AFTER: u32 = 0x7fc0beefu;
+
+fn before_arrival(i: u32) -> bool {
+    return reads_no_arrival(slab_layer(pos[i], halo_ctl.axis), halo_ctl);
+}
+
+var<workgroup> group_reads_arrival: atomic<u32>;
+
+// The first half sums a workgroup's particles only where none of them reads an arrival: a
+// workgroup of both kinds (where the sorted order crosses the layers by a cut) would run its
+// neighbour loops in both halves, its lanes half idle in each, so all of it is left for after.
+@compute @workgroup_size(WG)
+fn interaction_interior(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    let n = params.n_particles;
+    if (i < n && !before_arrival(i)) {
+        atomicStore(&group_reads_arrival, 1u);
+    }
+    workgroupBarrier();
+    let leave = atomicLoad(&group_reads_arrival) != 0u;
+    if (i >= n) {
+        return;
+    }
+    if (leave) {
+        rate[i] = vec4<f32>(bitcast<f32>(LEFT_FOR_AFTER));
+    } else {
+        interact(i);
+    }
+}
+
+@compute @workgroup_size(WG)
+fn interaction_boundary(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if (i < params.n_particles && (bitcast<u32>(rate[i].w) == LEFT_FOR_AFTER || !before_arrival(i))) {
+        interact(i);
+    }
 }

@@ -382,7 +382,7 @@ pub struct OutletDef {
     pub pad1: u32,
 }
 
-/// Mirrors `HaloCtl` in shaders/halo.wgsl: a subdomain's own cell layers along the cut axis,
+/// Mirrors `HaloCtl` in shaders/lib/slab.wgsl: a subdomain's own cell layers along the cut axis,
 /// its halo thickness, which neighbours it has, and how many records `halo_out` holds.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]

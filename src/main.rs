@@ -588,11 +588,15 @@ fn bench_ranked(
         100.0 * r.imbalance(),
         r.ranks[0].rebalances
     );
-    println!("rank  own particles  halo/step  migrants/step  halo bytes/step  ms/step: pack  exchange  compute  agree");
+    println!(
+        "rank  own particles  halo/step  migrants/step  halo bytes/step  ms/step: pack  \
+         exchange  compute  agree  % steps overlapped  % of them hidden"
+    );
     for (k, b) in r.ranks.iter().enumerate() {
         let ms = |s: f64| 1e3 * s;
         println!(
-            "{k:>4}  {:>13}  {:>9.1}  {:>13.2}  {:>15.0}  {:>13.3}  {:>8.3}  {:>7.3}  {:>5.3}",
+            "{k:>4}  {:>13}  {:>9.1}  {:>13.2}  {:>15.0}  {:>13.3}  {:>8.3}  {:>7.3}  {:>5.3}  \
+             {:>18.0}  {:>16.0}",
             b.own_particles,
             b.halo_particles_per_step,
             b.migrants_per_step,
@@ -600,7 +604,9 @@ fn bench_ranked(
             ms(b.seconds_per_step.pack),
             ms(b.seconds_per_step.exchange),
             ms(b.seconds_per_step.compute),
-            ms(b.seconds_per_step.agree)
+            ms(b.seconds_per_step.agree),
+            100.0 * b.overlapped,
+            100.0 * b.exchange_hidden
         );
     }
     Ok(ExitCode::SUCCESS)

@@ -171,6 +171,9 @@ pub struct TimeControl {
     pub cfl: f64,
     /// Which particle outputs hold the boundary particles that have not moved.
     pub output_boundary: OutputBoundary,
+    /// Whether a run over ranks overlaps the exchange with the sums that need nothing from
+    /// it, where the case allows (`sph::overlap::unsupported`); the results are the same.
+    pub overlap_exchange: OverlapExchange,
     /// The run warns when the fluid's density varies from ρ0 by more than this fraction (the
     /// weakly-compressible limit), and keeps only outputs within it when it stops unstable.
     pub density_variation_warn: f64,
@@ -185,6 +188,18 @@ impl TimeControl {
     /// `time.density_variation_stop`'s default (or twice `density_variation_warn` when that is
     /// above 5 %).
     pub const DENSITY_VARIATION_STOP: f64 = 0.1;
+}
+
+/// Whether a subdomain's steps overlap the exchange with its interior's sums
+/// (`time.overlap_exchange`, docs/scaling.md "Overlapping the exchange").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OverlapExchange {
+    /// Each rank times its steps both ways now and then and takes the faster
+    /// (`sph::overlap::Choice`).
+    #[default]
+    Auto,
+    Always,
+    Never,
 }
 
 /// Which particle outputs hold the boundary particles still where they started (fixed walls,

@@ -708,7 +708,8 @@ fn two_ranks_write_what_one_run_writes(
 /// rank files used), then `mpirun -np 2 wgsph resume` takes it from t = 0.032 s to 0.06 s: the
 /// outputs before and after the resume are all compared. The cut lies across the water
 /// column, which falls through it: particles migrate, and run.json says how much each rank
-/// sent.
+/// sent. The ranks overlap the exchange with their interior's sums up to the resume, and take
+/// the serial step after it (`time.overlap_exchange`): run.json says which.
 #[test]
 fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
     let (one, two) = (
@@ -716,11 +717,20 @@ fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
         common::Scratch::new("mpi-run-two"),
     );
     on_one_rank(dam_break("time.end_s=0.06", &one));
-    on_two_ranks(dam_break("time.end_s=0.04", &two));
+    let mut overlapping = dam_break("time.end_s=0.04", &two);
+    overlapping.extend(["--set".into(), "time.overlap_exchange=\"always\"".into()]);
+    on_two_ranks(overlapping);
     for set in ["g0", "g1"] {
         assert!(two.join(format!("checkpoint_{set}_p0001.bin")).is_file());
     }
-    let log = on_two_ranks(resume(&two, "0.06"));
+    let overlapped = RunSummary::read(&two).unwrap().ranks.unwrap();
+    println!("{overlapped:#?}");
+    assert!(overlapped
+        .iter()
+        .all(|r| r.overlapped == 1.0 && (0.0..=1.0).contains(&r.exchange_hidden)));
+    let mut serial = resume(&two, "0.06");
+    serial.extend(["--set".into(), "time.overlap_exchange=\"never\"".into()]);
+    let log = on_two_ranks(serial);
     assert!(log.contains("resuming from t = 0.032000 s"), "{log}");
     let (live, _) = assert_same_outputs(&one, &two);
     let (a, b) = (
@@ -734,6 +744,10 @@ fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
     let ranks = b.ranks.expect("run.json of a run over ranks lists them");
     assert_eq!(ranks.len(), 2);
     println!("{ranks:#?}");
+    // Up to the checkpoint resumed from (t = 0.032 s) overlapped, then not.
+    assert!(ranks
+        .iter()
+        .all(|r| 0.0 < r.overlapped && r.overlapped < 1.0));
     let own: u64 = ranks.iter().map(|r| r.own_particles).sum();
     assert_eq!(own, live as u64, "every live particle is own on one rank");
     assert!(ranks.iter().all(|r| r.halo_bytes_per_step > 0.0));
@@ -966,7 +980,8 @@ fn ranks_with_an_outlet_drain_what_one_run_drains() {
 }
 
 /// `mpirun -np 2 wgsph bench`: rank 0 names each rank's adapter and prints the whole run's
-/// figures and a line per rank with the halo it sent and where its step time went.
+/// figures and a line per rank with the halo it sent, where its step time went and how many of
+/// its steps overlapped the exchange.
 #[test]
 fn bench_under_mpirun_reports_every_rank() {
     common::one_lavapipe_thread_each();
@@ -1005,6 +1020,9 @@ fn bench_under_mpirun_reports_every_rank() {
     let own: f64 = rows.iter().map(|r| r[1]).sum();
     assert_eq!(own, 4274.0, "every particle is own on one rank");
     assert!(rows.iter().all(|r| r[2] > 0.0 && r[4] > 0.0), "{stdout}");
+    // `time.overlap_exchange = "auto"` tries both ways in the first steps
+    // (`sph::overlap::Choice`).
+    assert!(rows.iter().all(|r| r[9] > 0.0 && r[9] < 100.0), "{stdout}");
 }
 
 /// A box pushed down through the 2D dam break's water column (dynamic walls, 0.5 m/s down and

@@ -192,6 +192,16 @@ pub(super) struct RawTime {
     pub output_boundary: Option<OutputBoundaryName>,
     pub density_variation_warn: Option<f64>,
     pub density_variation_stop: Option<f64>,
+    pub overlap_exchange: Option<OverlapExchangeName>,
+}
+
+/// Whether a run over ranks overlaps the exchange with its interior's sums.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum OverlapExchangeName {
+    Auto,
+    Always,
+    Never,
 }
 
 /// Which particle outputs hold the boundary particles that have not moved.
@@ -531,6 +541,13 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "time.output_boundary",
         "which particle outputs hold the boundary particles that have not moved: every or first",
         "output_boundary = \"first\"",
+    ),
+    f(
+        "time.overlap_exchange",
+        "whether a run over ranks sums its particles away from the cuts while the halo \
+         travels: \"auto\" (each rank times both ways and takes the faster), \"always\" or \
+         \"never\"; no result changes",
+        "overlap_exchange = \"never\"",
     ),
     f(
         "time.density_variation_warn",

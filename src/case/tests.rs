@@ -955,6 +955,12 @@ const BAD_NUMBERS: &[(&str, &str, usize, &[&str])] = &[
         &["time.output_boundary = \"firs\"", "\"every\", \"first\""],
     ),
     (
+        "output_every_s = 0.1",
+        "output_every_s = 0.1\noverlap_exchange = true",
+        12,
+        &["time.overlap_exchange", "\"auto\""],
+    ),
+    (
         "sound_speed_coef = 10.0",
         "sound_speed_coef = 10.0\nrho0_kg_m3 = 0",
         8,

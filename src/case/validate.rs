@@ -4,8 +4,8 @@
 
 use crate::grid::CellEdge;
 use crate::scenario::{
-    DeltaSphForm, DensityFilter, FrictionPair, GhostCorrection, KernelKind, OutputBoundary, Probe,
-    RepulsiveForm, TimeControl, Viscosity, DEFAULT_FRICTION_SLIP,
+    DeltaSphForm, DensityFilter, FrictionPair, GhostCorrection, KernelKind, OutputBoundary,
+    OverlapExchange, Probe, RepulsiveForm, TimeControl, Viscosity, DEFAULT_FRICTION_SLIP,
 };
 
 use super::check::{aabb, initial_velocity, number, treatment, vector, Aabb, Bound, Treatment};
@@ -14,7 +14,8 @@ use super::locate::Ctx;
 use super::probes::Checked;
 use super::schema::{
     CellName, DeltaSphFormName, DensityFilterName, GhostCorrectionName, KernelName,
-    OutputBoundaryName, RawCase, RawPhysics, RepulsiveFormName, ViscosityName, WallName,
+    OutputBoundaryName, OverlapExchangeName, RawCase, RawPhysics, RepulsiveFormName, ViscosityName,
+    WallName,
 };
 
 #[derive(Debug, Clone, Copy)]
@@ -531,6 +532,11 @@ fn time(ctx: &Ctx<'_>, raw: &RawCase) -> Result<TimeControl, CaseError> {
         cfl,
         density_variation_warn,
         density_variation_stop,
+        overlap_exchange: match t.overlap_exchange {
+            None | Some(OverlapExchangeName::Auto) => OverlapExchange::Auto,
+            Some(OverlapExchangeName::Always) => OverlapExchange::Always,
+            Some(OverlapExchangeName::Never) => OverlapExchange::Never,
+        },
         output_boundary: match t.output_boundary {
             None | Some(OutputBoundaryName::Every) => OutputBoundary::Every,
             Some(OutputBoundaryName::First) => OutputBoundary::First,

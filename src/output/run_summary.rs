@@ -80,6 +80,14 @@ pub struct RankSummary {
     /// (`Grid::for_subdomain`).
     #[serde(default)]
     pub hash_slots: u64,
+    /// The share of the rank's steps that overlapped the exchange with its interior's sums
+    /// (`time.overlap_exchange`, where the case allows; a resume may change it).
+    #[serde(default)]
+    pub overlapped: f64,
+    /// The share of those steps whose exchange ended while those sums were still running:
+    /// the exchange wholly hidden behind them.
+    #[serde(default)]
+    pub exchange_hidden: f64,
 }
 
 impl RunSummary {

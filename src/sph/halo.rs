@@ -5,9 +5,9 @@
 use anyhow::{anyhow, ensure, Result};
 
 use super::buffers::{Bindings, ParticleBuffers};
-use super::shader::PARTICLE_ID;
+use super::shader::{PARTICLE_ID, SLAB};
 use crate::decomposition::Slabs;
-use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init};
+use crate::gpu::buffers::{map_read, map_read_after, read, readback_buffer, storage, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
 use crate::layout::{
@@ -20,7 +20,7 @@ use bytemuck::{Pod, Zeroable};
 pub const SHADER: Shader = Shader {
     name: "halo",
     source: include_str!("../../shaders/halo.wgsl"),
-    libs: &[PARTICLE_ID],
+    libs: &[PARTICLE_ID, SLAB],
 };
 
 /// Cell layers of halo `sc` needs. Cells are the kernel support 2h, so one layer holds every
@@ -408,6 +408,11 @@ impl Halo {
         Ok(())
     }
 
+    /// The subdomain's `HaloCtl` uniform, which an overlapped step's interaction reads too.
+    pub fn slab(&self) -> &wgpu::Buffer {
+        &self.ctl
+    }
+
     /// GPU memory of the pass's own buffers, in bytes: the packing buffer's records as it
     /// stands ([`Halo::reserve`] grows it) and the layer loads.
     pub fn bytes(&self) -> u64 {
@@ -463,6 +468,25 @@ impl Halo {
     pub fn encode_pack(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.tail.dispatch_groups(pass, p, 1);
         self.pack.dispatch(pass, p, self.n);
+    }
+
+    /// Where the free tail of the arrays of parity `q` starts, sorted into them just now (an
+    /// overlapped step's first sort, where the arrivals go): for [`Halo::read_tail`], with
+    /// `copy_counts`.
+    pub fn encode_tail(&self, pass: &mut wgpu::ComputePass<'_>, q: usize) {
+        self.tail.dispatch_groups(pass, q, 1);
+    }
+
+    /// The tail [`Halo::encode_tail`] found, once `submission` (which recorded it and
+    /// `copy_counts`) is done; later submissions go on running.
+    pub fn read_tail(
+        &self,
+        device: &wgpu::Device,
+        submission: wgpu::SubmissionIndex,
+    ) -> Result<u32> {
+        let bytes = map_read_after(device, &self.counts_staging, Some(submission))?;
+        let counts: HaloCounts = bytemuck::pod_read_unaligned(&bytes);
+        Ok(counts.tail)
     }
 
     /// Excludes the halo copies and the migrants sent from the arrays of parity `q` (after the

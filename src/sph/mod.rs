@@ -20,6 +20,7 @@ pub mod initial;
 pub mod integrate;
 pub mod interaction;
 pub mod open_boundaries;
+pub mod overlap;
 pub mod params;
 pub mod passes;
 pub mod probes;

@@ -14,6 +14,7 @@ use super::halo::{self, Halo};
 use super::integrate::{self, Integrate};
 use super::interaction::{self, Interaction};
 use super::open_boundaries::{self, OpenBoundaries};
+use super::overlap::{self, Overlap};
 use super::probes::{self, PointTracker, Probes};
 use super::profile::Recorder;
 use super::shader::{module, ShaderConfig};
@@ -21,10 +22,10 @@ use super::total_lagrangian::{self, TotalLagrangian};
 use crate::gpu::shader::Shader;
 use crate::grid::Grid;
 use crate::layout::{BodyMotion, HaloCtl, ProbeDef};
-use crate::scenario::{Kind, Scenario, SolidFormulation};
+use crate::scenario::{Kind, OverlapExchange, Scenario, SolidFormulation};
 
 /// Every pass's shader, for the checks that compose them all.
-pub const SHADERS: [&Shader; 12] = [
+pub const SHADERS: [&Shader; 13] = [
     &cell_list::SHADER,
     &cell_list::SCAN_SHADER,
     &interaction::SHADER,
@@ -37,6 +38,7 @@ pub const SHADERS: [&Shader; 12] = [
     &total_lagrangian::SHADER,
     &open_boundaries::SHADER,
     &halo::SHADER,
+    &overlap::SHADER,
 ];
 
 /// The passes of a run; those of what the case lacks are `None`.
@@ -60,6 +62,9 @@ pub struct Passes {
     pub points: Option<PointTracker>,
     /// A subdomain's halo and migrants (`Solver::subdomain`); None in a whole run.
     pub halo: Option<Halo>,
+    /// A subdomain whose steps may overlap the exchange (`overlap::unsupported`,
+    /// `time.overlap_exchange`): its choice, and its second sort's rates.
+    pub overlap: Option<Overlap>,
 }
 
 impl Passes {
@@ -87,6 +92,17 @@ impl Passes {
         let has_kind = |k: &[Kind]| sc.particles.iter().any(|p| k.contains(&p.kind));
         let has_formulation = |f| sc.solids.as_ref().is_some_and(|s| s.has(f));
         let probe_module = shader(&probes::SHADER)?;
+        let halo = subdomain
+            .map(|ctl| {
+                let layers = grid.cells[ctl.axis as usize];
+                let records = halo::records_per_particle(sc);
+                Halo::new(device, &shader(&halo::SHADER)?, b, ctl, layers, records)
+            })
+            .transpose()?;
+        let policy = sc.time.overlap_exchange;
+        let overlapped = halo
+            .as_ref()
+            .filter(|_| policy != OverlapExchange::Never && overlap::unsupported(sc).is_none());
         Ok(Self {
             cell_list: CellList::new(
                 device,
@@ -95,7 +111,15 @@ impl Passes {
                 b,
                 ph.energy,
             )?,
-            interaction: Interaction::new(device, &shader(&interaction::SHADER)?, b)?,
+            interaction: Interaction::new(
+                device,
+                &shader(&interaction::SHADER)?,
+                b,
+                overlapped.map(Halo::slab),
+            )?,
+            overlap: overlapped
+                .map(|_| Overlap::new(device, &shader(&overlap::SHADER)?, b, policy))
+                .transpose()?,
             ghost: Ghost::new(
                 device,
                 &shader(&ghost::SHADER)?,
@@ -142,13 +166,7 @@ impl Passes {
                     .collect(),
             )?,
             points: PointTracker::new(device, &probe_module, b, &sc.points)?,
-            halo: subdomain
-                .map(|ctl| {
-                    let layers = grid.cells[ctl.axis as usize];
-                    let records = halo::records_per_particle(sc);
-                    Halo::new(device, &shader(&halo::SHADER)?, b, ctl, layers, records)
-                })
-                .transpose()?,
+            halo,
         })
     }
 
@@ -157,6 +175,7 @@ impl Passes {
         self.total_lagrangian.as_ref().map_or(0, |t| t.bytes())
             + self.elastic.as_ref().map_or(0, |e| e.bytes())
             + self.halo.as_ref().map_or(0, |h| h.bytes())
+            + self.overlap.as_ref().map_or(0, |o| o.bytes())
     }
 
     /// The stages of one step on the arrays of parity `p`, in order (the sort moves them to
@@ -164,7 +183,7 @@ impl Passes {
     /// migrants with its neighbours between the two halves.
     pub(super) fn record_step(&self, mut r: Recorder<'_>, p: usize) {
         self.record_to_exchange(&mut r, p);
-        self.record_from_exchange(&mut r, p);
+        self.record_from_exchange(&mut r, p, false);
     }
 
     /// The step up to the exchange: the predictors, and a subdomain's packing.
@@ -189,15 +208,46 @@ impl Passes {
         }
     }
 
-    /// The step from the exchange on: the sort, the sums and the correctors.
-    pub(super) fn record_from_exchange(&self, r: &mut Recorder<'_>, p: usize) {
-        let q = 1 - p;
-        let bodies = self.bodies.as_ref();
+    /// An overlapped subdomain's step before what the exchange brings arrives (the host
+    /// swaps it meanwhile): the arrays of parity `p` sorted, and the sums of the particles
+    /// that need nothing from it; the rest of the step starts again from the other parity
+    /// (`record_from_exchange(r, 1 - p)`), whose sort takes the arrivals in.
+    pub(super) fn record_before_arrival(&self, r: &mut Recorder<'_>, p: usize) {
+        self.record_sort(r, p, None);
+        let halo = self.halo();
+        r.stage("halo_tail", |pass| halo.encode_tail(pass, 1 - p));
+    }
+
+    /// The sums of [`Passes::record_before_arrival`]'s particles, on its sorted arrays.
+    pub(super) fn record_interior(&self, r: &mut Recorder<'_>, q: usize) {
+        r.stage("interaction_interior", |pass| {
+            self.interaction.encode_interior(pass, q)
+        });
+    }
+
+    /// The sort of the arrays of parity `p` into the other; with `rates`, carrying this
+    /// step's rates the interior's sums wrote beside the last ones.
+    fn record_sort(&self, r: &mut Recorder<'_>, p: usize, rates: Option<&Overlap>) {
         let cells = &self.cell_list;
         r.stage("sort_key", |pass| cells.encode_key(pass, p));
         r.stage("sort_scan", |pass| cells.encode_scan(pass));
         r.stage("sort_scatter", |pass| cells.encode_scatter(pass, p));
+        if let Some(o) = rates {
+            r.stage("hold_old_rates", |pass| o.encode_hold(pass));
+        }
         r.stage("sort_reorder", |pass| cells.encode_reorder(pass, p));
+        if let Some(o) = rates {
+            r.stage("settle_rates", |pass| o.encode_settle(pass));
+        }
+    }
+
+    /// The step from the exchange on: the sort, the sums and the correctors. An
+    /// `overlapped` subdomain's sort carries the interior's rates, and its sums are the rest's.
+    pub(super) fn record_from_exchange(&self, r: &mut Recorder<'_>, p: usize, overlapped: bool) {
+        let q = 1 - p;
+        let bodies = self.bodies.as_ref();
+        let overlap = self.overlap.as_ref().filter(|_| overlapped);
+        self.record_sort(r, p, overlap);
         if let Some(t) = &self.total_lagrangian {
             r.stage("total_lagrangian_index", |pass| t.encode_index(pass, q));
         }
@@ -208,7 +258,12 @@ impl Passes {
         if let Some(o) = &self.open_boundaries {
             r.stage("inlet_pressure", |pass| o.encode_pressure(pass, q));
         }
-        r.stage("interaction", |pass| self.interaction.encode(pass, q));
+        match overlap {
+            Some(_) => r.stage("interaction_boundary", |pass| {
+                self.interaction.encode_boundary(pass, q)
+            }),
+            None => r.stage("interaction", |pass| self.interaction.encode(pass, q)),
+        }
         if let Some(e) = &self.elastic {
             r.stage("elastic_rates", |pass| e.encode_rates(pass, q));
             r.stage("elastic_correct", |pass| e.encode_correct(pass, q));

@@ -31,6 +31,9 @@ pub const WORKGROUP_MAX: &str = include_str!("../../shaders/lib/workgroup_max.wg
 /// A particle's id and the solid arrays' index (`shaders/lib/particle_id.wgsl`; the pass
 /// declares `code`).
 pub const PARTICLE_ID: &str = include_str!("../../shaders/lib/particle_id.wgsl");
+/// A subdomain's slab and which of its particles read nothing the exchange brings
+/// (`shaders/lib/slab.wgsl`).
+pub const SLAB: &str = include_str!("../../shaders/lib/slab.wgsl");
 /// A wall-pressure sensor's patch of boundary particles (`shaders/lib/wall_patch.wgsl`).
 pub const WALL_PATCH: &str = include_str!("../../shaders/lib/wall_patch.wgsl");
 

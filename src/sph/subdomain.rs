@@ -55,6 +55,15 @@ pub struct Ranked {
     pub owned: u32,
     /// This rank's wall time in each part of its steps, summed: [`Split`].
     pub split: Split,
+    /// Steps taken, those that overlapped the exchange, and of them those whose exchange
+    /// ended while the interior's sums were still running (the exchange wholly hidden behind
+    /// them; `Solver::ranked_step`).
+    #[serde(default)]
+    pub exchanges: u64,
+    #[serde(default)]
+    pub overlapped: u64,
+    #[serde(default)]
+    pub hidden: u64,
     /// The present cuts (set once the subdomain is made), and how often they moved.
     pub slabs: Option<Slabs>,
     pub rebalances: u32,
@@ -72,6 +81,14 @@ pub struct Ranked {
     /// they stand, which the cuts keep whole as they go (`Solver::keep_probes_whole`).
     #[serde(skip)]
     pub(super) moving_probes: Vec<usize>,
+}
+
+/// What an overlapped step's GPU does while the host swaps (`Solver::submit_interior`): the
+/// submission of its first sort, after which the free tail is known, and whether the
+/// interior's sums are done.
+struct Interior {
+    sorted: wgpu::SubmissionIndex,
+    summed: std::sync::Arc<std::sync::atomic::AtomicBool>,
 }
 
 /// Steps between two looks at the ranks' balance (`Solver::rebalance`).
@@ -523,7 +540,7 @@ impl Solver {
             .iter()
             .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, HaloRecord>(b))
             .collect();
-        self.unpack(&incoming, packed.tail, p)?;
+        self.unpack(&incoming, packed.tail, p, &self.buffers.rate)?;
         self.sort_in_place();
         let halo = self.passes.halo();
         halo.set_cuts(&self.queue, &next, rank, true);
@@ -557,6 +574,9 @@ impl Solver {
             split.agree / steps,
             (now.rebalances - since.rebalances) as f64,
             self.grid.slots as f64,
+            (now.overlapped - since.overlapped) as f64
+                / (now.exchanges - since.exchanges).max(1) as f64,
+            (now.hidden - since.hidden) as f64 / (now.overlapped - since.overlapped).max(1) as f64,
         ];
         let mut adapters = ranks.gather_text(adapter)?.into_iter();
         Ok(ranks
@@ -576,6 +596,8 @@ impl Solver {
                 },
                 rebalances: v[8] as u32,
                 hash_slots: v[9] as u64,
+                overlapped: v[10],
+                exchange_hidden: v[11],
             })
             .collect())
     }
@@ -586,7 +608,10 @@ impl Solver {
     }
 
     /// One step of a subdomain: predict and pack, swap with the neighbours, unpack, the rest
-    /// of the step; then the ranks' smallest time step and their summed counts.
+    /// of the step; then the ranks' smallest time step and their summed counts. An overlapped
+    /// subdomain (`Passes::overlap`) sorts and sums its interior on the GPU while the host
+    /// swaps, then writes what arrived after its sorted particles and takes the rest of the
+    /// step from there, sorting again: its arrays come back to the parity they started in.
     fn ranked_step(&mut self, ranks: &dyn Ranks) -> Result<()> {
         let start = std::time::Instant::now();
         let body_dt = self.bodies.is_some().then(|| self.predict_bodies());
@@ -595,23 +620,46 @@ impl Solver {
             passes.record_to_exchange(&mut Recorder::Shared(pass), p)
         })?;
         let packed_at = std::time::Instant::now();
+        let k = self.ranked.as_ref().expect("a subdomain").exchanges;
+        let overlaps = (self.passes.overlap.as_ref()).is_some_and(|o| o.choice.overlaps(k));
+        let interior = overlaps.then(|| self.submit_interior(p));
 
         let incoming = self.swap(&packed.lower, &packed.upper, ranks)?;
         self.share_tl_positions(ranks)?;
         let swapped_at = std::time::Instant::now();
+        // Runs the callback of `interior.summed` if the GPU is done with them.
+        let _ = self.device.poll(wgpu::PollType::Poll);
         let ranked = self.ranked.as_mut().expect("a subdomain");
-        let tail = ranked.first_tail.take().unwrap_or(packed.tail);
+        let first_tail = ranked.first_tail.take();
+        ranked.exchanges += 1;
         let sent = (packed.lower.iter().chain(&packed.upper))
             .filter(|r| r.dest & DEST_SOLID_STATE == 0)
             .count();
         ranked.migrants_sent += packed.migrants as u64;
         ranked.halo_sent += sent as u64 - packed.migrants as u64;
         ranked.owned = packed.owned;
-        self.unpack(&incoming, tail, p)?;
+        // The arrays the arrivals go into, and the rest of the step starts from.
+        let p = match interior {
+            Some(interior) => {
+                ranked.overlapped += 1;
+                if !interior.summed.load(std::sync::atomic::Ordering::Acquire) {
+                    ranked.hidden += 1;
+                }
+                let tail = self
+                    .passes
+                    .halo()
+                    .read_tail(&self.device, interior.sorted)?;
+                self.unpack(&incoming, tail, 1 - p, &self.buffers.rate_sorted)?;
+                1 - p
+            }
+            None => {
+                let tail = first_tail.unwrap_or(packed.tail);
+                self.unpack(&incoming, tail, p, &self.buffers.rate)?;
+                p
+            }
+        };
 
         // The GPU counts a step of dt > 0 (integrate.wgsl `timestep`): whether the density
-        // filter fires is known now. Its submission frees the entries this step excluded, or
-        // this one does.
         let steps_before = self.state.steps;
         let filters = self.passes.density_filter.as_ref().is_some_and(|f| {
             f.fires_after(steps_before, steps_before + (self.state.dt > 0.0) as u32)
@@ -620,7 +668,7 @@ impl Solver {
         self.passes.cell_list.clear(&mut encoder, &self.buffers);
         {
             let mut r = Recorder::Shared(encoder.begin_compute_pass(&Default::default()));
-            self.passes.record_from_exchange(&mut r, p);
+            self.passes.record_from_exchange(&mut r, p, overlaps);
             if !filters {
                 let halo = self.passes.halo();
                 r.stage("halo_forget", |pass| halo.encode_forget(pass, 1 - p));
@@ -638,6 +686,9 @@ impl Solver {
         };
         self.parity = 1 - p;
         let computed_at = std::time::Instant::now();
+        if let Some(o) = &mut self.passes.overlap {
+            o.choice.record(k, (computed_at - start).as_secs_f64());
+        }
         self.agree(local, packed.owned + packed.migrants, ranks);
         if let (Some(dt), Some(mine)) = (body_dt, particle_loads) {
             self.correct_bodies(dt, &mine, ranks);
@@ -835,10 +886,42 @@ impl Solver {
         self.faults.check()
     }
 
-    /// Writes the received particles into the free tail of the arrays of parity `p`.
-    /// A solid particle's record is followed by one of its stress state
-    /// ([`Solver::write_solid_states`]).
-    fn unpack(&self, incoming: &[HaloRecord], tail: u32, p: usize) -> Result<()> {
+    /// Submits an overlapped step's first sort of the arrays of parity `p` (and where their
+    /// free tail then starts), then, apart, the sums of the particles that need nothing from
+    /// the exchange; waits for neither.
+    fn submit_interior(&self, p: usize) -> Interior {
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.passes.cell_list.clear(&mut encoder, &self.buffers);
+        self.passes.record_before_arrival(
+            &mut Recorder::Shared(encoder.begin_compute_pass(&Default::default())),
+            p,
+        );
+        self.passes.halo().copy_counts(&mut encoder);
+        let sorted = self.queue.submit([encoder.finish()]);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.passes.record_interior(
+            &mut Recorder::Shared(encoder.begin_compute_pass(&Default::default())),
+            1 - p,
+        );
+        self.queue.submit([encoder.finish()]);
+        let summed = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let done = summed.clone();
+        self.queue
+            .on_submitted_work_done(move || done.store(true, std::sync::atomic::Ordering::Release));
+        Interior { sorted, summed }
+    }
+
+    /// Writes the received particles into the free tail of the arrays of parity `p`, their
+    /// last rates into `rates` (the sort's input: `rate` before it, `rate_sorted` after an
+    /// overlapped step's first). A solid particle's record is followed by one of its stress
+    /// state ([`Solver::write_solid_states`]).
+    fn unpack(
+        &self,
+        incoming: &[HaloRecord],
+        tail: u32,
+        p: usize,
+        rates: &wgpu::Buffer,
+    ) -> Result<()> {
         let (states, incoming): (Vec<HaloRecord>, Vec<HaloRecord>) =
             (incoming.iter()).partition(|r| r.dest & DEST_SOLID_STATE != 0);
         self.write_solid_states(&states);
@@ -876,7 +959,7 @@ impl Solver {
             self.queue
                 .write_buffer(&b.code[p], at, bytemuck::cast_slice(&high));
         }
-        write(&b.rate, 16, bytemuck::cast_slice(&rate));
+        write(rates, 16, bytemuck::cast_slice(&rate));
         if self.energy {
             let energy: Vec<[f32; 2]> = incoming.iter().map(|r| r.energy).collect();
             write(&b.energy[p], 8, bytemuck::cast_slice(&energy));

@@ -161,6 +161,7 @@ pub fn scenario(
             probe_every_s: 0.1,
             cfl: 0.2,
             output_boundary: Default::default(),
+            overlap_exchange: Default::default(),
             density_variation_warn: TimeControl::DENSITY_VARIATION_WARN,
             density_variation_stop: TimeControl::DENSITY_VARIATION_STOP,
         },

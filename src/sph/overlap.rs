@@ -1,0 +1,256 @@
+//! A subdomain's step that overlaps the exchange with the sums of the particles that read
+//! nothing it brings (shaders/overlap.wgsl; issue 32, docs/scaling.md): the second sort's two
+//! rates a particle. Which cases can: [`unsupported`].
+
+use anyhow::Result;
+
+use super::buffers::ParticleBuffers;
+use crate::gpu::buffers::storage;
+use crate::gpu::kernel::ShaderModule;
+use crate::gpu::shader::Shader;
+use crate::gpu::Kernel;
+use crate::layout::HaloCtl;
+use crate::scenario::{Kind, OverlapExchange, Scenario};
+
+pub const SHADER: Shader = Shader {
+    name: "overlap",
+    source: include_str!("../../shaders/overlap.wgsl"),
+    libs: &[],
+};
+
+/// What keeps a case's subdomains from overlapping the exchange (they then take the serial
+/// step), or None. Each of these passes reads or writes something between the sort and the
+/// interaction, or after it, that the two halves of the step would have to split too: fixed
+/// ghosts' and solids' interface values (the ghost pass), the solids' stress rates, the bodies'
+/// indices, the inlets' pressure and waiting particles, the energy rates, and the density
+/// filter's second exchange.
+pub fn unsupported(sc: &Scenario) -> Option<&'static str> {
+    let has = |kinds: &[Kind]| sc.particles.iter().any(|p| kinds.contains(&p.kind));
+    let ph = &sc.physics;
+    [
+        (
+            has(&[Kind::GhostNoSlip, Kind::GhostFreeSlip]),
+            "fixed ghost particles",
+        ),
+        (has(&[Kind::Solid, Kind::SolidClamped]), "elastic solids"),
+        (!sc.bodies.is_empty(), "bodies"),
+        (
+            !sc.inlets.is_empty() || !sc.outlets.is_empty(),
+            "inlets or outlets",
+        ),
+        (ph.energy, "the energy equation"),
+        (
+            ph.density_filter != crate::scenario::DensityFilter::None,
+            "a density filter",
+        ),
+    ]
+    .into_iter()
+    .find_map(|(has, what)| has.then_some(what))
+}
+
+/// Whether a particle in cell layer `layer` of the subdomain `ctl` reads nothing the exchange
+/// brings, so that its sums run before it arrives: two layers or more inside every cut that
+/// has a neighbour (mirrors `reads_no_arrival` in shaders/lib/slab.wgsl, which says why).
+pub fn reads_no_arrival(layer: u32, ctl: &HaloCtl) -> bool {
+    layer >= ctl.own_lo + 2 * ctl.lower && layer + 2 * ctl.upper < ctl.own_hi
+}
+
+/// Steps taken each way in a trial of `time.overlap_exchange = "auto"`, and steps from the
+/// start of one trial to the next.
+pub const TRIAL_STEPS: u64 = 10;
+pub const TRIAL_EVERY: u64 = 1000;
+
+/// A subdomain's choice, step by step, of whether to overlap (`time.overlap_exchange`). With
+/// "auto" it times [`TRIAL_STEPS`] steps of each way every [`TRIAL_EVERY`] steps and takes the
+/// faster until the next trial: which is faster depends on the device (on a CPU adapter the
+/// sums and the exchange share the cores), the network and the slabs' thickness (how much of
+/// a slab is interior), which change as the run goes. Each rank chooses for itself: the
+/// results and the messages are the same either way.
+#[derive(Clone, Debug)]
+pub struct Choice {
+    policy: OverlapExchange,
+    /// Seconds of the present trial's serial and overlapped steps.
+    trial: [f64; 2],
+    chosen: bool,
+}
+
+impl Choice {
+    pub fn new(policy: OverlapExchange) -> Self {
+        Self {
+            policy,
+            trial: [0.0; 2],
+            chosen: false,
+        }
+    }
+
+    /// Whether the subdomain's step `k` (counted from its first) overlaps.
+    pub fn overlaps(&self, k: u64) -> bool {
+        match self.policy {
+            OverlapExchange::Always => true,
+            OverlapExchange::Never => false,
+            OverlapExchange::Auto => match k % TRIAL_EVERY {
+                t if t < TRIAL_STEPS => false,
+                t if t < 2 * TRIAL_STEPS => true,
+                _ => self.chosen,
+            },
+        }
+    }
+
+    /// Step `k` took `seconds` of this rank's (its packing, exchange and sums; not the wait
+    /// for the other ranks' time step, which their choices move).
+    pub fn record(&mut self, k: u64, seconds: f64) {
+        if self.policy != OverlapExchange::Auto {
+            return;
+        }
+        let t = k % TRIAL_EVERY;
+        if t < 2 * TRIAL_STEPS {
+            self.trial[self.overlaps(k) as usize] += seconds;
+        }
+        if t == 2 * TRIAL_STEPS - 1 {
+            let [serial, overlapped] = self.trial.map(|s| s / TRIAL_STEPS as f64);
+            self.chosen = overlapped < serial;
+            log::debug!(
+                "exchange: {:.2} ms a step serial, {:.2} ms overlapped; {} from step {k}",
+                1e3 * serial,
+                1e3 * overlapped,
+                if self.chosen { "overlapping" } else { "serial" }
+            );
+            self.trial = [0.0; 2];
+        }
+    }
+}
+
+pub struct Overlap {
+    /// Whether each step overlaps.
+    pub choice: Choice,
+    hold: Kernel,
+    settle: Kernel,
+    bind: [wgpu::BindGroup; 2],
+    /// The last rates during the second sort (16 bytes a particle).
+    held: wgpu::Buffer,
+    n: u32,
+}
+
+impl Overlap {
+    pub fn new(
+        device: &wgpu::Device,
+        module: &ShaderModule,
+        b: &ParticleBuffers,
+        policy: OverlapExchange,
+    ) -> Result<Self> {
+        let held = storage(device, "rate held", 16 * b.n as u64);
+        let hold = module.kernel(device, "hold_old_rates")?;
+        let settle = module.kernel(device, "settle_rates")?;
+        let bindings = || b.unparitied().with("rate_held", &held);
+        let bind = [
+            hold.bind(device, &bindings())?,
+            settle.bind(device, &bindings())?,
+        ];
+        Ok(Self {
+            choice: Choice::new(policy),
+            hold,
+            settle,
+            bind,
+            held,
+            n: b.n,
+        })
+    }
+
+    /// Before the second sort's gather (after its scatter): the last rates in its order.
+    pub fn encode_hold(&self, pass: &mut wgpu::ComputePass<'_>) {
+        self.hold.dispatch(pass, &self.bind[0], self.n);
+    }
+
+    /// After the gather: this step's rates and the last ones each in its place.
+    pub fn encode_settle(&self, pass: &mut wgpu::ComputePass<'_>) {
+        self.settle.dispatch(pass, &self.bind[1], self.n);
+    }
+
+    /// GPU memory of the pass's own buffer, in bytes.
+    pub fn bytes(&self) -> u64 {
+        self.held.size()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::decomposition::{cut_axis, layer_load, Slabs};
+    use crate::grid::{CellEdge, Grid};
+    use crate::scenario::{Domain, Particle};
+
+    /// No particle that [`reads_no_arrival`] says may be summed early has a neighbour (within
+    /// the support 2h, the cell edge) where the exchange writes: a halo layer, or the first
+    /// own layer by a cut with a neighbour, where migrants land (brute force over random
+    /// particles in 3 slabs). A rule of one layer instead of two fails it.
+    #[test]
+    fn the_interior_reads_nothing_the_exchange_brings() {
+        let h = 0.05;
+        let g = Grid::new(
+            &Domain {
+                min: [0.0; 3],
+                max: [3.0, 0.8, 0.6],
+            },
+            h,
+            3,
+            3000,
+            [false; 3],
+            Some(CellEdge::Support),
+        )
+        .unwrap();
+        let axis = cut_axis(&g, 3).unwrap();
+        let mut rng = 7u64;
+        let mut uniform = |scale: f64| {
+            rng = rng
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            scale * ((rng >> 11) as f64 / (1u64 << 53) as f64)
+        };
+        let particles: Vec<Particle> = (0..3000)
+            .map(|_| Particle {
+                pos: [0, 1, 2].map(|a| uniform(g.extent[a])),
+                vel: [0.0; 3],
+                rho: 1000.0,
+                kind: Kind::Fluid,
+            })
+            .collect();
+        let s = Slabs::balanced(axis, &layer_load(&g, axis, &particles), 3, 1).unwrap();
+        let layer = |p: &Particle| {
+            let (off, b) = g.to_block(p.pos);
+            g.cell_of(off, b)[axis] as u32
+        };
+        let support = 2.0 * h;
+        let early_reads_arrival = |rule: &dyn Fn(u32, &HaloCtl) -> bool| {
+            let (mut early, mut wrong) = (0, 0);
+            for r in 0..3 {
+                let ctl = crate::sph::halo::control(&s, r, 1);
+                let arrives = |l: u32| {
+                    (ctl.lower != 0 && l + 1 >= ctl.own_lo && l <= ctl.own_lo)
+                        || (ctl.upper != 0 && l + 1 >= ctl.own_hi && l <= ctl.own_hi)
+                };
+                for i in particles.iter().filter(|p| s.owner(layer(p)) == r) {
+                    if !rule(layer(i), &ctl) {
+                        continue;
+                    }
+                    early += 1;
+                    wrong += particles
+                        .iter()
+                        .filter(|j| {
+                            let d2: f64 = (0..3).map(|a| (i.pos[a] - j.pos[a]).powi(2)).sum();
+                            d2 < support * support && arrives(layer(j))
+                        })
+                        .count();
+                }
+            }
+            (early, wrong)
+        };
+        let (early, wrong) = early_reads_arrival(&reads_no_arrival);
+        assert!(early > 1000, "only {early} particles summed early");
+        assert_eq!(wrong, 0, "an early particle reads an arrival");
+        let one_layer = |l: u32, c: &HaloCtl| l >= c.own_lo + c.lower && l + c.upper < c.own_hi;
+        assert!(
+            early_reads_arrival(&one_layer).1 > 0,
+            "the test cannot fail"
+        );
+    }
+}
