@@ -401,6 +401,27 @@ impl Slabs {
     }
 }
 
+/// `n` fluid particles at rest at random places in `grid` (a fixed sequence from `seed`), for
+/// brute-force tests of the halos.
+#[cfg(test)]
+pub(crate) fn random_fluid(grid: &Grid, n: usize, seed: u64) -> Vec<Particle> {
+    let mut rng = seed;
+    let mut uniform = |scale: f64| {
+        rng = rng
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        scale * ((rng >> 11) as f64 / (1u64 << 53) as f64)
+    };
+    (0..n)
+        .map(|_| Particle {
+            pos: [0, 1, 2].map(|a| uniform(grid.extent[a])),
+            vel: [0.0; 3],
+            rho: 1000.0,
+            kind: Kind::Fluid,
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -504,21 +525,7 @@ mod tests {
         let g = grid([30.0, 8.0, 6.0], 3);
         let axis = cut_axis(&g, 3).unwrap();
         assert_eq!(axis, 0);
-        let mut rng = 12345u64;
-        let mut uniform = |scale: f64| {
-            rng = rng
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            scale * ((rng >> 11) as f64 / (1u64 << 53) as f64)
-        };
-        let particles: Vec<Particle> = (0..3000)
-            .map(|_| Particle {
-                pos: [0, 1, 2].map(|a| uniform(g.extent[a])),
-                vel: [0.0; 3],
-                rho: 1000.0,
-                kind: Kind::Fluid,
-            })
-            .collect();
+        let particles = random_fluid(&g, 3000, 12345);
         let load = layer_load(&g, axis, &particles);
         assert_eq!(load.iter().sum::<f64>(), 3000.0);
         let s = Slabs::balanced(axis, &load, 3, 1).unwrap();

@@ -175,7 +175,7 @@ impl Overlap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::decomposition::{cut_axis, layer_load, Slabs};
+    use crate::decomposition::{cut_axis, layer_load, random_fluid, Slabs};
     use crate::grid::{CellEdge, Grid};
     use crate::scenario::{Domain, Particle};
 
@@ -199,21 +199,7 @@ mod tests {
         )
         .unwrap();
         let axis = cut_axis(&g, 3).unwrap();
-        let mut rng = 7u64;
-        let mut uniform = |scale: f64| {
-            rng = rng
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            scale * ((rng >> 11) as f64 / (1u64 << 53) as f64)
-        };
-        let particles: Vec<Particle> = (0..3000)
-            .map(|_| Particle {
-                pos: [0, 1, 2].map(|a| uniform(g.extent[a])),
-                vel: [0.0; 3],
-                rho: 1000.0,
-                kind: Kind::Fluid,
-            })
-            .collect();
+        let particles = random_fluid(&g, 3000, 7);
         let s = Slabs::balanced(axis, &layer_load(&g, axis, &particles), 3, 1).unwrap();
         let layer = |p: &Particle| {
             let (off, b) = g.to_block(p.pos);
