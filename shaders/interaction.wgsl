@@ -634,9 +634,10 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
 // that read nothing the exchange brings, summed while it travels, and the rest after it.
 @group(0) @binding(10) var<uniform> halo_ctl: HaloCtl;
 
-// What the first half leaves to the second in `rate`: a NaN of its own (a NaN rate the sums
-// make is summed again the same).
-const LEFT_FOR_AFTER: u32 = 0x7fc0beefu;
+// What the first half writes into the `.w` of a rate it leaves to the second: about −3.4e38,
+// finite, so that no device's moves of a NaN change it; a rate that is this by chance is only
+// summed again, the same.
+const LEFT_FOR_AFTER: u32 = 0xff7fbeefu;
 
 fn before_arrival(i: u32) -> bool {
     return reads_no_arrival(slab_layer(pos[i], halo_ctl.axis), halo_ctl);

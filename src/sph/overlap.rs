@@ -22,11 +22,9 @@ pub const SHADER: Shader = Shader {
 /// step), or None. Each of these passes reads or writes something between the sort and the
 /// interaction, or after it, that the two halves of the step would have to split too: fixed
 /// ghosts' and solids' interface values (the ghost pass), the solids' stress rates, the bodies'
-/// indices, the inlets' pressure and waiting particles, the energy rates, and the density
-/// filter's second exchange.
+/// indices and loads, and the inlets' pressure (outlets: the same pass).
 pub fn unsupported(sc: &Scenario) -> Option<&'static str> {
     let has = |kinds: &[Kind]| sc.particles.iter().any(|p| kinds.contains(&p.kind));
-    let ph = &sc.physics;
     [
         (
             has(&[Kind::GhostNoSlip, Kind::GhostFreeSlip]),
@@ -37,11 +35,6 @@ pub fn unsupported(sc: &Scenario) -> Option<&'static str> {
         (
             !sc.inlets.is_empty() || !sc.outlets.is_empty(),
             "inlets or outlets",
-        ),
-        (ph.energy, "the energy equation"),
-        (
-            ph.density_filter != crate::scenario::DensityFilter::None,
-            "a density filter",
         ),
     ]
     .into_iter()
@@ -126,8 +119,10 @@ pub struct Overlap {
     hold: Kernel,
     settle: Kernel,
     bind: [wgpu::BindGroup; 2],
-    /// The last rates during the second sort (16 bytes a particle).
+    /// The last rates during the second sort (16 bytes a particle), and this step's de/dt
+    /// with the energy equation (4 more).
     held: wgpu::Buffer,
+    energy_held: wgpu::Buffer,
     n: u32,
 }
 
@@ -139,9 +134,14 @@ impl Overlap {
         policy: OverlapExchange,
     ) -> Result<Self> {
         let held = storage(device, "rate held", 16 * b.n as u64);
+        let energy_held = storage(device, "energy rate held", b.energy_rate.size());
         let hold = module.kernel(device, "hold_old_rates")?;
         let settle = module.kernel(device, "settle_rates")?;
-        let bindings = || b.unparitied().with("rate_held", &held);
+        let bindings = || {
+            (b.unparitied())
+                .with("rate_held", &held)
+                .with("energy_rate_held", &energy_held)
+        };
         let bind = [
             hold.bind(device, &bindings())?,
             settle.bind(device, &bindings())?,
@@ -152,6 +152,7 @@ impl Overlap {
             settle,
             bind,
             held,
+            energy_held,
             n: b.n,
         })
     }
@@ -168,7 +169,7 @@ impl Overlap {
 
     /// GPU memory of the pass's own buffer, in bytes.
     pub fn bytes(&self) -> u64 {
-        self.held.size()
+        self.held.size() + self.energy_held.size()
     }
 }
 
