@@ -638,28 +638,11 @@ impl Solver {
         ranked.migrants_sent += packed.migrants as u64;
         ranked.halo_sent += sent as u64 - packed.migrants as u64;
         ranked.owned = packed.owned;
-        // The arrays the arrivals go into, and the rest of the step starts from.
-        let p = match interior {
-            Some(interior) => {
-                ranked.overlapped += 1;
-                if !interior.summed.load(std::sync::atomic::Ordering::Acquire) {
-                    ranked.hidden += 1;
-                }
-                let tail = self
-                    .passes
-                    .halo()
-                    .read_tail(&self.device, interior.sorted)?;
-                self.unpack(&incoming, tail, 1 - p, &self.buffers.rate_sorted)?;
-                1 - p
-            }
-            None => {
-                let tail = first_tail.unwrap_or(packed.tail);
-                self.unpack(&incoming, tail, p, &self.buffers.rate)?;
-                p
-            }
-        };
+        let p = self.place_arrivals(&incoming, interior, p, first_tail.unwrap_or(packed.tail))?;
 
         // The GPU counts a step of dt > 0 (integrate.wgsl `timestep`): whether the density
+        // filter fires is known now. Its submission frees the entries this step excluded, or
+        // this one does.
         let steps_before = self.state.steps;
         let filters = self.passes.density_filter.as_ref().is_some_and(|f| {
             f.fires_after(steps_before, steps_before + (self.state.dt > 0.0) as u32)
@@ -884,6 +867,31 @@ impl Solver {
             halo.encode_forget(pass, q);
         });
         self.faults.check()
+    }
+
+    /// Writes what arrived into the arrays the rest of the step starts from, and returns their
+    /// parity: after an overlapped step's first sort (`interior`), into the other parity than
+    /// `p`, where it left its free tail; else into `p`'s, from `tail` on.
+    fn place_arrivals(
+        &mut self,
+        incoming: &[HaloRecord],
+        interior: Option<Interior>,
+        p: usize,
+        tail: u32,
+    ) -> Result<usize> {
+        let Some(interior) = interior else {
+            self.unpack(incoming, tail, p, &self.buffers.rate)?;
+            return Ok(p);
+        };
+        let ranked = self.ranked.as_mut().expect("a subdomain");
+        ranked.overlapped += 1;
+        if !interior.summed.load(std::sync::atomic::Ordering::Acquire) {
+            ranked.hidden += 1;
+        }
+        let halo = self.passes.halo();
+        let tail = halo.read_tail(&self.device, interior.sorted)?;
+        self.unpack(incoming, tail, 1 - p, &self.buffers.rate_sorted)?;
+        Ok(1 - p)
     }
 
     /// Submits an overlapped step's first sort of the arrays of parity `p` (and where their
