@@ -1063,7 +1063,9 @@ fn a_body_crossing_the_cut_moves_as_in_one_run() {
 /// takes its values from the fluid around it earlier in the step, so the halo is two cell layers
 /// thick (`halo::halo_layers`). From cuts at equal numbers of layers, moved at step 100, every
 /// particle equals one whole run's bit for bit after 300 steps. Both ranks' packing buffers,
-/// made for their starting halos, grow on the way (`Halo::reserve`).
+/// made for their starting halos, grow on the way (`Halo::reserve`). Steps 10 to 19 overlap
+/// the exchange (`time.overlap_exchange = "auto"`'s first trial), the ghosts interpolated after
+/// both sorts and the first half three layers from the cut.
 #[test]
 fn ranks_with_fixed_ghost_walls_equal_one_run() {
     Comparison {

@@ -20,9 +20,13 @@ fn slab_layer(p: Pos, axis: u32) -> u32 {
 
 // Whether a particle in cell layer `layer` reads nothing the exchange brings, so that its sums
 // can run while the halo travels (the overlapped step, docs/scaling.md). With cells of 2h a
-// particle reads the layers next to its own. The exchange writes the halo layers beyond a cut
-// and, with the migrants (which move less than a layer a step), the first own layer by it: a
-// particle two layers or more inside every cut that has a neighbour reads neither.
+// particle reads the layers next to its own, and through a fixed ghost (whose values the ghost
+// pass interpolates from the fluid around it) the layers next to those: as far as the halo is
+// thick (`halo::halo_layers`: one layer, two with fixed ghosts). The exchange writes the halo
+// layers beyond a cut and, with the migrants (which move less than a layer a step), the first
+// own layer by it: a particle one layer more than the halo's thickness inside every cut that
+// has a neighbour reads neither.
 fn reads_no_arrival(layer: u32, ctl: HaloCtl) -> bool {
-    return layer >= ctl.own_lo + 2u * ctl.lower && layer + 2u * ctl.upper < ctl.own_hi;
+    let margin = ctl.layers + 1u;
+    return layer >= ctl.own_lo + margin * ctl.lower && layer + margin * ctl.upper < ctl.own_hi;
 }

@@ -213,9 +213,12 @@ impl Passes {
     /// that need nothing from it; the rest of the step starts again from the other parity
     /// (`record_from_exchange(r, 1 - p)`), whose sort takes the arrivals in.
     pub(super) fn record_before_arrival(&self, r: &mut Recorder<'_>, p: usize) {
+        let q = 1 - p;
         self.record_sort(r, p, None);
+        // The fixed ghosts' values, which those sums read (again after the second sort).
+        r.stage("ghost", |pass| self.ghost.encode(pass, q));
         let halo = self.halo();
-        r.stage("halo_tail", |pass| halo.encode_tail(pass, 1 - p));
+        r.stage("halo_tail", |pass| halo.encode_tail(pass, q));
     }
 
     /// The sums of [`Passes::record_before_arrival`]'s particles, on its sorted arrays.
