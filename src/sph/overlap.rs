@@ -21,14 +21,14 @@ pub const SHADER: Shader = Shader {
 /// What keeps a case's subdomains from overlapping the exchange (they then take the serial
 /// step), or None. Each of these passes reads or writes something between the sort and the
 /// interaction, or after it, that the two halves of the step would have to split too: the
-/// solids' interface pressure and stress rates, the bodies' indices and loads, and the inlets'
-/// pressure (outlets: the same pass). Fixed ghosts need none: the ghost pass runs after each
-/// sort, and the first half keeps a layer further from the cuts.
+/// solids' interface pressure and stress rates, and the inlets' pressure (outlets: the same
+/// pass). Fixed ghosts need none: the ghost pass runs after each sort, and the first half
+/// keeps a layer further from the cuts. Nor do bodies: the sums read them by id, and their
+/// index into the arrays (`body_index`) and their loads come after the second sort.
 pub fn unsupported(sc: &Scenario) -> Option<&'static str> {
     let has = |kinds: &[Kind]| sc.particles.iter().any(|p| kinds.contains(&p.kind));
     [
         (has(&[Kind::Solid, Kind::SolidClamped]), "elastic solids"),
-        (!sc.bodies.is_empty(), "bodies"),
         (
             !sc.inlets.is_empty() || !sc.outlets.is_empty(),
             "inlets or outlets",
