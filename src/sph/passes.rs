@@ -211,7 +211,7 @@ impl Passes {
     /// An overlapped subdomain's step before what the exchange brings arrives (the host
     /// swaps it meanwhile): the arrays of parity `p` sorted, and the sums of the particles
     /// that need nothing from it; the rest of the step starts again from the other parity
-    /// (`record_from_exchange(r, 1 - p)`), whose sort takes the arrivals in.
+    /// (`record_from_exchange(r, 1 - p, true)`), whose sort takes the arrivals in.
     pub(super) fn record_before_arrival(&self, r: &mut Recorder<'_>, p: usize) {
         let q = 1 - p;
         self.record_sort(r, p, None);

@@ -627,8 +627,6 @@ impl Solver {
         let incoming = self.swap(&packed.lower, &packed.upper, ranks)?;
         self.share_tl_positions(ranks)?;
         let swapped_at = std::time::Instant::now();
-        // Runs the callback of `interior.summed` if the GPU is done with them.
-        let _ = self.device.poll(wgpu::PollType::Poll);
         let ranked = self.ranked.as_mut().expect("a subdomain");
         let first_tail = ranked.first_tail.take();
         ranked.exchanges += 1;
@@ -883,6 +881,8 @@ impl Solver {
             self.unpack(incoming, tail, p, &self.buffers.rate)?;
             return Ok(p);
         };
+        // Runs the callback of `interior.summed` if the GPU is done with the sums.
+        let _ = self.device.poll(wgpu::PollType::Poll);
         let ranked = self.ranked.as_mut().expect("a subdomain");
         ranked.overlapped += 1;
         if !interior.summed.load(std::sync::atomic::Ordering::Acquire) {
