@@ -2,9 +2,11 @@
 // cell grid along one axis, each rank owning the cell layers [own_lo, own_hi).
 // `halo_pack`, after the predictor: every live particle outside the own layers has crossed a
 // cut and migrates (packed with its last rates); every own particle within `layers` of a cut
-// with a neighbour is packed as that neighbour's halo. The host reads the records, swaps them
-// with the neighbours and writes what it received after `tail`, the first entry of the last
-// sort's free slot. Free entries: `halo_forget` gives every entry excluded since the sort (the
+// with a neighbour is packed as that neighbour's halo. `halo_count` counts them first, so that
+// `halo_pack` writes each neighbour's message as it travels (`Message`): the host reads the
+// messages back and sends them as they are, with no loop over particles, and uploads what it
+// received as it came; `halo_unpack` writes the arrivals into the arrays after `tail`, the
+// first entry of the last sort's free slot. Free entries: `halo_forget` gives every entry excluded since the sort (the
 // halo copies and migrants sent, a particle the corrector found non-finite) the free id at the
 // step's end, so the next sort puts them in the free slot, apart from the excluded slot, where
 // the inlet particles waiting behind their buffers keep their ids (`inlet_flow` wakes them by
@@ -27,21 +29,17 @@
 // found by id among the records received (sorted by id, in `halo_out`), until `halo_drop`
 // excludes it again after the filter.
 
-@group(0) @binding(1) var<storage, read> pos: array<Pos>;
-@group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read_write> code: array<u32>;
-@group(0) @binding(4) var<storage, read> rate: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read> cell_start: array<u32>;
-
-// Mirrored by `sph::halo::HaloCounts`.
+// Mirrored by `layout::HaloCounts`. A stream is one section of one message: 3 × neighbour
+// (0 below, 1 above) + section (`SECTION_*`).
 struct HaloCounts {
-    records: atomic<u32>,
     owned: atomic<u32>,     // live own particles at packing
-    tail: u32,
-    overflow: atomic<u32>,  // records that did not fit
+    tail: u32,              // the first free entry: where `halo_unpack` writes the arrivals
+    sizes: array<atomic<u32>, 6>,   // records of each stream (`halo_count`)
+    filled: array<atomic<u32>, 6>,  // of them written so far (`halo_pack`)
+    restored: u32,          // records `halo_out` holds for `halo_restore`, sorted by id
 }
 
-// Mirrored by `sph::halo::HaloRecord`.
+// Mirrored by `layout::HaloRecord`.
 struct HaloRecord {
     pos: Pos,
     velrho: vec4<f32>,
@@ -53,24 +51,57 @@ struct HaloRecord {
 
 const DEST_UPPER: u32 = 1u;
 const DEST_MIGRANT: u32 = 2u;
-// The record after a solid particle's: its stress state, which the receiver writes into its
-// solid arrays (τ in velrho and pos.off, dτ/dt in rate and energy; the code word names the
-// particle; body, material and interface pressure are not sent: the first two never change,
-// the ghost pass recomputes the third).
+// A solid particle's stress state, which the receiver writes into its solid arrays (τ in
+// velrho and pos.off, dτ/dt in rate and energy; the code word names the particle; body,
+// material and interface pressure are not sent: the first two never change, the ghost pass
+// recomputes the third).
 const DEST_SOLID_STATE: u32 = 4u;
 const DEST_ID_SHIFT: u32 = 3u;
 
+// A message to a neighbour, as it travels (`sph::halo::Message`): a header of three counts,
+// one per section, then the sections' records. Migrants go whole (they go on integrating their
+// last rates and energy), solid stress states too; a halo copy carries only what the
+// receiver's passes read of it (its place, (v, ρ), code word and dest), which its copy in the
+// arrays gets with zero rates and energy: 10 words where a record is 16.
+const SECTION_MIGRANTS: u32 = 0u;
+const SECTION_STATES: u32 = 1u;
+const SECTION_COPIES: u32 = 2u;
+const HEADER_WORDS: u32 = 3u;
+const RECORD_WORDS: u32 = 16u;
+const COPY_WORDS: u32 = 10u;
+
+// Mirrored by `layout::HaloArrivals`: the messages received, one after the other in `halo_out`
+// (at most one per neighbour): each one's first word and its sections' counts; `particles`:
+// the migrants and copies of all, `states` the stress states.
+struct HaloArrivals {
+    messages: array<vec4<u32>, 2>,
+    particles: u32,
+    states: u32,
+    pad: vec2<u32>,
+}
+
+@group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
+@group(0) @binding(2) var<storage, read_write> velrho: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> code: array<u32>;
+@group(0) @binding(4) var<storage, read> rate: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> cell_start: array<u32>;
 // A uniform: the packing binds the eight storage buffers every adapter allows.
 @group(0) @binding(6) var<uniform> halo_ctl: HaloCtl;
 @group(0) @binding(7) var<storage, read_write> halo_counts: HaloCounts;
-@group(0) @binding(8) var<storage, read_write> halo_out: array<HaloRecord>;
+// The messages packed (`halo_pack`), then those received (`halo_unpack`); on the density
+// filter's steps the records `halo_restore` searches.
+@group(0) @binding(8) var<storage, read_write> halo_out: array<u32>;
 // Weighted own particles per cell layer along the axis (`count_layers`): 2 for a particle that
 // moves, 1 for a boundary particle (decomposition.rs's weights, doubled to be whole).
 @group(0) @binding(9) var<storage, read_write> layer_load: array<atomic<u32>>;
 // (e, de/dt of the last evaluation); one unused entry without the energy equation.
-@group(0) @binding(10) var<storage, read> energy: array<vec2<f32>>;
+@group(0) @binding(10) var<storage, read_write> energy: array<vec2<f32>>;
 // The solid particles' stress state, by id − solid_id_base (one unused entry without solids).
-@group(0) @binding(11) var<storage, read> solid: array<SolidState>;
+@group(0) @binding(11) var<storage, read_write> solid: array<SolidState>;
+@group(0) @binding(12) var<uniform> halo_arrivals: HaloArrivals;
+// Where the arrivals' last rates go: the sort's input (`rate` before it, `rate_sorted` after
+// an overlapped step's first sort).
+@group(0) @binding(13) var<storage, read_write> arrival_rate: array<vec4<f32>>;
 
 fn layer_of(p: Pos) -> u32 {
     return slab_layer(p, halo_ctl.axis);
@@ -81,53 +112,242 @@ fn record_id(r: HaloRecord) -> u32 {
     return whole_id(r.code, r.dest >> DEST_ID_SHIFT);
 }
 
-fn pack_record(i: u32, flags: u32) {
-    var dest = flags;
+// Whether a particle in cell layer `layer` has left the rank's own layers (a migrant).
+fn outside(layer: u32) -> bool {
+    return layer < halo_ctl.own_lo || layer >= halo_ctl.own_hi;
+}
+
+const NO_STREAM: u32 = 0xffffffffu;
+
+// The streams live particle i goes in (NO_STREAM where fewer than two): a migrant's to the
+// neighbour whose layers it entered, or a halo copy to each neighbour within `layers` of it.
+fn streams_of(i: u32) -> vec2<u32> {
+    let layer = layer_of(pos[i]);
+    var s = vec2<u32>(NO_STREAM);
+    if (outside(layer)) {
+        s.x = select(0u, 3u, layer >= halo_ctl.own_hi) + SECTION_MIGRANTS;
+        return s;
+    }
+    if (halo_ctl.lower != 0u && layer < halo_ctl.own_lo + halo_ctl.layers) {
+        s.x = SECTION_COPIES;
+    }
+    if (halo_ctl.upper != 0u && layer + halo_ctl.layers >= halo_ctl.own_hi) {
+        s.y = 3u + SECTION_COPIES;
+    }
+    return s;
+}
+
+// The stream of the stress states that go with stream `s`'s particles.
+fn states_stream(s: u32) -> u32 {
+    return s - s % 3u + SECTION_STATES;
+}
+
+// Words of the message to neighbour `nb` (0 below, 1 above).
+fn message_words(nb: u32) -> u32 {
+    let b = 3u * nb;
+    let records = atomicLoad(&halo_counts.sizes[b]) + atomicLoad(&halo_counts.sizes[b + 1u]);
+    return HEADER_WORDS + RECORD_WORDS * records + COPY_WORDS * atomicLoad(&halo_counts.sizes[b + 2u]);
+}
+
+// The first word of stream `s`'s records: the messages lie one after the other.
+fn stream_start(s: u32) -> u32 {
+    let nb = s / 3u;
+    var at = select(0u, message_words(0u), nb == 1u) + HEADER_WORDS;
+    for (var k = 0u; k < s % 3u; k++) {
+        at += RECORD_WORDS * atomicLoad(&halo_counts.sizes[3u * nb + k]);
+    }
+    return at;
+}
+
+fn put_vec4(at: u32, v: vec4<f32>) {
+    for (var c = 0u; c < 4u; c++) {
+        halo_out[at + c] = bitcast<u32>(v[c]);
+    }
+}
+
+fn get_vec4(at: u32) -> vec4<f32> {
+    return bitcast<vec4<f32>>(vec4<u32>(halo_out[at], halo_out[at + 1u], halo_out[at + 2u], halo_out[at + 3u]));
+}
+
+fn put_pos(at: u32, p: Pos) {
+    put_vec4(at, vec4<f32>(p.off, bitcast<f32>(p.block)));
+}
+
+fn get_pos(at: u32) -> Pos {
+    let w = get_vec4(at);
+    return Pos(w.xyz, bitcast<u32>(w.w));
+}
+
+// A whole record's words: pos, velrho, rate, code, dest, energy (as `HaloRecord`).
+fn put_record(at: u32, r: HaloRecord) {
+    put_pos(at, r.pos);
+    put_vec4(at + 4u, r.velrho);
+    put_vec4(at + 8u, r.rate);
+    put_vec4(at + 12u, vec4<f32>(bitcast<f32>(r.code), bitcast<f32>(r.dest), r.energy));
+}
+
+fn get_record(at: u32) -> HaloRecord {
+    let last = get_vec4(at + 12u);
+    return HaloRecord(get_pos(at), get_vec4(at + 4u), get_vec4(at + 8u), bitcast<u32>(last.x),
+        bitcast<u32>(last.y), last.zw);
+}
+
+// A halo copy's words: pos, velrho, code, dest (`sph::halo::HaloCopy`).
+fn put_copy(at: u32, r: HaloRecord) {
+    put_pos(at, r.pos);
+    put_vec4(at + 4u, r.velrho);
+    halo_out[at + 8u] = r.code;
+    halo_out[at + 9u] = r.dest;
+}
+
+// The record of a copy: its rates and energy zero, which no pass reads of a copy.
+fn get_copy(at: u32) -> HaloRecord {
+    return HaloRecord(get_pos(at), get_vec4(at + 4u), vec4<f32>(0.0), halo_out[at + 8u],
+        halo_out[at + 9u], vec2<f32>(0.0));
+}
+
+// Writes particle i's record into the next place of stream `s`, and its stress state (a solid
+// particle's) into the next of the states' stream.
+fn pack_into(i: u32, s: u32) {
+    if (s == NO_STREAM) {
+        return;
+    }
+    var dest = select(0u, DEST_UPPER, s >= 3u) | select(0u, DEST_MIGRANT, s % 3u == SECTION_MIGRANTS);
     if (WIDE_IDS) {
         dest |= (particle_id(i) >> ID_LOW_BITS) << DEST_ID_SHIFT;
-    }
-    let solid_state = is_solid(code_kind(code[i]));
-    let n = select(1u, 2u, solid_state);
-    let k = atomicAdd(&halo_counts.records, n);
-    if (k + n > halo_ctl.capacity) {
-        atomicAdd(&halo_counts.overflow, n);
-        return;
     }
     var e = vec2<f32>(0.0);
     if (ENERGY) {
         e = energy[i];
     }
-    halo_out[k] = HaloRecord(pos[i], velrho[i], rate[i], code[i], dest, e);
-    if (solid_state) {
-        let s = solid[solid_slot(i)];
-        halo_out[k + 1u] = HaloRecord(
-            Pos(s.tau_b, 0u), s.tau_a, s.rate_a, code[i], dest | DEST_SOLID_STATE, s.rate_b);
+    let r = HaloRecord(pos[i], velrho[i], rate[i], code[i], dest, e);
+    let k = atomicAdd(&halo_counts.filled[s], 1u);
+    if (s % 3u == SECTION_COPIES) {
+        put_copy(stream_start(s) + COPY_WORDS * k, r);
+    } else {
+        put_record(stream_start(s) + RECORD_WORDS * k, r);
+    }
+    if (is_solid(code_kind(code[i]))) {
+        let t = states_stream(s);
+        let st = solid[solid_slot(i)];
+        let state = HaloRecord(Pos(st.tau_b, 0u), st.tau_a, st.rate_a, code[i],
+            dest | DEST_SOLID_STATE, st.rate_b);
+        put_record(stream_start(t) + RECORD_WORDS * atomicAdd(&halo_counts.filled[t], 1u), state);
     }
 }
 
-// The free tail for the host (`halo_pack`'s records go after it): the last sort's free slot.
+// The free tail, where `halo_unpack` writes: the last sort's free slot.
 @compute @workgroup_size(1)
 fn halo_tail() {
     halo_counts.tail = cell_start[params.hash_mask + 2u];
 }
 
+// Counts the rank's own particles and the records of each stream, for `halo_pack`.
 @compute @workgroup_size(WG)
-fn halo_pack(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+fn halo_count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
     if (i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
         return;
     }
-    let layer = layer_of(pos[i]);
-    if (layer < halo_ctl.own_lo || layer >= halo_ctl.own_hi) {
-        pack_record(i, DEST_MIGRANT | select(0u, DEST_UPPER, layer >= halo_ctl.own_hi));
+    if (!outside(layer_of(pos[i]))) {
+        atomicAdd(&halo_counts.owned, 1u);
+    }
+    let s = streams_of(i);
+    let solid = is_solid(code_kind(code[i]));
+    for (var k = 0u; k < 2u; k++) {
+        if (s[k] != NO_STREAM) {
+            atomicAdd(&halo_counts.sizes[s[k]], 1u);
+            if (solid) {
+                atomicAdd(&halo_counts.sizes[states_stream(s[k])], 1u);
+            }
+        }
+    }
+}
+
+// Writes the two messages `halo_count` counted, headers first; nothing where they do not fit
+// (the host grows `halo_out` and packs again).
+@compute @workgroup_size(WG)
+fn halo_pack(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    let lower = message_words(0u);
+    if (lower + message_words(1u) > halo_ctl.capacity * RECORD_WORDS) {
         return;
     }
-    atomicAdd(&halo_counts.owned, 1u);
-    if (halo_ctl.lower != 0u && layer < halo_ctl.own_lo + halo_ctl.layers) {
-        pack_record(i, 0u);
+    if (i == 0u) {
+        for (var k = 0u; k < 3u; k++) {
+            halo_out[k] = atomicLoad(&halo_counts.sizes[k]);
+            halo_out[lower + k] = atomicLoad(&halo_counts.sizes[3u + k]);
+        }
     }
-    if (halo_ctl.upper != 0u && layer + halo_ctl.layers >= halo_ctl.own_hi) {
-        pack_record(i, DEST_UPPER);
+    if (i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
+        return;
+    }
+    let s = streams_of(i);
+    pack_into(i, s.x);
+    pack_into(i, s.y);
+}
+
+// Writes arrival k (`HaloArrivals`'s migrants and copies, message by message) at the free tail.
+fn place_particle(k: u32) {
+    let j = halo_counts.tail + k;
+    if (j >= params.n_particles) {
+        return; // the host checked the room; never written past the arrays
+    }
+    var r = k;
+    for (var m = 0u; m < 2u; m++) {
+        let msg = halo_arrivals.messages[m];
+        let records = msg.x + HEADER_WORDS;
+        var a: HaloRecord;
+        if (r < msg.y) {
+            a = get_record(records + RECORD_WORDS * r);
+        } else if (r < msg.y + msg.w) {
+            a = get_copy(records + RECORD_WORDS * (msg.y + msg.z) + COPY_WORDS * (r - msg.y));
+        } else {
+            r -= msg.y + msg.w;
+            continue;
+        }
+        pos[j] = a.pos;
+        velrho[j] = a.velrho;
+        code[j] = a.code;
+        if (WIDE_IDS) {
+            code[params.n_particles + j] = a.dest >> DEST_ID_SHIFT;
+        }
+        arrival_rate[j] = a.rate;
+        if (ENERGY) {
+            energy[j] = a.energy;
+        }
+        return;
+    }
+}
+
+// Writes stress state k of the arrivals into the solid arrays, by its particle's id.
+fn place_state(k: u32) {
+    var r = k;
+    for (var m = 0u; m < 2u; m++) {
+        let msg = halo_arrivals.messages[m];
+        if (r < msg.z) {
+            let a = get_record(msg.x + HEADER_WORDS + RECORD_WORDS * (msg.y + r));
+            let s = record_id(a) - params.solid_id_base;
+            solid[s].tau_a = a.velrho;
+            solid[s].tau_b = a.pos.off;
+            solid[s].rate_a = a.rate;
+            solid[s].rate_b = a.energy;
+            return;
+        }
+        r -= msg.z;
+    }
+}
+
+// Writes what the neighbours sent (uploaded as it came into `halo_out`) into the arrays: the
+// particles from the free tail on, in message order (the sort orders them), the stress states
+// into the solid arrays.
+@compute @workgroup_size(WG)
+fn halo_unpack(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let k = linear_index(gid, nwg);
+    if (k < halo_arrivals.particles) {
+        place_particle(k);
+    } else if (k < halo_arrivals.particles + halo_arrivals.states) {
+        place_state(k - halo_arrivals.particles);
     }
 }
 
@@ -137,8 +357,7 @@ fn halo_drop(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     if (i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
         return;
     }
-    let layer = layer_of(pos[i]);
-    if (layer < halo_ctl.own_lo || layer >= halo_ctl.own_hi) {
+    if (outside(layer_of(pos[i]))) {
         code[i] = with_kind(code[i], KIND_EXCLUDED);
     }
 }
@@ -165,19 +384,22 @@ fn halo_restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     }
     let id = particle_id(i);
     var lo = 0u;
-    var hi = atomicLoad(&halo_counts.records);
+    var hi = halo_counts.restored;
     let n = hi;
     while (lo < hi) {
         let mid = (lo + hi) / 2u;
-        if (record_id(halo_out[mid]) < id) {
+        if (record_id(get_record(RECORD_WORDS * mid)) < id) {
             lo = mid + 1u;
         } else {
             hi = mid;
         }
     }
-    if (lo < n && record_id(halo_out[lo]) == id) {
-        code[i] = halo_out[lo].code;
-        velrho[i].w = halo_out[lo].velrho.w;
+    if (lo < n) {
+        let found = get_record(RECORD_WORDS * lo);
+        if (record_id(found) == id) {
+            code[i] = found.code;
+            velrho[i].w = found.velrho.w;
+        }
     }
 }
 

@@ -397,14 +397,28 @@ pub struct HaloCtl {
     pub pad: u32,
 }
 
-/// Mirrors `HaloCounts` in shaders/halo.wgsl.
+/// Mirrors `HaloCounts` in shaders/halo.wgsl: the rank's own particles, the free tail, and the
+/// records of each stream of the two messages (3 × neighbour + section: migrants, solid stress
+/// states, halo copies), counted and written.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct HaloCounts {
-    pub records: u32,
     pub owned: u32,
     pub tail: u32,
-    pub overflow: u32,
+    pub sizes: [u32; 6],
+    pub filled: [u32; 6],
+    pub restored: u32,
+}
+
+/// Mirrors `HaloArrivals` in shaders/halo.wgsl: the messages received, one after the other
+/// (each one's first word, then its sections' counts), and their particles and stress states.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct HaloArrivals {
+    pub messages: [[u32; 4]; 2],
+    pub particles: u32,
+    pub states: u32,
+    pub pad: [u32; 2],
 }
 
 /// Mirrors `HaloRecord` in shaders/halo.wgsl: one particle sent to a neighbour, as a halo copy
@@ -791,7 +805,23 @@ mod tests {
             &halo::SHADER,
             "HaloCounts",
             HaloCounts,
-            [records, owned, tail, overflow]
+            [owned, tail, sizes, filled, restored]
+        );
+        check_layout!(
+            &halo::SHADER,
+            "HaloArrivals",
+            HaloArrivals,
+            [messages, particles, states]
+        );
+        assert_eq!(wgsl_u32(&halo::SHADER, "HEADER_WORDS"), halo::HEADER_WORDS);
+        let words = |bytes: usize| (bytes / 4) as u32;
+        assert_eq!(
+            wgsl_u32(&halo::SHADER, "RECORD_WORDS"),
+            words(std::mem::size_of::<HaloRecord>())
+        );
+        assert_eq!(
+            wgsl_u32(&halo::SHADER, "COPY_WORDS"),
+            words(std::mem::size_of::<halo::HaloCopy>())
         );
         check_layout!(
             &halo::SHADER,

@@ -77,25 +77,12 @@ pub fn readback_buffer(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::
 /// Waits for the GPU and returns the contents of `staging` (a [`readback_buffer`] whose copies
 /// have been submitted); leaves it unmapped for reuse.
 pub fn map_read(device: &wgpu::Device, staging: &wgpu::Buffer) -> Result<Vec<u8>> {
-    map_read_after(device, staging, None)
-}
-
-/// [`map_read`] waiting only for `submission` (which made the copies), where given: the GPU
-/// goes on with what was submitted after it.
-pub fn map_read_after(
-    device: &wgpu::Device,
-    staging: &wgpu::Buffer,
-    submission: Option<wgpu::SubmissionIndex>,
-) -> Result<Vec<u8>> {
     let (tx, rx) = std::sync::mpsc::channel();
     staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
     device
-        .poll(wgpu::PollType::Wait {
-            submission_index: submission,
-            timeout: None,
-        })
+        .poll(wgpu::PollType::wait_indefinitely())
         .map_err(|e| anyhow!("GPU wait failed during readback: {e}"))?;
     rx.recv()
         .map_err(|_| anyhow!("readback callback dropped"))?

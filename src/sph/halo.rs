@@ -7,13 +7,10 @@ use anyhow::{anyhow, ensure, Result};
 use super::buffers::{Bindings, ParticleBuffers};
 use super::shader::{PARTICLE_ID, SLAB};
 use crate::decomposition::Slabs;
-use crate::gpu::buffers::{map_read, map_read_after, read, readback_buffer, storage, uniform_init};
+use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
-use crate::layout::{
-    HaloCounts, HaloCtl, HaloRecord, IdSplit, Pos, DEST_ID_SHIFT, DEST_MIGRANT, DEST_SOLID_STATE,
-    DEST_UPPER,
-};
+use crate::layout::{HaloArrivals, HaloCounts, HaloCtl, HaloRecord, IdSplit, Pos, DEST_ID_SHIFT};
 use crate::scenario::{InletPressure, Kind, Scenario};
 use bytemuck::{Pod, Zeroable};
 
@@ -85,15 +82,23 @@ fn records_buffer(device: &wgpu::Device, capacity: u32) -> wgpu::Buffer {
     storage(device, "halo records", bytes)
 }
 
-/// The halo kernels' buffers on the arrays of parity `p`: the particle arrays and the pass's
-/// own (its control, counters, records and layer loads).
-fn bindings<'a>(b: &'a ParticleBuffers, p: usize, own: [&'a wgpu::Buffer; 4]) -> Bindings<'a> {
-    let [ctl, counts, records, layer_load] = own;
+/// The halo kernels' buffers on the arrays of parity `p`: the particle arrays, the pass's own
+/// (its control, counters, messages, layer loads and arrivals) and where the arrivals' last
+/// rates go.
+fn bindings<'a>(
+    b: &'a ParticleBuffers,
+    p: usize,
+    own: [&'a wgpu::Buffer; 5],
+    arrival_rate: &'a wgpu::Buffer,
+) -> Bindings<'a> {
+    let [ctl, counts, records, layer_load, arrivals] = own;
     b.at(p)
         .with("halo_ctl", ctl)
         .with("halo_counts", counts)
         .with("halo_out", records)
         .with("layer_load", layer_load)
+        .with("halo_arrivals", arrivals)
+        .with("arrival_rate", arrival_rate)
 }
 
 /// Rank `rank`'s part of `slabs` with a halo of `layers` ([`halo_layers`]): what `halo_pack`
@@ -114,7 +119,11 @@ pub fn control(slabs: &Slabs, rank: usize, layers: u32) -> HaloCtl {
 
 pub struct Halo {
     tail: ParityKernel,
+    count: ParityKernel,
     pack: ParityKernel,
+    /// `halo_unpack` with the arrivals' last rates into `rate`, and into `rate_sorted` (after
+    /// an overlapped step's first sort).
+    unpack: [ParityKernel; 2],
     drop: ParityKernel,
     restore: ParityKernel,
     forget: ParityKernel,
@@ -125,6 +134,9 @@ pub struct Halo {
     counts_staging: wgpu::Buffer,
     records: wgpu::Buffer,
     layer_load: wgpu::Buffer,
+    /// The messages received ([`HaloArrivals`]), and their particles and states.
+    arrivals: wgpu::Buffer,
+    arrived: u32,
     /// Cell layers along the cut axis.
     layers: u32,
     /// Cell layers of halo.
@@ -141,7 +153,7 @@ pub struct Halo {
 /// What the density filter's exchange sends of a halo copy: its owner's code word and
 /// corrected density, all that `halo_restore` gives the copy back (the filter reads no other
 /// field of a neighbour's), and with wide ids the id's high bits: 8 bytes a particle (12 with
-/// wide ids) where a record is 64. Only the host and the ranks' messages hold it; the receiver
+/// wide ids) where a copy is 40. Only the host and the ranks' messages hold it; the receiver
 /// uploads full records.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FilterRecord {
@@ -151,8 +163,8 @@ pub struct FilterRecord {
     pub id_high: u32,
 }
 
-impl From<&HaloRecord> for FilterRecord {
-    fn from(r: &HaloRecord) -> Self {
+impl From<&HaloCopy> for FilterRecord {
+    fn from(r: &HaloCopy) -> Self {
         Self {
             code: r.code,
             rho: r.velrho[3],
@@ -171,19 +183,11 @@ impl FilterRecord {
             ..Default::default()
         }
     }
-}
 
-/// How records travel between neighbours: the bytes of one message and back.
-pub trait Wire: Sized {
-    fn to_wire(records: &[Self]) -> Vec<u8>;
-    fn from_wire(bytes: &[u8]) -> Result<Vec<Self>>;
-}
-
-/// A density-filter message: a word saying whether the ids' high bits follow (only where
-/// some are not 0, so narrow ids never send them), each record's code word and ρ, then the
-/// high bits.
-impl Wire for FilterRecord {
-    fn to_wire(records: &[Self]) -> Vec<u8> {
+    /// A density-filter message: a word saying whether the ids' high bits follow (only where
+    /// some are not 0, so narrow ids never send them), each record's code word and ρ, then
+    /// the high bits.
+    pub fn to_wire(records: &[Self]) -> Vec<u8> {
         let wide = records.iter().any(|r| r.id_high != 0);
         let mut words = vec![wide as u32];
         words.extend(records.iter().flat_map(|r| [r.code, r.rho.to_bits()]));
@@ -191,7 +195,7 @@ impl Wire for FilterRecord {
         bytemuck::cast_slice(&words).to_vec()
     }
 
-    fn from_wire(bytes: &[u8]) -> Result<Vec<Self>> {
+    pub fn from_wire(bytes: &[u8]) -> Result<Vec<Self>> {
         let words: Vec<u32> = match bytes.len().is_multiple_of(4) {
             true => bytemuck::pod_collect_to_vec(bytes),
             false => Vec::new(),
@@ -231,87 +235,100 @@ pub struct HaloCopy {
     pub dest: u32,
 }
 
-impl From<&HaloRecord> for HaloCopy {
-    fn from(r: &HaloRecord) -> Self {
-        Self {
-            pos: r.pos,
-            velrho: r.velrho,
-            code: r.code,
-            dest: r.dest,
-        }
-    }
+/// Words of a message's header: its sections' counts.
+pub const HEADER_WORDS: u32 = 3;
+const RECORD_BYTES: usize = std::mem::size_of::<HaloRecord>();
+const COPY_BYTES: usize = std::mem::size_of::<HaloCopy>();
+
+/// A message to a neighbour as it travels, and as `halo_pack` writes it on the GPU: a header
+/// of three counts, then three sections: the migrants (whole [`HaloRecord`]s), the solid
+/// particles' stress states (records flagged [`crate::layout::DEST_SOLID_STATE`], one for each solid migrant
+/// or copy), the halo copies ([`HaloCopy`]s). The receiver uploads it as it came and
+/// `halo_unpack` writes it into the arrays; the host reads it record by record only to move
+/// the cuts (`Solver::redistribute`) and for the density filter's exchange.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Message {
+    pub migrants: Vec<HaloRecord>,
+    pub states: Vec<HaloRecord>,
+    pub copies: Vec<HaloCopy>,
 }
 
-impl HaloCopy {
-    /// Whether `r` is a halo copy's record (migrants' and solid states' go whole).
-    fn is_copy(r: &HaloRecord) -> bool {
-        r.dest & (DEST_MIGRANT | DEST_SOLID_STATE) == 0
-    }
-
-    /// The copy's record on the receiver, its rates and energy zero.
-    fn record(&self) -> HaloRecord {
-        HaloRecord {
-            pos: self.pos,
-            velrho: self.velrho,
-            code: self.code,
-            dest: self.dest,
-            ..Default::default()
-        }
-    }
-}
-
-/// A message to a neighbour: the count of its whole records, those, then its halo copies as
-/// [`HaloCopy`]s; the receiver's copies get zero rates and energy.
-impl Wire for HaloRecord {
-    fn to_wire(records: &[Self]) -> Vec<u8> {
-        let whole: Vec<HaloRecord> = (records.iter())
-            .filter(|r| !HaloCopy::is_copy(r))
-            .copied()
-            .collect();
-        let copies: Vec<HaloCopy> = (records.iter())
-            .filter(|r| HaloCopy::is_copy(r))
-            .map(HaloCopy::from)
-            .collect();
-        let mut bytes = (whole.len() as u32).to_le_bytes().to_vec();
-        bytes.extend_from_slice(bytemuck::cast_slice(&whole));
-        bytes.extend_from_slice(bytemuck::cast_slice(&copies));
-        bytes
-    }
-
-    fn from_wire(bytes: &[u8]) -> Result<Vec<Self>> {
+impl Message {
+    /// The sections' counts in the header of `bytes`, which must be a whole message.
+    pub fn header(bytes: &[u8]) -> Result<[u32; 3]> {
         let malformed = || {
             anyhow!(
                 "a neighbour's halo message of {} bytes is malformed",
                 bytes.len()
             )
         };
-        let (count, rest) = bytes.split_first_chunk::<4>().ok_or_else(malformed)?;
-        let whole = u32::from_le_bytes(*count) as usize * std::mem::size_of::<HaloRecord>();
-        if rest.len() < whole
-            || !(rest.len() - whole).is_multiple_of(std::mem::size_of::<HaloCopy>())
-        {
-            return Err(malformed());
-        }
-        let mut records: Vec<HaloRecord> = bytemuck::pod_collect_to_vec(&rest[..whole]);
-        let copies: Vec<HaloCopy> = bytemuck::pod_collect_to_vec(&rest[whole..]);
-        records.extend(copies.iter().map(HaloCopy::record));
-        Ok(records)
+        let head = bytes
+            .get(..4 * HEADER_WORDS as usize)
+            .ok_or_else(malformed)?;
+        let counts: [u32; 3] = bytemuck::pod_read_unaligned(head);
+        let [migrants, states, copies] = counts.map(|c| c as u64);
+        let body = (migrants + states) * RECORD_BYTES as u64 + copies * COPY_BYTES as u64;
+        ensure!(
+            bytes.len() as u64 == 4 * HEADER_WORDS as u64 + body,
+            malformed()
+        );
+        Ok(counts)
+    }
+
+    /// The message's bytes.
+    pub fn to_wire(&self) -> Vec<u8> {
+        let counts = [self.migrants.len(), self.states.len(), self.copies.len()];
+        let mut bytes = bytemuck::cast_slice(&counts.map(|c| c as u32)).to_vec();
+        bytes.extend_from_slice(bytemuck::cast_slice(&self.migrants));
+        bytes.extend_from_slice(bytemuck::cast_slice(&self.states));
+        bytes.extend_from_slice(bytemuck::cast_slice(&self.copies));
+        bytes
+    }
+
+    pub fn from_wire(bytes: &[u8]) -> Result<Self> {
+        let [migrants, states, _] = Self::header(bytes)?.map(|c| c as usize);
+        let at = 4 * HEADER_WORDS as usize;
+        let (whole, copies) = bytes[at..].split_at((migrants + states) * RECORD_BYTES);
+        let (migrants, states) = whole.split_at(migrants * RECORD_BYTES);
+        Ok(Self {
+            migrants: bytemuck::pod_collect_to_vec(migrants),
+            states: bytemuck::pod_collect_to_vec(states),
+            copies: bytemuck::pod_collect_to_vec(copies),
+        })
     }
 }
 
-/// What one `halo_pack` found: the records for each neighbour, the rank's own live particles,
+/// What one `halo_pack` found: the messages to the neighbours, the rank's own live particles,
 /// and where the free tail of the arrays starts.
 #[derive(Default)]
 pub struct Packed {
-    /// (to the neighbour below, to the neighbour above): halo copies and migrants.
-    pub lower: Vec<HaloRecord>,
-    pub upper: Vec<HaloRecord>,
+    /// To the neighbour below and above, as they travel ([`Message`]).
+    pub messages: [Vec<u8>; 2],
+    /// The records of each section of each ([`HaloCounts::sizes`]).
+    pub sizes: [u32; 6],
     pub owned: u32,
     pub tail: u32,
-    pub migrants: u32,
-    /// The records the packing made where they did not fit the buffer (then no record is
+    /// The records the packing needed where they did not fit the buffer (then no message is
     /// read): [`Halo::reserve`] them and pack again.
     pub needed: Option<u32>,
+}
+
+impl Packed {
+    /// Particles that left the rank's own layers, sent to their new owners.
+    pub fn migrants(&self) -> u32 {
+        self.sizes[0] + self.sizes[3]
+    }
+
+    /// Halo copies sent.
+    pub fn copies(&self) -> u32 {
+        self.sizes[2] + self.sizes[5]
+    }
+}
+
+/// Words of the message with section sizes `sizes` (as `message_words` in halo.wgsl).
+fn message_words(sizes: &[u32]) -> u64 {
+    let records = (sizes[0] + sizes[1]) as u64 * (RECORD_BYTES / 4) as u64;
+    HEADER_WORDS as u64 + records + sizes[2] as u64 * (COPY_BYTES / 4) as u64
 }
 
 impl Halo {
@@ -340,14 +357,23 @@ impl Halo {
             std::mem::size_of::<HaloCounts>() as u64,
         );
         let records = records_buffer(device, ctl.capacity);
-        let bufs = |p: usize| bindings(b, p, [&ctl_buffer, &counts, &records, &layer_load]);
+        let arrivals = uniform_init(device, "halo arrivals", &HaloArrivals::default());
+        let own = [&ctl_buffer, &counts, &records, &layer_load, &arrivals];
+        let bufs = |p: usize| bindings(b, p, own, &b.rate);
+        let kernel = |entry: &str| ParityKernel::new(device, module, entry, bufs);
+        let sorted = |p: usize| bindings(b, p, own, &b.rate_sorted);
         Ok(Self {
-            tail: ParityKernel::new(device, module, "halo_tail", bufs)?,
-            pack: ParityKernel::new(device, module, "halo_pack", bufs)?,
-            drop: ParityKernel::new(device, module, "halo_drop", bufs)?,
-            restore: ParityKernel::new(device, module, "halo_restore", bufs)?,
-            forget: ParityKernel::new(device, module, "halo_forget", bufs)?,
-            count_layers: ParityKernel::new(device, module, "count_layers", bufs)?,
+            tail: kernel("halo_tail")?,
+            count: kernel("halo_count")?,
+            pack: kernel("halo_pack")?,
+            unpack: [
+                kernel("halo_unpack")?,
+                ParityKernel::new(device, module, "halo_unpack", sorted)?,
+            ],
+            drop: kernel("halo_drop")?,
+            restore: kernel("halo_restore")?,
+            forget: kernel("halo_forget")?,
+            count_layers: kernel("count_layers")?,
             ctl: ctl_buffer,
             counts_staging: readback_buffer(
                 device,
@@ -357,6 +383,8 @@ impl Halo {
             counts,
             records,
             layer_load,
+            arrivals,
+            arrived: 0,
             layers,
             thickness: ctl.layers,
             capacity: ctl.capacity,
@@ -390,11 +418,21 @@ impl Halo {
         self.capacity = grown.min(self.max_capacity as u64) as u32;
         self.growths += 1;
         self.records = records_buffer(device, self.capacity);
-        let own = [&self.ctl, &self.counts, &self.records, &self.layer_load];
-        let bufs = |p: usize| bindings(b, p, own);
+        let own = [
+            &self.ctl,
+            &self.counts,
+            &self.records,
+            &self.layer_load,
+            &self.arrivals,
+        ];
+        let bufs = |p: usize| bindings(b, p, own, &b.rate);
+        let [unpack, unpack_sorted] = &mut self.unpack;
+        unpack_sorted.rebind(device, |p| bindings(b, p, own, &b.rate_sorted))?;
         for kernel in [
             &mut self.tail,
+            &mut self.count,
             &mut self.pack,
+            unpack,
             &mut self.drop,
             &mut self.restore,
             &mut self.forget,
@@ -463,30 +501,73 @@ impl Halo {
         encoder.copy_buffer_to_buffer(&self.counts, 0, &self.counts_staging, 0, bytes);
     }
 
-    /// Packs the migrants and the halo copies of the arrays of parity `p` (after the predictor,
-    /// before the sort); the migrants stay until `encode_drop`, as halo copies.
+    /// Packs the migrants and the halo copies of the arrays of parity `p` into the messages to
+    /// the neighbours (after the predictor, before the sort); the migrants stay until
+    /// `encode_drop`, as halo copies.
     pub fn encode_pack(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.tail.dispatch_groups(pass, p, 1);
+        self.count.dispatch(pass, p, self.n);
         self.pack.dispatch(pass, p, self.n);
     }
 
     /// Where the free tail of the arrays of parity `q` starts, sorted into them just now (an
-    /// overlapped step's first sort, where the arrivals go): for [`Halo::read_tail`], with
-    /// `copy_counts`.
+    /// overlapped step's first sort), for `encode_unpack`.
     pub fn encode_tail(&self, pass: &mut wgpu::ComputePass<'_>, q: usize) {
         self.tail.dispatch_groups(pass, q, 1);
     }
 
-    /// The tail [`Halo::encode_tail`] found, once `submission` (which recorded it and
-    /// `copy_counts`) is done; later submissions go on running.
-    pub fn read_tail(
-        &self,
+    /// Sets where the arrivals go in place of the last sort's free tail (the first step's:
+    /// no sort has run).
+    pub fn set_tail(&self, queue: &wgpu::Queue, tail: u32) {
+        let at = std::mem::offset_of!(HaloCounts, tail) as u64;
+        queue.write_buffer(&self.counts, at, bytemuck::bytes_of(&tail));
+    }
+
+    /// Uploads the messages the neighbours sent ([`Message`], at most two), as they came,
+    /// for the next `encode_unpack`; grows the buffer where they need it. Returns their
+    /// particles (migrants and copies), which go after the free tail.
+    pub fn upload_arrivals(
+        &mut self,
         device: &wgpu::Device,
-        submission: wgpu::SubmissionIndex,
+        queue: &wgpu::Queue,
+        b: &ParticleBuffers,
+        messages: &[Vec<u8>],
     ) -> Result<u32> {
-        let bytes = map_read_after(device, &self.counts_staging, Some(submission))?;
-        let counts: HaloCounts = bytemuck::pod_read_unaligned(&bytes);
-        Ok(counts.tail)
+        ensure!(
+            messages.len() <= 2,
+            "{} halo messages arrived where a subdomain has two neighbours",
+            messages.len()
+        );
+        let mut arrivals = HaloArrivals::default();
+        let mut words = 0u64;
+        for (m, bytes) in messages.iter().enumerate() {
+            let [migrants, states, copies] = Message::header(bytes)?;
+            arrivals.messages[m] = [words as u32, migrants, states, copies];
+            arrivals.particles += migrants + copies;
+            arrivals.states += states;
+            words += bytes.len() as u64 / 4;
+        }
+        self.reserve(
+            device,
+            queue,
+            b,
+            words.div_ceil(RECORD_BYTES as u64 / 4) as usize,
+        )?;
+        for (bytes, m) in messages.iter().zip(arrivals.messages) {
+            queue.write_buffer(&self.records, 4 * m[0] as u64, bytes);
+        }
+        queue.write_buffer(&self.arrivals, 0, bytemuck::bytes_of(&arrivals));
+        self.arrived = arrivals.particles + arrivals.states;
+        Ok(arrivals.particles)
+    }
+
+    /// Writes the arrivals [`Halo::upload_arrivals`] uploaded last into the arrays of parity
+    /// `p` after their free tail, their last rates into `rate`, or with `sorted_rates` into
+    /// `rate_sorted` (after an overlapped step's first sort).
+    pub fn encode_unpack(&self, pass: &mut wgpu::ComputePass<'_>, p: usize, sorted_rates: bool) {
+        if self.arrived > 0 {
+            self.unpack[sorted_rates as usize].dispatch(pass, p, self.arrived);
+        }
     }
 
     /// Excludes the halo copies and the migrants sent from the arrays of parity `q` (after the
@@ -514,7 +595,7 @@ impl Halo {
         received.sort_unstable_by_key(|r| ids.record_id(r));
         queue.write_buffer(&self.records, 0, bytemuck::cast_slice(received));
         let counts = HaloCounts {
-            records: received.len() as u32,
+            restored: received.len() as u32,
             ..Default::default()
         };
         queue.write_buffer(&self.counts, 0, bytemuck::bytes_of(&counts));
@@ -533,28 +614,26 @@ impl Halo {
     }
 
     /// Reads what the last `halo_pack` packed, once its submission (with `copy_counts`) is
-    /// made: the counts, then only as many records as were packed. Waits for the GPU.
+    /// made: the counts, then the two messages, as they travel. Waits for the GPU.
     pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Packed> {
         let counts: HaloCounts =
             bytemuck::pod_read_unaligned(&map_read(device, &self.counts_staging)?);
-        if counts.overflow > 0 {
+        let lower = message_words(&counts.sizes[..3]) as usize;
+        let words = lower + message_words(&counts.sizes[3..]) as usize;
+        let record_words = RECORD_BYTES / 4;
+        if words > self.capacity as usize * record_words {
             return Ok(Packed {
-                needed: Some(counts.records),
+                needed: Some(words.div_ceil(record_words) as u32),
                 ..Default::default()
             });
         }
-        let records = read::<HaloRecord>(device, queue, &self.records, counts.records as usize)?;
-        let migrants = records
-            .iter()
-            .filter(|r| r.dest & (DEST_MIGRANT | DEST_SOLID_STATE) == DEST_MIGRANT)
-            .count() as u32;
-        let (upper, lower) = records.into_iter().partition(|r| r.dest & DEST_UPPER != 0);
+        let mut messages = read::<u8>(device, queue, &self.records, 4 * words)?;
+        let upper = messages.split_off(4 * lower);
         Ok(Packed {
-            lower,
-            upper,
+            messages: [messages, upper],
+            sizes: counts.sizes,
             owned: counts.owned,
             tail: counts.tail,
-            migrants,
             needed: None,
         })
     }
@@ -563,6 +642,17 @@ impl Halo {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::layout::{DEST_MIGRANT, DEST_SOLID_STATE, DEST_UPPER};
+
+    /// What `halo_pack` writes of `r` as a halo copy.
+    fn copy_of(r: &HaloRecord) -> HaloCopy {
+        HaloCopy {
+            pos: r.pos,
+            velrho: r.velrho,
+            code: r.code,
+            dest: r.dest,
+        }
+    }
 
     /// The filter's exchange sends an eighth of a record (with narrow ids) and gives
     /// `halo_restore` everything it reads: the code word and the id's high bits (the id it
@@ -581,7 +671,7 @@ mod tests {
             dest: DEST_UPPER,
             energy: [5.0, 6.0],
         };
-        let lean = FilterRecord::from(&full);
+        let lean = FilterRecord::from(&copy_of(&full));
         let restored = lean.restored();
         assert_eq!(
             (restored.code, restored.velrho[3]),
@@ -597,8 +687,8 @@ mod tests {
             ..full
         };
         let ids = IdSplit::for_run(0, Some(4));
-        let lean = FilterRecord::from(&wide);
-        let message = FilterRecord::to_wire(&[lean, FilterRecord::from(&full)]);
+        let lean = FilterRecord::from(&copy_of(&wide));
+        let message = FilterRecord::to_wire(&[lean, FilterRecord::from(&copy_of(&full))]);
         assert_eq!(message.len(), 4 + 2 * 12);
         let back = FilterRecord::from_wire(&message).unwrap();
         assert_eq!(ids.record_id(&back[0].restored()), ids.record_id(&wide));
@@ -617,9 +707,9 @@ mod tests {
         assert_eq!(records_capacity(2, u32::MAX, u64::MAX), u32::MAX);
     }
 
-    /// A halo message carries migrants and solid states whole and copies lean (40 bytes), and
-    /// reads back as the same records but for the copies' rates and energy, which no pass
-    /// reads.
+    /// A halo message carries migrants and solid states whole and copies lean (40 bytes), in
+    /// sections after a header of their counts, and reads back as it was sent; a message that
+    /// is not whole is refused.
     #[test]
     fn a_halo_message_sends_copies_lean_and_the_rest_whole() {
         let record = |k: u32, dest: u32| HaloRecord {
@@ -633,27 +723,25 @@ mod tests {
             dest,
             energy: [5.0, 6.0 + k as f32],
         };
-        let sent = [
-            record(1, DEST_UPPER),
-            record(2, DEST_UPPER | DEST_MIGRANT),
-            record(3, DEST_UPPER | DEST_SOLID_STATE),
-            record(4, DEST_UPPER),
-            record(5, 0),
-        ];
-        let bytes = HaloRecord::to_wire(&sent);
+        let sent = Message {
+            migrants: vec![record(2, DEST_UPPER | DEST_MIGRANT)],
+            states: vec![record(3, DEST_UPPER | DEST_SOLID_STATE)],
+            copies: [record(1, DEST_UPPER), record(4, DEST_UPPER), record(5, 0)]
+                .iter()
+                .map(copy_of)
+                .collect(),
+        };
+        let bytes = sent.to_wire();
         assert_eq!(std::mem::size_of::<HaloCopy>(), 40);
-        assert_eq!(bytes.len(), 4 + 2 * 64 + 3 * 40);
-        let received = HaloRecord::from_wire(&bytes).unwrap();
-        let mut expected = vec![sent[1], sent[2]];
-        for r in [sent[0], sent[3], sent[4]] {
-            expected.push(HaloRecord {
-                rate: [0.0; 4],
-                energy: [0.0; 2],
-                ..r
-            });
-        }
-        assert_eq!(received, expected);
-        assert!(HaloRecord::from_wire(&bytes[..bytes.len() - 1]).is_err());
-        assert!(HaloRecord::from_wire(&[]).is_err());
+        assert_eq!(bytes.len(), 12 + 2 * 64 + 3 * 40);
+        assert_eq!(Message::header(&bytes).unwrap(), [1, 1, 3]);
+        assert_eq!(Message::from_wire(&bytes).unwrap(), sent);
+        assert_eq!(message_words(&[1, 1, 3]) * 4, bytes.len() as u64);
+        assert!(Message::from_wire(&bytes[..bytes.len() - 4]).is_err());
+        assert!(Message::from_wire(&[]).is_err());
+        assert_eq!(
+            Message::from_wire(&Message::default().to_wire()).unwrap(),
+            Message::default()
+        );
     }
 }

@@ -244,12 +244,17 @@ impl Passes {
         }
     }
 
-    /// The step from the exchange on: the sort, the sums and the correctors. An
-    /// `overlapped` subdomain's sort carries the interior's rates, and its sums are the rest's.
+    /// The step from the exchange on: a subdomain's arrivals, the sort, the sums and the
+    /// correctors. An `overlapped` subdomain's sort carries the interior's rates, and its sums
+    /// are the rest's.
     pub(super) fn record_from_exchange(&self, r: &mut Recorder<'_>, p: usize, overlapped: bool) {
         let q = 1 - p;
         let bodies = self.bodies.as_ref();
         let overlap = self.overlap.as_ref().filter(|_| overlapped);
+        // A subdomain's arrivals, after its free tail (`Solver::place_arrivals`).
+        if let Some(h) = &self.halo {
+            r.stage("halo_unpack", |pass| h.encode_unpack(pass, p, overlapped));
+        }
         self.record_sort(r, p, overlap);
         if let Some(t) = &self.total_lagrangian {
             r.stage("total_lagrangian_index", |pass| t.encode_index(pass, q));

@@ -12,9 +12,9 @@
 
 use std::ops::Range;
 
-use anyhow::{bail, ensure, Context, Result};
+use anyhow::{anyhow, bail, ensure, Context, Result};
 
-use super::halo::{FilterRecord, Wire};
+use super::halo::{FilterRecord, Message};
 use super::initial::Packed;
 use super::passes::Passes;
 use super::profile::Recorder;
@@ -25,10 +25,7 @@ use crate::decomposition::{
 };
 use crate::gpu::GpuContext;
 use crate::grid::Grid;
-use crate::layout::{
-    unpack_block, HaloCtl, HaloRecord, IdSplit, Pos, SolidState, DEST_SOLID_STATE, KIND_EXCLUDED,
-    KIND_SHIFT,
-};
+use crate::layout::{unpack_block, HaloCtl, IdSplit, Pos, KIND_EXCLUDED, KIND_SHIFT};
 use crate::output::RankSummary;
 use crate::ranks::Ranks;
 use crate::scenario::{Kind, Scenario};
@@ -83,11 +80,9 @@ pub struct Ranked {
     pub(super) moving_probes: Vec<usize>,
 }
 
-/// What an overlapped step's GPU does while the host swaps (`Solver::submit_interior`): the
-/// submission of its first sort, after which the free tail is known, and whether the
-/// interior's sums are done.
+/// What an overlapped step's GPU does while the host swaps (`Solver::submit_interior`):
+/// whether the interior's sums are done.
 struct Interior {
-    sorted: wgpu::SubmissionIndex,
     summed: std::sync::Arc<std::sync::atomic::AtomicBool>,
 }
 
@@ -519,28 +514,39 @@ impl Solver {
             halo.encode_drop(pass, p);
             halo.encode_forget(pass, p);
         });
-        let mut to: Vec<Vec<HaloRecord>> = vec![Vec::new(); size];
-        let mut owner = rank;
-        for r in packed.lower.into_iter().chain(packed.upper) {
-            // A solid's stress state goes where its particle goes, the record before it.
-            if r.dest & DEST_SOLID_STATE == 0 {
-                let layer = layer_of(&self.grid, next.axis, r.pos);
-                owner = next.owner(layer as u32);
+        // The host reads the records here, the one place a message goes to any rank: each
+        // migrant to its owner under `next`, its stress state (a solid's) where it goes.
+        let mut to = vec![Message::default(); size];
+        let mut owners = std::collections::HashMap::new();
+        for bytes in &packed.messages {
+            let message = Message::from_wire(bytes)?;
+            for r in message.migrants {
+                let owner = next.owner(layer_of(&self.grid, next.axis, r.pos) as u32);
+                owners.insert(self.ids.record_id(&r), owner);
+                to[owner].migrants.push(r);
             }
-            to[owner].push(r);
+            for r in message.states {
+                let id = self.ids.record_id(&r);
+                let owner = (owners.get(&id).copied())
+                    .ok_or_else(|| anyhow!("the stress state of solid particle {id} came alone"))?;
+                to[owner].states.push(r);
+            }
         }
-        ensure!(to[rank].is_empty(), "rank {rank} packed its own particles");
+        ensure!(
+            to[rank] == Message::default(),
+            "rank {rank} packed its own particles"
+        );
         let others: Vec<usize> = (0..size).filter(|&q| q != rank).collect();
-        let sends: Vec<(usize, Vec<u8>)> = others
-            .iter()
-            .map(|&q| (q, bytemuck::cast_slice(&to[q]).to_vec()))
-            .collect();
-        let received = ranks.exchange(&sends, &others)?;
-        let incoming: Vec<HaloRecord> = received
-            .iter()
-            .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, HaloRecord>(b))
-            .collect();
-        self.unpack(&incoming, packed.tail, p, &self.buffers.rate)?;
+        let sends: Vec<(usize, Vec<u8>)> = others.iter().map(|&q| (q, to[q].to_wire())).collect();
+        let mut arrived = Message::default();
+        for bytes in ranks.exchange(&sends, &others)? {
+            let message = Message::from_wire(&bytes)?;
+            arrived.migrants.extend(message.migrants);
+            arrived.states.extend(message.states);
+        }
+        self.place_arrivals(&[arrived.to_wire()], None, p, packed.tail)?;
+        let halo = self.passes.halo();
+        self.submit_pass("halo unpack", |pass| halo.encode_unpack(pass, p, false));
         self.sort_in_place();
         let halo = self.passes.halo();
         halo.set_cuts(&self.queue, &next, rank, true);
@@ -616,7 +622,7 @@ impl Solver {
         let start = std::time::Instant::now();
         let body_dt = self.bodies.is_some().then(|| self.predict_bodies());
         let p = self.parity;
-        let packed = self.pack(true, p, |passes, pass| {
+        let mut packed = self.pack(true, p, |passes, pass| {
             passes.record_to_exchange(&mut Recorder::Shared(pass), p)
         })?;
         let packed_at = std::time::Instant::now();
@@ -624,17 +630,14 @@ impl Solver {
         let overlaps = (self.passes.overlap.as_ref()).is_some_and(|o| o.choice.overlaps(k));
         let interior = overlaps.then(|| self.submit_interior(p));
 
-        let incoming = self.swap(&packed.lower, &packed.upper, ranks)?;
+        let incoming = self.swap(std::mem::take(&mut packed.messages), ranks)?;
         self.share_tl_positions(ranks)?;
         let swapped_at = std::time::Instant::now();
         let ranked = self.ranked.as_mut().expect("a subdomain");
         let first_tail = ranked.first_tail.take();
         ranked.exchanges += 1;
-        let sent = (packed.lower.iter().chain(&packed.upper))
-            .filter(|r| r.dest & DEST_SOLID_STATE == 0)
-            .count();
-        ranked.migrants_sent += packed.migrants as u64;
-        ranked.halo_sent += sent as u64 - packed.migrants as u64;
+        ranked.migrants_sent += packed.migrants() as u64;
+        ranked.halo_sent += packed.copies() as u64;
         ranked.owned = packed.owned;
         let p = self.place_arrivals(&incoming, interior, p, first_tail.unwrap_or(packed.tail))?;
 
@@ -670,7 +673,7 @@ impl Solver {
         if let Some(o) = &mut self.passes.overlap {
             o.choice.record(k, (computed_at - start).as_secs_f64());
         }
-        self.agree(local, packed.owned + packed.migrants, ranks);
+        self.agree(local, packed.owned + packed.migrants(), ranks);
         if let (Some(dt), Some(mine)) = (body_dt, particle_loads) {
             self.correct_bodies(dt, &mine, ranks);
         }
@@ -800,33 +803,23 @@ impl Solver {
         halo.reserve(&self.device, &self.queue, &self.buffers, needed)
     }
 
-    /// Sends `lower` and `upper` to the neighbour below and above, in `T`'s wire format, and
-    /// returns what the neighbours sent this rank (every rank together); counts the bytes
-    /// sent.
-    fn swap<T: Wire>(&mut self, lower: &[T], upper: &[T], ranks: &dyn Ranks) -> Result<Vec<T>> {
+    /// Sends the messages `lower` and `upper` to the neighbour below and above (where there is
+    /// one), and returns what the neighbours sent this rank (every rank together); counts the
+    /// bytes sent.
+    fn swap(&mut self, [lower, upper]: [Vec<u8>; 2], ranks: &dyn Ranks) -> Result<Vec<Vec<u8>>> {
         let rank = ranks.rank();
         let mut sends = Vec::new();
-        for (to, records) in [
-            (rank.checked_sub(1), lower),
-            ((rank + 1 < ranks.size()).then_some(rank + 1), upper),
-        ] {
-            match to {
-                Some(to) => sends.push((to, T::to_wire(records))),
-                None => ensure!(
-                    records.is_empty(),
-                    "rank {rank} packed records for no neighbour"
-                ),
-            }
+        if rank > 0 {
+            sends.push((rank - 1, lower));
+        }
+        if rank + 1 < ranks.size() {
+            sends.push((rank + 1, upper));
         }
         let from: Vec<usize> = sends.iter().map(|(to, _)| *to).collect();
         let received = ranks.exchange(&sends, &from)?;
         let ranked = self.ranked.as_mut().expect("a subdomain");
         ranked.bytes_sent += sends.iter().map(|(_, b)| b.len() as u64).sum::<u64>();
-        let mut records = Vec::new();
-        for bytes in &received {
-            records.extend(T::from_wire(bytes)?);
-        }
-        Ok(records)
+        Ok(received)
     }
 
     /// The density filter of a step it fires on (`DensityFilter::fires_after`), over ranks: it
@@ -842,18 +835,27 @@ impl Solver {
             passes.halo().encode_pack(&mut pass, q)
         })?;
         ensure!(
-            packed.migrants == 0,
+            packed.migrants() == 0,
             "{} particles outside the subdomain after the corrector",
-            packed.migrants
+            packed.migrants()
         );
-        let lean = |records: &[HaloRecord]| -> Vec<FilterRecord> {
-            (records.iter())
-                .filter(|r| r.dest & DEST_SOLID_STATE == 0)
-                .map(FilterRecord::from)
-                .collect()
+        // The host reads the copies here (on the filter's steps only) to send 8 bytes of each.
+        let lean = |bytes: &[u8]| -> Result<Vec<u8>> {
+            let copies = Message::from_wire(bytes)?.copies;
+            let records: Vec<FilterRecord> = copies.iter().map(FilterRecord::from).collect();
+            Ok(FilterRecord::to_wire(&records))
         };
-        let incoming = self.swap(&lean(&packed.lower), &lean(&packed.upper), ranks)?;
-        let mut incoming: Vec<HaloRecord> = incoming.iter().map(FilterRecord::restored).collect();
+        let [lower, upper] = &packed.messages;
+        let incoming = self.swap([lean(lower)?, lean(upper)?], ranks)?;
+        let mut restored = Vec::new();
+        for bytes in &incoming {
+            restored.extend(
+                FilterRecord::from_wire(bytes)?
+                    .iter()
+                    .map(FilterRecord::restored),
+            );
+        }
+        let mut incoming = restored;
         self.reserve_records(incoming.len())?;
         let halo = self.passes.halo();
         let filter = self.passes.density_filter.as_ref().expect("a filter");
@@ -867,18 +869,37 @@ impl Solver {
         self.faults.check()
     }
 
-    /// Writes what arrived into the arrays the rest of the step starts from, and returns their
-    /// parity: after an overlapped step's first sort (`interior`), into the other parity than
-    /// `p`, where it left its free tail; else into `p`'s, from `tail` on.
+    /// Uploads what arrived for `halo_unpack`, which writes it into the arrays the rest of the
+    /// step starts from, and returns their parity: after an overlapped step's first sort
+    /// (`interior`), into the other parity than `p`, from where that sort left its free tail
+    /// (on the GPU: the host does not wait for it); else into `p`'s, from `tail` on. `tail`
+    /// is the last sort's free tail, after which the serial step writes; the first sort of an
+    /// overlapped step frees what the last step excluded, so the arrivals find as much room
+    /// there at least.
     fn place_arrivals(
         &mut self,
-        incoming: &[HaloRecord],
+        incoming: &[Vec<u8>],
         interior: Option<Interior>,
         p: usize,
         tail: u32,
     ) -> Result<usize> {
+        let halo = self
+            .passes
+            .halo
+            .as_mut()
+            .expect("a subdomain has a halo pass");
+        let particles = halo.upload_arrivals(&self.device, &self.queue, &self.buffers, incoming)?;
+        let free = self.buffers.n.saturating_sub(tail);
+        if particles > free {
+            bail!(
+                "the subdomain received {particles} halo and migrant particles but has room \
+                 for {free} ({} in all): more water flowed into it than its arrays were made \
+                 for before the cuts moved",
+                self.buffers.n
+            );
+        }
         let Some(interior) = interior else {
-            self.unpack(incoming, tail, p, &self.buffers.rate)?;
+            halo.set_tail(&self.queue, tail);
             return Ok(p);
         };
         // Runs the callback of `interior.summed` if the GPU is done with the sums.
@@ -888,9 +909,6 @@ impl Solver {
         if !interior.summed.load(std::sync::atomic::Ordering::Acquire) {
             ranked.hidden += 1;
         }
-        let halo = self.passes.halo();
-        let tail = halo.read_tail(&self.device, interior.sorted)?;
-        self.unpack(incoming, tail, 1 - p, &self.buffers.rate_sorted)?;
         Ok(1 - p)
     }
 
@@ -904,8 +922,7 @@ impl Solver {
             &mut Recorder::Shared(encoder.begin_compute_pass(&Default::default())),
             p,
         );
-        self.passes.halo().copy_counts(&mut encoder);
-        let sorted = self.queue.submit([encoder.finish()]);
+        self.queue.submit([encoder.finish()]);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         self.passes.record_interior(
             &mut Recorder::Shared(encoder.begin_compute_pass(&Default::default())),
@@ -916,103 +933,7 @@ impl Solver {
         let done = summed.clone();
         self.queue
             .on_submitted_work_done(move || done.store(true, std::sync::atomic::Ordering::Release));
-        Interior { sorted, summed }
-    }
-
-    /// Writes the received particles into the free tail of the arrays of parity `p`, their
-    /// last rates into `rates` (the sort's input: `rate` before it, `rate_sorted` after an
-    /// overlapped step's first). A solid particle's record is followed by one of its stress
-    /// state ([`Solver::write_solid_states`]).
-    fn unpack(
-        &self,
-        incoming: &[HaloRecord],
-        tail: u32,
-        p: usize,
-        rates: &wgpu::Buffer,
-    ) -> Result<()> {
-        let (states, incoming): (Vec<HaloRecord>, Vec<HaloRecord>) =
-            (incoming.iter()).partition(|r| r.dest & DEST_SOLID_STATE != 0);
-        self.write_solid_states(&states);
-        let free = self.buffers.n.saturating_sub(tail) as usize;
-        if incoming.len() > free {
-            bail!(
-                "the subdomain received {} halo and migrant particles but has room for {free} \
-                 ({} in all): more water flowed into it than its arrays were made for before \
-                 the cuts moved",
-                incoming.len(),
-                self.buffers.n
-            );
-        }
-        if incoming.is_empty() {
-            return Ok(());
-        }
-        let b = &self.buffers;
-        let write = |buffer: &wgpu::Buffer, bytes_each: usize, data: &[u8]| {
-            self.queue
-                .write_buffer(buffer, tail as u64 * bytes_each as u64, data);
-        };
-        let pos: Vec<Pos> = incoming.iter().map(|r| r.pos).collect();
-        let velrho: Vec<[f32; 4]> = incoming.iter().map(|r| r.velrho).collect();
-        let code: Vec<u32> = incoming.iter().map(|r| r.code).collect();
-        let rate: Vec<[f32; 4]> = incoming.iter().map(|r| r.rate).collect();
-        write(&b.pos[p], 16, bytemuck::cast_slice(&pos));
-        write(&b.velrho[p], 16, bytemuck::cast_slice(&velrho));
-        write(&b.code[p], 4, bytemuck::cast_slice(&code));
-        if self.ids.wide {
-            // The ids' high words, after the n code words.
-            let high: Vec<u32> = (incoming.iter())
-                .map(|r| self.ids.high(self.ids.record_id(r)))
-                .collect();
-            let at = (b.n as u64 + tail as u64) * 4;
-            self.queue
-                .write_buffer(&b.code[p], at, bytemuck::cast_slice(&high));
-        }
-        write(rates, 16, bytemuck::cast_slice(&rate));
-        if self.energy {
-            let energy: Vec<[f32; 2]> = incoming.iter().map(|r| r.energy).collect();
-            write(&b.energy[p], 8, bytemuck::cast_slice(&energy));
-        }
-        Ok(())
-    }
-
-    /// Writes the stress states of solid particles received (halo copies and migrants, whose
-    /// owners predicted them this step) into this rank's solid arrays, by id: τ and the last
-    /// dτ/dt (`halo_pack`'s solid record); a solid's body and material never change, and the
-    /// ghost pass sets its interface pressure.
-    fn write_solid_states(&self, states: &[HaloRecord]) {
-        let size = std::mem::size_of::<SolidState>() as u64;
-        for r in states {
-            let at = (self.ids.record_id(r) - self.params.solid_id_base) as u64 * size;
-            let tau_b = r.pos.off;
-            let tau: [f32; 7] = [
-                r.velrho[0],
-                r.velrho[1],
-                r.velrho[2],
-                r.velrho[3],
-                tau_b[0],
-                tau_b[1],
-                tau_b[2],
-            ];
-            let rates: [f32; 6] = [
-                r.rate[0],
-                r.rate[1],
-                r.rate[2],
-                r.rate[3],
-                r.energy[0],
-                r.energy[1],
-            ];
-            let solid = &self.buffers.solid;
-            self.queue.write_buffer(
-                solid,
-                at + std::mem::offset_of!(SolidState, tau_a) as u64,
-                bytemuck::cast_slice(&tau),
-            );
-            self.queue.write_buffer(
-                solid,
-                at + std::mem::offset_of!(SolidState, rate_a) as u64,
-                bytemuck::cast_slice(&rates),
-            );
-        }
+        Interior { summed }
     }
 
     /// Corrects the bodies over dt with the loads of every rank's body particles (`mine`:
