@@ -26,8 +26,8 @@
 // densities): after the corrector the ranks pack their own halo particles again and swap them;
 // each copy the sort put in a cell and `halo_drop` excluded gets back its owner's code word
 // and corrected density (the one field of a neighbour the filter reads besides its place),
-// found by id among the records received (sorted by id, in `halo_out`), until `halo_drop`
-// excludes it again after the filter.
+// found by id among the copies received (indexed by `halo_index`), until `halo_drop` excludes
+// it again after the filter.
 
 // Mirrored by `layout::HaloCounts`. A stream is one section of one message: 3 × neighbour
 // (0 below, 1 above) + section (`SECTION_*`).
@@ -36,7 +36,6 @@ struct HaloCounts {
     tail: u32,              // the first free entry: where `halo_unpack` writes the arrivals
     sizes: array<atomic<u32>, 6>,   // records of each stream (`halo_count`)
     filled: array<atomic<u32>, 6>,  // of them written so far (`halo_pack`)
-    restored: u32,          // records `halo_out` holds for `halo_restore`, sorted by id
 }
 
 // Mirrored by `layout::HaloRecord`.
@@ -69,6 +68,10 @@ const SECTION_COPIES: u32 = 2u;
 const HEADER_WORDS: u32 = 3u;
 const RECORD_WORDS: u32 = 16u;
 const COPY_WORDS: u32 = 10u;
+// The density filter's exchange (`halo_ctl.lean`) sends of a copy only what `halo_restore`
+// gives it back, its owner's code word and corrected ρ (the filter reads no other field of a
+// neighbour's), with wide ids the id's high bits too; and no stress states.
+const LEAN_WORDS: u32 = select(2u, 3u, WIDE_IDS);
 
 // Mirrored by `layout::HaloArrivals`: the messages received, one after the other in `halo_out`
 // (at most one per neighbour): each one's first word and its sections' counts; `particles`:
@@ -77,7 +80,8 @@ struct HaloArrivals {
     messages: array<vec4<u32>, 2>,
     particles: u32,
     states: u32,
-    pad: vec2<u32>,
+    copy_words: u32,    // COPY_WORDS, or LEAN_WORDS for the density filter's
+    pad: u32,
 }
 
 @group(0) @binding(1) var<storage, read_write> pos: array<Pos>;
@@ -88,8 +92,8 @@ struct HaloArrivals {
 // A uniform: the packing binds the eight storage buffers every adapter allows.
 @group(0) @binding(6) var<uniform> halo_ctl: HaloCtl;
 @group(0) @binding(7) var<storage, read_write> halo_counts: HaloCounts;
-// The messages packed (`halo_pack`), then those received (`halo_unpack`); on the density
-// filter's steps the records `halo_restore` searches.
+// The messages packed (`halo_pack`), then those received (`halo_unpack`, and on the density
+// filter's steps `halo_restore`).
 @group(0) @binding(8) var<storage, read_write> halo_out: array<u32>;
 // Weighted own particles per cell layer along the axis (`count_layers`): 2 for a particle that
 // moves, 1 for a boundary particle (decomposition.rs's weights, doubled to be whole).
@@ -102,6 +106,10 @@ struct HaloArrivals {
 // Where the arrivals' last rates go: the sort's input (`rate` before it, `rate_sorted` after
 // an overlapped step's first sort).
 @group(0) @binding(13) var<storage, read_write> arrival_rate: array<vec4<f32>>;
+// The copies received for the density filter by id (`halo_index`): an open-addressing table of
+// 1 + the copy's index among the arrivals (0: empty), its size a power of two at least twice
+// their number.
+@group(0) @binding(14) var<storage, read_write> restore_index: array<atomic<u32>>;
 
 fn layer_of(p: Pos) -> u32 {
     return slab_layer(p, halo_ctl.axis);
@@ -137,16 +145,26 @@ fn streams_of(i: u32) -> vec2<u32> {
     return s;
 }
 
+// Whether particle i's stress state goes with it: a solid particle's, but for the filter.
+fn sends_state(i: u32) -> bool {
+    return is_solid(code_kind(code[i])) && halo_ctl.lean == 0u;
+}
+
 // The stream of the stress states that go with stream `s`'s particles.
 fn states_stream(s: u32) -> u32 {
     return s - s % 3u + SECTION_STATES;
+}
+
+// Words of a halo copy as this packing writes it.
+fn copy_words() -> u32 {
+    return select(COPY_WORDS, LEAN_WORDS, halo_ctl.lean != 0u);
 }
 
 // Words of the message to neighbour `nb` (0 below, 1 above).
 fn message_words(nb: u32) -> u32 {
     let b = 3u * nb;
     let records = atomicLoad(&halo_counts.sizes[b]) + atomicLoad(&halo_counts.sizes[b + 1u]);
-    return HEADER_WORDS + RECORD_WORDS * records + COPY_WORDS * atomicLoad(&halo_counts.sizes[b + 2u]);
+    return HEADER_WORDS + RECORD_WORDS * records + copy_words() * atomicLoad(&halo_counts.sizes[b + 2u]);
 }
 
 // The first word of stream `s`'s records: the messages lie one after the other.
@@ -192,16 +210,35 @@ fn get_record(at: u32) -> HaloRecord {
         bitcast<u32>(last.y), last.zw);
 }
 
-// A halo copy's words: pos, velrho, code, dest (`sph::halo::HaloCopy`).
+// A halo copy's words: pos, velrho, code, dest (`sph::halo::HaloCopy`); lean: code, ρ and
+// with wide ids dest (`LEAN_WORDS`).
 fn put_copy(at: u32, r: HaloRecord) {
+    if (halo_ctl.lean != 0u) {
+        halo_out[at] = r.code;
+        halo_out[at + 1u] = bitcast<u32>(r.velrho.w);
+        if (WIDE_IDS) {
+            halo_out[at + 2u] = r.dest;
+        }
+        return;
+    }
     put_pos(at, r.pos);
     put_vec4(at + 4u, r.velrho);
     halo_out[at + 8u] = r.code;
     halo_out[at + 9u] = r.dest;
 }
 
-// The record of a copy: its rates and energy zero, which no pass reads of a copy.
+// The record of a copy received: its rates and energy zero, which no pass reads of a copy
+// (a lean copy's: its code word, ρ and dest, all `halo_restore` reads).
 fn get_copy(at: u32) -> HaloRecord {
+    if (halo_arrivals.copy_words != COPY_WORDS) {
+        var dest = 0u;
+        if (WIDE_IDS) {
+            dest = halo_out[at + 2u];
+        }
+        let rho = bitcast<f32>(halo_out[at + 1u]);
+        return HaloRecord(Pos(), vec4<f32>(0.0, 0.0, 0.0, rho), vec4<f32>(0.0), halo_out[at], dest,
+            vec2<f32>(0.0));
+    }
     return HaloRecord(get_pos(at), get_vec4(at + 4u), vec4<f32>(0.0), halo_out[at + 8u],
         halo_out[at + 9u], vec2<f32>(0.0));
 }
@@ -223,11 +260,11 @@ fn pack_into(i: u32, s: u32) {
     let r = HaloRecord(pos[i], velrho[i], rate[i], code[i], dest, e);
     let k = atomicAdd(&halo_counts.filled[s], 1u);
     if (s % 3u == SECTION_COPIES) {
-        put_copy(stream_start(s) + COPY_WORDS * k, r);
+        put_copy(stream_start(s) + copy_words() * k, r);
     } else {
         put_record(stream_start(s) + RECORD_WORDS * k, r);
     }
-    if (is_solid(code_kind(code[i]))) {
+    if (sends_state(i)) {
         let t = states_stream(s);
         let st = solid[solid_slot(i)];
         let state = HaloRecord(Pos(st.tau_b, 0u), st.tau_a, st.rate_a, code[i],
@@ -253,7 +290,7 @@ fn halo_count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         atomicAdd(&halo_counts.owned, 1u);
     }
     let s = streams_of(i);
-    let solid = is_solid(code_kind(code[i]));
+    let solid = sends_state(i);
     for (var k = 0u; k < 2u; k++) {
         if (s[k] != NO_STREAM) {
             atomicAdd(&halo_counts.sizes[s[k]], 1u);
@@ -287,36 +324,40 @@ fn halo_pack(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     pack_into(i, s.y);
 }
 
-// Writes arrival k (`HaloArrivals`'s migrants and copies, message by message) at the free tail.
+// Particle k of the arrivals (`HaloArrivals`'s migrants and copies, message by message).
+fn arrival(k: u32) -> HaloRecord {
+    var r = k;
+    for (var m = 0u; m < 2u; m++) {
+        let msg = halo_arrivals.messages[m];
+        let records = msg.x + HEADER_WORDS;
+        if (r < msg.y) {
+            return get_record(records + RECORD_WORDS * r);
+        }
+        if (r < msg.y + msg.w) {
+            let copy = halo_arrivals.copy_words * (r - msg.y);
+            return get_copy(records + RECORD_WORDS * (msg.y + msg.z) + copy);
+        }
+        r -= msg.y + msg.w;
+    }
+    return HaloRecord();
+}
+
+// Writes arrival k at the free tail.
 fn place_particle(k: u32) {
     let j = halo_counts.tail + k;
     if (j >= params.n_particles) {
         return; // the host checked the room; never written past the arrays
     }
-    var r = k;
-    for (var m = 0u; m < 2u; m++) {
-        let msg = halo_arrivals.messages[m];
-        let records = msg.x + HEADER_WORDS;
-        var a: HaloRecord;
-        if (r < msg.y) {
-            a = get_record(records + RECORD_WORDS * r);
-        } else if (r < msg.y + msg.w) {
-            a = get_copy(records + RECORD_WORDS * (msg.y + msg.z) + COPY_WORDS * (r - msg.y));
-        } else {
-            r -= msg.y + msg.w;
-            continue;
-        }
-        pos[j] = a.pos;
-        velrho[j] = a.velrho;
-        code[j] = a.code;
-        if (WIDE_IDS) {
-            code[params.n_particles + j] = a.dest >> DEST_ID_SHIFT;
-        }
-        arrival_rate[j] = a.rate;
-        if (ENERGY) {
-            energy[j] = a.energy;
-        }
-        return;
+    let a = arrival(k);
+    pos[j] = a.pos;
+    velrho[j] = a.velrho;
+    code[j] = a.code;
+    if (WIDE_IDS) {
+        code[params.n_particles + j] = a.dest >> DEST_ID_SHIFT;
+    }
+    arrival_rate[j] = a.rate;
+    if (ENERGY) {
+        energy[j] = a.energy;
     }
 }
 
@@ -376,6 +417,35 @@ fn count_layers(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     atomicAdd(&layer_load[layer_of(pos[i])], select(1u, 2u, moves));
 }
 
+// Multiplicative hashing (Knuth, TAOCP vol. 3, 6.4): odd, so consecutive ids take distinct
+// slots of a power-of-two table.
+fn id_slot(id: u32, mask: u32) -> u32 {
+    return (id * 2654435761u) & mask;
+}
+
+// Indexes the copies received for the density filter (uploaded as they came) by id, for
+// `halo_restore`: no sort, and the same table whatever order they go in.
+@compute @workgroup_size(WG)
+fn halo_index(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let k = linear_index(gid, nwg);
+    if (k >= halo_arrivals.particles) {
+        return;
+    }
+    let mask = arrayLength(&restore_index) - 1u;
+    var slot = id_slot(record_id(arrival(k)), mask);
+    loop {
+        let r = atomicCompareExchangeWeak(&restore_index[slot], 0u, k + 1u);
+        if (r.exchanged) {
+            return;
+        }
+        if (r.old_value != 0u) {
+            slot = (slot + 1u) & mask;
+        }
+    }
+}
+
+// Gives each halo copy that `halo_drop` excluded its owner's code word and corrected density,
+// found by id among the copies received (`halo_index`).
 @compute @workgroup_size(WG)
 fn halo_restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
@@ -383,23 +453,20 @@ fn halo_restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         return;
     }
     let id = particle_id(i);
-    var lo = 0u;
-    var hi = halo_counts.restored;
-    let n = hi;
-    while (lo < hi) {
-        let mid = (lo + hi) / 2u;
-        if (record_id(get_record(RECORD_WORDS * mid)) < id) {
-            lo = mid + 1u;
-        } else {
-            hi = mid;
+    let mask = arrayLength(&restore_index) - 1u;
+    var slot = id_slot(id, mask);
+    loop {
+        let k = atomicLoad(&restore_index[slot]);
+        if (k == 0u) {
+            return;
         }
-    }
-    if (lo < n) {
-        let found = get_record(RECORD_WORDS * lo);
-        if (record_id(found) == id) {
-            code[i] = found.code;
-            velrho[i].w = found.velrho.w;
+        let a = arrival(k - 1u);
+        if (record_id(a) == id) {
+            code[i] = a.code;
+            velrho[i].w = a.velrho.w;
+            return;
         }
+        slot = (slot + 1u) & mask;
     }
 }
 

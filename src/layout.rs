@@ -394,7 +394,8 @@ pub struct HaloCtl {
     pub lower: u32,
     pub upper: u32,
     pub capacity: u32,
-    pub pad: u32,
+    /// 1: halo copies packed as the density filter's exchange needs them (`halo::Lean`).
+    pub lean: u32,
 }
 
 /// Mirrors `HaloCounts` in shaders/halo.wgsl: the rank's own particles, the free tail, and the
@@ -407,7 +408,6 @@ pub struct HaloCounts {
     pub tail: u32,
     pub sizes: [u32; 6],
     pub filled: [u32; 6],
-    pub restored: u32,
 }
 
 /// Mirrors `HaloArrivals` in shaders/halo.wgsl: the messages received, one after the other
@@ -418,7 +418,9 @@ pub struct HaloArrivals {
     pub messages: [[u32; 4]; 2],
     pub particles: u32,
     pub states: u32,
-    pub pad: [u32; 2],
+    /// Words of a halo copy in the messages: `COPY_WORDS`, or the density filter's lean ones.
+    pub copy_words: u32,
+    pub pad: u32,
 }
 
 /// Mirrors `HaloRecord` in shaders/halo.wgsl: one particle sent to a neighbour, as a halo copy
@@ -799,19 +801,19 @@ mod tests {
             &halo::SHADER,
             "HaloCtl",
             HaloCtl,
-            [axis, own_lo, own_hi, layers, lower, upper, capacity]
+            [axis, own_lo, own_hi, layers, lower, upper, capacity, lean]
         );
         check_layout!(
             &halo::SHADER,
             "HaloCounts",
             HaloCounts,
-            [owned, tail, sizes, filled, restored]
+            [owned, tail, sizes, filled]
         );
         check_layout!(
             &halo::SHADER,
             "HaloArrivals",
             HaloArrivals,
-            [messages, particles, states]
+            [messages, particles, states, copy_words]
         );
         assert_eq!(wgsl_u32(&halo::SHADER, "HEADER_WORDS"), halo::HEADER_WORDS);
         let words = |bytes: usize| (bytes / 4) as u32;

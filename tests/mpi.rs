@@ -276,6 +276,9 @@ struct Comparison {
     tables: &'static str,
     /// The ranks' halo packing buffers must grow during the run (`Halo::reserve`).
     grows: bool,
+    /// With `uneven`: a cut must move past a neighbour's slab, so that a particle crosses a
+    /// rank on its way to its new owner (`Solver::redistribute` takes two rounds or more).
+    far: bool,
 }
 
 impl Comparison {
@@ -340,7 +343,7 @@ impl Comparison {
             let bytes = std::fs::read(out.join(format!("rank{r}.bin"))).unwrap();
             let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
             let (halo, migrants, rebalances, drained) = (words[0], words[1], words[2], words[3]);
-            let (held, growths, words) = (words[4], words[5], &words[6..]);
+            let (held, growths, rounds, words) = (words[4], words[5], words[6], &words[7..]);
             grown += growths;
             let (pose, words) = words.split_at(poses.len());
             assert_eq!(pose, poses, "rank {r}'s bodies differ from the whole run's");
@@ -362,6 +365,11 @@ impl Comparison {
             );
             assert!(halo > 0, "rank {r} sent no halo");
             assert!(!self.uneven || rebalances > 0, "the cuts never moved");
+            println!("rank {r}: a move of the cuts took {rounds} rounds at most");
+            assert!(
+                !self.far || rounds >= 2,
+                "no cut moved past a neighbour's slab"
+            );
             let mine: Live = (words.chunks(10))
                 .map(|c| {
                     (
@@ -446,6 +454,7 @@ impl Comparison {
                 solver.drained() as u32,
                 held.count() as u32,
                 solver.halo_growths(),
+                counts.moving_rounds,
             ];
             words.extend(body_words(&solver));
             for (id, p, v) in live {
@@ -854,9 +863,10 @@ fn ranks_that_move_their_cuts_still_equal_one_run() {
         test: "ranks_that_move_their_cuts_still_equal_one_run",
         case: "cases/dam_break_2d.toml",
         set: &["particles.dx_m=0.0073"],
-        ranks: 2,
+        ranks: 3,
         steps: 300,
         uneven: true,
+        far: true,
         restore_at: Some(200),
         ..Default::default()
     }

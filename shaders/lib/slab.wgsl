@@ -10,7 +10,7 @@ struct HaloCtl {
     lower: u32,         // 1: a neighbour owns the layers below own_lo
     upper: u32,         // 1: a neighbour owns the layers from own_hi on
     capacity: u32,      // records `halo_out` holds
-    pad: u32,
+    lean: u32,          // 1: copies packed for the density filter (halo.wgsl `LEAN_WORDS`)
 }
 
 // The cell layer along the cut axis of a particle at `p`.

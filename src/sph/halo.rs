@@ -10,7 +10,7 @@ use crate::decomposition::Slabs;
 use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
-use crate::layout::{HaloArrivals, HaloCounts, HaloCtl, HaloRecord, IdSplit, Pos, DEST_ID_SHIFT};
+use crate::layout::{HaloArrivals, HaloCounts, HaloCtl, HaloRecord, Pos};
 use crate::scenario::{InletPressure, Kind, Scenario};
 use bytemuck::{Pod, Zeroable};
 
@@ -88,10 +88,10 @@ fn records_buffer(device: &wgpu::Device, capacity: u32) -> wgpu::Buffer {
 fn bindings<'a>(
     b: &'a ParticleBuffers,
     p: usize,
-    own: [&'a wgpu::Buffer; 5],
+    own: [&'a wgpu::Buffer; 6],
     arrival_rate: &'a wgpu::Buffer,
 ) -> Bindings<'a> {
-    let [ctl, counts, records, layer_load, arrivals] = own;
+    let [ctl, counts, records, layer_load, arrivals, restore_index] = own;
     b.at(p)
         .with("halo_ctl", ctl)
         .with("halo_counts", counts)
@@ -99,6 +99,7 @@ fn bindings<'a>(
         .with("layer_load", layer_load)
         .with("halo_arrivals", arrivals)
         .with("arrival_rate", arrival_rate)
+        .with("restore_index", restore_index)
 }
 
 /// Rank `rank`'s part of `slabs` with a halo of `layers` ([`halo_layers`]): what `halo_pack`
@@ -113,7 +114,7 @@ pub fn control(slabs: &Slabs, rank: usize, layers: u32) -> HaloCtl {
         lower: (rank > 0) as u32,
         upper: (rank + 1 < slabs.ranks()) as u32,
         capacity: 0,
-        pad: 0,
+        lean: 0,
     }
 }
 
@@ -125,6 +126,7 @@ pub struct Halo {
     /// an overlapped step's first sort).
     unpack: [ParityKernel; 2],
     drop: ParityKernel,
+    index: ParityKernel,
     restore: ParityKernel,
     forget: ParityKernel,
     count_layers: ParityKernel,
@@ -137,10 +139,15 @@ pub struct Halo {
     /// The messages received ([`HaloArrivals`]), and their particles and states.
     arrivals: wgpu::Buffer,
     arrived: u32,
+    /// The density filter's index of the copies received (`halo_index`), grown to their
+    /// number by [`Halo::upload_restoring`].
+    restore_index: wgpu::Buffer,
     /// Cell layers along the cut axis.
     layers: u32,
     /// Cell layers of halo.
     pub thickness: u32,
+    /// How the next packing writes its copies ([`Halo::set_lean`]).
+    copies: Copies,
     /// Records `halo_out` holds.
     capacity: u32,
     /// Records it may grow to ([`records_capacity`]).
@@ -148,78 +155,6 @@ pub struct Halo {
     /// Times it grew ([`Halo::reserve`]).
     pub growths: u32,
     n: u32,
-}
-
-/// What the density filter's exchange sends of a halo copy: its owner's code word and
-/// corrected density, all that `halo_restore` gives the copy back (the filter reads no other
-/// field of a neighbour's), and with wide ids the id's high bits: 8 bytes a particle (12 with
-/// wide ids) where a copy is 40. Only the host and the ranks' messages hold it; the receiver
-/// uploads full records.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FilterRecord {
-    pub code: u32,
-    pub rho: f32,
-    /// The id's high bits as `HaloRecord::dest` holds them (0 with narrow ids).
-    pub id_high: u32,
-}
-
-impl From<&HaloCopy> for FilterRecord {
-    fn from(r: &HaloCopy) -> Self {
-        Self {
-            code: r.code,
-            rho: r.velrho[3],
-            id_high: r.dest >> DEST_ID_SHIFT << DEST_ID_SHIFT,
-        }
-    }
-}
-
-impl FilterRecord {
-    /// The record `halo_restore` reads: the code word, the id's high bits and ρ, the rest zero.
-    pub fn restored(&self) -> HaloRecord {
-        HaloRecord {
-            velrho: [0.0, 0.0, 0.0, self.rho],
-            code: self.code,
-            dest: self.id_high,
-            ..Default::default()
-        }
-    }
-
-    /// A density-filter message: a word saying whether the ids' high bits follow (only where
-    /// some are not 0, so narrow ids never send them), each record's code word and ρ, then
-    /// the high bits.
-    pub fn to_wire(records: &[Self]) -> Vec<u8> {
-        let wide = records.iter().any(|r| r.id_high != 0);
-        let mut words = vec![wide as u32];
-        words.extend(records.iter().flat_map(|r| [r.code, r.rho.to_bits()]));
-        words.extend(records.iter().map(|r| r.id_high).filter(|_| wide));
-        bytemuck::cast_slice(&words).to_vec()
-    }
-
-    pub fn from_wire(bytes: &[u8]) -> Result<Vec<Self>> {
-        let words: Vec<u32> = match bytes.len().is_multiple_of(4) {
-            true => bytemuck::pod_collect_to_vec(bytes),
-            false => Vec::new(),
-        };
-        let per = match words.first() {
-            Some(0) => 2,
-            Some(1) => 3,
-            _ => 0,
-        };
-        ensure!(
-            per > 0 && (words.len() - 1).is_multiple_of(per),
-            "a neighbour's density-filter message of {} bytes is not whole records",
-            bytes.len()
-        );
-        let n = (words.len() - 1) / per;
-        let (pairs, high) = words[1..].split_at(2 * n);
-        Ok((0..n)
-            .map(|k| Self {
-                code: pairs[2 * k],
-                rho: f32::from_bits(pairs[2 * k + 1]),
-                id_high: high.get(k).copied().unwrap_or(0),
-            })
-            .collect())
-    }
 }
 
 /// What a halo copy carries to the neighbour: what the neighbour's passes read of it (its
@@ -238,71 +173,58 @@ pub struct HaloCopy {
 /// Words of a message's header: its sections' counts.
 pub const HEADER_WORDS: u32 = 3;
 const RECORD_BYTES: usize = std::mem::size_of::<HaloRecord>();
-const COPY_BYTES: usize = std::mem::size_of::<HaloCopy>();
 
-/// A message to a neighbour as it travels, and as `halo_pack` writes it on the GPU: a header
-/// of three counts, then three sections: the migrants (whole [`HaloRecord`]s), the solid
-/// particles' stress states (records flagged [`crate::layout::DEST_SOLID_STATE`], one for each solid migrant
-/// or copy), the halo copies ([`HaloCopy`]s). The receiver uploads it as it came and
-/// `halo_unpack` writes it into the arrays; the host reads it record by record only to move
-/// the cuts (`Solver::redistribute`) and for the density filter's exchange.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Message {
-    pub migrants: Vec<HaloRecord>,
-    pub states: Vec<HaloRecord>,
-    pub copies: Vec<HaloCopy>,
+/// How a message carries its halo copies: as [`HaloCopy`]s (40 bytes), or `lean` as the
+/// density filter's exchange needs them (halo.wgsl `LEAN_WORDS`: its owner's code word and
+/// corrected ρ, all `halo_restore` gives a copy back, with wide ids the id's high bits too: 8
+/// or 12 bytes) and with no stress states.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Copies {
+    pub lean: bool,
+    pub wide_ids: bool,
 }
 
-impl Message {
-    /// The sections' counts in the header of `bytes`, which must be a whole message.
-    pub fn header(bytes: &[u8]) -> Result<[u32; 3]> {
-        let malformed = || {
-            anyhow!(
-                "a neighbour's halo message of {} bytes is malformed",
-                bytes.len()
-            )
-        };
-        let head = bytes
-            .get(..4 * HEADER_WORDS as usize)
-            .ok_or_else(malformed)?;
-        let counts: [u32; 3] = bytemuck::pod_read_unaligned(head);
-        let [migrants, states, copies] = counts.map(|c| c as u64);
-        let body = (migrants + states) * RECORD_BYTES as u64 + copies * COPY_BYTES as u64;
-        ensure!(
-            bytes.len() as u64 == 4 * HEADER_WORDS as u64 + body,
-            malformed()
-        );
-        Ok(counts)
+impl Copies {
+    /// Bytes of a copy.
+    pub fn bytes(self) -> usize {
+        match self.lean {
+            true => 4 * (2 + self.wide_ids as usize),
+            false => std::mem::size_of::<HaloCopy>(),
+        }
     }
+}
 
-    /// The message's bytes.
-    pub fn to_wire(&self) -> Vec<u8> {
-        let counts = [self.migrants.len(), self.states.len(), self.copies.len()];
-        let mut bytes = bytemuck::cast_slice(&counts.map(|c| c as u32)).to_vec();
-        bytes.extend_from_slice(bytemuck::cast_slice(&self.migrants));
-        bytes.extend_from_slice(bytemuck::cast_slice(&self.states));
-        bytes.extend_from_slice(bytemuck::cast_slice(&self.copies));
-        bytes
-    }
-
-    pub fn from_wire(bytes: &[u8]) -> Result<Self> {
-        let [migrants, states, _] = Self::header(bytes)?.map(|c| c as usize);
-        let at = 4 * HEADER_WORDS as usize;
-        let (whole, copies) = bytes[at..].split_at((migrants + states) * RECORD_BYTES);
-        let (migrants, states) = whole.split_at(migrants * RECORD_BYTES);
-        Ok(Self {
-            migrants: bytemuck::pod_collect_to_vec(migrants),
-            states: bytemuck::pod_collect_to_vec(states),
-            copies: bytemuck::pod_collect_to_vec(copies),
-        })
-    }
+/// The sections' counts in the header of a message to a neighbour, which must be whole. A
+/// message travels as `halo_pack` writes it on the GPU: a header of three counts, then three
+/// sections: the migrants (whole [`HaloRecord`]s), the solid particles' stress states (records
+/// flagged [`crate::layout::DEST_SOLID_STATE`], one for each solid migrant or copy), the halo
+/// copies ([`HaloCopy`]s). The receiver uploads it as it came, and `halo_unpack` (or, for the
+/// density filter, `halo_restore`) reads it there: the host reads no record.
+pub fn message_header(bytes: &[u8], copies: Copies) -> Result<[u32; 3]> {
+    let malformed = || {
+        anyhow!(
+            "a neighbour's halo message of {} bytes is malformed",
+            bytes.len()
+        )
+    };
+    let head = bytes
+        .get(..4 * HEADER_WORDS as usize)
+        .ok_or_else(malformed)?;
+    let counts: [u32; 3] = bytemuck::pod_read_unaligned(head);
+    let [migrants, states, n_copies] = counts.map(|c| c as u64);
+    let body = (migrants + states) * RECORD_BYTES as u64 + n_copies * copies.bytes() as u64;
+    ensure!(
+        bytes.len() as u64 == 4 * HEADER_WORDS as u64 + body,
+        malformed()
+    );
+    Ok(counts)
 }
 
 /// What one `halo_pack` found: the messages to the neighbours, the rank's own live particles,
 /// and where the free tail of the arrays starts.
 #[derive(Default)]
 pub struct Packed {
-    /// To the neighbour below and above, as they travel ([`Message`]).
+    /// To the neighbour below and above, as they travel ([`message_header`]).
     pub messages: [Vec<u8>; 2],
     /// The records of each section of each ([`HaloCounts::sizes`]).
     pub sizes: [u32; 6],
@@ -326,9 +248,9 @@ impl Packed {
 }
 
 /// Words of the message with section sizes `sizes` (as `message_words` in halo.wgsl).
-fn message_words(sizes: &[u32]) -> u64 {
+fn message_words(sizes: &[u32], copies: Copies) -> u64 {
     let records = (sizes[0] + sizes[1]) as u64 * (RECORD_BYTES / 4) as u64;
-    HEADER_WORDS as u64 + records + sizes[2] as u64 * (COPY_BYTES / 4) as u64
+    HEADER_WORDS as u64 + records + sizes[2] as u64 * (copies.bytes() / 4) as u64
 }
 
 impl Halo {
@@ -342,6 +264,7 @@ impl Halo {
         ctl: HaloCtl,
         layers: u32,
         records_per_particle: u32,
+        wide_ids: bool,
     ) -> Result<Self> {
         let max_binding = device.limits().max_storage_buffer_binding_size;
         let max_capacity = records_capacity(records_per_particle, b.n, max_binding);
@@ -358,7 +281,15 @@ impl Halo {
         );
         let records = records_buffer(device, ctl.capacity);
         let arrivals = uniform_init(device, "halo arrivals", &HaloArrivals::default());
-        let own = [&ctl_buffer, &counts, &records, &layer_load, &arrivals];
+        let restore_index = storage(device, "restore index", 4);
+        let own = [
+            &ctl_buffer,
+            &counts,
+            &records,
+            &layer_load,
+            &arrivals,
+            &restore_index,
+        ];
         let bufs = |p: usize| bindings(b, p, own, &b.rate);
         let kernel = |entry: &str| ParityKernel::new(device, module, entry, bufs);
         let sorted = |p: usize| bindings(b, p, own, &b.rate_sorted);
@@ -371,6 +302,7 @@ impl Halo {
                 ParityKernel::new(device, module, "halo_unpack", sorted)?,
             ],
             drop: kernel("halo_drop")?,
+            index: kernel("halo_index")?,
             restore: kernel("halo_restore")?,
             forget: kernel("halo_forget")?,
             count_layers: kernel("count_layers")?,
@@ -385,8 +317,13 @@ impl Halo {
             layer_load,
             arrivals,
             arrived: 0,
+            restore_index,
             layers,
             thickness: ctl.layers,
+            copies: Copies {
+                lean: false,
+                wide_ids,
+            },
             capacity: ctl.capacity,
             max_capacity,
             growths: 0,
@@ -418,12 +355,22 @@ impl Halo {
         self.capacity = grown.min(self.max_capacity as u64) as u32;
         self.growths += 1;
         self.records = records_buffer(device, self.capacity);
+        self.rebind(device, b)?;
+        let at = std::mem::offset_of!(HaloCtl, capacity) as u64;
+        queue.write_buffer(&self.ctl, at, bytemuck::bytes_of(&self.capacity));
+        log::debug!("halo records: room for {} now", self.capacity);
+        Ok(())
+    }
+
+    /// Binds the kernels to the pass's buffers again, one of them new.
+    fn rebind(&mut self, device: &wgpu::Device, b: &ParticleBuffers) -> Result<()> {
         let own = [
             &self.ctl,
             &self.counts,
             &self.records,
             &self.layer_load,
             &self.arrivals,
+            &self.restore_index,
         ];
         let bufs = |p: usize| bindings(b, p, own, &b.rate);
         let [unpack, unpack_sorted] = &mut self.unpack;
@@ -434,15 +381,13 @@ impl Halo {
             &mut self.pack,
             unpack,
             &mut self.drop,
+            &mut self.index,
             &mut self.restore,
             &mut self.forget,
             &mut self.count_layers,
         ] {
             kernel.rebind(device, bufs)?;
         }
-        let at = std::mem::offset_of!(HaloCtl, capacity) as u64;
-        queue.write_buffer(&self.ctl, at, bytemuck::bytes_of(&self.capacity));
-        log::debug!("halo records: room for {} now", self.capacity);
         Ok(())
     }
 
@@ -462,12 +407,21 @@ impl Halo {
     pub fn set_cuts(&self, queue: &wgpu::Queue, slabs: &Slabs, rank: usize, halos: bool) {
         let mut ctl = HaloCtl {
             capacity: self.capacity,
+            lean: self.copies.lean as u32,
             ..control(slabs, rank, self.thickness)
         };
         if !halos {
             (ctl.lower, ctl.upper) = (0, 0);
         }
         queue.write_buffer(&self.ctl, 0, bytemuck::bytes_of(&ctl));
+    }
+
+    /// Packs the copies of the next packings lean ([`Copies`]: for the density filter's
+    /// exchange), or as a step's exchange needs them.
+    pub fn set_lean(&mut self, queue: &wgpu::Queue, lean: bool) {
+        self.copies.lean = lean;
+        let at = std::mem::offset_of!(HaloCtl, lean) as u64;
+        queue.write_buffer(&self.ctl, at, bytemuck::bytes_of(&(lean as u32)));
     }
 
     /// The rank's own particles per cell layer along the cut axis, weighted as
@@ -523,7 +477,7 @@ impl Halo {
         queue.write_buffer(&self.counts, at, bytemuck::bytes_of(&tail));
     }
 
-    /// Uploads the messages the neighbours sent ([`Message`], at most two), as they came,
+    /// Uploads the messages the neighbours sent ([`message_header`], at most two), as they came,
     /// for the next `encode_unpack`; grows the buffer where they need it. Returns their
     /// particles (migrants and copies), which go after the free tail.
     pub fn upload_arrivals(
@@ -532,18 +486,22 @@ impl Halo {
         queue: &wgpu::Queue,
         b: &ParticleBuffers,
         messages: &[Vec<u8>],
+        copies: Copies,
     ) -> Result<u32> {
         ensure!(
             messages.len() <= 2,
             "{} halo messages arrived where a subdomain has two neighbours",
             messages.len()
         );
-        let mut arrivals = HaloArrivals::default();
+        let mut arrivals = HaloArrivals {
+            copy_words: copies.bytes() as u32 / 4,
+            ..Default::default()
+        };
         let mut words = 0u64;
         for (m, bytes) in messages.iter().enumerate() {
-            let [migrants, states, copies] = Message::header(bytes)?;
-            arrivals.messages[m] = [words as u32, migrants, states, copies];
-            arrivals.particles += migrants + copies;
+            let [migrants, states, n_copies] = message_header(bytes, copies)?;
+            arrivals.messages[m] = [words as u32, migrants, states, n_copies];
+            arrivals.particles += migrants + n_copies;
             arrivals.states += states;
             words += bytes.len() as u64 / 4;
         }
@@ -576,34 +534,41 @@ impl Halo {
         self.drop.dispatch(pass, q, self.n);
     }
 
-    /// Gives the halo copies of the arrays of parity `q`, excluded by `encode_drop`, their
-    /// owners' values in `received` again (for the density filter; [`Halo::encode_restore`]).
-    /// `received` is sorted by id, which `ids` says how to read.
-    pub fn upload_restored(
-        &self,
+    /// Uploads the lean copies the neighbours sent for the density filter (as
+    /// [`Halo::upload_arrivals`]) and makes the index `encode_restore` builds of them room for
+    /// them all: a power of two of entries at least twice their number, so that its probes
+    /// stay short.
+    pub fn upload_restoring(
+        &mut self,
+        device: &wgpu::Device,
         queue: &wgpu::Queue,
-        received: &mut [HaloRecord],
-        ids: IdSplit,
+        b: &ParticleBuffers,
+        messages: &[Vec<u8>],
     ) -> Result<()> {
-        ensure!(
-            received.len() <= self.capacity as usize,
-            "{} halo copies received for the density filter, more than the subdomain's {} \
-             records hold (Halo::reserve first)",
-            received.len(),
-            self.capacity
-        );
-        received.sort_unstable_by_key(|r| ids.record_id(r));
-        queue.write_buffer(&self.records, 0, bytemuck::cast_slice(received));
-        let counts = HaloCounts {
-            restored: received.len() as u32,
-            ..Default::default()
+        let lean = Copies {
+            lean: true,
+            ..self.copies
         };
-        queue.write_buffer(&self.counts, 0, bytemuck::bytes_of(&counts));
+        let copies = self.upload_arrivals(device, queue, b, messages, lean)?;
+        let entries = (2 * copies as u64).next_power_of_two();
+        if 4 * entries > self.restore_index.size() {
+            self.restore_index = storage(device, "restore index", 4 * entries);
+            self.rebind(device, b)?;
+        }
         Ok(())
     }
 
-    /// Restores the copies [`Halo::upload_restored`] gave, in the arrays of parity `q`.
+    /// Empties the index of the copies received; record outside a compute pass, before
+    /// `encode_restore`.
+    pub fn clear_index(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.clear_buffer(&self.restore_index, 0, None);
+    }
+
+    /// Gives the halo copies of the arrays of parity `q`, excluded by `encode_drop`, their
+    /// owners' code word and corrected density among the copies [`Halo::upload_restoring`]
+    /// uploaded (for the density filter), found by id in the index it builds first.
     pub fn encode_restore(&self, pass: &mut wgpu::ComputePass<'_>, q: usize) {
+        self.index.dispatch(pass, q, self.arrived);
         self.restore.dispatch(pass, q, self.n);
     }
 
@@ -618,8 +583,8 @@ impl Halo {
     pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Packed> {
         let counts: HaloCounts =
             bytemuck::pod_read_unaligned(&map_read(device, &self.counts_staging)?);
-        let lower = message_words(&counts.sizes[..3]) as usize;
-        let words = lower + message_words(&counts.sizes[3..]) as usize;
+        let lower = message_words(&counts.sizes[..3], self.copies) as usize;
+        let words = lower + message_words(&counts.sizes[3..], self.copies) as usize;
         let record_words = RECORD_BYTES / 4;
         if words > self.capacity as usize * record_words {
             return Ok(Packed {
@@ -644,6 +609,25 @@ mod tests {
     use super::*;
     use crate::layout::{DEST_MIGRANT, DEST_SOLID_STATE, DEST_UPPER};
 
+    /// A message as the tests build it ([`message_header`]).
+    #[derive(Debug, Default, PartialEq)]
+    struct Message {
+        migrants: Vec<HaloRecord>,
+        states: Vec<HaloRecord>,
+        copies: Vec<HaloCopy>,
+    }
+
+    impl Message {
+        fn to_wire(&self) -> Vec<u8> {
+            let counts = [self.migrants.len(), self.states.len(), self.copies.len()];
+            let mut bytes = bytemuck::cast_slice(&counts.map(|c| c as u32)).to_vec();
+            bytes.extend_from_slice(bytemuck::cast_slice(&self.migrants));
+            bytes.extend_from_slice(bytemuck::cast_slice(&self.states));
+            bytes.extend_from_slice(bytemuck::cast_slice(&self.copies));
+            bytes
+        }
+    }
+
     /// What `halo_pack` writes of `r` as a halo copy.
     fn copy_of(r: &HaloRecord) -> HaloCopy {
         HaloCopy {
@@ -652,49 +636,6 @@ mod tests {
             code: r.code,
             dest: r.dest,
         }
-    }
-
-    /// The filter's exchange sends an eighth of a record (with narrow ids) and gives
-    /// `halo_restore` everything it reads: the code word and the id's high bits (the id it
-    /// searches by) and ρ.
-    #[test]
-    fn a_filter_record_carries_what_the_restore_reads() {
-        assert_eq!(std::mem::size_of::<HaloRecord>(), 64);
-        let full = HaloRecord {
-            pos: Pos {
-                off: [0.1, 0.2, 0.3],
-                block: 7,
-            },
-            velrho: [1.0, -2.0, 0.5, 1003.25],
-            rate: [4.0; 4],
-            code: 0x1000_0abc,
-            dest: DEST_UPPER,
-            energy: [5.0, 6.0],
-        };
-        let lean = FilterRecord::from(&copy_of(&full));
-        let restored = lean.restored();
-        assert_eq!(
-            (restored.code, restored.velrho[3]),
-            (full.code, full.velrho[3])
-        );
-        assert_eq!(restored.dest & DEST_SOLID_STATE, 0);
-        let message = FilterRecord::to_wire(&[lean, lean]);
-        assert_eq!(message.len(), 4 + 2 * 8);
-        assert_eq!(FilterRecord::from_wire(&message).unwrap(), [lean, lean]);
-        // A wide id's high bits travel too, and come back where `halo_restore` reads them.
-        let wide = HaloRecord {
-            dest: DEST_UPPER | 5 << DEST_ID_SHIFT,
-            ..full
-        };
-        let ids = IdSplit::for_run(0, Some(4));
-        let lean = FilterRecord::from(&copy_of(&wide));
-        let message = FilterRecord::to_wire(&[lean, FilterRecord::from(&copy_of(&full))]);
-        assert_eq!(message.len(), 4 + 2 * 12);
-        let back = FilterRecord::from_wire(&message).unwrap();
-        assert_eq!(ids.record_id(&back[0].restored()), ids.record_id(&wide));
-        assert_eq!(ids.record_id(&back[1].restored()), ids.record_id(&full));
-        assert_ne!(ids.record_id(&wide), ids.record_id(&full));
-        assert!(FilterRecord::from_wire(&message[..message.len() - 4]).is_err());
     }
 
     /// The packing buffer holds two records an entry (four with solids), but never more than
@@ -708,8 +649,8 @@ mod tests {
     }
 
     /// A halo message carries migrants and solid states whole and copies lean (40 bytes), in
-    /// sections after a header of their counts, and reads back as it was sent; a message that
-    /// is not whole is refused.
+    /// sections after a header of their counts, which the receiver reads back and checks
+    /// against the message's length; a message that is not whole is refused.
     #[test]
     fn a_halo_message_sends_copies_lean_and_the_rest_whole() {
         let record = |k: u32, dest: u32| HaloRecord {
@@ -734,14 +675,31 @@ mod tests {
         let bytes = sent.to_wire();
         assert_eq!(std::mem::size_of::<HaloCopy>(), 40);
         assert_eq!(bytes.len(), 12 + 2 * 64 + 3 * 40);
-        assert_eq!(Message::header(&bytes).unwrap(), [1, 1, 3]);
-        assert_eq!(Message::from_wire(&bytes).unwrap(), sent);
-        assert_eq!(message_words(&[1, 1, 3]) * 4, bytes.len() as u64);
-        assert!(Message::from_wire(&bytes[..bytes.len() - 4]).is_err());
-        assert!(Message::from_wire(&[]).is_err());
-        assert_eq!(
-            Message::from_wire(&Message::default().to_wire()).unwrap(),
-            Message::default()
-        );
+        let whole = Copies {
+            lean: false,
+            wide_ids: false,
+        };
+        assert_eq!(message_header(&bytes, whole).unwrap(), [1, 1, 3]);
+        assert_eq!(message_words(&[1, 1, 3], whole) * 4, bytes.len() as u64);
+        assert!(message_header(&bytes[..bytes.len() - 4], whole).is_err());
+        assert!(message_header(&bytes[..8], whole).is_err());
+        let empty = Message::default().to_wire();
+        assert_eq!(message_header(&empty, whole).unwrap(), [0; 3]);
+        // The density filter's copies: 8 bytes, 12 with wide ids, and no states.
+        let lean = Copies {
+            lean: true,
+            wide_ids: false,
+        };
+        let wide = Copies {
+            wide_ids: true,
+            ..lean
+        };
+        let mut filter = bytemuck::cast_slice(&[0u32, 0, 3]).to_vec();
+        filter.extend_from_slice(&[0; 3 * 8]);
+        assert_eq!(message_header(&filter, lean).unwrap(), [0, 0, 3]);
+        assert!(message_header(&filter, wide).is_err());
+        filter.extend_from_slice(&[0; 3 * 4]);
+        assert_eq!(message_header(&filter, wide).unwrap(), [0, 0, 3]);
+        assert_eq!(message_words(&[0, 0, 3], wide) * 4, filter.len() as u64);
     }
 }

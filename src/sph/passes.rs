@@ -96,7 +96,8 @@ impl Passes {
             .map(|ctl| {
                 let layers = grid.cells[ctl.axis as usize];
                 let records = halo::records_per_particle(sc);
-                Halo::new(device, &shader(&halo::SHADER)?, b, ctl, layers, records)
+                let module = shader(&halo::SHADER)?;
+                Halo::new(device, &module, b, ctl, layers, records, cfg.ids.wide)
             })
             .transpose()?;
         let policy = sc.time.overlap_exchange;

@@ -12,9 +12,8 @@
 
 use std::ops::Range;
 
-use anyhow::{anyhow, bail, ensure, Context, Result};
+use anyhow::{bail, ensure, Context, Result};
 
-use super::halo::{FilterRecord, Message};
 use super::initial::Packed;
 use super::passes::Passes;
 use super::profile::Recorder;
@@ -64,6 +63,10 @@ pub struct Ranked {
     /// The present cuts (set once the subdomain is made), and how often they moved.
     pub slabs: Option<Slabs>,
     pub rebalances: u32,
+    /// The most rounds one move of the cuts took (`Solver::redistribute`: more than one where
+    /// a cut moved past a neighbour's slab).
+    #[serde(default)]
+    pub moving_rounds: u32,
     /// The whole run's steps when these counts were taken.
     pub steps: u64,
     /// Each cell layer where inlet particles join (the back of a buffer) and the rank that
@@ -500,59 +503,46 @@ impl Solver {
         self.parity = 1 - self.parity;
     }
 
-    /// Sends every particle to its owner under `next` (any rank), then sorts, so that the next
-    /// step's packing finds the free tail; the last rates follow the sort.
+    /// Sends every particle to its owner under `next`, then sorts, so that the next step's
+    /// packing finds the free tail; the last rates follow the sort. A particle moves one
+    /// neighbour a round, packed, swapped and unpacked as a step's migrants are (no record
+    /// passes through the host), towards its owner; the rounds end when no rank sent one: one
+    /// round where no cut moved past a neighbour's slab, at most one per rank.
     fn redistribute(&mut self, next: Slabs, ranks: &dyn Ranks) -> Result<()> {
-        let (rank, size, p) = (ranks.rank(), ranks.size(), self.parity);
+        let rank = ranks.rank();
         // Migrants only: no halo this time.
         self.passes.halo().set_cuts(&self.queue, &next, rank, false);
-        let packed = self.pack(false, p, |passes, mut pass| {
-            passes.halo().encode_pack(&mut pass, p)
-        })?;
-        let halo = self.passes.halo();
-        self.submit_pass("halo drop", |pass| {
-            halo.encode_drop(pass, p);
-            halo.encode_forget(pass, p);
-        });
-        // The host reads the records here, the one place a message goes to any rank: each
-        // migrant to its owner under `next`, its stress state (a solid's) where it goes.
-        let mut to = vec![Message::default(); size];
-        let mut owners = std::collections::HashMap::new();
-        for bytes in &packed.messages {
-            let message = Message::from_wire(bytes)?;
-            for r in message.migrants {
-                let owner = next.owner(layer_of(&self.grid, next.axis, r.pos) as u32);
-                owners.insert(self.ids.record_id(&r), owner);
-                to[owner].migrants.push(r);
+        let mut rounds = 0u32;
+        loop {
+            let p = self.parity;
+            let mut packed = self.pack(false, p, |passes, mut pass| {
+                passes.halo().encode_pack(&mut pass, p)
+            })?;
+            if ranks.sum_in_rank_order(&[packed.migrants() as f64])[0] == 0.0 {
+                break;
             }
-            for r in message.states {
-                let id = self.ids.record_id(&r);
-                let owner = (owners.get(&id).copied())
-                    .ok_or_else(|| anyhow!("the stress state of solid particle {id} came alone"))?;
-                to[owner].states.push(r);
-            }
+            ensure!(
+                (rounds as usize) < ranks.size(),
+                "particles still moving to their ranks after {rounds} rounds of moving the cuts"
+            );
+            rounds += 1;
+            let halo = self.passes.halo();
+            self.submit_pass("halo drop", |pass| {
+                halo.encode_drop(pass, p);
+                halo.encode_forget(pass, p);
+            });
+            let (incoming, _) = self.swap(std::mem::take(&mut packed.messages), ranks)?;
+            self.place_arrivals(&incoming, None, p, packed.tail)?;
+            let halo = self.passes.halo();
+            self.submit_pass("halo unpack", |pass| halo.encode_unpack(pass, p, false));
+            self.sort_in_place();
         }
-        ensure!(
-            to[rank] == Message::default(),
-            "rank {rank} packed its own particles"
-        );
-        let others: Vec<usize> = (0..size).filter(|&q| q != rank).collect();
-        let sends: Vec<(usize, Vec<u8>)> = others.iter().map(|&q| (q, to[q].to_wire())).collect();
-        let mut arrived = Message::default();
-        for bytes in ranks.exchange(&sends, &others)? {
-            let message = Message::from_wire(&bytes)?;
-            arrived.migrants.extend(message.migrants);
-            arrived.states.extend(message.states);
-        }
-        self.place_arrivals(&[arrived.to_wire()], None, p, packed.tail)?;
-        let halo = self.passes.halo();
-        self.submit_pass("halo unpack", |pass| halo.encode_unpack(pass, p, false));
-        self.sort_in_place();
         let halo = self.passes.halo();
         halo.set_cuts(&self.queue, &next, rank, true);
         let ranked = self.ranked.as_mut().expect("a subdomain");
         ranked.slabs = Some(next);
         ranked.rebalances += 1;
+        ranked.moving_rounds = ranked.moving_rounds.max(rounds);
         self.faults.check()
     }
 
@@ -630,10 +620,11 @@ impl Solver {
         let overlaps = (self.passes.overlap.as_ref()).is_some_and(|o| o.choice.overlaps(k));
         let interior = overlaps.then(|| self.submit_interior(p));
 
-        let incoming = self.swap(std::mem::take(&mut packed.messages), ranks)?;
+        let (incoming, bytes) = self.swap(std::mem::take(&mut packed.messages), ranks)?;
         self.share_tl_positions(ranks)?;
         let swapped_at = std::time::Instant::now();
         let ranked = self.ranked.as_mut().expect("a subdomain");
+        ranked.bytes_sent += bytes;
         let first_tail = ranked.first_tail.take();
         ranked.exchanges += 1;
         ranked.migrants_sent += packed.migrants() as u64;
@@ -804,9 +795,9 @@ impl Solver {
     }
 
     /// Sends the messages `lower` and `upper` to the neighbour below and above (where there is
-    /// one), and returns what the neighbours sent this rank (every rank together); counts the
-    /// bytes sent.
-    fn swap(&mut self, [lower, upper]: [Vec<u8>; 2], ranks: &dyn Ranks) -> Result<Vec<Vec<u8>>> {
+    /// one), and returns what the neighbours sent this rank (every rank together) and the
+    /// bytes this rank sent.
+    fn swap(&self, [lower, upper]: [Vec<u8>; 2], ranks: &dyn Ranks) -> Result<(Vec<Vec<u8>>, u64)> {
         let rank = ranks.rank();
         let mut sends = Vec::new();
         if rank > 0 {
@@ -816,56 +807,60 @@ impl Solver {
             sends.push((rank + 1, upper));
         }
         let from: Vec<usize> = sends.iter().map(|(to, _)| *to).collect();
-        let received = ranks.exchange(&sends, &from)?;
-        let ranked = self.ranked.as_mut().expect("a subdomain");
-        ranked.bytes_sent += sends.iter().map(|(_, b)| b.len() as u64).sum::<u64>();
-        Ok(received)
+        let bytes = sends.iter().map(|(_, b)| b.len() as u64).sum();
+        Ok((ranks.exchange(&sends, &from)?, bytes))
     }
 
     /// The density filter of a step it fires on (`DensityFilter::fires_after`), over ranks: it
     /// reads the corrected densities of the neighbours, the halo copies' included, which
     /// `halo_drop` excluded before the corrector. So the ranks pack their own halo particles
-    /// again, corrected, and swap their code words and densities ([`FilterRecord`], 8 bytes
-    /// where a record is 64); each rank gives its copies their owners' values back
-    /// (`halo_restore`), filters, excludes them again and frees the step's excluded entries
-    /// (every rank together).
+    /// again, corrected, and swap them as a step swaps its halo; each rank gives its copies
+    /// their owners' code word and density back (`halo_restore`, which finds them by id),
+    /// filters, excludes them again and frees the step's excluded entries (every rank
+    /// together).
     fn filter_over_ranks(&mut self, ranks: &dyn Ranks) -> Result<()> {
         let q = self.parity;
+        let halo = self
+            .passes
+            .halo
+            .as_mut()
+            .expect("a subdomain has a halo pass");
+        halo.set_lean(&self.queue, true);
         let packed = self.pack(false, q, |passes, mut pass| {
             passes.halo().encode_pack(&mut pass, q)
-        })?;
+        });
+        let halo = self
+            .passes
+            .halo
+            .as_mut()
+            .expect("a subdomain has a halo pass");
+        halo.set_lean(&self.queue, false);
+        let mut packed = packed?;
         ensure!(
             packed.migrants() == 0,
             "{} particles outside the subdomain after the corrector",
             packed.migrants()
         );
-        // The host reads the copies here (on the filter's steps only) to send 8 bytes of each.
-        let lean = |bytes: &[u8]| -> Result<Vec<u8>> {
-            let copies = Message::from_wire(bytes)?.copies;
-            let records: Vec<FilterRecord> = copies.iter().map(FilterRecord::from).collect();
-            Ok(FilterRecord::to_wire(&records))
-        };
-        let [lower, upper] = &packed.messages;
-        let incoming = self.swap([lean(lower)?, lean(upper)?], ranks)?;
-        let mut restored = Vec::new();
-        for bytes in &incoming {
-            restored.extend(
-                FilterRecord::from_wire(bytes)?
-                    .iter()
-                    .map(FilterRecord::restored),
-            );
-        }
-        let mut incoming = restored;
-        self.reserve_records(incoming.len())?;
+        let (incoming, bytes) = self.swap(std::mem::take(&mut packed.messages), ranks)?;
+        self.ranked.as_mut().expect("a subdomain").bytes_sent += bytes;
+        let halo = self
+            .passes
+            .halo
+            .as_mut()
+            .expect("a subdomain has a halo pass");
+        halo.upload_restoring(&self.device, &self.queue, &self.buffers, &incoming)?;
         let halo = self.passes.halo();
         let filter = self.passes.density_filter.as_ref().expect("a filter");
-        halo.upload_restored(&self.queue, &mut incoming, self.ids)?;
-        self.submit_pass("density filter over ranks", |pass| {
-            halo.encode_restore(pass, q);
-            filter.encode(pass, q);
-            halo.encode_drop(pass, q);
-            halo.encode_forget(pass, q);
-        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        halo.clear_index(&mut encoder);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            halo.encode_restore(&mut pass, q);
+            filter.encode(&mut pass, q);
+            halo.encode_drop(&mut pass, q);
+            halo.encode_forget(&mut pass, q);
+        }
+        self.queue.submit([encoder.finish()]);
         self.faults.check()
     }
 
@@ -888,7 +883,12 @@ impl Solver {
             .halo
             .as_mut()
             .expect("a subdomain has a halo pass");
-        let particles = halo.upload_arrivals(&self.device, &self.queue, &self.buffers, incoming)?;
+        let copies = halo::Copies {
+            lean: false,
+            wide_ids: self.ids.wide,
+        };
+        let b = &self.buffers;
+        let particles = halo.upload_arrivals(&self.device, &self.queue, b, incoming, copies)?;
         let free = self.buffers.n.saturating_sub(tail);
         if particles > free {
             bail!(
