@@ -2,11 +2,12 @@
 // cell grid along one axis, each rank owning the cell layers [own_lo, own_hi).
 // `halo_pack`, after the predictor: every live particle outside the own layers has crossed a
 // cut and migrates (packed with its last rates); every own particle within `layers` of a cut
-// with a neighbour is packed as that neighbour's halo. `halo_count` counts them first, so that
-// `halo_pack` writes each neighbour's message as it travels (`Message`): the host reads the
-// messages back and sends them as they are, with no loop over particles, and uploads what it
-// received as it came; `halo_unpack` writes the arrivals into the arrays after `tail`, the
-// first entry of the last sort's free slot. Free entries: `halo_forget` gives every entry excluded since the sort (the
+// with a neighbour is packed as that neighbour's halo. `halo_count` counts them first and
+// `halo_layout` lays the messages out, so that `halo_pack` writes each neighbour's message as
+// it travels (`sph::halo::message_header`): the host reads the messages back and sends them as
+// they are, with no loop over particles, and uploads what it received as it came;
+// `halo_unpack` writes the arrivals into the arrays after `tail`, the first entry of the last
+// sort's free slot. Free entries: `halo_forget` gives every entry excluded since the sort (the
 // halo copies and migrants sent, a particle the corrector found non-finite) the free id at the
 // step's end, so the next sort puts them in the free slot, apart from the excluded slot, where
 // the inlet particles waiting behind their buffers keep their ids (`inlet_flow` wakes them by
@@ -36,6 +37,8 @@ struct HaloCounts {
     tail: u32,              // the first free entry: where `halo_unpack` writes the arrivals
     sizes: array<atomic<u32>, 6>,   // records of each stream (`halo_count`)
     filled: array<atomic<u32>, 6>,  // of them written so far (`halo_pack`)
+    starts: array<u32, 6>,  // each stream's first word in `halo_out` (`halo_layout`)
+    fits: u32,              // 1: the messages fit `halo_out`
 }
 
 // Mirrored by `layout::HaloRecord`.
@@ -167,15 +170,6 @@ fn message_words(nb: u32) -> u32 {
     return HEADER_WORDS + RECORD_WORDS * records + copy_words() * atomicLoad(&halo_counts.sizes[b + 2u]);
 }
 
-// The first word of stream `s`'s records: the messages lie one after the other.
-fn stream_start(s: u32) -> u32 {
-    let nb = s / 3u;
-    var at = select(0u, message_words(0u), nb == 1u) + HEADER_WORDS;
-    for (var k = 0u; k < s % 3u; k++) {
-        at += RECORD_WORDS * atomicLoad(&halo_counts.sizes[3u * nb + k]);
-    }
-    return at;
-}
 
 fn put_vec4(at: u32, v: vec4<f32>) {
     for (var c = 0u; c < 4u; c++) {
@@ -260,16 +254,16 @@ fn pack_into(i: u32, s: u32) {
     let r = HaloRecord(pos[i], velrho[i], rate[i], code[i], dest, e);
     let k = atomicAdd(&halo_counts.filled[s], 1u);
     if (s % 3u == SECTION_COPIES) {
-        put_copy(stream_start(s) + copy_words() * k, r);
+        put_copy(halo_counts.starts[s] + copy_words() * k, r);
     } else {
-        put_record(stream_start(s) + RECORD_WORDS * k, r);
+        put_record(halo_counts.starts[s] + RECORD_WORDS * k, r);
     }
     if (sends_state(i)) {
         let t = states_stream(s);
         let st = solid[solid_slot(i)];
         let state = HaloRecord(Pos(st.tau_b, 0u), st.tau_a, st.rate_a, code[i],
             dest | DEST_SOLID_STATE, st.rate_b);
-        put_record(stream_start(t) + RECORD_WORDS * atomicAdd(&halo_counts.filled[t], 1u), state);
+        put_record(halo_counts.starts[t] + RECORD_WORDS * atomicAdd(&halo_counts.filled[t], 1u), state);
     }
 }
 
@@ -301,22 +295,33 @@ fn halo_count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     }
 }
 
-// Writes the two messages `halo_count` counted, headers first; nothing where they do not fit
-// (the host grows `halo_out` and packs again).
+// Lays out the two messages `halo_count` counted, one after the other: writes their headers
+// and where each stream starts; nothing where they do not fit (the host grows `halo_out` and
+// packs again).
+@compute @workgroup_size(1)
+fn halo_layout() {
+    let lower = message_words(0u);
+    halo_counts.fits = u32(lower + message_words(1u) <= halo_ctl.capacity * RECORD_WORDS);
+    if (halo_counts.fits == 0u) {
+        return;
+    }
+    for (var nb = 0u; nb < 2u; nb++) {
+        let header = select(0u, lower, nb == 1u);
+        var at = header + HEADER_WORDS;
+        for (var k = 0u; k < 3u; k++) {
+            let size = atomicLoad(&halo_counts.sizes[3u * nb + k]);
+            halo_out[header + k] = size;
+            halo_counts.starts[3u * nb + k] = at;
+            at += select(RECORD_WORDS, copy_words(), k == SECTION_COPIES) * size;
+        }
+    }
+}
+
+// Writes the particles' records into the messages `halo_layout` laid out.
 @compute @workgroup_size(WG)
 fn halo_pack(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
-    let lower = message_words(0u);
-    if (lower + message_words(1u) > halo_ctl.capacity * RECORD_WORDS) {
-        return;
-    }
-    if (i == 0u) {
-        for (var k = 0u; k < 3u; k++) {
-            halo_out[k] = atomicLoad(&halo_counts.sizes[k]);
-            halo_out[lower + k] = atomicLoad(&halo_counts.sizes[3u + k]);
-        }
-    }
-    if (i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
+    if (halo_counts.fits == 0u || i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
         return;
     }
     let s = streams_of(i);

@@ -400,7 +400,7 @@ pub struct HaloCtl {
 
 /// Mirrors `HaloCounts` in shaders/halo.wgsl: the rank's own particles, the free tail, and the
 /// records of each stream of the two messages (3 × neighbour + section: migrants, solid stress
-/// states, halo copies), counted and written.
+/// states, halo copies), counted and written, where each starts and whether they fit.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct HaloCounts {
@@ -408,6 +408,8 @@ pub struct HaloCounts {
     pub tail: u32,
     pub sizes: [u32; 6],
     pub filled: [u32; 6],
+    pub starts: [u32; 6],
+    pub fits: u32,
 }
 
 /// Mirrors `HaloArrivals` in shaders/halo.wgsl: the messages received, one after the other
@@ -807,7 +809,7 @@ mod tests {
             &halo::SHADER,
             "HaloCounts",
             HaloCounts,
-            [owned, tail, sizes, filled]
+            [owned, tail, sizes, filled, starts, fits]
         );
         check_layout!(
             &halo::SHADER,

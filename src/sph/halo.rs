@@ -121,6 +121,7 @@ pub fn control(slabs: &Slabs, rank: usize, layers: u32) -> HaloCtl {
 pub struct Halo {
     tail: ParityKernel,
     count: ParityKernel,
+    layout: ParityKernel,
     pack: ParityKernel,
     /// `halo_unpack` with the arrivals' last rates into `rate`, and into `rate_sorted` (after
     /// an overlapped step's first sort).
@@ -296,6 +297,7 @@ impl Halo {
         Ok(Self {
             tail: kernel("halo_tail")?,
             count: kernel("halo_count")?,
+            layout: kernel("halo_layout")?,
             pack: kernel("halo_pack")?,
             unpack: [
                 kernel("halo_unpack")?,
@@ -378,6 +380,7 @@ impl Halo {
         for kernel in [
             &mut self.tail,
             &mut self.count,
+            &mut self.layout,
             &mut self.pack,
             unpack,
             &mut self.drop,
@@ -461,6 +464,7 @@ impl Halo {
     pub fn encode_pack(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
         self.tail.dispatch_groups(pass, p, 1);
         self.count.dispatch(pass, p, self.n);
+        self.layout.dispatch_groups(pass, p, 1);
         self.pack.dispatch(pass, p, self.n);
     }
 
