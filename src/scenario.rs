@@ -172,7 +172,7 @@ pub struct TimeControl {
     /// Which particle outputs hold the boundary particles that have not moved.
     pub output_boundary: OutputBoundary,
     /// Whether a run over ranks overlaps the exchange with the sums that need nothing from
-    /// it, where the case allows (`sph::overlap::unsupported`); the results are the same.
+    /// it (`sph::overlap`); the results are the same.
     pub overlap_exchange: OverlapExchange,
     /// The run warns when the fluid's density varies from ρ0 by more than this fraction (the
     /// weakly-compressible limit), and keeps only outputs within it when it stops unstable.

@@ -1136,7 +1136,7 @@ fn ranks_with_an_inlet_inject_what_one_run_injects() {
     Comparison {
         test: "ranks_with_an_inlet_inject_what_one_run_injects",
         case: "cases/dam_break_2d.toml",
-        set: &["particles.dx_m=0.0073"],
+        set: &["particles.dx_m=0.0073", "time.overlap_exchange=\"always\""],
         ranks: 2,
         steps: 300,
         uneven: true,
@@ -1204,7 +1204,10 @@ fn ranks_hold_the_water_with_an_elastic_gate_as_one_run() {
     Comparison {
         test: "ranks_hold_the_water_with_an_elastic_gate_as_one_run",
         case: "cases/elastic_gate_2d.toml",
-        set: &["solid[0].formulation=\"updated_lagrangian\""],
+        set: &[
+            "solid[0].formulation=\"updated_lagrangian\"",
+            "time.overlap_exchange=\"always\"",
+        ],
         ranks: 2,
         steps: 300,
         ..Default::default()

@@ -1,6 +1,10 @@
 //! A subdomain's step that overlaps the exchange with the sums of the particles that read
 //! nothing it brings (shaders/overlap.wgsl; issue 32, docs/scaling.md): the second sort's two
-//! rates a particle. Which cases can: [`unsupported`].
+//! rates a particle. Every case can: what a pass writes between the sort and the sums (the
+//! fixed ghosts' and the solids' values, the extrapolated inlet buffers' pressure) it writes
+//! after each sort, and the first half keeps a layer further from the cuts than those read;
+//! what comes after the sums (the solids' stress rates, the bodies' loads) runs after the
+//! second; the bodies and the solids' stress are read by id, which no sort moves.
 
 use anyhow::Result;
 
@@ -10,33 +14,13 @@ use crate::gpu::kernel::ShaderModule;
 use crate::gpu::shader::Shader;
 use crate::gpu::Kernel;
 use crate::layout::HaloCtl;
-use crate::scenario::{Kind, OverlapExchange, Scenario};
+use crate::scenario::OverlapExchange;
 
 pub const SHADER: Shader = Shader {
     name: "overlap",
     source: include_str!("../../shaders/overlap.wgsl"),
     libs: &[],
 };
-
-/// What keeps a case's subdomains from overlapping the exchange (they then take the serial
-/// step), or None. Each of these passes reads or writes something between the sort and the
-/// interaction, or after it, that the two halves of the step would have to split too: the
-/// solids' interface pressure and stress rates, and the inlets' pressure (outlets: the same
-/// pass). Fixed ghosts need none: the ghost pass runs after each sort, and the first half
-/// keeps a layer further from the cuts. Nor do bodies: the sums read them by id, and their
-/// index into the arrays (`body_index`) and their loads come after the second sort.
-pub fn unsupported(sc: &Scenario) -> Option<&'static str> {
-    let has = |kinds: &[Kind]| sc.particles.iter().any(|p| kinds.contains(&p.kind));
-    [
-        (has(&[Kind::Solid, Kind::SolidClamped]), "elastic solids"),
-        (
-            !sc.inlets.is_empty() || !sc.outlets.is_empty(),
-            "inlets or outlets",
-        ),
-    ]
-    .into_iter()
-    .find_map(|(has, what)| has.then_some(what))
-}
 
 /// Whether a particle in cell layer `layer` of the subdomain `ctl` reads nothing the exchange
 /// brings, so that its sums run before it arrives: a layer more than the halo is thick inside

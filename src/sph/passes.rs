@@ -62,8 +62,8 @@ pub struct Passes {
     pub points: Option<PointTracker>,
     /// A subdomain's halo and migrants (`Solver::subdomain`); None in a whole run.
     pub halo: Option<Halo>,
-    /// A subdomain whose steps may overlap the exchange (`overlap::unsupported`,
-    /// `time.overlap_exchange`): its choice, and its second sort's rates.
+    /// A subdomain whose steps may overlap the exchange (`time.overlap_exchange`): its
+    /// choice, and its second sort's rates.
     pub overlap: Option<Overlap>,
 }
 
@@ -101,9 +101,7 @@ impl Passes {
             })
             .transpose()?;
         let policy = sc.time.overlap_exchange;
-        let overlapped = halo
-            .as_ref()
-            .filter(|_| policy != OverlapExchange::Never && overlap::unsupported(sc).is_none());
+        let overlapped = halo.as_ref().filter(|_| policy != OverlapExchange::Never);
         Ok(Self {
             cell_list: CellList::new(
                 device,
@@ -216,8 +214,12 @@ impl Passes {
     pub(super) fn record_before_arrival(&self, r: &mut Recorder<'_>, p: usize) {
         let q = 1 - p;
         self.record_sort(r, p, None);
-        // The fixed ghosts' values, which those sums read (again after the second sort).
+        // The fixed ghosts' and solids' values and the inlet buffers' pressure, which those sums
+        // read (again after the second sort).
         r.stage("ghost", |pass| self.ghost.encode(pass, q));
+        if let Some(o) = &self.open_boundaries {
+            r.stage("inlet_pressure", |pass| o.encode_pressure(pass, q));
+        }
         let halo = self.halo();
         r.stage("halo_tail", |pass| halo.encode_tail(pass, q));
     }
