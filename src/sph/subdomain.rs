@@ -370,10 +370,12 @@ impl Solver {
             return Ok(false);
         };
         if let Some((layer, holder)) = self.joining_beyond_neighbours(&next) {
-            log::debug!(
-                "rank {}: cuts kept: under {next:?} the inlet particles rank {holder} holds \
-                 would join in layer {layer}, beyond its neighbours",
-                ranks.rank()
+            log::info!(
+                "rank {}: cuts kept, imbalance {:.1} %: under {next:?} the inlet particles \
+                 rank {holder} holds would join in layer {layer}, beyond its neighbours (the \
+                 cuts do not move an inlet's waiting particles yet)",
+                ranks.rank(),
+                100.0 * slabs.imbalance(&load),
             );
             return Ok(false);
         }
