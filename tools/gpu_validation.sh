@@ -30,7 +30,7 @@ validate:floating_box_2d validate:water_entry_cylinder_2d validate:water_entry_c
 validate:sloshing_2d validate:oscillating_plate_2d validate:oscillating_plate_tl_2d
 validate:elastic_gate_2d sloshing_3d street_flood_3d street_flood_3d_open validate:dam_break_3d
 spheric_0.04 spheric_0.0323529 spheric_0.025
-validate:hydrostatic_2d validate:dam_break_2d validate:dam_break_lobovsky_2d"
+validate:hydrostatic_2d validate:dam_break_2d validate:dam_break_lobovsky_2d mpi_np1 mpi_np2"
 items=${ITEMS:-$all}
 
 [ -x "$wgsph" ] || { echo "no engine at $wgsph: cargo build --release, or set WGSPH" >&2; exit 2; }
@@ -67,6 +67,12 @@ command_of() {
     # SPHERIC Test 2's 6 s at coarser dx, probes on the box's faces every 5 ms: with the
     # shipped dx (validate:dam_break_3d) the convergence study of docs/validation.md.
     spheric_*) echo "$wgsph run cases/dam_break_3d.toml --set particles.dx_m=${item#spheric_} --set time.probe_every_s=0.005 --set time.output_every_s=1 --out $dir" ;;
+    # Issue 32: two ranks sharing the GPU against one rank, on the same 1 M particles
+    # (docs/scaling.md); needs an engine built with --features mpi, and mpirun.
+    mpi_np1 | mpi_np2)
+        command -v mpirun >/dev/null && grep -q MPI_Init "$wgsph" || return 1
+        echo "env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe -np ${item#mpi_np} $wgsph bench cases/dam_break_3d.toml --set particles.dx_m=0.01 --steps 300"
+        ;;
     *) return 1 ;;
     esac
 }
@@ -78,7 +84,7 @@ for item in $items; do
     [[ $item == validate:* ]] && dir="$work/validate" && rm -f "$dir/report.md"
     left=$((budget - ($(date +%s) - start)))
     if ! cmd=$(command_of "$item" "$dir"); then
-        echo "$item: skipped (unknown item, or no VALIDATION_TESTS for it)" | tee -a "$summary"
+        echo "$item: skipped (unknown item, or what it needs is missing: VALIDATION_TESTS, mpirun)" | tee -a "$summary"
         continue
     fi
     if [ "$left" -lt 20 ]; then
