@@ -60,7 +60,7 @@ const DEST_MIGRANT: u32 = 2u;
 const DEST_SOLID_STATE: u32 = 4u;
 const DEST_ID_SHIFT: u32 = 3u;
 
-// A message to a neighbour, as it travels (`sph::halo::Message`): a header of three counts,
+// A message to a neighbour, as it travels (`sph::halo::message_header`): a header of three counts,
 // one per section, then the sections' records. Migrants go whole (they go on integrating their
 // last rates and energy), solid stress states too; a halo copy carries only what the
 // receiver's passes read of it (its place, (v, ρ), code word and dest), which its copy in the
@@ -126,6 +126,26 @@ fn record_id(r: HaloRecord) -> u32 {
 // Whether a particle in cell layer `layer` has left the rank's own layers (a migrant).
 fn outside(layer: u32) -> bool {
     return layer < halo_ctl.own_lo || layer >= halo_ctl.own_hi;
+}
+
+// Whether the packing takes entry i: a live particle; and while the cuts move
+// (`halo_ctl.moving`), an excluded one that keeps its id outside the slab, so that the rank
+// whose layers hold its place holds it: an inlet particle waiting behind its buffer (whose
+// place is where it will join, so that the rank that wakes it owns it then), or one drained
+// or gone out of the domain (which the ranks write as one whole run writes them).
+fn packs(i: u32) -> bool {
+    if (code_kind(code[i]) != KIND_EXCLUDED) {
+        return true;
+    }
+    return halo_ctl.moving != 0u && particle_id(i) != FREE_ID && outside(layer_of(pos[i]));
+}
+
+// Makes entry i free: excluded, of the free id.
+fn free_entry(i: u32) {
+    code[i] = with_kind(FREE_ID & ID_LOW_MASK, KIND_EXCLUDED);
+    if (WIDE_IDS) {
+        code[params.n_particles + i] = FREE_ID >> ID_LOW_BITS;
+    }
 }
 
 const NO_STREAM: u32 = 0xffffffffu;
@@ -277,10 +297,10 @@ fn halo_tail() {
 @compute @workgroup_size(WG)
 fn halo_count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
-    if (i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
+    if (i >= params.n_particles || !packs(i)) {
         return;
     }
-    if (!outside(layer_of(pos[i]))) {
+    if (code_kind(code[i]) != KIND_EXCLUDED && !outside(layer_of(pos[i]))) {
         atomicAdd(&halo_counts.owned, 1u);
     }
     let s = streams_of(i);
@@ -321,12 +341,16 @@ fn halo_layout() {
 @compute @workgroup_size(WG)
 fn halo_pack(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
-    if (halo_counts.fits == 0u || i >= params.n_particles || code_kind(code[i]) == KIND_EXCLUDED) {
+    if (halo_counts.fits == 0u || i >= params.n_particles || !packs(i)) {
         return;
     }
     let s = streams_of(i);
     pack_into(i, s.x);
     pack_into(i, s.y);
+    // An excluded particle goes as it is: no pass excludes it again on its way out.
+    if (code_kind(code[i]) == KIND_EXCLUDED) {
+        free_entry(i);
+    }
 }
 
 // Particle k of the arrivals (`HaloArrivals`'s migrants and copies, message by message).
@@ -479,9 +503,6 @@ fn halo_restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
 fn halo_forget(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
     if (i < cell_start[params.hash_mask + 1u] && code_kind(code[i]) == KIND_EXCLUDED) {
-        code[i] = with_kind(FREE_ID & ID_LOW_MASK, KIND_EXCLUDED);
-        if (WIDE_IDS) {
-            code[params.n_particles + i] = FREE_ID >> ID_LOW_BITS;
-        }
+        free_entry(i);
     }
 }

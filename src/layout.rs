@@ -394,8 +394,11 @@ pub struct HaloCtl {
     pub lower: u32,
     pub upper: u32,
     pub capacity: u32,
-    /// 1: halo copies packed as the density filter's exchange needs them (`halo::Lean`).
+    /// 1: halo copies packed as the density filter's exchange needs them (`halo::Copies`).
     pub lean: u32,
+    /// 1: the cuts move: the packing takes the excluded particles that keep their ids too.
+    pub moving: u32,
+    pub pad: [u32; 3],
 }
 
 /// Mirrors `HaloCounts` in shaders/halo.wgsl: the rank's own particles, the free tail, and the
@@ -803,7 +806,7 @@ mod tests {
             &halo::SHADER,
             "HaloCtl",
             HaloCtl,
-            [axis, own_lo, own_hi, layers, lower, upper, capacity, lean]
+            [axis, own_lo, own_hi, layers, lower, upper, capacity, lean, moving]
         );
         check_layout!(
             &halo::SHADER,

@@ -443,6 +443,23 @@ impl Comparison {
                     "rank {r} holds a particle in layer {layer}, its slab is {mine:?}"
                 );
             }
+            // So do the excluded particles that keep their ids (inlet particles waiting at the
+            // place they join from, those drained or gone out of the domain): the cuts move
+            // them as they move.
+            let (pos, _, code) = solver.read_raw()?;
+            let ids = solver.ids();
+            for k in 0..pos.len() {
+                let id = ids.id_at(&code, pos.len(), k);
+                if code[k] >> KIND_SHIFT != KIND_EXCLUDED || id == ids.free_id() {
+                    continue;
+                }
+                let layer = grid.cell_of(pos[k].off, unpack_block(pos[k].block))[slabs.axis];
+                anyhow::ensure!(
+                    layer as u32 + 1 >= mine.start && layer as u32 <= mine.end,
+                    "rank {r} holds the excluded particle {id} in layer {layer}, its slab is \
+                     {mine:?}"
+                );
+            }
             let counts = solver.ranked().unwrap();
             let live = live_particles(&solver);
             let body_ids = (sc.bodies.iter().map(|b| b.particles.start as u32)).min();

@@ -11,6 +11,10 @@ struct HaloCtl {
     upper: u32,         // 1: a neighbour owns the layers from own_hi on
     capacity: u32,      // records `halo_out` holds
     lean: u32,          // 1: copies packed for the density filter (halo.wgsl `LEAN_WORDS`)
+    moving: u32,        // 1: the cuts move (halo.wgsl `packs`)
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 // The cell layer along the cut axis of a particle at `p`.

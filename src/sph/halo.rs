@@ -115,6 +115,8 @@ pub fn control(slabs: &Slabs, rank: usize, layers: u32) -> HaloCtl {
         upper: (rank + 1 < slabs.ranks()) as u32,
         capacity: 0,
         lean: 0,
+        moving: 0,
+        pad: [0; 3],
     }
 }
 
@@ -405,16 +407,17 @@ impl Halo {
         self.records.size() + self.layer_load.size()
     }
 
-    /// The subdomain of rank `rank` under `slabs` from now on (its cuts moved); `halos: false`
-    /// packs migrants only.
-    pub fn set_cuts(&self, queue: &wgpu::Queue, slabs: &Slabs, rank: usize, halos: bool) {
+    /// The subdomain of rank `rank` under `slabs` from now on; `moving`: while the cuts move to
+    /// `slabs`, whose packings take what lies outside the slab only (no halo), the excluded
+    /// particles that keep their ids too.
+    pub fn set_cuts(&self, queue: &wgpu::Queue, slabs: &Slabs, rank: usize, moving: bool) {
         let mut ctl = HaloCtl {
             capacity: self.capacity,
             lean: self.copies.lean as u32,
             ..control(slabs, rank, self.thickness)
         };
-        if !halos {
-            (ctl.lower, ctl.upper) = (0, 0);
+        if moving {
+            (ctl.lower, ctl.upper, ctl.moving) = (0, 0, 1);
         }
         queue.write_buffer(&self.ctl, 0, bytemuck::bytes_of(&ctl));
     }

@@ -180,7 +180,7 @@ impl Solver {
         let mut capacity = n as u32;
         let ranked = (subdomain.as_mut())
             .map(|ctl| -> Result<_> {
-                let (own, waiting) = subdomain::exclude_others(&mut packed, &grid, ctl, sc);
+                let (own, waiting) = subdomain::exclude_others(&mut packed, &grid, ctl);
                 capacity = subdomain::capacity(own, waiting, n as u32);
                 check_capacity(ctx, capacity as usize)?;
                 subdomain::resize(&mut packed, capacity as usize);

@@ -73,6 +73,11 @@ impl Passes {
         self.halo.as_ref().expect("a subdomain has a halo pass")
     }
 
+    /// [`Passes::halo`], to grow its buffers or change how it packs.
+    pub fn halo_mut(&mut self) -> &mut Halo {
+        self.halo.as_mut().expect("a subdomain has a halo pass")
+    }
+
     /// The passes `sc` needs, compiled for `cfg`, over `b`; `defs` are the probes' GPU
     /// definitions and `motions` the bodies' table the buffers were made with; with
     /// `subdomain`, those of one rank's subdomain (its halo pass).

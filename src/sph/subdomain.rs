@@ -69,11 +69,6 @@ pub struct Ranked {
     pub moving_rounds: u32,
     /// The whole run's steps when these counts were taken.
     pub steps: u64,
-    /// Each cell layer where inlet particles join (the back of a buffer) and the rank that
-    /// holds the particles waiting to join there (its owner under the starting cuts:
-    /// [`exclude_others`]).
-    #[serde(default)]
-    pub(super) joining: Vec<(u32, u32)>,
     /// The cell layers each probe reads (`decomposition::probe_layers`; none for fronts): the
     /// rank that owns them samples it.
     pub(super) probe_layers: Vec<Option<Range<u32>>>,
@@ -178,40 +173,27 @@ pub fn window(ctl: &HaloCtl, grid: &Grid) -> Range<u32> {
 }
 
 /// Which entries of `packed` are `ctl`'s subdomain's at the start: its own live particles, and
-/// the inlet particles waiting behind their buffers (`Inlet::dormant`) whose joining place, at
-/// the back of the buffer, lies in its own layers (a rank holds a waiting particle until
-/// `inlet_flow` wakes it, then sends it on if it stands beyond a cut, as any migrant). The own
+/// the inlet particles waiting behind their buffers (`Inlet::dormant`, the only excluded ones
+/// at the start) whose place, where they will join at the back of the buffer, lies in its own
+/// layers (a rank holds a waiting particle until `inlet_flow` wakes it there, and the cuts
+/// move it as they move: `Solver::redistribute`). The own
 /// come first, then the waiting; every other entry is free: excluded, its id the free one (the
 /// sort puts free entries after the waiting ones, which keep theirs). Returns (own, waiting).
-pub fn exclude_others(
-    packed: &mut Packed,
-    grid: &Grid,
-    ctl: &HaloCtl,
-    sc: &Scenario,
-) -> (u32, u32) {
+pub fn exclude_others(packed: &mut Packed, grid: &Grid, ctl: &HaloCtl) -> (u32, u32) {
     let axis = ctl.axis as usize;
     let mine = |layer: i64| {
         let layer = layer.clamp(0, grid.cells[axis] as i64 - 1) as u32;
         (ctl.own_lo..ctl.own_hi).contains(&layer)
     };
-    let own = |k: usize| {
-        packed.code[k] >> KIND_SHIFT != KIND_EXCLUDED && mine(layer_of(grid, axis, packed.pos[k]))
+    let held = |k: usize, excluded: bool| {
+        (packed.code[k] >> KIND_SHIFT == KIND_EXCLUDED) == excluded
+            && mine(layer_of(grid, axis, packed.pos[k]))
     };
-    let joining_here = |id: usize| {
-        sc.inlets.iter().any(|inlet| {
-            let k = id.wrapping_sub(inlet.particles.start);
-            inlet.particles.contains(&id)
-                && inlet.dormant(k)
-                && mine(joining_layer(inlet, k % inlet.columns.len(), grid, axis) as i64)
-        })
-    };
-    let ids: Vec<usize> = packed.id.iter().map(|&id| id as usize).collect();
-    let first: Vec<usize> = (0..ids.len()).filter(|&k| own(k)).collect();
-    let waiting: Vec<usize> = (0..ids.len())
-        .filter(|&k| packed.code[k] >> KIND_SHIFT == KIND_EXCLUDED && joining_here(ids[k]))
-        .collect();
+    let n = packed.id.len();
+    let first: Vec<usize> = (0..n).filter(|&k| held(k, false)).collect();
+    let waiting: Vec<usize> = (0..n).filter(|&k| held(k, true)).collect();
     let taken: std::collections::HashSet<usize> = first.iter().chain(&waiting).copied().collect();
-    let free = (0..ids.len()).filter(|k| !taken.contains(k));
+    let free = (0..n).filter(|k| !taken.contains(k));
     let order: Vec<usize> = first.iter().chain(&waiting).copied().chain(free).collect();
     let kept = first.len() + waiting.len();
     packed.pos = order.iter().map(|&k| packed.pos[k]).collect();
@@ -230,28 +212,6 @@ pub fn exclude_others(
         .map(|(at, &k)| if at < kept { packed.id[k] } else { free_id })
         .collect();
     (first.len() as u32, waiting.len() as u32)
-}
-
-/// The cell layers along `axis` where `sc`'s inlet particles join (the backs of the buffers,
-/// where [`exclude_others`] assigns their holders), each once.
-fn joining_layers(sc: &Scenario, grid: &Grid, axis: usize) -> Vec<u32> {
-    let mut layers: Vec<u32> = sc
-        .inlets
-        .iter()
-        .flat_map(|inlet| (0..inlet.columns.len()).map(|c| joining_layer(inlet, c, grid, axis)))
-        .collect();
-    layers.sort_unstable();
-    layers.dedup();
-    layers
-}
-
-/// The cell layer along `axis` where the particles of `inlet`'s column `c` join: the back of
-/// its buffer.
-fn joining_layer(inlet: &crate::scenario::Inlet, c: usize, grid: &Grid, axis: usize) -> u32 {
-    let p = inlet.columns[c];
-    let back = [0, 1, 2].map(|a| p[a] - inlet.thickness * inlet.normal[a]);
-    let (off, block) = grid.to_block(back);
-    grid.cell_of(off, block)[axis].clamp(0, grid.cells[axis] as i64 - 1) as u32
 }
 
 /// The code word of a free entry of a subdomain's arrays: excluded, of the free id
@@ -309,10 +269,6 @@ impl Solver {
         ranked.moving_probes = (0..sc.probes.len())
             .filter(|&k| on_free_body(sc, &sc.probes[k]))
             .collect();
-        ranked.joining = joining_layers(sc, &solver.grid, slabs.axis)
-            .into_iter()
-            .map(|layer| (layer, slabs.owner(layer) as u32))
-            .collect();
         solver.ranked_step(ranks)?;
         solver.initial_dt = solver.state.dt_cfl;
         Ok(solver)
@@ -369,16 +325,6 @@ impl Solver {
         let Some(next) = slabs.rebalanced(&load, thickness, &moving) else {
             return Ok(false);
         };
-        if let Some((layer, holder)) = self.joining_beyond_neighbours(&next) {
-            log::info!(
-                "rank {}: cuts kept, imbalance {:.1} %: under {next:?} the inlet particles \
-                 rank {holder} holds would join in layer {layer}, beyond its neighbours (the \
-                 cuts do not move an inlet's waiting particles yet)",
-                ranks.rank(),
-                100.0 * slabs.imbalance(&load),
-            );
-            return Ok(false);
-        }
         log::info!(
             "rank {}: cuts moved, imbalance {:.1} % -> {:.1} %",
             ranks.rank(),
@@ -406,13 +352,6 @@ impl Solver {
             .clone()
             .clear_of_moving(&load, thickness, &clear))
         .context("moving the cuts out of the way of a probe on a free body")?;
-        if let Some((layer, holder)) = self.joining_beyond_neighbours(&next) {
-            bail!(
-                "a probe on a free body nears a cut, and the cuts cannot move out of its way: \
-                 under {next:?} the inlet particles rank {holder} holds would join in cell \
-                 layer {layer}, beyond its neighbours; run the case on fewer ranks"
-            );
-        }
         log::info!(
             "rank {}: cuts moved out of the way of a probe on a free body at t = {:.4} s",
             ranks.rank(),
@@ -433,15 +372,6 @@ impl Solver {
         let halo = self.passes.halo();
         let mine = halo.layer_load(&self.device, &self.queue, self.parity)?;
         Ok((ranks.sum_in_rank_order(&mine), halo.thickness))
-    }
-
-    /// A place where inlet particles join that `next` puts beyond the neighbours of the rank
-    /// holding them, and that rank: a rank wakes the particles it holds and sends them on one
-    /// rank at most, so such cuts cannot be taken.
-    fn joining_beyond_neighbours(&self, next: &Slabs) -> Option<(u32, u32)> {
-        let ranked = self.ranked.as_ref().expect("a subdomain");
-        let far = |&&(layer, holder): &&(u32, u32)| next.owner(layer).abs_diff(holder as usize) > 1;
-        ranked.joining.iter().find(far).copied()
     }
 
     /// The cell layers each probe on a free body reads where it stands now, `by` layers more
@@ -475,7 +405,7 @@ impl Solver {
             slabs.ranks()
         );
         let halo = self.passes.halo();
-        halo.set_cuts(&self.queue, &slabs, ranks.rank(), true);
+        halo.set_cuts(&self.queue, &slabs, ranks.rank(), false);
         let ranked = self.ranked.as_mut().expect("a subdomain");
         *ranked = Ranked {
             first_tail: None,
@@ -505,15 +435,17 @@ impl Solver {
         self.parity = 1 - self.parity;
     }
 
-    /// Sends every particle to its owner under `next`, then sorts, so that the next step's
-    /// packing finds the free tail; the last rates follow the sort. A particle moves one
+    /// Sends every particle to its owner under `next`, with the excluded ones that keep their
+    /// ids (inlet particles waiting at the place they will join from, particles drained or
+    /// gone out of the domain: halo.wgsl `packs`), then sorts, so that the next step's packing
+    /// finds the free tail; the last rates follow the sort. A particle moves one
     /// neighbour a round, packed, swapped and unpacked as a step's migrants are (no record
     /// passes through the host), towards its owner; the rounds end when no rank sent one: one
     /// round where no cut moved past a neighbour's slab, at most one per rank.
     fn redistribute(&mut self, next: Slabs, ranks: &dyn Ranks) -> Result<()> {
         let rank = ranks.rank();
-        // Migrants only: no halo this time.
-        self.passes.halo().set_cuts(&self.queue, &next, rank, false);
+        // No halo this time.
+        self.passes.halo().set_cuts(&self.queue, &next, rank, true);
         let mut rounds = 0u32;
         loop {
             let p = self.parity;
@@ -540,7 +472,7 @@ impl Solver {
             self.sort_in_place();
         }
         let halo = self.passes.halo();
-        halo.set_cuts(&self.queue, &next, rank, true);
+        halo.set_cuts(&self.queue, &next, rank, false);
         let ranked = self.ranked.as_mut().expect("a subdomain");
         ranked.slabs = Some(next);
         ranked.rebalances += 1;
@@ -788,11 +720,7 @@ impl Solver {
 
     /// Makes the halo's packing buffer hold `needed` records (`Halo::reserve`).
     fn reserve_records(&mut self, needed: usize) -> Result<()> {
-        let halo = self
-            .passes
-            .halo
-            .as_mut()
-            .expect("a subdomain has a halo pass");
+        let halo = self.passes.halo_mut();
         halo.reserve(&self.device, &self.queue, &self.buffers, needed)
     }
 
@@ -822,21 +750,11 @@ impl Solver {
     /// together).
     fn filter_over_ranks(&mut self, ranks: &dyn Ranks) -> Result<()> {
         let q = self.parity;
-        let halo = self
-            .passes
-            .halo
-            .as_mut()
-            .expect("a subdomain has a halo pass");
-        halo.set_lean(&self.queue, true);
+        self.passes.halo_mut().set_lean(&self.queue, true);
         let packed = self.pack(false, q, |passes, mut pass| {
             passes.halo().encode_pack(&mut pass, q)
         });
-        let halo = self
-            .passes
-            .halo
-            .as_mut()
-            .expect("a subdomain has a halo pass");
-        halo.set_lean(&self.queue, false);
+        self.passes.halo_mut().set_lean(&self.queue, false);
         let mut packed = packed?;
         ensure!(
             packed.migrants() == 0,
@@ -845,11 +763,7 @@ impl Solver {
         );
         let (incoming, bytes) = self.swap(std::mem::take(&mut packed.messages), ranks)?;
         self.ranked.as_mut().expect("a subdomain").bytes_sent += bytes;
-        let halo = self
-            .passes
-            .halo
-            .as_mut()
-            .expect("a subdomain has a halo pass");
+        let halo = self.passes.halo_mut();
         halo.upload_restoring(&self.device, &self.queue, &self.buffers, &incoming)?;
         let halo = self.passes.halo();
         let filter = self.passes.density_filter.as_ref().expect("a filter");
@@ -880,11 +794,7 @@ impl Solver {
         p: usize,
         tail: u32,
     ) -> Result<usize> {
-        let halo = self
-            .passes
-            .halo
-            .as_mut()
-            .expect("a subdomain has a halo pass");
+        let halo = self.passes.halo_mut();
         let copies = halo::Copies {
             lean: false,
             wide_ids: self.ids.wide,
@@ -1022,7 +932,7 @@ mod tests {
             ..Default::default()
         };
         let mut packed = super::super::initial::pack(&sc, &grid);
-        let (own, _) = exclude_others(&mut packed, &grid, &ctl, &sc);
+        let (own, _) = exclude_others(&mut packed, &grid, &ctl);
         let near = |lo: u32, hi: u32| -> u32 {
             (sc.particles.iter())
                 .filter(|p| {
@@ -1059,7 +969,7 @@ mod tests {
                 own_hi: (r + 1) * layers / 3,
                 ..Default::default()
             };
-            let (own, held) = exclude_others(&mut packed, &grid, &ctl, &sc);
+            let (own, held) = exclude_others(&mut packed, &grid, &ctl);
             let (own, held) = (own as usize, held as usize);
             for (k, &c) in packed.code.iter().enumerate() {
                 let id = packed.id[k] as usize;
