@@ -19,10 +19,10 @@ use crate::sph::halo::halo_layers;
 pub const MOVING_WEIGHT: f64 = 1.0;
 
 /// A step's work of a boundary particle relative to a moving one: a wall or ghost particle
-/// only sums its density rate (or is interpolated) and is never integrated. Measured on
-/// lavapipe from two ranks' step times against their fluid and boundary particles (dynamic
-/// walls, the 3D dam break; docs/performance.md), not yet on a GPU.
-pub const BOUNDARY_WEIGHT: f64 = 0.4;
+/// only sums its density rate over the fluid (or is interpolated) and is never integrated.
+/// Measured on lavapipe from two ranks' step times against their fluid and boundary particles
+/// (dynamic walls, the 3D dam break; docs/performance.md, 2026-12-06), not yet on a GPU.
+pub const BOUNDARY_WEIGHT: f64 = 0.15;
 
 /// Move the cuts when the most loaded rank carries this much more than the mean.
 pub const REBALANCE_THRESHOLD: f64 = 0.1;
