@@ -869,11 +869,13 @@ fn three_ranks_of_the_3d_dam_break_equal_one_run() {
     .check();
 }
 
-/// Two ranks of the 2D dam break that start from cuts at equal numbers of cell layers (most of
-/// the water on one rank): the ranks move the cuts at their first look (step 100), and the
-/// particles still equal one whole run's bit for bit after 300 steps, the last 100 of them
-/// taken by subdomains restored from the state saved at step 200 (with the moved cuts, which
-/// differ from the ones the new subdomains are made with).
+/// Three ranks of the 2D dam break that start from cuts at equal numbers of cell layers (most
+/// of the water on one rank): the ranks move the cuts at their first look (step 100), a cut
+/// past a neighbour's slab (the move takes two rounds: particles cross a rank on their way;
+/// with four ranks it still takes two), and the particles still equal one whole run's bit for
+/// bit after 300 steps, the last 100 of them taken by subdomains restored from the state saved
+/// at step 200 (with the moved cuts, which differ from the ones the new subdomains are made
+/// with).
 #[test]
 fn ranks_that_move_their_cuts_still_equal_one_run() {
     Comparison {
