@@ -47,25 +47,20 @@ struct HaloRecord {
     velrho: vec4<f32>,
     rate: vec4<f32>,
     code: u32,
-    dest: u32,          // DEST_* bits; with wide ids, the id's high bits from DEST_ID_SHIFT on
+    id_high: u32,       // with wide ids, the id's bits above ID_LOW_BITS; else 0
     energy: vec2<f32>,  // (e, de/dt of the last evaluation) when ENERGY, else zeros
 }
-
-const DEST_UPPER: u32 = 1u;
-const DEST_MIGRANT: u32 = 2u;
-// A solid particle's stress state, which the receiver writes into its solid arrays (τ in
-// velrho and pos.off, dτ/dt in rate and energy; the code word names the particle; body,
-// material and interface pressure are not sent: the first two never change, the ghost pass
-// recomputes the third).
-const DEST_SOLID_STATE: u32 = 4u;
-const DEST_ID_SHIFT: u32 = 3u;
 
 // A message to a neighbour, as it travels (`sph::halo::message_header`): a header of three counts,
 // one per section, then the sections' records. Migrants go whole (they go on integrating their
 // last rates and energy), solid stress states too; a halo copy carries only what the
-// receiver's passes read of it (its place, (v, ρ), code word and dest), which its copy in the
+// receiver's passes read of it (its place, (v, ρ), code word and id_high), which its copy in the
 // arrays gets with zero rates and energy: 10 words where a record is 16.
 const SECTION_MIGRANTS: u32 = 0u;
+// A solid particle's stress state, which the receiver writes into its solid arrays (τ in
+// velrho and pos.off, dτ/dt in rate and energy; the code word names the particle; body,
+// material and interface pressure are not sent: the first two never change, the ghost pass
+// recomputes the third).
 const SECTION_STATES: u32 = 1u;
 const SECTION_COPIES: u32 = 2u;
 const HEADER_WORDS: u32 = 3u;
@@ -120,7 +115,7 @@ fn layer_of(p: Pos) -> u32 {
 
 // The id of the particle a record carries.
 fn record_id(r: HaloRecord) -> u32 {
-    return whole_id(r.code, r.dest >> DEST_ID_SHIFT);
+    return whole_id(r.code, r.id_high);
 }
 
 // Whether a particle in cell layer `layer` has left the rank's own layers (a migrant).
@@ -190,7 +185,6 @@ fn message_words(nb: u32) -> u32 {
     return HEADER_WORDS + RECORD_WORDS * records + copy_words() * atomicLoad(&halo_counts.sizes[b + 2u]);
 }
 
-
 fn put_vec4(at: u32, v: vec4<f32>) {
     for (var c = 0u; c < 4u; c++) {
         halo_out[at + c] = bitcast<u32>(v[c]);
@@ -210,12 +204,12 @@ fn get_pos(at: u32) -> Pos {
     return Pos(w.xyz, bitcast<u32>(w.w));
 }
 
-// A whole record's words: pos, velrho, rate, code, dest, energy (as `HaloRecord`).
+// A whole record's words: pos, velrho, rate, code, id_high, energy (as `HaloRecord`).
 fn put_record(at: u32, r: HaloRecord) {
     put_pos(at, r.pos);
     put_vec4(at + 4u, r.velrho);
     put_vec4(at + 8u, r.rate);
-    put_vec4(at + 12u, vec4<f32>(bitcast<f32>(r.code), bitcast<f32>(r.dest), r.energy));
+    put_vec4(at + 12u, vec4<f32>(bitcast<f32>(r.code), bitcast<f32>(r.id_high), r.energy));
 }
 
 fn get_record(at: u32) -> HaloRecord {
@@ -224,34 +218,34 @@ fn get_record(at: u32) -> HaloRecord {
         bitcast<u32>(last.y), last.zw);
 }
 
-// A halo copy's words: pos, velrho, code, dest (`sph::halo::HaloCopy`); lean: code, ρ and
-// with wide ids dest (`LEAN_WORDS`).
+// A halo copy's words: pos, velrho, code, id_high (`sph::halo::HaloCopy`); lean: code, ρ and
+// with wide ids id_high (`LEAN_WORDS`).
 fn put_copy(at: u32, r: HaloRecord) {
     if (halo_ctl.lean != 0u) {
         halo_out[at] = r.code;
         halo_out[at + 1u] = bitcast<u32>(r.velrho.w);
         if (WIDE_IDS) {
-            halo_out[at + 2u] = r.dest;
+            halo_out[at + 2u] = r.id_high;
         }
         return;
     }
     put_pos(at, r.pos);
     put_vec4(at + 4u, r.velrho);
     halo_out[at + 8u] = r.code;
-    halo_out[at + 9u] = r.dest;
+    halo_out[at + 9u] = r.id_high;
 }
 
 // The record of a copy received: its rates and energy zero, which no pass reads of a copy
-// (a lean copy's: its code word, ρ and dest, all `halo_restore` reads).
+// (a lean copy's: its code word, ρ and id_high, all `halo_restore` reads).
 fn get_copy(at: u32) -> HaloRecord {
     if (halo_arrivals.copy_words != COPY_WORDS) {
-        var dest = 0u;
+        var id_high = 0u;
         if (WIDE_IDS) {
-            dest = halo_out[at + 2u];
+            id_high = halo_out[at + 2u];
         }
         let rho = bitcast<f32>(halo_out[at + 1u]);
-        return HaloRecord(Pos(), vec4<f32>(0.0, 0.0, 0.0, rho), vec4<f32>(0.0), halo_out[at], dest,
-            vec2<f32>(0.0));
+        return HaloRecord(Pos(), vec4<f32>(0.0, 0.0, 0.0, rho), vec4<f32>(0.0), halo_out[at],
+            id_high, vec2<f32>(0.0));
     }
     return HaloRecord(get_pos(at), get_vec4(at + 4u), vec4<f32>(0.0), halo_out[at + 8u],
         halo_out[at + 9u], vec2<f32>(0.0));
@@ -263,15 +257,15 @@ fn pack_into(i: u32, s: u32) {
     if (s == NO_STREAM) {
         return;
     }
-    var dest = select(0u, DEST_UPPER, s >= 3u) | select(0u, DEST_MIGRANT, s % 3u == SECTION_MIGRANTS);
+    var id_high = 0u;
     if (WIDE_IDS) {
-        dest |= (particle_id(i) >> ID_LOW_BITS) << DEST_ID_SHIFT;
+        id_high = particle_id(i) >> ID_LOW_BITS;
     }
     var e = vec2<f32>(0.0);
     if (ENERGY) {
         e = energy[i];
     }
-    let r = HaloRecord(pos[i], velrho[i], rate[i], code[i], dest, e);
+    let r = HaloRecord(pos[i], velrho[i], rate[i], code[i], id_high, e);
     let k = atomicAdd(&halo_counts.filled[s], 1u);
     if (s % 3u == SECTION_COPIES) {
         put_copy(halo_counts.starts[s] + copy_words() * k, r);
@@ -281,8 +275,7 @@ fn pack_into(i: u32, s: u32) {
     if (sends_state(i)) {
         let t = states_stream(s);
         let st = solid[solid_slot(i)];
-        let state = HaloRecord(Pos(st.tau_b, 0u), st.tau_a, st.rate_a, code[i],
-            dest | DEST_SOLID_STATE, st.rate_b);
+        let state = HaloRecord(Pos(st.tau_b, 0u), st.tau_a, st.rate_a, code[i], id_high, st.rate_b);
         put_record(halo_counts.starts[t] + RECORD_WORDS * atomicAdd(&halo_counts.filled[t], 1u), state);
     }
 }
@@ -382,7 +375,7 @@ fn place_particle(k: u32) {
     velrho[j] = a.velrho;
     code[j] = a.code;
     if (WIDE_IDS) {
-        code[params.n_particles + j] = a.dest >> DEST_ID_SHIFT;
+        code[params.n_particles + j] = a.id_high;
     }
     arrival_rate[j] = a.rate;
     if (ENERGY) {

@@ -260,8 +260,8 @@ pub const KIND_EXCLUDED: u32 = 15;
 /// How a run stores its particle ids (issue 32: runs of 2²⁸ particles or more). Narrow: an id
 /// is its code word's low 28 bits. Wide: the code word keeps the id's low `low_bits` bits, and
 /// the rest (`id >> low_bits`) is a second word per particle after the n code words of the same
-/// buffer (which the sort gathers with them), and a halo record's `dest` above its flags
-/// ([`DEST_ID_SHIFT`]). An id is a u32 either way; the free entries' is the largest.
+/// buffer (which the sort gathers with them), and a halo record's `id_high`. An id is a u32
+/// either way; the free entries' is the largest.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct IdSplit {
     pub wide: bool,
@@ -327,11 +327,6 @@ impl IdSplit {
     /// The id of particle `i` of the `n` a code buffer's words `code` hold.
     pub fn id_at(self, code: &[u32], n: usize, i: usize) -> u32 {
         self.id(code[i], if self.wide { code[n + i] } else { 0 })
-    }
-
-    /// The id of the particle a halo record carries.
-    pub fn record_id(self, r: &HaloRecord) -> u32 {
-        self.id(r.code, r.dest >> DEST_ID_SHIFT)
     }
 }
 /// Largest block coordinate per axis (11/11/10 bits).
@@ -428,8 +423,8 @@ pub struct HaloArrivals {
     pub pad: u32,
 }
 
-/// Mirrors `HaloRecord` in shaders/halo.wgsl: one particle sent to a neighbour, as a halo copy
-/// or as a migrant (`dest`: [`DEST_UPPER`] | [`DEST_MIGRANT`]).
+/// Mirrors `HaloRecord` in shaders/halo.wgsl: one particle sent to a neighbour as a migrant, or
+/// a solid particle's stress state (its message's section says which).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct HaloRecord {
@@ -437,19 +432,12 @@ pub struct HaloRecord {
     pub velrho: [f32; 4],
     pub rate: [f32; 4],
     pub code: u32,
-    pub dest: u32,
+    /// With wide ids, the id's bits above the code word's ([`IdSplit::high`]); else 0.
+    pub id_high: u32,
     /// (e, de/dt of the last evaluation) with the energy equation on (a migrant goes on
     /// integrating it), else zeros.
     pub energy: [f32; 2],
 }
-
-/// `HaloRecord::dest`: to the neighbour above (else below); a migrant (else a halo copy).
-pub const DEST_UPPER: u32 = 1;
-pub const DEST_MIGRANT: u32 = 2;
-/// A record that carries the stress state of the solid particle of the record before it.
-pub const DEST_SOLID_STATE: u32 = 4;
-/// With wide ids, the id's high bits ([`IdSplit::high`]) above the flags.
-pub const DEST_ID_SHIFT: u32 = 3;
 
 /// Mirrors `TlParams` in shaders/total_lagrangian.wgsl: the total-Lagrangian solid's
 /// particle count and first particle id (its particles have consecutive ids) and the cell
@@ -834,13 +822,7 @@ mod tests {
             &halo::SHADER,
             "HaloRecord",
             HaloRecord,
-            [pos, velrho, rate, code, dest, energy]
-        );
-        assert_eq!(wgsl_u32(&halo::SHADER, "DEST_UPPER"), DEST_UPPER);
-        assert_eq!(wgsl_u32(&halo::SHADER, "DEST_MIGRANT"), DEST_MIGRANT);
-        assert_eq!(
-            wgsl_u32(&halo::SHADER, "DEST_SOLID_STATE"),
-            DEST_SOLID_STATE
+            [pos, velrho, rate, code, id_high, energy]
         );
     }
 

@@ -161,7 +161,7 @@ pub struct Halo {
 }
 
 /// What a halo copy carries to the neighbour: what the neighbour's passes read of it (its
-/// place, (v, ρ) and code word) and its `dest`; not the last rates nor the energy, which only a
+/// place, (v, ρ) and code word) and its `id_high`; not the last rates nor the energy, which only a
 /// migrant goes on integrating (a copy is excluded before the corrector): 40 bytes where a
 /// record is 64.
 #[repr(C)]
@@ -170,7 +170,7 @@ pub struct HaloCopy {
     pub pos: Pos,
     pub velrho: [f32; 4],
     pub code: u32,
-    pub dest: u32,
+    pub id_high: u32,
 }
 
 /// Words of a message's header: its sections' counts.
@@ -200,7 +200,7 @@ impl Copies {
 /// The sections' counts in the header of a message to a neighbour, which must be whole. A
 /// message travels as `halo_pack` writes it on the GPU: a header of three counts, then three
 /// sections: the migrants (whole [`HaloRecord`]s), the solid particles' stress states (records
-/// flagged [`crate::layout::DEST_SOLID_STATE`], one for each solid migrant or copy), the halo
+/// too, one for each solid migrant or copy), the halo
 /// copies ([`HaloCopy`]s). The receiver uploads it as it came, and `halo_unpack` (or, for the
 /// density filter, `halo_restore`) reads it there: the host reads no record.
 pub fn message_header(bytes: &[u8], copies: Copies) -> Result<[u32; 3]> {
@@ -214,10 +214,8 @@ pub fn message_header(bytes: &[u8], copies: Copies) -> Result<[u32; 3]> {
         .get(..4 * HEADER_WORDS as usize)
         .ok_or_else(malformed)?;
     let counts: [u32; 3] = bytemuck::pod_read_unaligned(head);
-    let [migrants, states, n_copies] = counts.map(|c| c as u64);
-    let body = (migrants + states) * RECORD_BYTES as u64 + n_copies * copies.bytes() as u64;
     ensure!(
-        bytes.len() as u64 == 4 * HEADER_WORDS as u64 + body,
+        bytes.len() as u64 == 4 * message_words(&counts, copies),
         malformed()
     );
     Ok(counts)
@@ -252,7 +250,7 @@ impl Packed {
 
 /// Words of the message with section sizes `sizes` (as `message_words` in halo.wgsl).
 fn message_words(sizes: &[u32], copies: Copies) -> u64 {
-    let records = (sizes[0] + sizes[1]) as u64 * (RECORD_BYTES / 4) as u64;
+    let records = (sizes[0] as u64 + sizes[1] as u64) * (RECORD_BYTES / 4) as u64;
     HEADER_WORDS as u64 + records + sizes[2] as u64 * (copies.bytes() / 4) as u64
 }
 
@@ -484,17 +482,22 @@ impl Halo {
         queue.write_buffer(&self.counts, at, bytemuck::bytes_of(&tail));
     }
 
-    /// Uploads the messages the neighbours sent ([`message_header`], at most two), as they came,
-    /// for the next `encode_unpack`; grows the buffer where they need it. Returns their
-    /// particles (migrants and copies), which go after the free tail.
+    /// Uploads the messages the neighbours sent ([`message_header`], at most two; with `lean`,
+    /// the density filter's: [`Copies`]), as they came, for the next `encode_unpack`; grows the
+    /// buffer where they need it. Returns their particles (migrants and copies), which go after
+    /// the free tail.
     pub fn upload_arrivals(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         b: &ParticleBuffers,
         messages: &[Vec<u8>],
-        copies: Copies,
+        lean: bool,
     ) -> Result<u32> {
+        let copies = Copies {
+            lean,
+            ..self.copies
+        };
         ensure!(
             messages.len() <= 2,
             "{} halo messages arrived where a subdomain has two neighbours",
@@ -552,11 +555,7 @@ impl Halo {
         b: &ParticleBuffers,
         messages: &[Vec<u8>],
     ) -> Result<()> {
-        let lean = Copies {
-            lean: true,
-            ..self.copies
-        };
-        let copies = self.upload_arrivals(device, queue, b, messages, lean)?;
+        let copies = self.upload_arrivals(device, queue, b, messages, true)?;
         let entries = (2 * copies as u64).next_power_of_two();
         if 4 * entries > self.restore_index.size() {
             self.restore_index = storage(device, "restore index", 4 * entries);
@@ -592,10 +591,9 @@ impl Halo {
             bytemuck::pod_read_unaligned(&map_read(device, &self.counts_staging)?);
         let lower = message_words(&counts.sizes[..3], self.copies) as usize;
         let words = lower + message_words(&counts.sizes[3..], self.copies) as usize;
-        let record_words = RECORD_BYTES / 4;
-        if words > self.capacity as usize * record_words {
+        if counts.fits == 0 {
             return Ok(Packed {
-                needed: Some(words.div_ceil(record_words) as u32),
+                needed: Some(words.div_ceil(RECORD_BYTES / 4) as u32),
                 ..Default::default()
             });
         }
@@ -614,7 +612,6 @@ impl Halo {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::layout::{DEST_MIGRANT, DEST_SOLID_STATE, DEST_UPPER};
 
     /// A message as the tests build it ([`message_header`]).
     #[derive(Debug, Default, PartialEq)]
@@ -641,7 +638,7 @@ mod tests {
             pos: r.pos,
             velrho: r.velrho,
             code: r.code,
-            dest: r.dest,
+            id_high: r.id_high,
         }
     }
 
@@ -660,7 +657,7 @@ mod tests {
     /// against the message's length; a message that is not whole is refused.
     #[test]
     fn a_halo_message_sends_copies_lean_and_the_rest_whole() {
-        let record = |k: u32, dest: u32| HaloRecord {
+        let record = |k: u32| HaloRecord {
             pos: Pos {
                 off: [0.1 * k as f32, 0.2, 0.3],
                 block: k,
@@ -668,13 +665,13 @@ mod tests {
             velrho: [k as f32, -2.0, 0.5, 1000.0 + k as f32],
             rate: [4.0 + k as f32; 4],
             code: 0x1000_0000 | k,
-            dest,
+            id_high: k % 2,
             energy: [5.0, 6.0 + k as f32],
         };
         let sent = Message {
-            migrants: vec![record(2, DEST_UPPER | DEST_MIGRANT)],
-            states: vec![record(3, DEST_UPPER | DEST_SOLID_STATE)],
-            copies: [record(1, DEST_UPPER), record(4, DEST_UPPER), record(5, 0)]
+            migrants: vec![record(2)],
+            states: vec![record(3)],
+            copies: [record(1), record(4), record(5)]
                 .iter()
                 .map(copy_of)
                 .collect(),

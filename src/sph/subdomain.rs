@@ -460,15 +460,16 @@ impl Solver {
                 "particles still moving to their ranks after {rounds} rounds of moving the cuts"
             );
             rounds += 1;
+            let (incoming, _) = self.swap(std::mem::take(&mut packed.messages), ranks)?;
+            self.place_arrivals(&incoming, None, p, packed.tail, None)?;
+            // What was sent goes before what arrived comes in: an arrival on its way further
+            // lies outside the slab too.
             let halo = self.passes.halo();
-            self.submit_pass("halo drop", |pass| {
+            self.submit_pass("halo drop and unpack", |pass| {
                 halo.encode_drop(pass, p);
                 halo.encode_forget(pass, p);
+                halo.encode_unpack(pass, p, false);
             });
-            let (incoming, _) = self.swap(std::mem::take(&mut packed.messages), ranks)?;
-            self.place_arrivals(&incoming, None, p, packed.tail)?;
-            let halo = self.passes.halo();
-            self.submit_pass("halo unpack", |pass| halo.encode_unpack(pass, p, false));
             self.sort_in_place();
         }
         let halo = self.passes.halo();
@@ -564,7 +565,7 @@ impl Solver {
         ranked.migrants_sent += packed.migrants() as u64;
         ranked.halo_sent += packed.copies() as u64;
         ranked.owned = packed.owned;
-        let p = self.place_arrivals(&incoming, interior, p, first_tail.unwrap_or(packed.tail))?;
+        let p = self.place_arrivals(&incoming, interior, p, packed.tail, first_tail)?;
 
         // The GPU counts a step of dt > 0 (integrate.wgsl `timestep`): whether the density
         // filter fires is known now. Its submission frees the entries this step excluded, or
@@ -783,24 +784,22 @@ impl Solver {
     /// Uploads what arrived for `halo_unpack`, which writes it into the arrays the rest of the
     /// step starts from, and returns their parity: after an overlapped step's first sort
     /// (`interior`), into the other parity than `p`, from where that sort left its free tail
-    /// (on the GPU: the host does not wait for it); else into `p`'s, from `tail` on. `tail`
-    /// is the last sort's free tail, after which the serial step writes; the first sort of an
-    /// overlapped step frees what the last step excluded, so the arrivals find as much room
-    /// there at least.
+    /// (on the GPU: the host does not wait for it); else into `p`'s, from the last sort's free
+    /// tail on (`tail`, which the packing found on the GPU), or from `first_tail` before any
+    /// sort. The first sort of an overlapped step frees what the last step excluded, so the
+    /// arrivals find as much room there at least.
     fn place_arrivals(
         &mut self,
         incoming: &[Vec<u8>],
         interior: Option<Interior>,
         p: usize,
         tail: u32,
+        first_tail: Option<u32>,
     ) -> Result<usize> {
+        let tail = first_tail.unwrap_or(tail);
         let halo = self.passes.halo_mut();
-        let copies = halo::Copies {
-            lean: false,
-            wide_ids: self.ids.wide,
-        };
         let b = &self.buffers;
-        let particles = halo.upload_arrivals(&self.device, &self.queue, b, incoming, copies)?;
+        let particles = halo.upload_arrivals(&self.device, &self.queue, b, incoming, false)?;
         let free = self.buffers.n.saturating_sub(tail);
         if particles > free {
             bail!(
@@ -811,7 +810,9 @@ impl Solver {
             );
         }
         let Some(interior) = interior else {
-            halo.set_tail(&self.queue, tail);
+            if first_tail.is_some() {
+                halo.set_tail(&self.queue, tail);
+            }
             return Ok(p);
         };
         // Runs the callback of `interior.summed` if the GPU is done with the sums.
