@@ -347,33 +347,27 @@ fn image_rates(pi: Particle, p_i: Pos, image: vec3<f32>, chain: vec3<u32>, n: u3
     let at = pos_of_point(image);
     // The fluid of each slot around, which comes first in it (shaders/lib/neighbours.wgsl).
     var rows: NeighbourRanges;
-    let n_rows = neighbour_rows(at, &rows);
-    for (var r = 0u; r < n_rows; r++) {
-        var end = cell_start[rows[r].x];
-        for (var s = rows[r].x; s < rows[r].y; s++) {
-            var j = end;
-            end = cell_start[s + 1u];
-            for (; j < end && code_kind(code[j]) == KIND_FLUID; j++) {
-                let x = rel_pos(at, pos[j]);
-                let r2 = dot(x, x);
-                if (r2 >= support2) {
-                    continue;
-                }
-                var x_ig = x;
-                var v_cont = velrho[j].xyz;
-                var v_visc = v_cont;
-                for (var c = n; c > 0u; c--) {
-                    let plane = tables.mirror_planes[chain[c - 1u]];
-                    x_ig = reflect_vec(x_ig, plane.normal);
-                    v_cont = reflect_vec(v_cont, plane.normal);
-                    v_visc = ghost_velocity(v_visc, plane);
-                }
-                let psi = diffused_density(pi.rho, velrho[j].w, rel_pos(p_i, pos[j]));
-                let pr = pair_rates(pi, x_ig, r2, v_cont, v_visc, velrho[j].w, psi, 1.0);
-                out.rate += pr.rate;
-                out.de += pr.de;
-            }
+    var w = slot_walk(at, &rows, false);
+    for (; walk_on(&w, &rows); w.j++) {
+        let j = w.j;
+        let x = rel_pos(at, pos[j]);
+        let r2 = dot(x, x);
+        if (r2 >= support2) {
+            continue;
         }
+        var x_ig = x;
+        var v_cont = velrho[j].xyz;
+        var v_visc = v_cont;
+        for (var c = n; c > 0u; c--) {
+            let plane = tables.mirror_planes[chain[c - 1u]];
+            x_ig = reflect_vec(x_ig, plane.normal);
+            v_cont = reflect_vec(v_cont, plane.normal);
+            v_visc = ghost_velocity(v_visc, plane);
+        }
+        let psi = diffused_density(pi.rho, velrho[j].w, rel_pos(p_i, pos[j]));
+        let pr = pair_rates(pi, x_ig, r2, v_cont, v_visc, velrho[j].w, psi, 1.0);
+        out.rate += pr.rate;
+        out.de += pr.de;
     }
     return out;
 }
@@ -414,27 +408,21 @@ fn mirror_rates(i: u32, pi: Particle) -> PairRates {
 }
 
 // dρ/dt of a fixed dynamic wall particle, eq. 22: continuity from the fluid alone. A slot holds
-// its fluid first (shaders/lib/neighbours.wgsl), so the loop leaves each slot at its first
+// its fluid first (shaders/lib/neighbours.wgsl), so the walk leaves each slot at its first
 // particle of another kind and never tests the walls around.
 fn wall_continuity(i: u32) -> f32 {
     let p_i = pos[i];
     let v_i = velrho[i].xyz;
     let support2 = 4.0 * params.h * params.h;
-    var rows: NeighbourRanges;
-    let n_rows = neighbour_rows(p_i, &rows);
     var drho = 0.0;
-    for (var r = 0u; r < n_rows; r++) {
-        var end = cell_start[rows[r].x];
-        for (var s = rows[r].x; s < rows[r].y; s++) {
-            var j = end;
-            end = cell_start[s + 1u];
-            for (; j < end && code_kind(code[j]) == KIND_FLUID; j++) {
-                let x_ij = rel_pos(p_i, pos[j]);
-                let r2 = dot(x_ij, x_ij);
-                if (r2 < support2) {
-                    drho += params.mass * dot(v_i - velrho[j].xyz, x_ij * kernel_f(sqrt(r2) / params.h));
-                }
-            }
+    var rows: NeighbourRanges;
+    var w = slot_walk(p_i, &rows, false);
+    for (; walk_on(&w, &rows); w.j++) {
+        let j = w.j;
+        let x_ij = rel_pos(p_i, pos[j]);
+        let r2 = dot(x_ij, x_ij);
+        if (r2 < support2) {
+            drho += params.mass * dot(v_i - velrho[j].xyz, x_ij * kernel_f(sqrt(r2) / params.h));
         }
     }
     return drho;
@@ -477,45 +465,39 @@ fn boundary_rates(i: u32, kind_i: u32, on_body: bool) -> vec4<f32> {
     }
     var r = vec4<f32>(0.0);
     var rows: NeighbourRanges;
-    let n_rows = neighbour_rows(p_i, &rows);
-    for (var row = 0u; row < n_rows; row++) {
-        var end = cell_start[rows[row].x];
-        for (var s = rows[row].x; s < rows[row].y; s++) {
-            var j = end;
-            end = cell_start[s + 1u];
-            for (; j < end && (on_body || code_kind(code[j]) == KIND_FLUID); j++) {
-                let x_ij = rel_pos(p_i, pos[j]);
-                let r2 = dot(x_ij, x_ij);
-                if (r2 >= support2 || j == i) {
-                    continue;
+    var w = slot_walk(p_i, &rows, on_body);
+    for (; walk_on(&w, &rows); w.j++) {
+        let j = w.j;
+        let x_ij = rel_pos(p_i, pos[j]);
+        let r2 = dot(x_ij, x_ij);
+        if (r2 >= support2 || j == i) {
+            continue;
+        }
+        let kind_j = code_kind(code[j]);
+        if (kind_j == KIND_FLUID) {
+            let vr_j = velrho[j];
+            let loads = sensor == NO_SENSOR || faces_sensor(tables.wall_sensors[sensor], x_i - x_ij);
+            if (is_repulsive(kind_i)) {
+                // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
+                if (loads) {
+                    r += vec4<f32>(repulsion(x_ij, r2), 0.0);
                 }
-                let kind_j = code_kind(code[j]);
-                if (kind_j == KIND_FLUID) {
-                    let vr_j = velrho[j];
-                    let loads = sensor == NO_SENSOR || faces_sensor(tables.wall_sensors[sensor], x_i - x_ij);
-                    if (is_repulsive(kind_i)) {
-                        // The reaction to the fluid's repulsion, −F(x_ji) = F(x_ij).
-                        if (loads) {
-                            r += vec4<f32>(repulsion(x_ij, r2), 0.0);
-                        }
-                    } else {
-                        // The reaction to the fluid's pressure and viscous force; a dynamic
-                        // wall or body particle also its dρ/dt (ghosts have none).
-                        let pr = pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, 0.0, 1.0).rate;
-                        let force = select(vec3<f32>(0.0), pr.xyz, loads);
-                        r += vec4<f32>(force, select(0.0, pr.w, kind_i == KIND_WALL));
-                    }
-                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
-                    // Contact with an elastic solid.
-                    let s_j = solid[solid_slot(j)];
-                    let mu = friction_between(1u + body_i, params.friction_first_solid + s_j.body);
-                    r += vec4<f32>(contact_weight(params.mass, material_of(s_j).mass) * contact(x_ij, r2, v_contact_i - velrho[j].xyz, mu), 0.0);
-                } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, particle_id(j)) && contact_counts(kinematic_i, particle_id(j))) {
-                    // Contact with a fixed wall or another body.
-                    let mu = friction_between(1u + body_i, boundary_group(particle_id(j)));
-                    r += vec4<f32>(contact(x_ij, r2, v_contact_i - contact_velocity(j), mu), 0.0);
-                }
+            } else {
+                // The reaction to the fluid's pressure and viscous force; a dynamic
+                // wall or body particle also its dρ/dt (ghosts have none).
+                let pr = pair_rates(pi, x_ij, r2, vr_j.xyz, vr_j.xyz, vr_j.w, 0.0, 1.0).rate;
+                let force = select(vec3<f32>(0.0), pr.xyz, loads);
+                r += vec4<f32>(force, select(0.0, pr.w, kind_i == KIND_WALL));
             }
+        } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && is_solid(kind_j)) {
+            // Contact with an elastic solid.
+            let s_j = solid[solid_slot(j)];
+            let mu = friction_between(1u + body_i, params.friction_first_solid + s_j.body);
+            r += vec4<f32>(contact_weight(params.mass, material_of(s_j).mass) * contact(x_ij, r2, v_contact_i - velrho[j].xyz, mu), 0.0);
+        } else if (body_i != NO_BODY && kind_j != KIND_EXCLUDED && kind_j != KIND_INLET && other_solid(body_i, particle_id(j)) && contact_counts(kinematic_i, particle_id(j))) {
+            // Contact with a fixed wall or another body.
+            let mu = friction_between(1u + body_i, boundary_group(particle_id(j)));
+            r += vec4<f32>(contact(x_ij, r2, v_contact_i - contact_velocity(j), mu), 0.0);
         }
     }
     return r;

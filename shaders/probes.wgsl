@@ -42,22 +42,16 @@ fn fluid_sums(x: vec3<f32>) -> KernelSums {
     var sums = KernelSums(0.0, 0.0);
     // The fluid of each slot around, which comes first in it (shaders/lib/neighbours.wgsl).
     var rows: NeighbourRanges;
-    let n_rows = neighbour_rows(p, &rows);
-    for (var r = 0u; r < n_rows; r++) {
-        var end = cell_start[rows[r].x];
-        for (var s = rows[r].x; s < rows[r].y; s++) {
-            var j = end;
-            end = cell_start[s + 1u];
-            for (; j < end && code_kind(code[j]) == KIND_FLUID; j++) {
-                let x_ij = rel_pos(p, pos[j]);
-                let r2 = dot(x_ij, x_ij);
-                if (r2 < support2) {
-                    let rho_j = velrho[j].w;
-                    let wv = kernel_w(sqrt(r2) / params.h) * params.mass / rho_j;
-                    sums.volume += wv;
-                    sums.pressure += pressure_of(rho_j) * wv;
-                }
-            }
+    var w = slot_walk(p, &rows, false);
+    for (; walk_on(&w, &rows); w.j++) {
+        let j = w.j;
+        let x_ij = rel_pos(p, pos[j]);
+        let r2 = dot(x_ij, x_ij);
+        if (r2 < support2) {
+            let rho_j = velrho[j].w;
+            let wv = kernel_w(sqrt(r2) / params.h) * params.mass / rho_j;
+            sums.volume += wv;
+            sums.pressure += pressure_of(rho_j) * wv;
         }
     }
     return sums;

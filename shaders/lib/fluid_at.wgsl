@@ -26,28 +26,22 @@ fn fluid_at(pg: Pos, g_eff: vec3<f32>) -> vec4<f32> {
     var m_vz = vec4<f32>(0.0);
     // The fluid of each slot around, which comes first in it (shaders/lib/neighbours.wgsl).
     var rows: NeighbourRanges;
-    let n_rows = neighbour_rows(pg, &rows);
-    for (var r = 0u; r < n_rows; r++) {
-        var end = cell_start[rows[r].x];
-        for (var s = rows[r].x; s < rows[r].y; s++) {
-            var j = end;
-            end = cell_start[s + 1u];
-            for (; j < end && code_kind(code[j]) == KIND_FLUID; j++) {
-                let x_gj = rel_pos(pg, pos[j]);
-                let r2 = dot(x_gj, x_gj);
-                if (r2 >= support2) {
-                    continue;
-                }
-                let vr = velrho[j];
-                let wv = kernel_w(sqrt(r2) / params.h) * params.mass / vr.w;
-                let basis = mls_basis(x_gj);
-                a = mls_add(a, x_gj, wv);
-                m_p += (pressure_of(vr.w) + vr.w * dot(g_eff, x_gj)) * wv * basis;
-                m_vx += vr.x * wv * basis;
-                m_vy += vr.y * wv * basis;
-                m_vz += vr.z * wv * basis;
-            }
+    var w = slot_walk(pg, &rows, false);
+    for (; walk_on(&w, &rows); w.j++) {
+        let j = w.j;
+        let x_gj = rel_pos(pg, pos[j]);
+        let r2 = dot(x_gj, x_gj);
+        if (r2 >= support2) {
+            continue;
         }
+        let vr = velrho[j];
+        let wv = kernel_w(sqrt(r2) / params.h) * params.mass / vr.w;
+        let basis = mls_basis(x_gj);
+        a = mls_add(a, x_gj, wv);
+        m_p += (pressure_of(vr.w) + vr.w * dot(g_eff, x_gj)) * wv * basis;
+        m_vx += vr.x * wv * basis;
+        m_vy += vr.y * wv * basis;
+        m_vz += vr.z * wv * basis;
     }
     let volume = a[0][0];
     if (volume <= 1e-6) {

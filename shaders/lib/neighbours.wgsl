@@ -1,11 +1,11 @@
 // Neighbour search over the cell list: the index ranges of the sorted particles in the cells
 // around a point. The pass file declares `cell_start` (slot s holds the sorted particles
-// cell_start[s] .. cell_start[s + 1]). Cells are the support 2h (CELL_REACH 1) or h
+// cell_start[s] .. cell_start[s + 1]) and `code`. Cells are the support 2h (CELL_REACH 1) or h
 // (CELL_REACH 2): a point's neighbours are in the (2 CELL_REACH + 1)^DIM cells around its own.
 //
 // A slot's particles are ordered by code word (cell_list.wgsl's `rank_in_cell`), so its fluid,
 // of kind 0, comes first: a sum over the fluid alone walks the slots of `neighbour_rows` one by
-// one and leaves each at its first particle of another kind, never testing the walls around
+// one (`SlotWalk`) and leaves each at its first particle of another kind, never testing the walls around
 // (most of a wall particle's neighbours, and most particles of a tank are walls), as
 // DualSPHysics' cell lists keep boundary and fluid particles apart.
 
@@ -147,4 +147,48 @@ fn neighbour_ranges(p: Pos, ranges: ptr<function, NeighbourRanges>) -> u32 {
         n += select(0u, 1u, (*ranges)[n].y > (*ranges)[n].x);
     }
     return n;
+}
+
+// A walk over the particles of the slots of `neighbour_rows`, slot by slot in the rows' order,
+// each slot's from its first: the fluid alone (a slot is left at its first particle of another
+// kind), or every kind (a body particle's sums, in the same order). The sums over the fluid
+// alone, and a body particle's, loop so:
+//     var rows: NeighbourRanges;
+//     var w = slot_walk(p, &rows, every_kind);
+//     for (; walk_on(&w, &rows); w.j++) { let j = w.j; ... }
+struct SlotWalk {
+    n_rows: u32,
+    every_kind: bool,
+    // The row and the slot walked, the particle visited and the end of the slot's particles.
+    row: u32,
+    slot: u32,
+    j: u32,
+    end: u32,
+}
+
+fn slot_walk(p: Pos, rows: ptr<function, NeighbourRanges>, every_kind: bool) -> SlotWalk {
+    let n_rows = neighbour_rows(p, rows);
+    let slot = (*rows)[0].x;
+    return SlotWalk(n_rows, every_kind, 0u, slot, cell_start[slot], cell_start[slot + 1u]);
+}
+
+// Whether the walk has a particle left, `w.j`: the one it is at if the walk takes it, otherwise
+// the first it takes in the slots after.
+fn walk_on(w: ptr<function, SlotWalk>, rows: ptr<function, NeighbourRanges>) -> bool {
+    while ((*w).row < (*w).n_rows) {
+        if ((*w).j < (*w).end && ((*w).every_kind || code_kind(code[(*w).j]) == KIND_FLUID)) {
+            return true;
+        }
+        (*w).slot++;
+        if ((*w).slot >= (*rows)[(*w).row].y) {
+            (*w).row++;
+            if ((*w).row >= (*w).n_rows) {
+                break;
+            }
+            (*w).slot = (*rows)[(*w).row].x;
+        }
+        (*w).j = cell_start[(*w).slot];
+        (*w).end = cell_start[(*w).slot + 1u];
+    }
+    return false;
 }
