@@ -200,9 +200,9 @@ impl Copies {
 /// The sections' counts in the header of a message to a neighbour, which must be whole. A
 /// message travels as `halo_pack` writes it on the GPU: a header of three counts, then three
 /// sections: the migrants (whole [`HaloRecord`]s), the solid particles' stress states (records
-/// too, one for each solid migrant or copy), the halo
-/// copies ([`HaloCopy`]s). The receiver uploads it as it came, and `halo_unpack` (or, for the
-/// density filter, `halo_restore`) reads it there: the host reads no record.
+/// too, one for each solid migrant or copy), the halo copies ([`HaloCopy`]s). The receiver
+/// uploads it as it came, and `halo_unpack` (or, for the density filter, `halo_restore`) reads
+/// it there: the host reads no record.
 pub fn message_header(bytes: &[u8], copies: Copies) -> Result<[u32; 3]> {
     let malformed = || {
         anyhow!(

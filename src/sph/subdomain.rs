@@ -176,24 +176,22 @@ pub fn window(ctl: &HaloCtl, grid: &Grid) -> Range<u32> {
 /// the inlet particles waiting behind their buffers (`Inlet::dormant`, the only excluded ones
 /// at the start) whose place, where they will join at the back of the buffer, lies in its own
 /// layers (a rank holds a waiting particle until `inlet_flow` wakes it there, and the cuts
-/// move it as they move: `Solver::redistribute`). The own
-/// come first, then the waiting; every other entry is free: excluded, its id the free one (the
-/// sort puts free entries after the waiting ones, which keep theirs). Returns (own, waiting).
+/// move it as they move: `Solver::redistribute`). The own come first, then the waiting; every
+/// other entry is free: excluded, its id the free one (the sort puts free entries after the
+/// waiting ones, which keep theirs). Returns (own, waiting).
 pub fn exclude_others(packed: &mut Packed, grid: &Grid, ctl: &HaloCtl) -> (u32, u32) {
     let axis = ctl.axis as usize;
-    let mine = |layer: i64| {
-        let layer = layer.clamp(0, grid.cells[axis] as i64 - 1) as u32;
-        (ctl.own_lo..ctl.own_hi).contains(&layer)
-    };
-    let held = |k: usize, excluded: bool| {
-        (packed.code[k] >> KIND_SHIFT == KIND_EXCLUDED) == excluded
-            && mine(layer_of(grid, axis, packed.pos[k]))
-    };
-    let n = packed.id.len();
-    let first: Vec<usize> = (0..n).filter(|&k| held(k, false)).collect();
-    let waiting: Vec<usize> = (0..n).filter(|&k| held(k, true)).collect();
-    let taken: std::collections::HashSet<usize> = first.iter().chain(&waiting).copied().collect();
-    let free = (0..n).filter(|k| !taken.contains(k));
+    let held: Vec<bool> = (packed.pos.iter())
+        .map(|&p| {
+            let layer = layer_of(grid, axis, p).clamp(0, grid.cells[axis] as i64 - 1) as u32;
+            (ctl.own_lo..ctl.own_hi).contains(&layer)
+        })
+        .collect();
+    let excluded = |k: usize| packed.code[k] >> KIND_SHIFT == KIND_EXCLUDED;
+    let n = held.len();
+    let first: Vec<usize> = (0..n).filter(|&k| held[k] && !excluded(k)).collect();
+    let waiting: Vec<usize> = (0..n).filter(|&k| held[k] && excluded(k)).collect();
+    let free = (0..n).filter(|&k| !held[k]);
     let order: Vec<usize> = first.iter().chain(&waiting).copied().chain(free).collect();
     let kept = first.len() + waiting.len();
     packed.pos = order.iter().map(|&k| packed.pos[k]).collect();
