@@ -39,8 +39,7 @@ var<private> hydrostatic_k: vec3<f32>;
 var<private> hydrostatic_series: vec3<f32>;
 
 fn set_hydrostatic_coefficients() {
-    let periodic = vec3<bool>((params.periodic & 1u) != 0u, (params.periodic & 2u) != 0u, (params.periodic & 4u) != 0u);
-    hydrostatic_k = select(params.gravity, vec3<f32>(0.0), periodic) * (params.rho0 / params.tait_b);
+    hydrostatic_k = select(params.gravity, vec3<f32>(0.0), periodic_axes()) * (params.rho0 / params.tait_b);
     let a = 1.0 / params.gamma;
     hydrostatic_series = vec3<f32>(params.rho0 * a, 0.5 * (a - 1.0), (a - 2.0) / 3.0);
 }

@@ -254,8 +254,15 @@ fn pack_block(b: vec3<i32>) -> u32 {
     return u32(b.x) | (u32(b.y) << 11u) | (u32(b.z) << 22u);
 }
 
+// The periodic axes: the uniform's bits, or none at compile time in a case without
+// (PERIODIC), so that no pass carries the wrap-around code it would never take.
 fn periodic_axes() -> vec3<bool> {
-    return vec3<bool>((params.periodic & 1u) != 0u, (params.periodic & 2u) != 0u, (params.periodic & 4u) != 0u);
+    let bits = select(0u, params.periodic, PERIODIC);
+    return vec3<bool>((bits & 1u) != 0u, (bits & 2u) != 0u, (bits & 4u) != 0u);
+}
+
+fn any_periodic() -> bool {
+    return PERIODIC && params.periodic != 0u;
 }
 
 // x_i - x_j, exact block difference plus offset difference: precise for neighbours anywhere;
@@ -263,7 +270,7 @@ fn periodic_axes() -> vec3<bool> {
 fn rel_pos(pi: Pos, pj: Pos) -> vec3<f32> {
     let db = vec3<f32>(unpack_block(pi.block) - unpack_block(pj.block));
     let x = db * params.block_size + (pi.off - pj.off);
-    if (params.periodic == 0u) {
+    if (!any_periodic()) {
         return x;
     }
     return select(x, x - params.domain_size * round(x / params.domain_size), periodic_axes());

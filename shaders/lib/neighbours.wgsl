@@ -24,7 +24,7 @@ fn neighbour_slots(c: vec3<i32>, slots: ptr<function, array<u32, 27>>) -> u32 {
         for (var dy = -1; dy <= 1; dy++) {
             for (var dx = -1; dx <= 1; dx++) {
                 var cn = c + vec3<i32>(dx, dy, dz);
-                if (params.periodic != 0u) {
+                if (any_periodic()) {
                     let cells = vec3<i32>(params.grid_cells);
                     cn = select(cn, (cn + cells) % cells, periodic_axes());
                 }

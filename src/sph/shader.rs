@@ -125,6 +125,10 @@ pub struct ShaderConfig {
     pub tables: TableSizes,
     /// Cells per kernel support (`Grid::reach`): 1 for cells of 2h, 2 for cells of h.
     pub cell_reach: u32,
+    /// Whether the case has a periodic axis (the uniform's `periodic` says which): without one,
+    /// no pass carries the nearest-image and wrap-around code, which costs every neighbour
+    /// candidate a division per axis where a run-time test leaves it in.
+    pub periodic: bool,
     /// The Tait exponent γ where it is a whole number from 1 to 15 (`tait_power` multiplies),
     /// otherwise 0 (pow).
     pub tait_gamma: u32,
@@ -148,6 +152,7 @@ impl Default for ShaderConfig {
                 wall_sensors: 1,
             },
             cell_reach: 2,
+            periodic: true,
             tait_gamma: 7,
             ids: IdSplit::NARROW,
         }
@@ -172,6 +177,7 @@ impl ShaderConfig {
             present: Present::of(sc)?,
             tables: TableSizes::of(sc),
             cell_reach: grid.reach,
+            periodic: grid.periodic.iter().any(|&p| p),
             tait_gamma: whole_exponent(ph.gamma),
             ids: super::initial::id_split(sc),
         })
@@ -194,7 +200,8 @@ impl ShaderConfig {
              const MIRRORS: bool = {mirrors};\nconst LONE_SOLID: bool = {lone_solid};\n\
              const WG: u32 = {wg}u;\n\
              const N_BODIES: u32 = {bodies_n}u;\nconst N_MIRROR_PLANES: u32 = {planes_n}u;\n\
-             const N_WALL_SENSORS: u32 = {sensors_n}u;\nconst CELL_REACH: i32 = {reach};\nconst TAIT_GAMMA: u32 = {gamma}u;\n\
+             const N_WALL_SENSORS: u32 = {sensors_n}u;\nconst CELL_REACH: i32 = {reach};\nconst PERIODIC: bool = {periodic};\n\
+             const TAIT_GAMMA: u32 = {gamma}u;\n\
              const WIDE_IDS: bool = {wide};\nconst ID_LOW_BITS: u32 = {low_bits}u;\n\
              const FREE_ID: u32 = {free}u;\nconst ID_LOW_MASK: u32 = {low_mask}u;\n",
             dim = self.dim,
@@ -214,6 +221,7 @@ impl ShaderConfig {
             planes_n = self.tables.mirror_planes,
             sensors_n = self.tables.wall_sensors,
             reach = self.cell_reach,
+            periodic = self.periodic,
             gamma = self.tait_gamma,
             wide = self.ids.wide,
             low_bits = self.ids.low_bits,
