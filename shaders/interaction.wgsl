@@ -605,7 +605,7 @@ fn interact(i: u32) {
 
 @compute @workgroup_size(WG)
 fn interaction(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = linear_index(gid, nwg);
+    let i = spread_index(gid, nwg);
     if (i < params.n_particles) {
         interact(i);
     }
@@ -631,7 +631,7 @@ var<workgroup> group_reads_arrival: atomic<u32>;
 // neighbour loops in both halves, its lanes half idle in each, so all of it is left for after.
 @compute @workgroup_size(WG)
 fn interaction_interior(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = linear_index(gid, nwg);
+    let i = spread_index(gid, nwg);
     let n = params.n_particles;
     if (i < n && !before_arrival(i)) {
         atomicStore(&group_reads_arrival, 1u);
@@ -650,7 +650,7 @@ fn interaction_interior(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(
 
 @compute @workgroup_size(WG)
 fn interaction_boundary(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = linear_index(gid, nwg);
+    let i = spread_index(gid, nwg);
     if (i < params.n_particles && (bitcast<u32>(rate[i].w) == LEFT_FOR_AFTER || !before_arrival(i))) {
         interact(i);
     }

@@ -244,6 +244,24 @@ fn linear_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return gid.x + gid.y * nwg.x * WG;
 }
 
+// The particle of invocation `gid` of a neighbour-sum pass: `linear_index`, or with
+// SPREAD_CHUNKS > 1 (a CPU adapter: ShaderConfig::for_adapter) the dispatch's workgroups taken
+// in SPREAD_CHUNKS chunks of consecutive ones, the chunks in bit-reversed order, so that each
+// contiguous share of the dispatch (what llvmpipe gives a thread) holds chunks from all over
+// the sorted order. A workgroup's particles, and a chunk's, stay neighbours. The workgroups
+// must be a whole number of chunks (`Kernel::dispatch_spread`); otherwise, as past 65535
+// workgroups (a 2D dispatch), the dispatch's order.
+fn spread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    let groups = nwg.x * nwg.y;
+    if (SPREAD_CHUNKS == 1u || nwg.y != 1u || groups % SPREAD_CHUNKS != 0u) {
+        return linear_index(gid, nwg);
+    }
+    let per_chunk = groups / SPREAD_CHUNKS;
+    let w = gid.x / WG;
+    let chunk = reverseBits(w / per_chunk) >> (32u - countTrailingZeros(SPREAD_CHUNKS));
+    return (chunk * per_chunk + w % per_chunk) * WG + gid.x % WG;
+}
+
 // ---- positions -------------------------------------------------------------------------
 
 fn unpack_block(b: u32) -> vec3<i32> {

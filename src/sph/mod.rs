@@ -193,7 +193,7 @@ impl Solver {
             .transpose()?;
         let mut params = Params::from_scenario(sc, &grid)?;
         params.n_particles = capacity;
-        let cfg = ShaderConfig::of(sc, &grid)?;
+        let cfg = ShaderConfig::of(sc, &grid)?.for_adapter(&ctx.info);
         probes::check_wall_pressure(sc)?;
         let device = ctx.device.clone();
         // Allocation failures are caught here to name what was being allocated; later ones

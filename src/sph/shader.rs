@@ -37,6 +37,11 @@ pub const SLAB: &str = include_str!("../../shaders/lib/slab.wgsl");
 /// A wall-pressure sensor's patch of boundary particles (`shaders/lib/wall_patch.wgsl`).
 pub const WALL_PATCH: &str = include_str!("../../shaders/lib/wall_patch.wgsl");
 
+/// The chunks of a spread dispatch on a CPU adapter ([`ShaderConfig::for_adapter`]): any
+/// power-of-two number of threads up to this many gets an equal share of every part of the
+/// domain.
+pub const SPREAD_CHUNKS: u32 = 64;
+
 /// The viscous term of the momentum equation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ViscosityForm {
@@ -125,6 +130,9 @@ pub struct ShaderConfig {
     pub tables: TableSizes,
     /// Cells per kernel support (`Grid::reach`): 1 for cells of 2h, 2 for cells of h.
     pub cell_reach: u32,
+    /// The chunks a neighbour-sum pass's workgroups are spread in (`spread_index` in
+    /// common.wgsl): 1 (the dispatch's order) but on a CPU adapter ([`ShaderConfig::for_adapter`]).
+    pub spread_chunks: u32,
     /// Whether the case has a periodic axis (the uniform's `periodic` says which): without one,
     /// no pass carries the nearest-image and wrap-around code, which costs every neighbour
     /// candidate a division per axis where a run-time test leaves it in.
@@ -152,6 +160,7 @@ impl Default for ShaderConfig {
                 wall_sensors: 1,
             },
             cell_reach: 2,
+            spread_chunks: 1,
             periodic: true,
             tait_gamma: 7,
             ids: IdSplit::NARROW,
@@ -177,10 +186,26 @@ impl ShaderConfig {
             present: Present::of(sc)?,
             tables: TableSizes::of(sc),
             cell_reach: grid.reach,
+            spread_chunks: 1,
             periodic: grid.periodic.iter().any(|&p| p),
             tait_gamma: whole_exponent(ph.gamma),
             ids: super::initial::id_split(sc),
         })
+    }
+
+    /// These choices on the adapter `info`: on a CPU adapter the neighbour sums spread their
+    /// workgroups over the sorted order in [`SPREAD_CHUNKS`] chunks. llvmpipe hands each of
+    /// its threads one contiguous share of a dispatch's workgroups, and the sorted order keeps
+    /// the water, most of the sums' cost, together, so in the dispatch's order one thread takes
+    /// most of the water while the others wait (docs/performance.md). A GPU schedules its
+    /// workgroups as they finish and keeps the dispatch's order, which neighbouring workgroups'
+    /// shared reads favour.
+    pub fn for_adapter(self, info: &wgpu::AdapterInfo) -> Self {
+        let spread = info.device_type == wgpu::DeviceType::Cpu;
+        Self {
+            spread_chunks: if spread { SPREAD_CHUNKS } else { 1 },
+            ..self
+        }
     }
 
     /// The WGSL constants of these choices, in front of every pass.
@@ -201,6 +226,7 @@ impl ShaderConfig {
              const WG: u32 = {wg}u;\n\
              const N_BODIES: u32 = {bodies_n}u;\nconst N_MIRROR_PLANES: u32 = {planes_n}u;\n\
              const N_WALL_SENSORS: u32 = {sensors_n}u;\nconst CELL_REACH: i32 = {reach};\nconst PERIODIC: bool = {periodic};\n\
+             const SPREAD_CHUNKS: u32 = {spread}u;\n\
              const TAIT_GAMMA: u32 = {gamma}u;\n\
              const WIDE_IDS: bool = {wide};\nconst ID_LOW_BITS: u32 = {low_bits}u;\n\
              const FREE_ID: u32 = {free}u;\nconst ID_LOW_MASK: u32 = {low_mask}u;\n",
@@ -222,6 +248,7 @@ impl ShaderConfig {
             sensors_n = self.tables.wall_sensors,
             reach = self.cell_reach,
             periodic = self.periodic,
+            spread = self.spread_chunks,
             gamma = self.tait_gamma,
             wide = self.ids.wide,
             low_bits = self.ids.low_bits,
