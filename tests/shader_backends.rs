@@ -1,4 +1,5 @@
-//! Every composed shader variant the shipped cases use (and the all-kinds variant) translates
+//! Every composed shader variant the shipped cases use (and the all-kinds variant, also as a CPU
+//! adapter spreads its neighbour sums) translates
 //! with naga's own backends to SPIR-V (Vulkan), MSL (Metal), HLSL (DX12) and GLSL (GL compute),
 //! so a shader change that would break another vendor's backend is caught without its device.
 
@@ -6,7 +7,7 @@ use naga::back::{glsl, hlsl, msl, spv};
 use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
 use wgsph::gpu::shader::Shader;
 use wgsph::sph::passes::SHADERS;
-use wgsph::sph::shader::{compose, ShaderConfig};
+use wgsph::sph::shader::{compose, ShaderConfig, SPREAD_CHUNKS};
 
 fn cases() -> Vec<std::path::PathBuf> {
     let mut files: Vec<_> = std::fs::read_dir("cases")
@@ -21,7 +22,16 @@ fn cases() -> Vec<std::path::PathBuf> {
 /// The distinct shader configurations of the shipped cases, after the all-kinds one, each with
 /// the first case that uses it.
 fn variants() -> Vec<(String, ShaderConfig)> {
-    let mut configs = vec![("all kinds".to_string(), ShaderConfig::default())];
+    let mut configs = vec![
+        ("all kinds".to_string(), ShaderConfig::default()),
+        (
+            "all kinds, spread (a CPU adapter's)".to_string(),
+            ShaderConfig {
+                spread_chunks: SPREAD_CHUNKS,
+                ..ShaderConfig::default()
+            },
+        ),
+    ];
     for file in cases() {
         let sc = wgsph::case::load(&file, &[]).unwrap();
         let grid = wgsph::grid::Grid::of(&sc).unwrap();

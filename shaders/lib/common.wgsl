@@ -258,8 +258,19 @@ fn spread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
     }
     let per_chunk = groups / SPREAD_CHUNKS;
     let w = gid.x / WG;
-    let chunk = reverseBits(w / per_chunk) >> (32u - countTrailingZeros(SPREAD_CHUNKS));
-    return (chunk * per_chunk + w % per_chunk) * WG + gid.x % WG;
+    return (reversed_chunk(w / per_chunk) * per_chunk + w % per_chunk) * WG + gid.x % WG;
+}
+
+// The lowest log2(SPREAD_CHUNKS) bits of `c` reversed, bit by bit (naga's MSL output at its
+// default version has no reverseBits).
+fn reversed_chunk(c: u32) -> u32 {
+    var r = 0u;
+    var rest = c;
+    for (var k = 1u; k < SPREAD_CHUNKS; k *= 2u) {
+        r = 2u * r + (rest & 1u);
+        rest >>= 1u;
+    }
+    return r;
 }
 
 // ---- positions -------------------------------------------------------------------------
