@@ -252,11 +252,10 @@ fn linear_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
 // must be a whole number of chunks (`Kernel::dispatch_spread`); otherwise, as past 65535
 // workgroups (a 2D dispatch), the dispatch's order.
 fn spread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
-    let groups = nwg.x * nwg.y;
-    if (SPREAD_CHUNKS == 1u || nwg.y != 1u || groups % SPREAD_CHUNKS != 0u) {
+    if (SPREAD_CHUNKS == 1u || nwg.y != 1u || nwg.x % SPREAD_CHUNKS != 0u) {
         return linear_index(gid, nwg);
     }
-    let per_chunk = groups / SPREAD_CHUNKS;
+    let per_chunk = nwg.x / SPREAD_CHUNKS;
     let w = gid.x / WG;
     return (reversed_chunk(w / per_chunk) * per_chunk + w % per_chunk) * WG + gid.x % WG;
 }

@@ -119,8 +119,7 @@ impl Kernel {
         bind: &wgpu::BindGroup,
         invocations: u32,
     ) {
-        let groups = invocations.div_ceil(super::shader::WORKGROUP_SIZE).max(1);
-        self.dispatch_groups(pass, bind, groups);
+        self.dispatch_spread(pass, bind, invocations, 1);
     }
 
     /// Records one dispatch covering `invocations` invocations in whole chunks of `chunks`
