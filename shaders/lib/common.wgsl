@@ -248,17 +248,23 @@ fn linear_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
 // SPREAD_CHUNKS > 1 (a CPU adapter: ShaderConfig::for_adapter) the dispatch's workgroups taken
 // in SPREAD_CHUNKS chunks of consecutive ones, the chunks in bit-reversed order, so that each
 // contiguous share of the dispatch (what llvmpipe gives a thread) holds chunks from all over
-// the sorted order. A workgroup's particles, and a chunk's, stay neighbours. The workgroups
-// must be a whole number of chunks (`Kernel::dispatch_spread`); otherwise, as past 65535
-// workgroups (a 2D dispatch), the dispatch's order.
+// the sorted order. A workgroup's particles, and a chunk's, stay neighbours. Only whole chunks
+// of at least SPREAD_MIN_CHUNK workgroups are spread; the workgroups past them (fewer than
+// SPREAD_CHUNKS) and a smaller or 2D dispatch keep the dispatch's order, and no workgroup is
+// added: on lavapipe, idle workgroups added to make whole chunks doubled a small case's sums,
+// and chunks of fewer workgroups gained nothing measurable (docs/performance.md).
 fn spread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
-    if (SPREAD_CHUNKS == 1u || nwg.y != 1u || nwg.x % SPREAD_CHUNKS != 0u) {
-        return linear_index(gid, nwg);
-    }
     let per_chunk = nwg.x / SPREAD_CHUNKS;
     let w = gid.x / WG;
+    if (SPREAD_CHUNKS == 1u || nwg.y != 1u || per_chunk < SPREAD_MIN_CHUNK || w >= per_chunk * SPREAD_CHUNKS) {
+        return linear_index(gid, nwg);
+    }
     return (reversed_chunk(w / per_chunk) * per_chunk + w % per_chunk) * WG + gid.x % WG;
 }
+
+// The fewest workgroups a spread chunk holds: 4 × SPREAD_CHUNKS × WG invocations, from 32 768
+// particles on at WG = 128.
+const SPREAD_MIN_CHUNK: u32 = 4u;
 
 // The lowest log2(SPREAD_CHUNKS) bits of `c` reversed, bit by bit (naga's MSL output at its
 // default version has no reverseBits).

@@ -119,21 +119,8 @@ impl Kernel {
         bind: &wgpu::BindGroup,
         invocations: u32,
     ) {
-        self.dispatch_spread(pass, bind, invocations, 1);
-    }
-
-    /// Records one dispatch covering `invocations` invocations in whole chunks of `chunks`
-    /// workgroups (a pass that spreads its workgroups: `spread_index` in common.wgsl); the
-    /// workgroups past the invocations do nothing.
-    pub fn dispatch_spread(
-        &self,
-        pass: &mut wgpu::ComputePass<'_>,
-        bind: &wgpu::BindGroup,
-        invocations: u32,
-        chunks: u32,
-    ) {
         let groups = invocations.div_ceil(super::shader::WORKGROUP_SIZE).max(1);
-        self.dispatch_groups(pass, bind, groups.next_multiple_of(chunks));
+        self.dispatch_groups(pass, bind, groups);
     }
 
     /// Records one dispatch of `groups` workgroups, folded into 2D past 65535.
@@ -210,19 +197,6 @@ impl ParityKernel {
     /// `invocations` invocations on the arrays of parity `p`.
     pub fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, p: usize, invocations: u32) {
         self.kernel.dispatch(pass, &self.bind[p], invocations);
-    }
-
-    /// `invocations` invocations on the arrays of parity `p`, in whole chunks of `chunks`
-    /// workgroups ([`Kernel::dispatch_spread`]).
-    pub fn dispatch_spread(
-        &self,
-        pass: &mut wgpu::ComputePass<'_>,
-        p: usize,
-        invocations: u32,
-        chunks: u32,
-    ) {
-        self.kernel
-            .dispatch_spread(pass, &self.bind[p], invocations, chunks);
     }
 
     /// `groups` workgroups on the arrays of parity `p`.

@@ -20,8 +20,6 @@ pub struct Interaction {
     /// `interaction_boundary`), its two halves.
     halves: Option<[ParityKernel; 2]>,
     n: u32,
-    /// The chunks its workgroups are spread in (`ShaderConfig::spread_chunks`).
-    spread_chunks: u32,
 }
 
 impl Interaction {
@@ -32,7 +30,6 @@ impl Interaction {
         module: &ShaderModule,
         b: &ParticleBuffers,
         slab: Option<&wgpu::Buffer>,
-        spread_chunks: u32,
     ) -> Result<Self> {
         let halves = slab
             .map(|ctl| {
@@ -49,27 +46,23 @@ impl Interaction {
             kernel: ParityKernel::new(device, module, "interaction", |p| b.at(p))?,
             halves,
             n: b.n,
-            spread_chunks,
         })
     }
 
     /// Evaluates the rates of the (sorted) arrays of parity `p` into `rate`.
     pub fn encode(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.kernel
-            .dispatch_spread(pass, p, self.n, self.spread_chunks);
+        self.kernel.dispatch(pass, p, self.n);
     }
 
     /// The rates of the particles that read nothing the exchange brings (`reads_no_arrival`,
     /// shaders/lib/slab.wgsl), before it arrives, workgroup by workgroup where all of one's
     /// do; the others' marked left for [`Interaction::encode_boundary`], after the second sort.
     pub fn encode_interior(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.half(0)
-            .dispatch_spread(pass, p, self.n, self.spread_chunks);
+        self.half(0).dispatch(pass, p, self.n);
     }
 
     pub fn encode_boundary(&self, pass: &mut wgpu::ComputePass<'_>, p: usize) {
-        self.half(1)
-            .dispatch_spread(pass, p, self.n, self.spread_chunks);
+        self.half(1).dispatch(pass, p, self.n);
     }
 
     fn half(&self, k: usize) -> &ParityKernel {

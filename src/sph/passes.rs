@@ -120,7 +120,6 @@ impl Passes {
                 &shader(&interaction::SHADER)?,
                 b,
                 overlapped.map(Halo::slab),
-                cfg.spread_chunks,
             )?,
             overlap: overlapped
                 .map(|_| Overlap::new(device, &shader(&overlap::SHADER)?, b, policy))
