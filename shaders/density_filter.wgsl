@@ -87,7 +87,7 @@ fn filter_density(i: u32, mls: bool) -> f32 {
 }
 
 fn filter_all(gid: vec3<u32>, nwg: vec3<u32>, mls: bool) {
-    let i = linear_index(gid, nwg);
+    let i = spread_index(gid, nwg);
     if (i >= params.n_particles) {
         return;
     }
