@@ -1283,3 +1283,94 @@ fn extrapolated_inlet_pressure_matches_reference() {
         }
     }
 }
+
+/// `spread_index` with a CPU adapter's chunks (forced, so on any adapter): each invocation of a
+/// dispatch takes a different particle and together they take every one, so a spread
+/// neighbour sum sums each particle once. Below 4 workgroups a chunk, and past the last whole
+/// chunk, the order is the dispatch's; with whole chunks it is not, and each workgroup's
+/// particles stay one workgroup's range. (Every test case is below the spread's size, so
+/// without this no test runs the spread order.)
+#[test]
+fn spread_index_takes_every_particle_once() {
+    use wgsph::gpu::buffers::read;
+    use wgsph::gpu::kernel::{Resolve, ShaderModule};
+    use wgsph::gpu::shader::{Shader, WORKGROUP_SIZE as WG};
+    use wgsph::sph::shader::{compose, ShaderConfig, SPREAD_CHUNKS};
+    struct Taken<'a>(&'a wgpu::Buffer);
+    impl Resolve for Taken<'_> {
+        fn resolve(&self, name: &str) -> anyhow::Result<&wgpu::Buffer> {
+            anyhow::ensure!(name == "taken", "no buffer {name}");
+            Ok(self.0)
+        }
+    }
+    const SPREAD_ORDER: Shader = Shader {
+        name: "spread_order",
+        source: "@group(0) @binding(1) var<storage, read_write> taken: array<u32>;\n\
+                 @compute @workgroup_size(WG)\n\
+                 fn spread_order(@builtin(global_invocation_id) gid: vec3<u32>, \
+                 @builtin(num_workgroups) nwg: vec3<u32>) {\n\
+                 taken[linear_index(gid, nwg)] = spread_index(gid, nwg);\n}\n",
+        libs: &[],
+    };
+    let ctx = gpu();
+    let cfg = ShaderConfig {
+        spread_chunks: SPREAD_CHUNKS,
+        ..ShaderConfig::default()
+    };
+    let module =
+        ShaderModule::new(&ctx.device, "spread_order", compose(&SPREAD_ORDER, cfg)).unwrap();
+    let kernel = module.kernel(&ctx.device, "spread_order").unwrap();
+    let min_spread = 4 * SPREAD_CHUNKS;
+    for groups in [
+        1,
+        13,
+        min_spread - 1,
+        min_spread,
+        min_spread + 17,
+        19 * SPREAD_CHUNKS + 63,
+    ] {
+        let n = (groups * WG) as usize;
+        let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("taken"),
+            size: 4 * n as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let bind = kernel.bind(&ctx.device, &Taken(&buffer)).unwrap();
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            kernel.dispatch_groups(&mut pass, &bind, groups);
+        }
+        ctx.queue.submit([encoder.finish()]);
+        let taken: Vec<u32> = read(&ctx.device, &ctx.queue, &buffer, n).unwrap();
+        let mut sorted = taken.clone();
+        sorted.sort_unstable();
+        assert!(
+            sorted.iter().enumerate().all(|(k, &i)| i as usize == k),
+            "{groups} workgroups: not every particle taken once"
+        );
+        let spread_groups = match groups / SPREAD_CHUNKS {
+            per_chunk if per_chunk >= 4 => per_chunk * SPREAD_CHUNKS,
+            _ => 0,
+        };
+        let (spread, tail) = taken.split_at((spread_groups * WG) as usize);
+        let in_order =
+            |s: &[u32], from: usize| s.iter().enumerate().all(|(k, &i)| i as usize == from + k);
+        assert!(
+            in_order(tail, spread.len()),
+            "{groups} workgroups: tail reordered"
+        );
+        assert_eq!(
+            in_order(spread, 0),
+            spread.is_empty(),
+            "{groups} workgroups"
+        );
+        for group in spread.chunks(WG as usize) {
+            assert!(
+                in_order(group, group[0] as usize) && group[0] % WG == 0,
+                "{groups}"
+            );
+        }
+    }
+}

@@ -1,7 +1,7 @@
 //! Every composed shader variant the shipped cases use (and the all-kinds variant, also as a CPU
-//! adapter spreads its neighbour sums) translates
-//! with naga's own backends to SPIR-V (Vulkan), MSL (Metal), HLSL (DX12) and GLSL (GL compute),
-//! so a shader change that would break another vendor's backend is caught without its device.
+//! adapter spreads its neighbour sums) translates with naga's own backends to SPIR-V (Vulkan),
+//! MSL (Metal), HLSL (DX12) and GLSL (GL compute), so a shader change that would break another
+//! vendor's backend is caught without its device.
 
 use naga::back::{glsl, hlsl, msl, spv};
 use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
