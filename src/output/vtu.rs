@@ -182,6 +182,16 @@ pub(crate) fn pvtu_pieces(text: &str) -> Result<Vec<String>, String> {
     if pieces.is_empty() {
         return Err("it names no pieces".into());
     }
+    // `write_pvtu` names `.vtu` files beside the `.pvtu`: anything else (another `.pvtu`, which
+    // could name this one, or a path elsewhere) is not a file wgsph wrote.
+    if let Some(odd) = pieces
+        .iter()
+        .find(|p| !p.ends_with(".vtu") || p.contains(['/', '\\']) || p.starts_with('.'))
+    {
+        return Err(format!(
+            "it names the piece \"{odd}\", not a .vtu file beside it"
+        ));
+    }
     Ok(pieces)
 }
 
@@ -448,12 +458,18 @@ pub(crate) mod reader {
                     Some(_) => number(line, "NumberOfComponents")?,
                     None => 1,
                 };
-                let at = base + number(line, "offset")?;
                 let cut = || format!("array {name} runs past the end of the file (cut short?)");
-                let count = bytes.get(at..at + 8).ok_or_else(cut)?;
-                let len = u64::from_le_bytes(count.try_into().expect("8 bytes")) as usize;
-                let data = bytes.get(at + 8..at + 8 + len).ok_or_else(cut)?.to_vec();
-                last_end = last_end.max(at + 8 + len);
+                // Offsets and lengths are the file's word: checked, as a corrupt one may be
+                // anything up to 2^64 - 1.
+                let at = base.checked_add(number(line, "offset")?).ok_or_else(cut)?;
+                let count = bytes.get(at..at.saturating_add(8)).ok_or_else(cut)?;
+                let len = u64::from_le_bytes(count.try_into().expect("8 bytes"));
+                let end = usize::try_from(len)
+                    .ok()
+                    .and_then(|len| (at + 8).checked_add(len))
+                    .ok_or_else(cut)?;
+                let data = bytes.get(at + 8..end).ok_or_else(cut)?.to_vec();
+                last_end = last_end.max(end);
                 let prev = arrays.insert(
                     name.clone(),
                     Array {
