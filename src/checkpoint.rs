@@ -18,8 +18,7 @@ use crate::output::write_atomic;
 use crate::scenario::{Kind, Scenario};
 use crate::sph::state::SolverState;
 
-/// Name of the checkpoint file inside the output directory.
-pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
+pub use crate::output::{rank_checkpoint_file, CHECKPOINT_FILE};
 const MAGIC: &[u8; 8] = b"WGSPHCKP";
 /// 2: the solid section holds the solid particles only, in id order. Format 1 (every particle,
 /// in the saved GPU order) is still read.
@@ -139,12 +138,6 @@ pub struct RankCheckpoint {
     pub ranks: usize,
     pub generation: u32,
     pub ranked: crate::sph::subdomain::Ranked,
-}
-
-/// The checkpoint file of rank `rank` (> 0) of a run over several ranks, in generation
-/// `generation` (0 or 1).
-pub fn rank_checkpoint_file(rank: usize, generation: u32) -> String {
-    format!("checkpoint_g{generation}_p{rank:04}.bin")
 }
 
 #[derive(Serialize, Deserialize)]

@@ -179,7 +179,9 @@ impl ParticleOutputs {
         // The picture is of every particle (over ranks, drawn from the joined pieces:
         // `draw_published`).
         if let Some(view) = self.png.as_ref().filter(|_| !self.own_only) {
-            view.write_png(&self.png_path(index), &p.snapshot(solver.time(), &[]))?;
+            let png = self.png_path(index);
+            self.out.claim(&png)?;
+            view.write_png(&png, &p.snapshot(solver.time(), &[]))?;
         }
         Ok(())
     }
@@ -197,13 +199,9 @@ impl ParticleOutputs {
         let (Some(view), Some(file)) = (&self.png, self.out.snapshot_file(index)) else {
             return Ok(());
         };
-        let read = draw_particle_file(
-            &file,
-            self.first_drawn.as_ref(),
-            sc,
-            view,
-            &self.png_path(index),
-        )?;
+        let png = self.png_path(index);
+        self.out.claim(&png)?;
+        let read = draw_particle_file(&file, self.first_drawn.as_ref(), sc, view, &png)?;
         if self.boundary_first && self.first_drawn.is_none() {
             self.first_drawn = Some(read.particles);
         }
@@ -232,7 +230,7 @@ fn point_columns(dim: u32) -> Vec<String> {
 }
 
 impl BodyOutputs {
-    fn new(out: &OutputDir, sc: &Scenario, writes: bool) -> Result<Self> {
+    fn new(out: &mut OutputDir, sc: &Scenario, writes: bool) -> Result<Self> {
         let dim = sc.physics.dim;
         let bodies = sc
             .bodies
@@ -288,54 +286,6 @@ fn schedule(every: f64, end: f64) -> impl Iterator<Item = f64> {
     (1..=n).map(move |k| (k as f64 * every).min(end))
 }
 
-/// Removes what an earlier run wrote into `dir` (the files this engine names: particle series,
-/// probe and body tables, snapshots, plots, summary, checkpoint), so that a new run into the
-/// same folder leaves no stale file beside its own (a longer earlier run's last VTU files, a
-/// removed probe's table). Other files stay.
-fn remove_previous_outputs(dir: &Path) -> Result<()> {
-    use crate::output::{PARTICLES_DIR, PROBES_DIR, PVD_FILE, RUN_SUMMARY_FILE};
-    use crate::plot::PLOTS_DIR;
-    let mut stale: Vec<std::path::PathBuf> = [PVD_FILE, RUN_SUMMARY_FILE, CHECKPOINT_FILE]
-        .iter()
-        .map(|f| dir.join(f))
-        .filter(|p| p.is_file())
-        .collect();
-    // The rank files of a run over several ranks' checkpoints.
-    let rank_checkpoints = std::fs::read_dir(dir).into_iter().flatten().flatten();
-    stale.extend(rank_checkpoints.map(|e| e.path()).filter(|p| {
-        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or_default();
-        name.starts_with("checkpoint_g") && name.ends_with(".bin") && p.is_file()
-    }));
-    for (sub, ext) in [
-        (PARTICLES_DIR, "pvtu"),
-        (PARTICLES_DIR, "vtu"),
-        (PROBES_DIR, "csv"),
-        (SNAPSHOTS_DIR, "png"),
-        (PLOTS_DIR, "png"),
-        (PLOTS_DIR, "csv"),
-    ] {
-        let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
-            continue;
-        };
-        for e in entries.flatten() {
-            let p = e.path();
-            if p.is_file() && p.extension().is_some_and(|x| x == ext) {
-                stale.push(p);
-            }
-        }
-    }
-    for p in stale {
-        std::fs::remove_file(&p).with_context(|| {
-            format!(
-                "cannot remove {}, an output of an earlier run in the same folder; remove it \
-                 or choose another --out",
-                p.display()
-            )
-        })?;
-    }
-    Ok(())
-}
-
 /// Runs `sc` on `ctx`, writing into `dir` (after removing an earlier run's outputs there);
 /// `progress` hears once per probe interval.
 pub fn run(
@@ -384,7 +334,7 @@ fn start(
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("cannot create the output folder {}", dir.display()))?;
             let lock = crate::output::DirLock::acquire(dir)?;
-            remove_previous_outputs(dir)?;
+            crate::output::clear_for_new_run(dir)?;
             Some(lock)
         }
         false => None,
@@ -509,6 +459,11 @@ fn resume_with(
         });
     }
     let ck = checkpoint_of_rank(dir, sc, ranks)?;
+    if first {
+        // A run's checkpoint: the outputs beside it are the run's, written before wgsph kept
+        // a manifest of them if none lists them.
+        crate::output::adopt_unlisted_outputs(dir)?;
+    }
     if ck.adapter != ctx.info.name {
         log::warn!(
             "resuming on '{}' a run checkpointed on '{}': it continues, but not bit-identically",
@@ -706,7 +661,7 @@ impl<'a> Runner<'a> {
         options: &'a RunOptions,
         ranks: Option<&'a dyn Ranks>,
     ) -> Result<Self> {
-        let out = match ranks {
+        let mut out = match ranks {
             Some(r) => OutputDir::for_piece(
                 dir,
                 Piece {
@@ -738,7 +693,7 @@ impl<'a> Runner<'a> {
             None => Solver::new(ctx, sc),
         }
         .context("setting up the GPU solver")?;
-        let bodies = BodyOutputs::new(&out, sc, first)?;
+        let bodies = BodyOutputs::new(&mut out, sc, first)?;
         let some = |n: usize, what: &str| match n {
             0 => String::new(),
             n => format!(", {n} {what}"),
@@ -1109,18 +1064,23 @@ impl<'a> Runner<'a> {
                 ranked: self.solver.ranked().cloned().unwrap_or_default(),
             }),
         };
-        let dir = self.outputs.out.path();
+        let dir = self.outputs.out.path().to_path_buf();
+        let mut write = |name: &str| -> Result<()> {
+            let path = dir.join(name);
+            self.outputs.out.claim(&path)?;
+            ck.write(&path)
+        };
         match self.ranks {
-            None => ck.write(&dir.join(CHECKPOINT_FILE))?,
+            None => write(CHECKPOINT_FILE)?,
             Some(r) => {
                 // The other ranks' files first; rank 0's, the manifest naming them, once
                 // they are all complete.
                 if r.rank() != 0 {
-                    ck.write(&dir.join(rank_checkpoint_file(r.rank(), self.generation)))?;
+                    write(&rank_checkpoint_file(r.rank(), self.generation))?;
                 }
                 r.barrier();
                 if r.rank() == 0 {
-                    ck.write(&dir.join(CHECKPOINT_FILE))?;
+                    write(CHECKPOINT_FILE)?;
                 }
                 self.generation = 1 - self.generation;
             }
@@ -1134,49 +1094,7 @@ impl<'a> Runner<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::{remove_previous_outputs, schedule};
-
-    /// A new run into an old run's folder removes the old run's outputs (a longer run's last
-    /// VTU files, a removed probe's table, its plots, summary and checkpoint) and nothing else.
-    #[test]
-    fn a_new_run_removes_the_previous_runs_outputs_only() {
-        let d = std::env::temp_dir().join(format!("wgsph-previous-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        let stale = [
-            "particles.pvd",
-            "run.json",
-            "checkpoint.bin",
-            "checkpoint_g1_p0003.bin",
-            "particles/particles_000004.pvtu",
-            "particles/particles_000004_p0001.vtu",
-            "particles/particles_000012.vtu",
-            "probes/old_probe.csv",
-            "snapshots/000003.png",
-            "plots/old_probe.png",
-            "plots/errors.csv",
-        ];
-        let kept = [
-            "notes.txt",
-            "particles/readme.md",
-            "probes/mine.txt",
-            "case.toml",
-        ];
-        for f in stale.iter().chain(&kept) {
-            let p = d.join(f);
-            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
-            std::fs::write(&p, "x").unwrap();
-        }
-        remove_previous_outputs(&d).unwrap();
-        for f in stale {
-            assert!(!d.join(f).exists(), "{f} was left");
-        }
-        for f in kept {
-            assert!(d.join(f).exists(), "{f} was removed");
-        }
-        // A folder that does not exist yet is fine.
-        remove_previous_outputs(&d.join("new")).unwrap();
-        std::fs::remove_dir_all(&d).unwrap();
-    }
+    use super::schedule;
 
     #[test]
     fn schedule_ends_exactly_at_end() {

@@ -794,6 +794,104 @@ point_m = [0.12, 0.09]
 /// `run` and a resume of the folder refuse, naming the folder and the process, and leaves the
 /// lock as it was; a dead process's lock (a pid above Linux's pid_max) is taken over; after a
 /// run no lock is left.
+/// A run never deletes or overwrites a file it did not write (issue 64). A case named ".."
+/// ran, without --out, into `out/..` (the working directory) and its clean-up of an earlier
+/// run's outputs deleted the user's `probes/*.csv` and `plots/*.png` there and overwrote their
+/// `run.json`. Now such a name is refused, an --out folder holding files by the names a run
+/// writes that no run wrote is refused with every file intact, and a run into its own earlier
+/// folder removes what the earlier run wrote (its manifest) and nothing else.
+#[test]
+fn a_run_never_deletes_or_overwrites_files_it_did_not_write() {
+    let home = temp_dir("foreign");
+    let mine = [
+        "run.json",
+        "probes/p_bottom.csv",
+        "plots/mine.png",
+        "notes.txt",
+    ];
+    for f in mine {
+        let p = home.join(f);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(&p, format!("the user's {f}")).unwrap();
+    }
+    let intact = |what: &str| {
+        for f in mine {
+            let text = std::fs::read_to_string(home.join(f)).unwrap();
+            assert_eq!(text, format!("the user's {f}"), "{what}: {f}");
+        }
+    };
+    let case = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/hydrostatic_2d.toml");
+    let short = ["--set", "particles.dx_m=0.05", "--set", "time.end_s=0.02"];
+    for name in ["..", ".", " .. "] {
+        let o = wgsph()
+            .current_dir(home.join("probes"))
+            .arg("run")
+            .arg(&case)
+            .args(short)
+            .args(["--set", &format!("name=\"{name}\"")])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "name {name:?} ran: {err}");
+        assert!(
+            err.contains("name") && err.contains("fix: "),
+            "{name:?}: {err}"
+        );
+        intact(&format!("name {name:?}"));
+    }
+    let run = |out: &std::path::Path| {
+        wgsph()
+            .arg("run")
+            .arg(&case)
+            .args(short)
+            .args(["-q", "--out"])
+            .arg(out)
+            .output()
+            .unwrap()
+    };
+    let o = run(&home);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "ran into a folder of the user's files");
+    for f in [
+        "run.json",
+        "probes/p_bottom.csv",
+        "plots/mine.png",
+        "did not write",
+    ] {
+        assert!(err.contains(f), "the refusal names {f}: {err}");
+    }
+    assert!(!err.contains("notes.txt"), "{err}");
+    intact("--out the user's folder");
+    assert!(
+        !home.join("particles").exists(),
+        "the refused run wrote nothing"
+    );
+    // Its own folder, twice: the second run replaces the first's files and keeps the user's.
+    let out = temp_dir("own-folder");
+    let o = run(&out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::write(out.join("notes.txt"), "kept").unwrap();
+    std::fs::write(out.join("probes/readme.md"), "kept").unwrap();
+    std::fs::write(out.join("particles/particles_000099.vtu"), "stale").unwrap();
+    let o = run(&out);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("particles_000099.vtu"),
+        "{err}"
+    );
+    std::fs::remove_file(out.join("particles/particles_000099.vtu")).unwrap();
+    let o = run(&out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in [
+        "notes.txt",
+        "probes/readme.md",
+        "run.json",
+        "probes/height.csv",
+    ] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+}
+
 #[test]
 fn a_locked_output_folder_is_refused_and_a_stale_lock_taken_over() {
     let out = temp_dir("lock");
@@ -840,7 +938,7 @@ fn a_locked_output_folder_is_refused_and_a_stale_lock_taken_over() {
     assert!(out.join("probes/height.csv").is_file());
     let left: Vec<_> = (std::fs::read_dir(&*out).unwrap().flatten())
         .map(|e| e.file_name())
-        .filter(|n| n.to_string_lossy().starts_with(".wgsph"))
+        .filter(|n| n.to_string_lossy().starts_with(".wgsph.lock"))
         .collect();
     assert!(
         left.is_empty(),

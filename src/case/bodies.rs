@@ -10,7 +10,8 @@ use std::sync::Arc;
 use crate::scenario::{Motion, MotionLaw, Prescribed};
 
 use super::check::{
-    aabb, initial_velocity, number, read_bounded, treatment, vector, Aabb, Bound, Treatment,
+    aabb, file_safe, initial_velocity, number, read_bounded, treatment, vector, Aabb, Bound,
+    Treatment, MAX_NAME_BYTES,
 };
 use super::error::{num, CaseError};
 use super::locate::Ctx;
@@ -45,13 +46,6 @@ pub(super) struct BodySpec {
     pub motion: Motion,
 }
 
-fn file_safe(name: &str) -> bool {
-    !name.is_empty()
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-}
-
 /// `[[body]]`: every body checked, in order.
 pub(super) fn validate(
     ctx: &Ctx<'_>,
@@ -80,8 +74,11 @@ fn body(
         return Err(ctx.err(
             &format!("{path}.name"),
             Some(format!("{:?}", b.name)),
-            "must be made of letters, digits, `_` and `-` (it becomes the file name \
-             probes/body_<name>.csv) and must not be \"tank\" (the moving tank's name)",
+            format!(
+                "must be 1 to {MAX_NAME_BYTES} letters, digits, `_` and `-` (it becomes the \
+                 file name probes/body_<name>.csv) and must not be \"tank\" (the moving \
+                 tank's name)"
+            ),
             "use a name like \"box\" or \"cylinder\"",
         ));
     }

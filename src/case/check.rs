@@ -13,6 +13,20 @@ use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::schema::{SlipName, WallName};
 
+/// The longest name (in bytes) of a case, probe or body: names become file and folder names
+/// (`out/<case>`, `probes/body_<name>.csv`), which file systems cap at 255 bytes; a longer one
+/// failed only after the run had made its folders (issue 64).
+pub(super) const MAX_NAME_BYTES: usize = 100;
+
+/// Whether `name` can be a probe's or body's file name: 1 to [`MAX_NAME_BYTES`] letters,
+/// digits, `_` and `-`.
+pub(super) fn file_safe(name: &str) -> bool {
+    (1..=MAX_NAME_BYTES).contains(&name.len())
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
 /// An axis-aligned box (3 components; in 2D the third is 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Aabb {

@@ -8,7 +8,7 @@ use crate::scenario::{
     Body, Particle, Probe, ProbeKind, TrackedPoint, WallParams, WallPatch, FACE_UNBOUNDED,
 };
 
-use super::check::vector;
+use super::check::{file_safe, vector, MAX_NAME_BYTES};
 use super::error::CaseError;
 use super::locate::Ctx;
 use super::schema::{ProbeName, RawProbe};
@@ -39,16 +39,14 @@ pub(super) fn probe(
     dim: usize,
 ) -> Result<Checked, CaseError> {
     let path = format!("probe[{i}]");
-    if p.name.is_empty()
-        || !p
-            .name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-    {
+    if !file_safe(&p.name) {
         return Err(ctx.err(
             &format!("{path}.name"),
             Some(format!("{:?}", p.name)),
-            "must be made of letters, digits, `_` and `-` only (it becomes a file name)",
+            format!(
+                "must be 1 to {MAX_NAME_BYTES} letters, digits, `_` and `-` (it becomes a file \
+                 name)"
+            ),
             "use a name like \"P1\" or \"front\"",
         ));
     }

@@ -8,7 +8,9 @@ use crate::scenario::{
     OverlapExchange, Probe, RepulsiveForm, TimeControl, Viscosity, DEFAULT_FRICTION_SLIP,
 };
 
-use super::check::{aabb, initial_velocity, number, treatment, vector, Aabb, Bound, Treatment};
+use super::check::{
+    aabb, initial_velocity, number, treatment, vector, Aabb, Bound, Treatment, MAX_NAME_BYTES,
+};
 use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::probes::Checked;
@@ -225,14 +227,22 @@ fn dimension(ctx: &Ctx<'_>, raw: &RawCase) -> Result<usize, CaseError> {
 /// `name`, or `default_name` without one.
 fn case_name(ctx: &Ctx<'_>, raw: &RawCase, default_name: &str) -> Result<String, CaseError> {
     Ok(match &raw.name {
+        // "." and ".." name the output folder's parent or itself (`out/..` is the working
+        // directory, issue 64).
         Some(n)
             if n.trim().is_empty()
+                || n.trim() == "."
+                || n.trim() == ".."
+                || n.len() > MAX_NAME_BYTES
                 || n.chars().any(|c| c.is_control() || c == '/' || c == '\\') =>
         {
             return Err(ctx.err(
                 "name",
                 Some(format!("{n:?}")),
-                "must be a non-empty name without slashes or control characters",
+                format!(
+                    "must be a non-empty name of at most {MAX_NAME_BYTES} bytes, not \".\" or \
+                     \"..\", without slashes or control characters (it names the output folder)"
+                ),
                 "use letters, digits, `_` and `-`, e.g. name = \"dam_break_2d\"",
             ))
         }

@@ -22,6 +22,7 @@
 
 mod atomic;
 mod lock;
+mod manifest;
 mod particle_file;
 mod probes_csv;
 mod pvd;
@@ -34,6 +35,9 @@ use std::path::{Path, PathBuf};
 
 pub use atomic::write_atomic;
 pub use lock::{DirLock, LOCK_FILE};
+pub use manifest::{
+    adopt_unlisted_outputs, clear_for_new_run, is_run_output, write_listed, Manifest, MANIFEST_FILE,
+};
 pub use particle_file::{particle_files, FirstPositions, ParticleFile, Particles};
 pub use probes_csv::ProbeWriter;
 pub use run_summary::{RankSummary, RunSummary};
@@ -52,6 +56,27 @@ pub const RUN_SUMMARY_FILE: &str = "run.json";
 /// of the particle file) and of their series file.
 pub const SURFACE_DIR: &str = "surface";
 pub const SURFACE_PVD_FILE: &str = "surface.pvd";
+
+/// Folder of the plots inside a run directory (`wgsph plot`).
+pub const PLOTS_DIR: &str = "plots";
+/// Name of the checkpoint file inside the output directory (of one whole run; of rank 0 of
+/// several, the manifest naming the other ranks' files).
+pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
+
+/// The checkpoint file of rank `rank` (> 0) of a run over several ranks, in generation
+/// `generation` (0 or 1).
+pub fn rank_checkpoint_file(rank: usize, generation: u32) -> String {
+    format!("checkpoint_g{generation}_p{rank:04}.bin")
+}
+
+/// Whether `name` is a name [`rank_checkpoint_file`] gives.
+pub fn is_rank_checkpoint(name: &str) -> bool {
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    (name.strip_prefix("checkpoint_g"))
+        .and_then(|r| r.strip_suffix(".bin"))
+        .and_then(|r| r.split_once("_p"))
+        .is_some_and(|(g, r)| digits(g) && digits(r))
+}
 
 /// A triangle mesh of the water's surface at one output (`wgsph surface`).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -82,7 +107,7 @@ impl SurfaceMesh {
                     .map(|c| c as usize)
                     .collect::<Vec<_>>(),
             };
-            if corners.len() != 3 * v.number_of_cells
+            if Some(corners.len()) != v.number_of_cells.checked_mul(3)
                 || corners.iter().any(|&c| c >= v.number_of_points)
             {
                 return Err("its cells are not triangles of its points".into());
@@ -121,15 +146,14 @@ pub fn write_surface(
     mesh: &SurfaceMesh,
 ) -> Result<(f64, String), OutputError> {
     let rel = format!("{SURFACE_DIR}/surface_{index:06}.vtu");
-    write_atomic(&dir.join(&rel), |w| vtu::write_triangles_vtu(w, mesh))?;
+    write_listed(dir, &rel, |w| vtu::write_triangles_vtu(w, mesh))?;
     Ok((mesh.time_s, rel))
 }
 
 /// Writes DIR/surface.pvd listing the surfaces `series` ([`write_surface`]'s), atomically.
 pub fn write_surface_series(dir: &Path, series: &[(f64, String)]) -> Result<PathBuf, OutputError> {
-    let pvd = dir.join(SURFACE_PVD_FILE);
-    write_atomic(&pvd, |w| pvd::write_pvd(w, series))?;
-    Ok(pvd)
+    write_listed(dir, SURFACE_PVD_FILE, |w| pvd::write_pvd(w, series))?;
+    Ok(dir.join(SURFACE_PVD_FILE))
 }
 
 /// Errors of the output module. Every message names the path involved and, for I/O failures,
@@ -194,6 +218,17 @@ pub enum OutputError {
     /// A file the engine wrote cannot be read back (`reason` says why).
     #[error("cannot read {}: {reason}", path.display())]
     Read { path: PathBuf, reason: String },
+    /// The output folder holds files by the names a run writes that no run wrote there
+    /// (`manifest::clear_for_new_run`).
+    #[error(
+        "{} holds {} that wgsph did not write there ({}{}): a run never deletes or overwrites          files it did not write; choose another --out, or move those files away (an output          folder of a wgsph older than its manifest {}: remove the folder)",
+        dir.display(),
+        match files.len() { 1 => "a file".to_string(), n => format!("{n} files") },
+        files.iter().take(5).map(String::as_str).collect::<Vec<_>>().join(", "),
+        if files.len() > 5 { ", ..." } else { "" },
+        MANIFEST_FILE
+    )]
+    Foreign { dir: PathBuf, files: Vec<String> },
 }
 
 impl OutputError {
@@ -306,6 +341,8 @@ pub struct OutputDir {
     piece: Option<Piece>,
     /// The further scalars of the last piece written (what the `.pvtu` declares).
     extra_names: Vec<String>,
+    /// What this process wrote here (rank r of several: its own list).
+    manifest: Manifest,
 }
 
 impl OutputDir {
@@ -326,6 +363,7 @@ impl OutputDir {
             snapshots: Vec::new(),
             piece: None,
             extra_names: Vec::new(),
+            manifest: Manifest::open(dir, 0)?,
         })
     }
 
@@ -344,6 +382,7 @@ impl OutputDir {
                     snapshots: Vec::new(),
                     piece: None,
                     extra_names: Vec::new(),
+                    manifest: Manifest::open(dir, piece.rank)?,
                 }
             }
         };
@@ -384,6 +423,7 @@ impl OutputDir {
             let rel = format!("{PARTICLES_DIR}/{}", pieces_file_name(index));
             let path = self.dir.join(piece_of(&rel, piece.rank));
             snap.validate(&path)?;
+            self.manifest.claim_path(&path)?;
             write_atomic(&path, |w| vtu::write_vtu(w, snap))?;
             self.snapshots.push((snap.time_s, rel));
             self.extra_names = snap.extra.iter().map(|(n, _)| n.to_string()).collect();
@@ -392,18 +432,18 @@ impl OutputDir {
         let rel = format!("{PARTICLES_DIR}/{}", particle_file_name(index));
         let vtu_path = particle_file_path(&self.dir, index);
         snap.validate(&vtu_path)?;
+        self.manifest.claim(&rel)?;
         write_atomic(&vtu_path, |w| vtu::write_vtu(w, snap))?;
         // The .vtu is complete and in place: from now on it belongs to the series, even if
         // rewriting the .pvd fails (the next snapshot's .pvd rewrite will list it).
         self.snapshots.push((snap.time_s, rel));
-        let pvd_path = self.pvd_path();
-        write_atomic(&pvd_path, |w| pvd::write_pvd(w, &self.snapshots))?;
+        self.write_series()?;
         Ok(vtu_path)
     }
 
     /// Rank 0 of a run over several ranks, once every rank has written its piece of the last
     /// output: writes that output's `.pvtu`, then the `.pvd` listing it. Nothing on other ranks.
-    pub fn publish_pieces(&self) -> Result<(), OutputError> {
+    pub fn publish_pieces(&mut self) -> Result<(), OutputError> {
         let (Some(piece), Some((_, rel))) = (self.piece, self.snapshots.last()) else {
             return Ok(());
         };
@@ -413,8 +453,24 @@ impl OutputDir {
         let name = rel.rsplit('/').next().unwrap_or(rel);
         let pieces: Vec<String> = (0..piece.ranks).map(|r| piece_of(name, r)).collect();
         let extra: Vec<&str> = self.extra_names.iter().map(String::as_str).collect();
-        write_atomic(&self.dir.join(rel), |w| vtu::write_pvtu(w, &extra, &pieces))?;
+        let rel = rel.clone();
+        self.manifest.claim(&rel)?;
+        write_atomic(&self.dir.join(&rel), |w| {
+            vtu::write_pvtu(w, &extra, &pieces)
+        })?;
+        self.write_series()
+    }
+
+    /// Rewrites DIR/particles.pvd listing the snapshots so far, atomically.
+    fn write_series(&mut self) -> Result<(), OutputError> {
+        self.manifest.claim(PVD_FILE)?;
         write_atomic(&self.pvd_path(), |w| pvd::write_pvd(w, &self.snapshots))
+    }
+
+    /// Lists `path`, a file of this run inside its folder, in the folder's manifest before it
+    /// is written (what the run writes beside the particles: checkpoints, pictures).
+    pub fn claim(&mut self, path: &Path) -> Result<(), OutputError> {
+        self.manifest.claim_path(path)
     }
 
     /// Drops the snapshots after `t_s` from the series: their files are removed and the `.pvd`
@@ -441,7 +497,7 @@ impl OutputDir {
         let dropped = keep..self.snapshots.len();
         self.snapshots.truncate(keep);
         if index_writer {
-            write_atomic(&self.pvd_path(), |w| pvd::write_pvd(w, &self.snapshots))?;
+            self.write_series()?;
         }
         Ok(dropped)
     }
@@ -472,30 +528,33 @@ impl OutputDir {
         if !index_writer {
             return Ok(());
         }
-        write_atomic(&self.pvd_path(), |w| pvd::write_pvd(w, &self.snapshots))
+        self.write_series()
     }
 
     /// Creates one CSV per probe at DIR/probes/<name>.csv with header `t_s,<column>` (written
     /// at once, atomically); rows are appended with [`ProbeWriter::record`] and made durable by
     /// [`ProbeWriter::flush`].
     pub fn probe_writer(
-        &self,
+        &mut self,
         names_and_columns: &[(String, String)],
     ) -> Result<ProbeWriter, OutputError> {
-        ProbeWriter::create(&self.dir.join(PROBES_DIR), names_and_columns)
+        let probes = self.dir.join(PROBES_DIR);
+        ProbeWriter::create(&probes, names_and_columns, &mut self.manifest)
     }
 
     /// Creates DIR/probes/<name>.csv files with several value columns each (`t_s,<columns>`),
     /// e.g. the bodies' motion and loads; rows are added with [`ProbeWriter::record_rows`].
     pub fn table_writer(
-        &self,
+        &mut self,
         tables: &[(String, Vec<String>)],
     ) -> Result<ProbeWriter, OutputError> {
-        ProbeWriter::create_tables(&self.dir.join(PROBES_DIR), tables)
+        let probes = self.dir.join(PROBES_DIR);
+        ProbeWriter::create_tables(&probes, tables, &mut self.manifest)
     }
 
     /// Writes DIR/run.json atomically (pretty-printed; non-finite numbers become `null`).
-    pub fn write_run_summary(&self, summary: &RunSummary) -> Result<(), OutputError> {
+    pub fn write_run_summary(&mut self, summary: &RunSummary) -> Result<(), OutputError> {
+        self.manifest.claim(RUN_SUMMARY_FILE)?;
         run_summary::write_run_summary(&self.dir.join(RUN_SUMMARY_FILE), summary)
     }
 }
@@ -699,6 +758,7 @@ mod tests {
         assert_eq!(
             names,
             [
+                MANIFEST_FILE,
                 "particles",
                 "particles.pvd",
                 "particles_000000.vtu",

@@ -209,15 +209,15 @@ impl ParticleFile {
             ));
         }
         let sized = |name: &str, a: Vec<f32>, per: usize| -> Result<Vec<f32>, String> {
-            check_len(name, a.len(), per * n)?;
+            check_len(name, a.len(), per, n)?;
             Ok(a)
         };
         let points = v.f64s("Points", 3)?;
-        check_len("Points", points.len(), 3 * n)?;
+        check_len("Points", points.len(), 3, n)?;
         let vel = sized("velocity", v.f32s("velocity", 3)?, 3)?;
         let (kind, id) = (v.u32s("kind")?, v.u32s("id")?);
-        check_len("kind", kind.len(), n)?;
-        check_len("id", id.len(), n)?;
+        check_len("kind", kind.len(), 1, n)?;
+        check_len("id", id.len(), 1, n)?;
         let optional = |name: &str| -> Result<Option<Vec<f32>>, String> {
             match v.arrays.contains_key(name) {
                 true => Ok(Some(sized(name, v.f32s(name, 1)?, 1)?)),
@@ -250,12 +250,15 @@ impl ParticleFile {
     }
 }
 
-fn check_len(name: &str, len: usize, expected: usize) -> Result<(), String> {
-    if len == expected {
+/// `len` values in array `name`, where NumberOfPoints asks for `per` a point (a corrupt
+/// count may overflow the product: then no array matches it).
+fn check_len(name: &str, len: usize, per: usize, n: usize) -> Result<(), String> {
+    let expected = per.checked_mul(n);
+    if Some(len) == expected {
         Ok(())
     } else {
         Err(format!(
-            "array {name} has {len} values, not {expected} (NumberOfPoints)"
+            "array {name} has {len} values, not {per} × {n} (NumberOfPoints)"
         ))
     }
 }
@@ -423,7 +426,7 @@ mod tests {
                 out.write_snapshot(&piece.snapshot(0.5 * k as f64, &extra))
                     .unwrap();
             }
-            for out in &outs {
+            for out in &mut outs {
                 out.publish_pieces().unwrap();
             }
         }

@@ -4,7 +4,7 @@ use std::collections::HashSet;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::{fmt_f64, write_atomic, OutputError};
+use super::{fmt_f64, write_atomic, Manifest, OutputError};
 
 struct ProbeFile {
     path: PathBuf,
@@ -33,15 +33,17 @@ pub struct ProbeWriter {
 
 impl ProbeWriter {
     /// Validates the names and writes each `dir/<name>.csv` with its header line only.
+    /// Each file is listed in `manifest` (the output folder's) before it is written.
     pub(crate) fn create(
         dir: &Path,
         names_and_columns: &[(String, String)],
+        manifest: &mut Manifest,
     ) -> Result<Self, OutputError> {
         let tables: Vec<(String, Vec<String>)> = names_and_columns
             .iter()
             .map(|(n, c)| (n.clone(), vec![c.clone()]))
             .collect();
-        Self::create_tables(dir, &tables)
+        Self::create_tables(dir, &tables, manifest)
     }
 
     /// As [`create`](ProbeWriter::create) with several value columns per file
@@ -49,6 +51,7 @@ impl ProbeWriter {
     pub(crate) fn create_tables(
         dir: &Path,
         tables: &[(String, Vec<String>)],
+        manifest: &mut Manifest,
     ) -> Result<Self, OutputError> {
         let mut seen = HashSet::new();
         let mut files = Vec::with_capacity(tables.len());
@@ -81,6 +84,9 @@ impl ProbeWriter {
                 columns: columns.len(),
                 text: format!("t_s,{}\n", columns.join(",")),
             });
+        }
+        for f in &files {
+            manifest.claim_path(&f.path)?;
         }
         let mut w = ProbeWriter {
             dir: dir.to_path_buf(),
@@ -244,7 +250,7 @@ mod tests {
     #[test]
     fn header_rows_and_flush() {
         let d = temp_dir("probes");
-        let out = OutputDir::create(&d).unwrap();
+        let mut out = OutputDir::create(&d).unwrap();
         let mut w = out
             .probe_writer(&cols(&[
                 ("p1", "pressure_pa"),
@@ -299,7 +305,7 @@ mod tests {
     #[test]
     fn truncate_after_keeps_the_rows_up_to_a_time() {
         let d = temp_dir("probes-truncate");
-        let out = OutputDir::create(&d).unwrap();
+        let mut out = OutputDir::create(&d).unwrap();
         let mut w = out
             .probe_writer(&cols(&[("a", "height_m"), ("b", "front_m")]))
             .unwrap();
@@ -327,7 +333,7 @@ mod tests {
     #[test]
     fn drop_flushes_pending_rows() {
         let d = temp_dir("probes-drop");
-        let out = OutputDir::create(&d).unwrap();
+        let mut out = OutputDir::create(&d).unwrap();
         {
             let mut w = out.probe_writer(&cols(&[("a", "height_m")])).unwrap();
             w.record(0.5, &[2.0]).unwrap();
@@ -342,7 +348,7 @@ mod tests {
     #[test]
     fn wrong_value_count_and_bad_names() {
         let d = temp_dir("probes-err");
-        let out = OutputDir::create(&d).unwrap();
+        let mut out = OutputDir::create(&d).unwrap();
         let mut w = out
             .probe_writer(&cols(&[("a", "height_m"), ("b", "height_m")]))
             .unwrap();

@@ -149,7 +149,7 @@ mod tests {
     #[test]
     fn writes_and_reads_back() {
         let d = temp_dir("summary");
-        let out = OutputDir::create(&d).unwrap();
+        let mut out = OutputDir::create(&d).unwrap();
         let s = sample();
         out.write_run_summary(&s).unwrap();
         let text = std::fs::read_to_string(d.join("run.json")).unwrap();
@@ -165,14 +165,15 @@ mod tests {
         let back: RunSummary =
             serde_json::from_str(&std::fs::read_to_string(d.join("run.json")).unwrap()).unwrap();
         assert_eq!(back.status, "stopped: NaN in density");
-        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 3); // run.json, particles, probes
+        // run.json, particles, probes and the manifest listing run.json.
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 4);
         std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]
     fn nan_becomes_null() {
         let d = temp_dir("summary-nan");
-        let out = OutputDir::create(&d).unwrap();
+        let mut out = OutputDir::create(&d).unwrap();
         let s = RunSummary {
             wall_time_s: f64::NAN,
             particle_steps_per_s: f64::INFINITY,

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 
-use crate::output::{write_atomic, SNAPSHOTS_DIR};
+use crate::output::{write_atomic, Manifest, SNAPSHOTS_DIR};
 
 /// The animation's file in DIR/snapshots/.
 pub const ANIMATION_FILE: &str = "animation.png";
@@ -49,6 +49,7 @@ pub fn write_animation(dir: &Path, frames: &[PathBuf], fps: u16) -> Result<PathB
     }
     let (size, _) = read_rgb(first)?;
     let path = dir.join(SNAPSHOTS_DIR).join(ANIMATION_FILE);
+    Manifest::open(dir, 0)?.claim_path(&path)?;
     write_atomic(&path, |w| {
         let mut enc = png::Encoder::new(w, size.0, size.1);
         enc.set_color(png::ColorType::Rgb);

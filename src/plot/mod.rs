@@ -23,10 +23,8 @@ use std::str::FromStr;
 use anyhow::{anyhow, bail, Context, Result};
 use plotters::prelude::*;
 
-use crate::output::{fmt_f64, write_atomic, PROBES_DIR, RUN_SUMMARY_FILE};
-
-/// Folder of the plots inside a run directory.
-pub const PLOTS_DIR: &str = "plots";
+pub use crate::output::PLOTS_DIR;
+use crate::output::{fmt_f64, write_atomic, Manifest, PROBES_DIR, RUN_SUMMARY_FILE};
 /// Error summary written next to the plots when references are given.
 pub const ERRORS_FILE: &str = "errors.csv";
 
@@ -480,6 +478,8 @@ pub fn plot_run(dir: &Path, opts: &PlotOptions) -> Result<PlotReport> {
     let plots = dir.join(PLOTS_DIR);
     std::fs::create_dir_all(&plots)
         .with_context(|| format!("cannot create {}", plots.display()))?;
+    // The plots join the run's files: the next run into the folder removes them.
+    let mut manifest = Manifest::open(dir, 0)?;
     let mut report = PlotReport::default();
     for name in &names {
         let main = read_probe(dir, name)?;
@@ -539,12 +539,14 @@ pub fn plot_run(dir: &Path, opts: &PlotOptions) -> Result<PlotReport> {
         } else {
             format!("{case}: {name}")
         };
+        manifest.claim_path(&png)?;
         render_png(&png, &title, "t [s]", &axis_label(&main.columns.1), &curves)?;
         report.pngs.push(png);
     }
     if !opts.references.is_empty() {
         let path = plots.join(ERRORS_FILE);
         let text = errors_csv(&report.errors);
+        manifest.claim_path(&path)?;
         write_atomic(&path, |w| w.write_all(text.as_bytes()))?;
         report.errors_csv = Some(path);
     }
@@ -603,7 +605,17 @@ const COLORS: [RGBColor; 6] = [
     RGBColor(23, 190, 207),
 ];
 
-/// Axis range of the finite values, padded by 5 % (and widened when degenerate).
+/// The largest magnitude an axis reaches: beyond it the span of an axis overflows f64, and
+/// plotters' tick loop (which steps over the span) never ends (issue 64: a probe table spanning
+/// ±1e308). Values beyond it are drawn clipped at the axis' end.
+const AXIS_LIMIT: f64 = 1e300;
+
+/// The smallest span of an axis relative to its magnitude: below it the ticks' step is lost in
+/// the values' rounding (1e16 + 0.2 == 1e16) and plotters' tick loop never ends.
+const AXIS_RESOLUTION: f64 = 1e-9;
+
+/// Axis range of the finite values, padded by 5 % (and widened when degenerate), within
+/// ±[`AXIS_LIMIT`] and at least [`AXIS_RESOLUTION`] of its magnitude wide.
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite()) {
@@ -613,11 +625,13 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     if !lo.is_finite() {
         return (0.0, 1.0);
     }
+    let (lo, hi) = (lo.max(-AXIS_LIMIT), hi.min(AXIS_LIMIT));
+    let magnitude = lo.abs().max(hi.abs());
     let span = hi - lo;
-    let pad = if span > 0.0 {
+    let pad = if span > AXIS_RESOLUTION * magnitude {
         0.05 * span
     } else {
-        0.5 * lo.abs().max(1.0)
+        0.5 * magnitude.max(1.0)
     };
     (lo - pad, hi + pad)
 }
@@ -677,7 +691,11 @@ pub fn render_png(
             };
             let style = ShapeStyle::from(&color).stroke_width(if c.reference { 1 } else { 2 });
             let mut labelled = false;
-            for seg in segments(&c.points) {
+            for mut seg in segments(&c.points) {
+                // Beyond the axes (past AXIS_LIMIT), a point's pixel overflows plotters' i32.
+                for p in &mut seg {
+                    *p = (p.0.clamp(x0, x1), p.1.clamp(y0, y1));
+                }
                 let series = chart.draw_series(LineSeries::new(seg.clone(), style))?;
                 if !labelled {
                     series
@@ -822,6 +840,47 @@ mod tests {
         let n = moving_average(&[(0.0, 1.0), (1.0, f64::NAN), (2.0, 3.0)], 4.0);
         assert_eq!((n[0].1, n[2].1), (2.0, 2.0));
         assert!(n[1].1.is_nan());
+    }
+
+    /// Values no axis can span (±1e308: the span overflows), or a span lost in the values'
+    /// rounding, drew forever inside plotters (issue 64); each must give a picture, soon.
+    #[test]
+    fn extreme_values_are_drawn_and_do_not_hang() {
+        let dir = std::env::temp_dir().join(format!("wgsph-plot-extreme-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let cases: Vec<Vec<(f64, f64)>> = vec![
+            vec![(0.0, -1e308), (1.0, 1e308)],
+            vec![(0.0, f64::MIN), (1.0, f64::MAX)],
+            vec![(-1e308, 0.0), (1e308, 1.0)],
+            vec![(0.0, 1e16), (1.0, 1e16 + 2.0)],
+            vec![(0.0, 1e300), (1.0, 1e300)],
+            vec![(0.0, 0.0), (1.0, 1e-300)],
+            vec![(0.0, -5e-324), (1e-310, 5e-324)],
+            vec![(0.0, f64::NAN), (1.0, f64::INFINITY)],
+        ];
+        let (tx, rx) = std::sync::mpsc::channel();
+        let d = dir.clone();
+        std::thread::spawn(move || {
+            for (k, points) in cases.into_iter().enumerate() {
+                let path = d.join(format!("{k}.png"));
+                let curve = Curve {
+                    label: "p".into(),
+                    points,
+                    reference: false,
+                };
+                tx.send((k, render_png(&path, "t", "x", "y", &[curve]).map(|_| path)))
+                    .unwrap();
+            }
+        });
+        for k in 0..8 {
+            let (i, drawn) = rx
+                .recv_timeout(std::time::Duration::from_secs(60))
+                .unwrap_or_else(|_| panic!("case {k}: still drawing after 60 s"));
+            let path = drawn.unwrap_or_else(|e| panic!("case {i}: {e:#}"));
+            assert!(std::fs::metadata(&path).unwrap().len() > 1000, "case {i}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

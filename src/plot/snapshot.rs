@@ -21,7 +21,7 @@ use plotters::prelude::*;
 use super::perspective::PerspectiveView;
 use super::{register_font, write_png};
 use crate::gpu::GpuContext;
-use crate::output::{particle_files, ParticleFile, Particles, Snapshot, SNAPSHOTS_DIR};
+use crate::output::{particle_files, Manifest, ParticleFile, Particles, Snapshot, SNAPSHOTS_DIR};
 use crate::scenario::{Domain, Kind, OutputBoundary, Scenario};
 use crate::sph::EXCLUDED;
 
@@ -198,8 +198,10 @@ pub fn draw_particle_files(
     std::fs::create_dir_all(&pngs).with_context(|| format!("cannot create {}", pngs.display()))?;
     let mut first: Option<ParticleFile> = None;
     let mut written = Vec::with_capacity(files.len());
+    let mut manifest = Manifest::open(dir, 0)?;
     for (index, file) in &files {
         let png = pngs.join(format!("{index:06}.png"));
+        manifest.claim_path(&png)?;
         let read = draw_particle_file(
             file,
             first.as_ref().map(|f| &f.particles),

@@ -555,10 +555,12 @@ pub fn draw(dir: &Path, figures: &[Figure]) -> Result<Vec<PathBuf>> {
     let plots = dir.join(PLOTS_DIR);
     std::fs::create_dir_all(&plots)
         .with_context(|| format!("cannot create {}", plots.display()))?;
+    let mut manifest = crate::output::Manifest::open(dir, 0)?;
     figures
         .iter()
         .map(|f| {
             let png = plots.join(format!("{}.png", f.name));
+            manifest.claim_path(&png)?;
             plot::render_png(&png, &f.title, &f.x_label, &f.y_label, &f.curves)?;
             Ok(png)
         })

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 
 use super::{Bound, CaseOutcome, Metric, Mode, Unit, Verdict};
-use crate::output::write_atomic;
+use crate::output::write_listed;
 
 /// The report's file name inside the output folder.
 pub const REPORT_FILE: &str = "report.md";
@@ -202,10 +202,9 @@ impl Report {
 
     /// Writes `out/report.md` atomically; returns its path.
     pub fn write(&self, out: &Path) -> Result<PathBuf> {
-        let path = out.join(REPORT_FILE);
         let text = self.markdown(out);
-        write_atomic(&path, |w| w.write_all(text.as_bytes()))?;
-        Ok(path)
+        write_listed(out, REPORT_FILE, |w| w.write_all(text.as_bytes()))?;
+        Ok(out.join(REPORT_FILE))
     }
 }
 
