@@ -708,6 +708,26 @@ mod tests {
         std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 
+    /// Damage behind a checksum that still matches (re-signed: a hostile edit, or the one
+    /// collision in 2^64) reaches the decoder itself: no damaged copy may panic it.
+    #[test]
+    fn damage_behind_a_matching_checksum_is_an_error_not_a_panic() {
+        let path = temp("resigned");
+        sample().write(&path).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let body = &bytes[..bytes.len() - 8];
+        let signed = |b: &[u8]| {
+            let mut sum = Fnv::default();
+            sum.update(b);
+            let mut signed = b.to_vec();
+            signed.extend_from_slice(&sum.finish().to_le_bytes());
+            Checkpoint::decode(&signed)
+        };
+        assert_eq!(signed(body).unwrap(), sample());
+        crate::output::test_util::survives_damage("a checkpoint", body, 1, signed);
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+    }
+
     #[test]
     fn checkpoint_policy_parses_simulated_and_wall_intervals() {
         let p = |s: &str| s.parse::<CheckpointPolicy>();

@@ -21,6 +21,8 @@
 //! ```
 
 mod atomic;
+#[cfg(test)]
+mod damaged_files;
 mod lock;
 mod manifest;
 mod particle_file;
@@ -91,39 +93,37 @@ impl SurfaceMesh {
     /// Reads a mesh [`write_surface`] wrote; errors name the file and what is wrong.
     pub fn read(path: &Path) -> Result<Self, OutputError> {
         let bytes = std::fs::read(path).map_err(|e| OutputError::io("read", path, e))?;
-        let v = vtu::reader::Vtu::parse(&bytes).map_err(|reason| OutputError::Read {
+        Self::parse(&bytes).map_err(|reason| OutputError::Read {
             path: path.to_path_buf(),
             reason,
-        })?;
-        let parsed = (|| -> Result<Self, String> {
-            let points = v.f64s("Points", 3)?;
-            let corners = match v.arrays.get("connectivity").map(|a| a.vtk_type.as_str()) {
-                Some("Int64") => v
-                    .i64s("connectivity")?
-                    .into_iter()
-                    .map(|c| c as usize)
-                    .collect(),
-                _ => (v.i32s("connectivity")?.into_iter())
-                    .map(|c| c as usize)
-                    .collect::<Vec<_>>(),
-            };
-            if Some(corners.len()) != v.number_of_cells.checked_mul(3)
-                || corners.iter().any(|&c| c >= v.number_of_points)
-            {
-                return Err("its cells are not triangles of its points".into());
-            }
-            Ok(SurfaceMesh {
-                time_s: v.f64s("TimeValue", 1)?.first().copied().unwrap_or(f64::NAN),
-                vertices: points.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
-                triangles: corners
-                    .chunks_exact(3)
-                    .map(|c| [c[0], c[1], c[2]])
-                    .collect(),
-            })
-        })();
-        parsed.map_err(|reason| OutputError::Read {
-            path: path.to_path_buf(),
-            reason,
+        })
+    }
+
+    pub(super) fn parse(bytes: &[u8]) -> Result<Self, String> {
+        let v = vtu::reader::Vtu::parse(bytes)?;
+        let points = v.f64s("Points", 3)?;
+        let corners = match v.arrays.get("connectivity").map(|a| a.vtk_type.as_str()) {
+            Some("Int64") => v
+                .i64s("connectivity")?
+                .into_iter()
+                .map(|c| c as usize)
+                .collect(),
+            _ => (v.i32s("connectivity")?.into_iter())
+                .map(|c| c as usize)
+                .collect::<Vec<_>>(),
+        };
+        if Some(corners.len()) != v.number_of_cells.checked_mul(3)
+            || corners.iter().any(|&c| c >= v.number_of_points)
+        {
+            return Err("its cells are not triangles of its points".into());
+        }
+        Ok(SurfaceMesh {
+            time_s: v.f64s("TimeValue", 1)?.first().copied().unwrap_or(f64::NAN),
+            vertices: points.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+            triangles: corners
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect(),
         })
     }
 }
@@ -515,6 +515,15 @@ impl OutputDir {
     pub fn resume_series(&mut self, snapshots: Vec<(f64, String)>) -> Result<(), OutputError> {
         let index_writer = self.piece.is_none_or(|p| p.rank == 0);
         for (_, rel) in &snapshots {
+            // Only particle files of this folder: the run removes and overwrites them.
+            let name = rel.strip_prefix(&format!("{PARTICLES_DIR}/"));
+            if !name.is_some_and(|n| is_run_output(rel) && n.starts_with("particles_")) {
+                return Err(OutputError::Resume {
+                    path: self.dir.join(rel),
+                    reason: "the checkpoint lists a snapshot that is no particle file of the run"
+                        .into(),
+                });
+            }
             let piece = self.piece.map(|p| self.dir.join(piece_of(rel, p.rank)));
             let index = index_writer.then(|| self.dir.join(rel));
             if let Some(file) = piece.into_iter().chain(index).find(|f| !f.is_file()) {
@@ -605,6 +614,53 @@ pub(crate) mod test_util {
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
         d
+    }
+
+    /// Damaged copies of a file's `bytes` (what a full disk, a bad copy or a hostile edit
+    /// leaves), each with what was done: cut short at every `step`-th length; at every
+    /// `step`-th offset eight bytes set to 0xff (a length word of 2^64 - 1) and to zero, and
+    /// one byte flipped.
+    pub fn damaged(bytes: &[u8], step: usize) -> impl Iterator<Item = (String, Vec<u8>)> + '_ {
+        let at = move |fill: Option<u8>| {
+            (0..bytes.len()).step_by(step).map(move |k| {
+                let mut b = bytes.to_vec();
+                let what = match fill {
+                    Some(v) => {
+                        let end = (k + 8).min(b.len());
+                        b[k..end].fill(v);
+                        format!("8 bytes of {v:#04x} at {k}")
+                    }
+                    None => {
+                        b[k] ^= 0xa5;
+                        format!("byte {k} flipped")
+                    }
+                };
+                (what, b)
+            })
+        };
+        let cut = (0..bytes.len())
+            .step_by(step)
+            .map(move |k| (format!("cut at {k}"), bytes[..k].to_vec()));
+        cut.chain(at(Some(0xff))).chain(at(Some(0))).chain(at(None))
+    }
+
+    /// Runs `read` on every damaged copy of `bytes` ([`damaged`]): none may panic (an error or a
+    /// value are both fine). Returns how many were read without an error.
+    pub fn survives_damage<T, E>(
+        what: &str,
+        bytes: &[u8],
+        step: usize,
+        read: impl Fn(&[u8]) -> Result<T, E>,
+    ) -> usize {
+        let mut ok = 0;
+        for (how, b) in damaged(bytes, step) {
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| read(&b)));
+            match r {
+                Ok(r) => ok += r.is_ok() as usize,
+                Err(_) => panic!("reading {what} with {how} panicked"),
+            }
+        }
+        ok
     }
 }
 

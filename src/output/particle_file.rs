@@ -199,7 +199,7 @@ impl ParticleFile {
         }
     }
 
-    fn parse(bytes: &[u8]) -> Result<Self, String> {
+    pub(super) fn parse(bytes: &[u8]) -> Result<Self, String> {
         let v = Vtu::parse(bytes)?;
         let n = v.number_of_points;
         if v.number_of_cells != n {

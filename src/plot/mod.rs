@@ -883,6 +883,18 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// A damaged probe table (cut short, words overwritten, a byte flipped) is an error or
+    /// a series, never a panic, read whole or by column.
+    #[test]
+    fn a_damaged_probe_table_is_an_error_not_a_panic() {
+        let text = "t_s,x_m,y_m\n0,0.5,0.3\n0.1,0.5,nan\n0.2,-inf,1e308\n";
+        let whole = |b: &[u8]| parse_csv(&String::from_utf8_lossy(b), "p.csv");
+        let column = |b: &[u8]| parse_table_column(&String::from_utf8_lossy(b), "p.csv", "y_m");
+        assert_eq!(column(text.as_bytes()).unwrap().points.len(), 3);
+        crate::output::test_util::survives_damage("a table", text.as_bytes(), 1, whole);
+        crate::output::test_util::survives_damage("a table's column", text.as_bytes(), 1, column);
+    }
+
     #[test]
     fn axis_labels_have_units() {
         assert_eq!(axis_label("pressure_pa"), "pressure [Pa]");
