@@ -17,6 +17,7 @@ use crate::layout::{Pos, SimState, SolidState, ID_MASK, KIND_SHIFT};
 use crate::output::write_atomic;
 use crate::scenario::{Kind, Scenario};
 use crate::sph::state::SolverState;
+use crate::sph::DensityPeaks;
 
 pub use crate::output::{rank_checkpoint_file, CHECKPOINT_FILE};
 const MAGIC: &[u8; 8] = b"WGSPHCKP";
@@ -168,6 +169,11 @@ struct Header {
     initial_dt_bits: u32,
     filter_last: u32,
     body_bits: Vec<u64>,
+    /// The density peaks of the probe interval so far: the variation's f32 bits, the fluid
+    /// particles beyond the warning and stop limits (zero at a probe time; before a run could
+    /// stop between probe times, never written).
+    #[serde(default)]
+    density_peaks: (u32, u32, u32),
     #[serde(default)]
     subdomain: Option<RankCheckpoint>,
     /// (name, bytes) of the binary sections, in file order.
@@ -294,6 +300,11 @@ impl Checkpoint {
             initial_dt_bits: s.initial_dt.to_bits(),
             filter_last: s.filter_last,
             body_bits: s.bodies.iter().map(|x| x.to_bits()).collect(),
+            density_peaks: (
+                s.peaks.variation.to_bits(),
+                s.peaks.beyond_warn,
+                s.peaks.beyond_stop,
+            ),
             subdomain: self.subdomain.clone(),
             sections: sections
                 .iter()
@@ -408,6 +419,11 @@ impl Checkpoint {
                 steps: h.steps,
                 initial_dt: f32::from_bits(h.initial_dt_bits),
                 sim,
+                peaks: DensityPeaks {
+                    variation: f32::from_bits(h.density_peaks.0),
+                    beyond_warn: h.density_peaks.1,
+                    beyond_stop: h.density_peaks.2,
+                },
                 filter_last: h.filter_last,
                 pos,
                 velrho,
@@ -511,6 +527,11 @@ mod tests {
                     dt: 2e-4,
                     steps: 77,
                     ..Default::default()
+                },
+                peaks: DensityPeaks {
+                    variation: 0.031,
+                    beyond_warn: 12,
+                    beyond_stop: 1,
                 },
                 filter_last: 60,
                 pos: (0..n)

@@ -1,7 +1,7 @@
 //! Progress of a run as it goes: a bar on a terminal ([`ProgressBarView`], indicatif) or plain
 //! log lines at a wall-clock cadence elsewhere ([`LogLines`]: CI, nohup, piped output).
 //!
-//! [`crate::run::run`] reports a [`RunStatus`] once per probe interval, built from what the
+//! [`crate::run::run`] reports a [`RunStatus`] after every batch of steps and at every probe time,
 //! solver already holds on the host (its 48-byte state is read back once per batch of steps
 //! anyway), so showing progress costs no GPU readback.
 
@@ -105,7 +105,8 @@ pub fn format_duration(seconds: f64) -> String {
 
 /// Receives a run's status as it goes.
 pub trait Progress {
-    /// Called once per probe interval, after the solver reached the probe time.
+    /// Called after every batch of steps (a few seconds apart at most) and once per probe
+    /// interval, after the solver reached the probe time.
     fn update(&mut self, status: &RunStatus);
     /// Called once when the run ends, completed or stopped early.
     fn finish(&mut self, status: &RunStatus);

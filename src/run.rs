@@ -1,6 +1,6 @@
 //! Running a scenario to its end with outputs: particle snapshots (VTU, and PNG when asked for)
 //! at every output time, probe samples at every probe time, run.json at the end (also when the
-//! run stops early). Progress is reported once per probe interval to a [`Progress`].
+//! run stops early). Progress is reported after every batch of steps to a [`Progress`].
 
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -280,9 +280,11 @@ impl BodyOutputs {
     }
 }
 
-/// Sample times of a series with interval `every` up to `end` (inclusive, `end` always last).
+/// Sample times of a series with interval `every` up to `end` (inclusive, `end` always last,
+/// also when `every` is longer than the run: an interval of 1e9 s sampled nothing, and the run
+/// "completed" at t = 0, issue 64).
 fn schedule(every: f64, end: f64) -> impl Iterator<Item = f64> {
-    let n = (end / every - 1e-9).ceil().max(0.0) as u64;
+    let n = (end / every - 1e-9).ceil().max(1.0) as u64;
     (1..=n).map(move |k| (k as f64 * every).min(end))
 }
 
@@ -811,7 +813,7 @@ impl<'a> Runner<'a> {
         for t in schedule(sc.time.probe_every_s, sc.time.end_s).filter(|&t| t > t0) {
             // Any failure from here on (instability, GPU failure, a full disk) ends the run
             // with what was written so far and the last checkpoint kept.
-            match self.probe_interval(t) {
+            match self.probe_interval(t, progress) {
                 Err(e) => {
                     // Every rank sees the run go unstable at the same step; anything else
                     // befalls one rank, and the others would wait for it.
@@ -952,8 +954,9 @@ impl<'a> Runner<'a> {
     }
 
     /// Advances to the probe time `t` and writes what is due there: probe rows, particle
-    /// outputs, a checkpoint. True when the run must stop here on request (with a checkpoint).
-    fn probe_interval(&mut self, t: f64) -> Result<bool> {
+    /// outputs, a checkpoint. True when the run must stop here on request (with a checkpoint),
+    /// which a signal makes it do between two batches of steps, short of `t`.
+    fn probe_interval(&mut self, t: f64, progress: &mut dyn Progress) -> Result<bool> {
         let sc = self.sc;
         let every_out = sc.time.output_every_s;
         #[cfg(feature = "test-hooks")]
@@ -964,9 +967,9 @@ impl<'a> Runner<'a> {
         {
             self.solver.lose_device();
         }
-        match self.ranks {
-            Some(r) => self.solver.advance_to_ranked(t, r)?,
-            None => self.solver.advance_to(t)?,
+        if !self.advance(t, progress)? {
+            self.write_checkpoint()?;
+            return Ok(true);
         }
         if self.first() {
             self.density.observe(
@@ -978,6 +981,7 @@ impl<'a> Runner<'a> {
             self.density
                 .record_max(self.solver.density_variation(), self.solver.time());
         }
+        self.solver.clear_density_peaks();
         self.record_probes()?;
         self.bodies.record(&self.solver, self.ranks)?;
         if self.solver.time() >= self.next_output - 1e-9 * every_out {
@@ -1008,6 +1012,34 @@ impl<'a> Runner<'a> {
             self.write_checkpoint()?;
         }
         Ok(halt && !end)
+    }
+
+    /// Advances the solver to the probe time `t`, telling `progress` where it stands and
+    /// looking for a signal to stop after every batch of steps (a few seconds of work at
+    /// most, whatever the probe interval: issue 64); false when a signal stopped it short of
+    /// `t`, in a state a checkpoint holds and a resume continues bit for bit.
+    fn advance(&mut self, t: f64, progress: &mut dyn Progress) -> Result<bool> {
+        let at_start = self.status();
+        let (started, wall_before) = (self.started, self.wall_before);
+        let interrupt = self.options.interrupt.clone();
+        let mut between = |s: &Solver| {
+            progress.update(&RunStatus {
+                time_s: s.time(),
+                dt_s: s.dt(),
+                steps: s.steps(),
+                excluded: s.excluded(),
+                drained: s.drained(),
+                wall_s: wall_before + started.elapsed().as_secs_f64(),
+                ..at_start.clone()
+            });
+            interrupt
+                .as_ref()
+                .is_some_and(|f| f.load(Ordering::Relaxed))
+        };
+        match self.ranks {
+            Some(r) => self.solver.advance_toward_ranked(t, r, &mut between),
+            None => self.solver.advance_toward(t, &mut between),
+        }
     }
 
     fn interrupted(&self) -> bool {
@@ -1102,5 +1134,8 @@ mod tests {
         assert_eq!(t.len(), 3);
         assert!((t[0] - 0.1).abs() < 1e-15 && (t[2] - 0.25).abs() < 1e-15);
         assert_eq!(schedule(0.1, 0.3).count(), 3);
+        for every in [0.3, 1.0, 1e9, 1e300, f64::MAX] {
+            assert_eq!(schedule(every, 0.3).collect::<Vec<_>>(), [0.3], "{every}");
+        }
     }
 }

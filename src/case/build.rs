@@ -15,7 +15,7 @@ use super::check::{fmt_box, inside, point_in, point_inside, Aabb, Treatment, AXE
 use super::domain::domain;
 use super::error::{num, CaseError};
 use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
-use super::limits;
+use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
 use super::validate::{Block, Case, Sound, WallSettings};
 
@@ -40,15 +40,19 @@ type Placed = (Vec<ElasticMaterial>, Vec<u32>);
 /// 7. probes, warnings, physics and wall parameters ([`finish`]).
 ///
 /// A case of elastic solids alone is built by [`build_solid_case`].
-pub(super) fn build(ctx: &Ctx<'_>, case: Case, max_particles: f64) -> Result<Scenario, CaseError> {
+pub(super) fn build(
+    ctx: &Ctx<'_>,
+    case: Case,
+    budget: &ParticleBudget,
+) -> Result<Scenario, CaseError> {
     let solids_alone = case.tank.is_none() && case.obstacles.is_empty() && case.bodies.is_empty();
     if !case.solids.is_empty() && case.blocks.is_empty() && case.inlets.is_empty() && solids_alone {
-        return build_solid_case(ctx, case, max_particles);
+        return build_solid_case(ctx, case, budget);
     }
     let geo = Geometry::of(ctx, &case)?;
-    let total = particle_budget(ctx, &case, &geo, max_particles)?;
+    let total = particle_budget(ctx, &case, &geo, budget)?;
     let wall = geo.tank_cells.map(|n| geo.tank_wall(&case, n));
-    let elastic = elastic_solids(ctx, &case, max_particles - total)?;
+    let elastic = elastic_solids(ctx, &case, &budget.less(total))?;
     let domain = domain(ctx, &case, &geo.lat, wall.as_ref())?;
     let start = Start::of(ctx, &case, elastic.as_ref())?;
 
@@ -355,14 +359,14 @@ fn inlet_layouts(
     Ok(inlet_layouts)
 }
 
-/// The particle count of the case, checked against `max_particles` before anything is
+/// The particle count of the case, checked against the `budget` before anything is
 /// allocated: every part's count (for a body, the lattice its particles are picked from, so
 /// that a long thin box counts its true length).
 fn particle_budget(
     ctx: &Ctx<'_>,
     case: &Case,
     geo: &Geometry,
-    max_particles: f64,
+    budget: &ParticleBudget,
 ) -> Result<f64, CaseError> {
     let (dim, dx) = (case.dim, case.dx);
     let mut parts: Vec<(String, f64)> = Vec::new();
@@ -400,7 +404,7 @@ fn particle_budget(
         (dx, dim),
         &parts,
         [n_fluid_parts, n_wall_parts],
-        max_particles,
+        budget,
     )
 }
 
@@ -416,7 +420,11 @@ struct Elastic {
 
 /// Elastic solids in the fluid: their particles, bodies and materials, within what is left of
 /// the budget (`budget`); and the box of each solid's particles.
-fn elastic_solids(ctx: &Ctx<'_>, case: &Case, budget: f64) -> Result<Option<Elastic>, CaseError> {
+fn elastic_solids(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    budget: &ParticleBudget,
+) -> Result<Option<Elastic>, CaseError> {
     if case.solids.is_empty() {
         return Ok(None);
     }
@@ -1030,6 +1038,7 @@ fn finish(
     built: Built,
 ) -> Result<Scenario, CaseError> {
     let (dim, dx) = (case.dim, case.dx);
+    let tank_moves = case.tank_moves();
     let Built {
         domain,
         particles,
@@ -1113,6 +1122,7 @@ fn finish(
         outlets: case.outlets,
         warnings,
     };
+    super::runnable::check(ctx, &sc, Some(start.sound_path), &case.blocks, tank_moves)?;
     // Probes that can never measure: said here, and NaN in their CSV (probe_reach.rs); those
     // that can but start inside a wall or body, said too.
     let blind = crate::probe_reach::unmeasurable(&sc);
@@ -1194,11 +1204,11 @@ fn walls(
 pub(super) fn build_solid_case(
     ctx: &Ctx<'_>,
     case: Case,
-    max_particles: f64,
+    budget: &ParticleBudget,
 ) -> Result<Scenario, CaseError> {
     let (dim, dx) = (case.dim, case.dx);
     let (materials, particles, body) =
-        super::solids::solid_particles(ctx, &case.solids, dim, dx, max_particles)?;
+        super::solids::solid_particles(ctx, &case.solids, dim, dx, budget)?;
     let d = solid_case_domain(ctx, &case)?;
     let n = particles.len();
     let points = super::probes::resolve_points(ctx, &case.points, &particles, &[], dim, dx)?;
@@ -1240,7 +1250,7 @@ pub(super) fn build_solid_case(
         (lo.min(p.pos[dim - 1]), hi.max(p.pos[dim - 1]))
     });
     let walls = wall_params(ctx, &case.walls, dx, hi - lo + dx, g, case.solids.len() > 1)?;
-    Ok(Scenario {
+    let sc = Scenario {
         name: case.name,
         physics,
         time: case.time,
@@ -1262,7 +1272,9 @@ pub(super) fn build_solid_case(
         inlets: Vec::new(),
         outlets: Vec::new(),
         warnings: Vec::new(),
-    })
+    };
+    super::runnable::check(ctx, &sc, None, &[], false)?;
+    Ok(sc)
 }
 
 /// The domain of a case of solids alone: the given one, or the solids' box with half its

@@ -11,6 +11,48 @@ use super::locate::Ctx;
 
 /// Refuse cases with more particles than this.
 pub const MAX_PARTICLES: f64 = 200e6;
+
+/// The most particles a case may make, and why (what a refusal says): the engine's limit, or
+/// what the adapter and the host's memory hold, checked before any particle is made (issue 64:
+/// a case of 150 million particles, within the engine's limit, exhausted the host's memory
+/// building them before the adapter's limit was looked at).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParticleBudget {
+    pub particles: f64,
+    pub why: String,
+}
+
+impl Default for ParticleBudget {
+    fn default() -> Self {
+        ParticleBudget {
+            particles: MAX_PARTICLES,
+            why: "the engine's".into(),
+        }
+    }
+}
+
+impl ParticleBudget {
+    /// At most `particles`, because of `why`, within the engine's own limit.
+    pub fn at_most(particles: f64, why: impl Into<String>) -> Self {
+        let engine = Self::default();
+        if particles < engine.particles {
+            ParticleBudget {
+                particles,
+                why: why.into(),
+            }
+        } else {
+            engine
+        }
+    }
+
+    /// What is left of it after `used` particles.
+    pub(super) fn less(&self, used: f64) -> Self {
+        ParticleBudget {
+            particles: self.particles - used,
+            why: self.why.clone(),
+        }
+    }
+}
 /// Longest tank, in particle spacings along one axis: the neighbour grid takes 2^30 cells of
 /// 2h <= 6 dx along an axis, so a longer tank could never run; its lattice count would also
 /// lose precision (and mirror walls, having no particles, escape the particle budget).
@@ -60,14 +102,15 @@ pub(super) fn tank_length(
 }
 
 /// The total particle count of `parts` (name, count), which are fluid blocks up to
-/// `ends[0]`, walls up to `ends[1]`, then bodies; refused above `max_particles`.
+/// `ends[0]`, walls up to `ends[1]`, then bodies; refused above the `budget`.
 pub(super) fn budget(
     ctx: &Ctx<'_>,
     (dx, dim): (f64, usize),
     parts: &[(String, f64)],
     ends: [usize; 2],
-    max_particles: f64,
+    budget: &ParticleBudget,
 ) -> Result<f64, CaseError> {
+    let max_particles = budget.particles;
     let sum = |r: std::ops::Range<usize>| parts[r].iter().map(|(_, n)| n).sum::<f64>();
     let (fluid_n, wall_n) = (sum(0..ends[0]), sum(ends[0]..ends[1]));
     let body_n = sum(ends[1]..parts.len());
@@ -84,13 +127,14 @@ pub(super) fn budget(
         Some(num(dx)),
         format!(
             "the case would create about {} particles ({} fluid, {} wall, {} body; the most, \
-             about {}, in {largest}), more than the limit of {}",
+             about {}, in {largest}), more than the limit of {} ({} limit)",
             fmt_count(total),
             fmt_count(fluid_n),
             fmt_count(wall_n),
             fmt_count(body_n),
             fmt_count(most),
-            fmt_limit(max_particles)
+            fmt_limit(max_particles),
+            budget.why
         ),
         if largest.starts_with("inlet") {
             // An inlet makes the particles of its whole inflow: its length in time counts.

@@ -20,7 +20,8 @@
 //! 4. the checks and particles of one kind of table each: `probes.rs`, `open_boundaries.rs`,
 //!    `solids.rs`, `bodies.rs`, and `friction.rs` (which names bodies and solids);
 //! 5. `validate.rs`: the whole checked case (`Case`);
-//! 6. the build: `warnings.rs` and `domain.rs`, used by `build.rs`;
+//! 6. the build: `warnings.rs`, `domain.rs` and `runnable.rs` (the f32 range, time step and
+//!    schedule of the built case), used by `build.rs`;
 //! 7. this file (the loader) with `built_in.rs` ([`BUILT_IN`], the case files built into the
 //!    binary, loaded through this file) and the tests.
 
@@ -40,6 +41,7 @@ mod open_boundaries;
 mod overrides;
 mod polygon;
 mod probes;
+mod runnable;
 mod schema;
 mod solids;
 mod validate;
@@ -53,7 +55,7 @@ use std::path::Path;
 pub use built_in::{built_in, BuiltIn, BUILT_IN};
 pub(crate) use check::read_bounded;
 pub use error::{CaseError, Diagnostic};
-pub use limits::MAX_PARTICLES;
+pub use limits::{ParticleBudget, MAX_PARTICLES};
 
 use crate::scenario::Scenario;
 use locate::{Ctx, Index};
@@ -65,12 +67,22 @@ const MAX_CASE_BYTES: u64 = 16 << 20;
 
 /// Reads and builds the case file at `path`, with `--set KEY=VALUE` overrides applied.
 pub fn load(path: &Path, overrides: &[String]) -> Result<Scenario, CaseError> {
+    load_within(path, overrides, &ParticleBudget::default())
+}
+
+/// [`load`] with at most `budget` particles (what the adapter and the host's memory hold, say),
+/// refused before any is made.
+pub fn load_within(
+    path: &Path,
+    overrides: &[String],
+    budget: &ParticleBudget,
+) -> Result<Scenario, CaseError> {
     let file = path.display().to_string();
     let text = read_bounded(path, MAX_CASE_BYTES).map_err(|source| CaseError::Read {
         file: file.clone(),
         source,
     })?;
-    load_str(&text, &file, overrides)
+    load_str_within(&text, &file, overrides, budget)
 }
 
 /// Builds a case from its text; `file_name` is used in messages and, without a `name` field,
@@ -87,6 +99,16 @@ pub fn load_str_limited(
     file_name: &str,
     overrides: &[String],
     max_particles: f64,
+) -> Result<Scenario, CaseError> {
+    let budget = ParticleBudget::at_most(max_particles, "this caller's");
+    load_str_within(text, file_name, overrides, &budget)
+}
+
+fn load_str_within(
+    text: &str,
+    file_name: &str,
+    overrides: &[String],
+    budget: &ParticleBudget,
 ) -> Result<Scenario, CaseError> {
     let doc = toml::de::DeTable::parse(text).map_err(|e| diagnose::syntax(file_name, text, &e))?;
     let index = Index::new(text, doc.get_ref());
@@ -127,7 +149,7 @@ pub fn load_str_limited(
         .map_or_else(|| "case".to_string(), |s| s.to_string_lossy().into_owned());
     let case_dir = Path::new(file_name).parent().unwrap_or(Path::new("."));
     let case = validate::validate(&ctx, &raw, &stem, case_dir)?;
-    build::build(&ctx, case, max_particles)
+    build::build(&ctx, case, budget)
 }
 
 /// The case text with `parsed` overrides applied to its document, re-serialised (the loader

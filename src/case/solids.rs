@@ -7,6 +7,7 @@ use crate::scenario::{distinct_materials, ElasticMaterial, Kind, Particle, Solid
 use super::check::{aabb, number, point_in, vector, Aabb, Bound};
 use super::error::{num, CaseError};
 use super::lattice::Lattice;
+use super::limits::ParticleBudget;
 use super::locate::Ctx;
 use super::schema::{RawSolid, SolidFormulationName, SolidVelocityName};
 use crate::layout::MAX_SOLID_MATERIALS;
@@ -368,14 +369,15 @@ fn body_len(body: &[u32], i: usize) -> usize {
 pub(super) type SolidParticles = (Vec<ElasticMaterial>, Vec<Particle>, Vec<u32>);
 
 /// The particles of the solids (on one lattice from the first solid's corner), their bodies
-/// (the solid's index) and the material of each solid; at most `max_particles` of them.
+/// (the solid's index) and the material of each solid; at most `budget` of them.
 pub(super) fn solid_particles(
     ctx: &Ctx<'_>,
     solids: &[SolidSpec],
     dim: usize,
     dx: f64,
-    max_particles: f64,
+    budget: &ParticleBudget,
 ) -> Result<SolidParticles, CaseError> {
+    let max_particles = budget.particles;
     let first = &solids[0];
     let materials = materials(ctx, solids)?;
     let lat = Lattice {
@@ -410,7 +412,8 @@ pub(super) fn solid_particles(
                 Some(format!("{dx}")),
                 format!(
                     "with solid[{i}] the solids would have {total:.3e} particles, more than the \
-                     limit of {max_particles:.3e}"
+                     limit of {max_particles:.3e} ({} limit)",
+                    budget.why
                 ),
                 "increase particles.dx_m",
             ));

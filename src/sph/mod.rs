@@ -51,6 +51,32 @@ use shader::ShaderConfig;
 /// Most steps recorded into one submission before the host looks at the state again.
 const MAX_BATCH: u32 = 64;
 
+/// The most particle-steps of a batch of a large case: the host looks at the state after every
+/// batch (progress, a signal to stop: `Solver::advance_toward`), so a batch is cut to about this
+/// much work, a few seconds on a CPU adapter and milliseconds on a GPU, whatever the probe
+/// interval (issue 64: a run at dx = 5 mm answered SIGTERM after 24 s). A count, not a time, so
+/// that the batches, where the GPU's f32 clock is re-based, are the case's alone.
+const BATCH_PARTICLE_STEPS: u64 = 1 << 21;
+
+/// The largest density variation and the most fluid particles beyond the warning and stop
+/// limits in any one step, since the host last cleared them (`Solver::clear_density_peaks`):
+/// the GPU's peaks count from each batch's upload, the host keeps their largest.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DensityPeaks {
+    pub variation: f32,
+    pub beyond_warn: u32,
+    pub beyond_stop: u32,
+}
+
+impl DensityPeaks {
+    /// Takes in the peaks of the steps of `state` since its upload.
+    fn absorb(&mut self, state: &SimState) {
+        self.variation = self.variation.max(state.density_variation_peak);
+        self.beyond_warn = self.beyond_warn.max(state.beyond_warn_peak);
+        self.beyond_stop = self.beyond_stop.max(state.beyond_stop_peak);
+    }
+}
+
 /// A part of the step that benchmarks time on its own.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
@@ -146,6 +172,10 @@ pub struct Solver {
     n_fluid_at_start: u64,
     /// Per-stage timestamps, while [`Solver::profile_steps`] runs.
     profiler: Option<Profiler>,
+    /// The density peaks since the host last cleared them.
+    peaks: DensityPeaks,
+    /// The most steps of a batch ([`BATCH_PARTICLE_STEPS`] over the whole case's particles).
+    batch_cap: u32,
     /// A subdomain's counts over all ranks (`subdomain::Ranked`); None in a whole run.
     ranked: Option<subdomain::Ranked>,
 }
@@ -157,6 +187,7 @@ impl Solver {
         // chooses the first dt; it moves nothing and is not counted.
         solver.take_steps(1)?;
         solver.initial_dt = solver.state.dt_cfl;
+        solver.check_first_dt()?;
         Ok(solver)
     }
 
@@ -284,6 +315,8 @@ impl Solver {
             density_variation_stop: sc.time.density_variation_stop,
             n_fluid_at_start: sc.count(Kind::Fluid) as u64,
             profiler: None,
+            peaks: DensityPeaks::default(),
+            batch_cap: (BATCH_PARTICLE_STEPS / n as u64).clamp(1, MAX_BATCH as u64) as u32,
             ranked,
         };
         // The first step's `body_move` finds the body particles where the case put them.
@@ -308,10 +341,11 @@ impl Solver {
         self.state.dt_cfl as f64
     }
 
-    /// How far the fluid went from the weakly-compressible regime in the steps of the last
-    /// [`advance_to`](Self::advance_to) (or `run_steps`).
+    /// How far the fluid went from the weakly-compressible regime in the steps since the
+    /// peaks were last cleared ([`clear_density_peaks`](Self::clear_density_peaks)).
     pub fn density_variation(&self) -> DensityVariation {
         let s = &self.state;
+        let peaks = &self.peaks;
         let joined = match &self.ranked {
             Some(ranked) => ranked.joined,
             None => s.inlet_joined as u64,
@@ -319,10 +353,30 @@ impl Solver {
         let fluid = (self.n_fluid_at_start + joined).saturating_sub(self.drained());
         let share = |count: u32| count as f64 / fluid.max(1) as f64;
         DensityVariation {
-            max: s.density_variation_peak as f64,
-            share_beyond_warn: share(s.beyond_warn_peak),
-            share_beyond_stop: share(s.beyond_stop_peak),
+            max: peaks.variation as f64,
+            share_beyond_warn: share(peaks.beyond_warn),
+            share_beyond_stop: share(peaks.beyond_stop),
         }
+    }
+
+    /// Starts the density peaks anew (after the run has looked at them for a probe interval).
+    pub fn clear_density_peaks(&mut self) {
+        self.peaks = DensityPeaks::default();
+    }
+
+    /// The first time step, after the warm-up: a positive normal f32 the clock can advance
+    /// by. The loader refuses the cases it can tell (`case::runnable`); this catches the rest
+    /// (a zero step ran "completed" with 0 steps, issue 64).
+    fn check_first_dt(&self) -> Result<()> {
+        let dt = self.state.dt_cfl;
+        if dt.is_normal() && dt > 0.0 {
+            return Ok(());
+        }
+        bail!(
+            "the first time step is {dt:e} s (time.cfl × h over the fastest speed: the sound \
+             speed, the flow, a body's motion, a solid's P wave), which the GPU cannot step by; \
+             give realistic speeds, time.cfl about 0.2 and particles.dx_m"
+        )
     }
 
     /// Particles that left the domain or became non-finite (not counting inlet particles that
@@ -374,10 +428,12 @@ impl Solver {
             let encoder = self.encode_steps(count);
             self.queue.submit([encoder.finish()]);
             self.state = self.read_state()?;
+            self.peaks.absorb(&self.state);
             return self.faults.check();
         }
         for _ in 0..count {
             self.step_with_bodies()?;
+            self.peaks.absorb(&self.state);
         }
         Ok(())
     }
@@ -516,13 +572,13 @@ impl Solver {
     }
 
     /// Re-bases the GPU's f32 clock on the host's f64 one, so that it only ever counts a short
-    /// span: the state to upload (with the time to run still to be set).
+    /// span (one batch): the state to upload (with the time to run still to be set).
     fn rebased_state(&mut self) -> SimState {
         self.t_base += self.state.t_rel as f64;
         let mut st = self.state;
         st.t_rel = 0.0;
         st.t_base = self.t_base as f32;
-        // The density-variation peaks count from each upload: over one `advance_to`.
+        // The GPU's density-variation peaks count from each upload; the host keeps theirs.
         st.density_variation_peak = 0.0;
         st.beyond_warn_peak = 0;
         st.beyond_stop_peak = 0;
@@ -549,9 +605,12 @@ impl Solver {
     /// present dt, and one more. Steps recorded past the arrival take dt = 0: they move nothing
     /// but sort and compute the rates, and the time step, at the state arrived at, from which
     /// the next interval starts.
+    /// At most `batch_cap` steps (computed in f64: a probe time 2^32 steps away overflowed
+    /// the count, issue 64).
     fn batch_to_target(&self) -> u32 {
-        let left = (self.state.t_target_rel - self.state.t_rel).max(0.0);
-        ((left / self.state.dt_cfl.max(1e-30)).ceil() as u32 + 1).clamp(1, MAX_BATCH)
+        let left = (self.state.t_target_rel - self.state.t_rel).max(0.0) as f64;
+        let steps = (left / (self.state.dt_cfl as f64).max(1e-30)).ceil() + 1.0;
+        (steps.min(self.batch_cap as f64) as u32).max(1)
     }
 
     /// Arrived at `t_target`: the host clock takes it exactly (the GPU's f32 clock is re-based
@@ -563,6 +622,20 @@ impl Solver {
 
     /// Advances to exactly `t_target` (the last step is shortened to land on it).
     pub fn advance_to(&mut self, t_target: f64) -> Result<()> {
+        self.advance_toward(t_target, &mut |_| false).map(|_| ())
+    }
+
+    /// Advances toward `t_target` as [`advance_to`](Self::advance_to) does, asking `halt`
+    /// between batches of steps (at most [`BATCH_PARTICLE_STEPS`] of work each): when it says
+    /// so, stops there, short of the target, and returns false. Such a state is one a
+    /// checkpoint holds: `advance_toward` the same target again, in this process or a resumed
+    /// one, continues it bit for bit (the next batch re-bases the f32 clock from it, as it
+    /// would have). True once arrived.
+    pub fn advance_toward(
+        &mut self,
+        t_target: f64,
+        halt: &mut dyn FnMut(&Self) -> bool,
+    ) -> Result<bool> {
         self.start_targeted(t_target);
         while self.state.dt > 0.0 {
             let batch = self.batch_to_target();
@@ -570,9 +643,17 @@ impl Solver {
             self.take_steps(batch)?;
             self.steps += (self.state.steps - before) as u64;
             self.check_stability()?;
+            // The GPU's dt of 0: arrived (its remainder within 1e-4 of a step).
+            if self.state.dt <= 0.0 {
+                break;
+            }
+            if halt(self) {
+                return Ok(false);
+            }
+            self.start_targeted(t_target);
         }
         self.arrive(t_target);
-        Ok(())
+        Ok(true)
     }
 
     /// Takes exactly `count` steps of CFL size (no target time), for benchmarks; waits for the
@@ -592,12 +673,14 @@ impl Solver {
             left -= batch as u64;
         }
         self.state = self.read_state()?;
+        self.peaks.absorb(&self.state);
         self.steps += (self.state.steps - st.steps) as u64;
         self.check_stability()
     }
 
     /// Sets the GPU state for steps of CFL size with no target time (benchmarks) and returns it.
     fn start_untargeted(&mut self) -> SimState {
+        self.clear_density_peaks();
         let mut st = self.rebased_state();
         st.t_target_rel = f32::MAX;
         st.dt = st.dt_cfl;

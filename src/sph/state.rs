@@ -27,6 +27,9 @@ pub struct SolverState {
     /// dt of the warm-up evaluation (the collapse check compares against it).
     pub initial_dt: f32,
     pub sim: SimState,
+    /// The density peaks of the probe interval so far (a run stopped between two probe times
+    /// goes on with them).
+    pub peaks: super::DensityPeaks,
     /// `state.steps` at the density filter's last application (0 without a filter).
     pub filter_last: u32,
     pub pos: Vec<Pos>,
@@ -70,6 +73,7 @@ impl Solver {
             steps: self.steps,
             initial_dt: self.initial_dt,
             sim: self.state,
+            peaks: self.peaks,
             filter_last,
             pos,
             velrho,
@@ -153,6 +157,7 @@ impl Solver {
         self.steps = s.steps;
         self.initial_dt = s.initial_dt;
         self.state = s.sim;
+        self.peaks = s.peaks;
         self.faults.check()
     }
 }

@@ -269,6 +269,7 @@ impl Solver {
             .collect();
         solver.ranked_step(ranks)?;
         solver.initial_dt = solver.state.dt_cfl;
+        solver.check_first_dt()?;
         Ok(solver)
     }
 
@@ -279,23 +280,45 @@ impl Solver {
         for _ in 0..count {
             self.step_and_balance(ranks)?;
         }
+        self.peaks.absorb(&self.state);
         self.check_stability()
     }
 
     /// Advances every rank together to exactly `t_target` as [`Solver::advance_to`] advances
-    /// one whole run: the same steps (the ranks agree on each) in the same batches, the steps
-    /// of a batch past the arrival included (`batch_to_target`: they compute the rates the
-    /// next interval starts from); looks at the balance every [`REBALANCE_EVERY`] steps.
+    /// one whole run: the same steps (the ranks agree on each) in the same batches, re-based
+    /// alike, the steps of a batch past the arrival included (`batch_to_target`: they compute
+    /// the rates the next interval starts from); looks at the balance every
+    /// [`REBALANCE_EVERY`] steps.
     pub fn advance_to_ranked(&mut self, t_target: f64, ranks: &dyn Ranks) -> Result<()> {
+        self.advance_toward_ranked(t_target, ranks, &mut |_| false)
+            .map(|_| ())
+    }
+
+    /// [`Solver::advance_toward`] over the ranks: every rank halts where any one's `halt`
+    /// says so (a signal reaches them at different batches).
+    pub fn advance_toward_ranked(
+        &mut self,
+        t_target: f64,
+        ranks: &dyn Ranks,
+        halt: &mut dyn FnMut(&Self) -> bool,
+    ) -> Result<bool> {
         self.start_targeted(t_target);
         while self.state.dt > 0.0 {
             for _ in 0..self.batch_to_target() {
                 self.step_and_balance(ranks)?;
             }
+            self.peaks.absorb(&self.state);
             self.check_stability()?;
+            if self.state.dt <= 0.0 {
+                break;
+            }
+            if ranks.min(if halt(self) { 0.0 } else { 1.0 }) == 0.0 {
+                return Ok(false);
+            }
+            self.start_targeted(t_target);
         }
         self.arrive(t_target);
-        Ok(())
+        Ok(true)
     }
 
     /// One step of every rank, and the balance looked at every [`REBALANCE_EVERY`] steps

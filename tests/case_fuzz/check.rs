@@ -9,6 +9,7 @@ use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRu
 use toml::{Table, Value};
 use wgsph::case::{load_str_limited, CaseError};
 use wgsph::grid::Grid;
+use wgsph::layout::Params;
 use wgsph::scenario::{Kind, Motion, RepulsiveForm, Scenario};
 
 use crate::doc::{generic, last_key, path_of, required, vector_len, Node, Seed, Seg};
@@ -209,8 +210,56 @@ pub(crate) fn check_sane(sc: &Scenario) -> Result<(), String> {
             ));
         }
     }
-    Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic, ph.cell)
+    let grid = Grid::new(&sc.domain, ph.h, ph.dim, n, sc.periodic, ph.cell)
         .map_err(|e| format!("grid: {e}"))?;
+    f32_sane(sc, &grid)?;
+    // A probe interval the run can step through, in a number of samples it can hold.
+    let samples = sc.time.end_s / sc.time.probe_every_s;
+    if samples.is_nan() || samples > 1e7 {
+        return Err(format!("{samples} probe samples"));
+    }
+    Ok(())
+}
+
+/// What the GPU computes with (issue 64: the loader checked f64 overflow only): the uniform's
+/// f32 quantities are finite, and those the kernels divide by or step with are normal numbers.
+fn f32_sane(sc: &Scenario, grid: &Grid) -> Result<(), String> {
+    let p = Params::from_scenario(sc, grid).map_err(|e| format!("params: {e:#}"))?;
+    let positive = [
+        ("h", p.h),
+        ("kernel_norm", p.kernel_norm),
+        ("eta2", p.eta2),
+        ("mass", p.mass),
+        ("rho0", p.rho0),
+        ("tait_b", p.tait_b),
+        ("gamma", p.gamma),
+        ("c0", p.c0),
+        ("cfl", p.cfl),
+    ];
+    for (name, v) in positive {
+        if !(v.is_normal() && v > 0.0) {
+            return Err(format!("f32 {name} = {v:e}"));
+        }
+    }
+    let finite = [
+        ("alpha", p.alpha),
+        ("nu", p.nu),
+        ("delta_coef", p.delta_coef),
+        ("gravity x", p.gravity[0]),
+        ("gravity y", p.gravity[1]),
+        ("gravity z", p.gravity[2]),
+    ];
+    if let Some((name, v)) = finite.iter().find(|(_, v)| !v.is_finite()) {
+        return Err(format!("f32 {name} = {v:e}"));
+    }
+    // The time step the GPU's `timestep` starts from: c0 alone bounds it from above.
+    let dt = p.cfl * p.h / p.c0;
+    if !(dt.is_normal() && (sc.time.end_s / dt as f64) <= 1e10) {
+        return Err(format!(
+            "the first time step {dt:e} s to {} s",
+            sc.time.end_s
+        ));
+    }
     Ok(())
 }
 

@@ -16,6 +16,8 @@
 //! then tries that many), `PROPTEST_RNG_SEED=n` repeats a run.
 
 mod check;
+#[path = "../common/mod.rs"]
+mod common;
 mod doc;
 mod values;
 
@@ -42,6 +44,12 @@ const CASES_DELETE_ADD: u32 = 1000;
 const CASES_OVERRIDES: u32 = 500;
 const CASES_COMPOUND: u32 = 1000;
 const CASES_TEXT: u32 = 3000;
+const CASES_EXTREMES: u32 = 1500;
+const CASES_NAMES: u32 = 300;
+const CASES_SOLVER: u32 = 30;
+
+/// The largest accepted edit `accepted_edits_run_a_few_steps` runs (a few seconds on lavapipe).
+const SOLVER_PARTICLES: usize = 25_000;
 
 #[test]
 fn every_seed_builds_and_survives_a_round_trip() {
@@ -79,6 +87,167 @@ fn every_field_with_hostile_values() {
             check(seed, &doc, &[], &node.segs, expect, &format!("{change:?}"))
         },
     );
+}
+
+/// The time control and what sets the time step, at both extremes of the f64 and f32 ranges
+/// (issue 64: `time.cfl = 1e-50`, `sound_speed_coef = 1e40`, `nu_m2_s = 1e40` ran "completed"
+/// with no step; a probe interval of 1e-300 s never advanced; one of 1e9 s sampled nothing):
+/// refused naming the field, or accepted as a case whose f32 quantities and first time step
+/// are sound (`check_sane`).
+#[test]
+fn time_and_speeds_at_both_extremes() {
+    let fields = prop::sample::select(vec![
+        "time.end_s",
+        "time.output_every_s",
+        "time.probe_every_s",
+        "time.cfl",
+        "physics.sound_speed_coef",
+        "physics.sound_speed_m_s",
+        "physics.rho0_kg_m3",
+        "physics.nu_m2_s",
+        "physics.gamma",
+        "particles.dx_m",
+    ]);
+    let extreme = prop::sample::select(vec![
+        5e-324,
+        1e-300,
+        1e-50,
+        1e-38,
+        1e-30,
+        1e-20,
+        1e-12,
+        5e-8,
+        1e-6,
+        1e6,
+        1e9,
+        1e20,
+        1e30,
+        1e38,
+        1e40,
+        1e300,
+        f64::MAX,
+    ]);
+    run(
+        "time_and_speeds_at_both_extremes",
+        CASES_EXTREMES,
+        (any::<Index>(), fields, extreme),
+        |(s, field, v)| {
+            let seed = s.get(seeds());
+            let segs: Vec<Seg> = field.split('.').map(|k| Seg::Key(k.into())).collect();
+            // A field the seed leaves out is added; the loader may then refuse the pair.
+            let doc = edit(&seed.doc, &segs, Some(Value::Float(v)));
+            check(
+                seed,
+                &doc,
+                &[],
+                &segs,
+                Expect::Either,
+                &format!("{field} = {v:e}"),
+            )
+        },
+    );
+}
+
+/// Names are file and folder names (`out/<name>`, `probes/<name>.csv`): "..", ".", paths and
+/// names too long for a file system are refused naming the field (issue 64: a case named ".."
+/// ran into the working directory and deleted the user's files there).
+#[test]
+fn names_that_are_paths_are_refused() {
+    let bad = prop::sample::select(vec![
+        "..".to_string(),
+        ".".to_string(),
+        " .. ".to_string(),
+        "../../etc".to_string(),
+        "a/b".to_string(),
+        "a\\b".to_string(),
+        "/tmp/x".to_string(),
+        "x\u{0}y".to_string(),
+        "".to_string(),
+        "n".repeat(300),
+    ]);
+    run(
+        "names_that_are_paths_are_refused",
+        CASES_NAMES,
+        (any::<Index>(), any::<Index>(), bad),
+        |(s, f, name)| {
+            let seed = s.get(seeds());
+            let named: Vec<Node> = nodes(&seed.doc)
+                .into_iter()
+                .filter(|n| {
+                    let part = n.path.split('[').next().unwrap_or_default();
+                    n.path == "name"
+                        || (n.path.ends_with("].name") && ["probe", "body"].contains(&part))
+                })
+                .collect();
+            let node = f.get(&named);
+            let doc = edit(&seed.doc, &node.segs, Some(Value::String(name)));
+            check(
+                seed,
+                &doc,
+                &[],
+                &node.segs,
+                Expect::Reject,
+                "a name that is a path",
+            )
+        },
+    );
+}
+
+/// The solver on a sample of accepted edits (issue 64: the fuzzing ran the loader only, and
+/// cases it accepted made runs panic, hang or "complete" with no step): a few steps of each, its
+/// probes sampled and its particles read back. An edit may make a run that stops (unstable,
+/// too large for the adapter), with an error; none may panic. Small cases only (at most
+/// `SOLVER_PARTICLES` particles), on the test adapter (lavapipe in CI).
+#[test]
+fn accepted_edits_run_a_few_steps() {
+    let strategy = (any::<Index>(), any::<Index>(), gentle_change());
+    let ran = std::cell::Cell::new(0usize);
+    run(
+        "accepted_edits_run_a_few_steps",
+        CASES_SOLVER,
+        strategy,
+        |(s, f, change)| {
+            let seed = s.get(seeds());
+            let nodes = nodes(&seed.doc);
+            let node = f.get(&nodes);
+            let doc = edit(&seed.doc, &node.segs, apply(&change, &node.value));
+            let Some(text) = write(&doc) else {
+                return Ok(());
+            };
+            let Ok(sc) = load(&text, &seed.file, &[]).map_err(TestCaseError::fail)? else {
+                return Ok(());
+            };
+            if sc.particles.len() > SOLVER_PARTICLES {
+                return Ok(());
+            }
+            ran.set(ran.get() + 1);
+            let what = format!("{change:?} of {} in {}", node.path, seed.file);
+            let steps = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                let mut solver = wgsph::sph::Solver::new(common::gpu(), &sc)?;
+                solver.run_steps(3)?;
+                solver.sample_probes()?;
+                solver.read_particles()?;
+                anyhow::Ok(solver.steps())
+            }));
+            match steps {
+                Err(_) => Err(TestCaseError::fail(format!("the solver panicked: {what}"))),
+                // Three steps taken, or an error that says why not.
+                Ok(Ok(n)) => {
+                    prop_assert_eq!(n, 3, "{}", what);
+                    Ok(())
+                }
+                Ok(Err(e)) => {
+                    prop_assert!(!format!("{e:#}").is_empty(), "{}", what);
+                    Ok(())
+                }
+            }
+        },
+    );
+    eprintln!(
+        "case_fuzz accepted_edits_run_a_few_steps: {} runs",
+        ran.get()
+    );
+    assert!(ran.get() > 0, "no accepted edit was small enough to run");
 }
 
 /// Vector fields with the wrong number of components (of any values) must be refused naming
