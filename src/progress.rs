@@ -1,9 +1,10 @@
 //! Progress of a run as it goes: a bar on a terminal ([`ProgressBarView`], indicatif) or plain
 //! log lines at a wall-clock cadence elsewhere ([`LogLines`]: CI, nohup, piped output).
 //!
-//! [`crate::run::run`] reports a [`RunStatus`] after every batch of steps and at every probe time,
-//! solver already holds on the host (its 48-byte state is read back once per batch of steps
-//! anyway), so showing progress costs no GPU readback.
+//! [`crate::run::run`] reports a [`RunStatus`] after every batch of steps (a few seconds of work
+//! at most) and at every probe time, built from what the solver already holds on the host (its
+//! 48-byte state is read back once per batch of steps anyway), so showing progress costs no
+//! GPU readback.
 
 use std::time::Duration;
 
