@@ -302,7 +302,14 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             checkpoint_every,
             quiet,
         } => {
-            let sc = wgsph::case::load(&case, &set)?;
+            #[cfg(feature = "mpi")]
+            let several = wgsph::ranks::launched_size().is_some_and(|n| n > 1);
+            #[cfg(not(feature = "mpi"))]
+            let several = false;
+            // The adapter first: the case is refused before its particles are made when it
+            // holds more than the adapter and the host's memory do.
+            let ctx = (!several).then(|| context(cli.adapter)).transpose()?;
+            let sc = load_case(&case, &set, ctx.as_ref())?;
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
             let options = RunOptions {
                 snapshot_png: snapshots.then(|| snapshot_field.unwrap_or_default()),
@@ -315,13 +322,14 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                 interrupt: Some(interrupt_flag()?),
                 ..Default::default()
             };
-            #[cfg(feature = "mpi")]
-            if wgsph::ranks::launched_size().is_some_and(|n| n > 1) {
+            let Some(ctx) = ctx else {
+                #[cfg(feature = "mpi")]
                 return on_ranks(cli.adapter, &dir, quiet, bars, |ctx, progress, ranks| {
                     wgsph::run::run_on_ranks(ctx, &sc, &dir, &options, progress, ranks)
                 });
-            }
-            let ctx = context(cli.adapter)?;
+                #[cfg(not(feature = "mpi"))]
+                unreachable!("one process without MPI");
+            };
             let report = wgsph::run::run(&ctx, &sc, &dir, &options, &mut *progress(quiet, bars))?;
             Ok(finish(&report, &dir, quiet))
         }
@@ -496,6 +504,19 @@ fn info(adapter: Option<AdapterChoice>) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The case at `path` with the overrides `set`, refused before its particles are made when it
+/// holds more than `ctx`'s adapter (None: a run over ranks, each on a slab) and the host's
+/// memory do (issue 64: 150 million particles ran the host out of memory while they were made).
+fn load_case(
+    path: &std::path::Path,
+    set: &[String],
+    ctx: Option<&GpuContext>,
+) -> Result<wgsph::scenario::Scenario> {
+    let (n, why) = wgsph::sph::run_budget(ctx, wgsph::sph::host_memory_available());
+    let budget = wgsph::case::ParticleBudget::at_most(n as f64, why);
+    Ok(wgsph::case::load_within(path, set, &budget)?)
+}
+
 /// `wgsph bench`: `steps` steps of `case` after `warmup`, particle-steps per second and bytes
 /// per particle, and with `stages` each stage's GPU time.
 fn bench(
@@ -514,8 +535,8 @@ fn bench(
         );
         return bench_ranked(adapter, case, set, steps, warmup);
     }
-    let sc = wgsph::case::load(case, set)?;
     let ctx = context(adapter)?;
+    let sc = load_case(case, set, Some(&ctx))?;
     let r = wgsph::bench::measure(&ctx, &sc, steps, warmup, stages)?;
     let n = r.particles;
     println!("case            {}", r.case);
@@ -560,7 +581,7 @@ fn bench_ranked(
     let ranks = Mpi::init().ok_or_else(|| anyhow::anyhow!("MPI was initialised twice"))?;
     let (rank, size) = (ranks.rank(), ranks.size());
     let result = (|| {
-        let sc = wgsph::case::load(case, set)?;
+        let sc = load_case(case, set, None)?;
         let ctx = GpuContext::for_rank(AdapterChoice::resolve(adapter)?, rank)?;
         eprintln!("rank {rank} of {size}: adapter {}", ctx.describe());
         wgsph::bench::measure_ranked(&ctx, &sc, steps, warmup, &ranks)

@@ -677,7 +677,21 @@ fn fluid_particles(
             .collect(),
         solids: elastic.map(|e| e.extents.as_slice()),
     };
-    let mut particles = Vec::with_capacity(total as usize);
+    // What the host cannot give is refused here rather than aborting the process (the budget
+    // estimates what it can: `sph::run_budget`).
+    let mut particles = Vec::new();
+    if particles.try_reserve_exact(total as usize).is_err() {
+        return Err(ctx.err(
+            "particles.dx_m",
+            Some(num(dx)),
+            format!(
+                "the host's memory cannot hold the case's {} particles ({:.1} GiB)",
+                total,
+                total * std::mem::size_of::<Particle>() as f64 / (1u64 << 30) as f64
+            ),
+            format!("increase particles.dx_m (the count scales as 1/dx^{dim})"),
+        ));
+    }
     for (i, (b, n)) in case.blocks.iter().zip(&geo.block_cells).enumerate() {
         let top = b.bx.max[v];
         let start_len = particles.len();

@@ -127,7 +127,7 @@ pub(super) fn budget(
         Some(num(dx)),
         format!(
             "the case would create about {} particles ({} fluid, {} wall, {} body; the most, \
-             about {}, in {largest}), more than the limit of {} ({} limit)",
+             about {}, in {largest}), more than {} ({} limit)",
             fmt_count(total),
             fmt_count(fluid_n),
             fmt_count(wall_n),

@@ -411,8 +411,8 @@ pub(super) fn solid_particles(
                 "particles.dx_m",
                 Some(format!("{dx}")),
                 format!(
-                    "with solid[{i}] the solids would have {total:.3e} particles, more than the \
-                     limit of {max_particles:.3e} ({} limit)",
+                    "with solid[{i}] the solids would have {total:.3e} particles, more than \
+                     {max_particles:.3e} ({} limit)",
                     budget.why
                 ),
                 "increase particles.dx_m",

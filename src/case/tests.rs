@@ -1808,3 +1808,22 @@ fn built_in_cases_are_found_by_name_and_file() {
     assert!(built_in(first.name, Path::new("cases/elsewhere.toml")).is_none());
     assert!(built_in("another_name", Path::new(first.file)).is_none());
 }
+
+/// A case beyond what the host's memory holds (as `sph::run_budget` reckons it) is refused
+/// naming the spacing and the memory, before a particle is made (issue 64: 150 million
+/// particles, within the engine's limit, aborted the process while they were made).
+#[test]
+fn a_case_beyond_the_hosts_memory_is_refused_before_it_is_built() {
+    let (n, why) = crate::sph::run_budget(None, Some(64 << 20));
+    let budget = super::ParticleBudget::at_most(n as f64, why);
+    // About 10^6 particles, more than 64 MiB hold at 250 bytes each.
+    let text = base_with("dx_m = 0.1", "dx_m = 0.0005");
+    let Err(e) = super::load_str_within(&text, "cases/t.toml", &[], &budget) else {
+        panic!("built beyond the budget of {n} particles");
+    };
+    let msg = format!("{e:#}");
+    for word in ["particles.dx_m", "host's memory", "0.1 GiB available"] {
+        assert!(msg.contains(word), "{word}: {msg}");
+    }
+    super::load_str_within(BASE, "cases/t.toml", &[], &budget).unwrap();
+}

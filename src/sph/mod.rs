@@ -43,7 +43,7 @@ use crate::grid::Grid;
 use crate::layout::{unpack_block, HaloCtl, IdSplit, Params, Pos, SimState, KIND_EXCLUDED};
 use crate::scenario::{Kind, Scenario};
 use buffers::{CaseTables, InitialParticles, ParticleBuffers};
-pub use capacity::{capacity, check_capacity, Capacity};
+pub use capacity::{capacity, check_capacity, host_memory_available, run_budget, Capacity};
 use passes::Passes;
 use profile::{Profiler, Recorder, StageTime};
 use shader::ShaderConfig;
