@@ -461,6 +461,17 @@ fn resume_with(
         });
     }
     let ck = checkpoint_of_rank(dir, sc, ranks)?;
+    let end = sc.time.end_s;
+    if ck.time_s >= end + 1e-9 * end {
+        // Not "completed": nothing would be computed, and run.json would say nothing of it
+        // (issue 64).
+        bail!(
+            "the checkpoint in {} is at t = {} s, past time.end_s = {end} s: there is nothing \
+             to compute; give a later time.end_s (--set time.end_s=...) to continue the run",
+            dir.display(),
+            ck.time_s
+        );
+    }
     if first {
         // A run's checkpoint: the outputs beside it are the run's, written before wgsph kept
         // a manifest of them if none lists them.
@@ -856,8 +867,13 @@ impl<'a> Runner<'a> {
             None => String::new(),
         };
         if let Some(e) = &stopped {
+            // The case's doubts (a speed beyond c0/10, say) may be the cause the stop can't tell.
+            let doubts = match (e.downcast_ref::<Unstable>(), sc.warnings.len()) {
+                (Some(_), n) if n > 0 => format!("; the case's {n} warning(s) may say why"),
+                _ => String::new(),
+            };
             log::error!(
-                "stopped: {e:#}; outputs up to t = {:.6} s are kept{}{resume_hint}",
+                "stopped: {e:#}{doubts}; outputs up to t = {:.6} s are kept{}{resume_hint}",
                 self.outputs.out.snapshots().last().map_or(0.0, |(t, _)| *t),
                 trimmed.as_deref().unwrap_or_default()
             );

@@ -516,6 +516,23 @@ fn resume_refuses_a_different_case() {
         msg.contains("different case") && msg.contains("checkpoint.bin"),
         "{msg}"
     );
+    // An end before the checkpoint: nothing to compute, and said so rather than "completed"
+    // (issue 64).
+    let shorter = load(
+        "cases/hydrostatic_2d.toml",
+        &["time.end_s=0.01", "time.probe_every_s=0.01"],
+    );
+    let e = wgsph::run::resume(
+        gpu(),
+        &shorter,
+        &dir,
+        &RunOptions::default(),
+        &mut LogLines::default(),
+    )
+    .err()
+    .expect("an end before the checkpoint must be refused");
+    let msg = format!("{e:#}");
+    assert!(msg.contains("past time.end_s = 0.01 s"), "{msg}");
     // A later end time is the same case: it extends the run.
     let longer = load(
         "cases/hydrostatic_2d.toml",

@@ -143,6 +143,9 @@ fn body(
 
 /// The mass of body `b` at `path` (of `shape`): from `density_kg_m3` or `mass_kg` (not both;
 /// neither: `None`), with a mass and moments of inertia that can be computed with.
+/// The largest body a case may hold, in metres across: a thousand kilometres.
+const MAX_BODY_SIZE_M: f64 = 1e6;
+
 fn mass(
     ctx: &Ctx<'_>,
     path: &str,
@@ -186,6 +189,26 @@ fn mass(
         let used: &[usize] = if dim == 2 { &[2] } else { &[0, 1, 2] };
         let fine = |x: f64| x.is_finite() && x > 0.0;
         if !(fine(m) && used.iter().all(|&a| fine(inertia[a][a]))) {
+            // A shape of no realistic size is the cause, not the density (issue 64: a vertex
+            // at 1e30 m was blamed on the density).
+            let bounds = shape.bounds(dim);
+            let size = (0..dim)
+                .map(|a| bounds.max[a] - bounds.min[a])
+                .fold(0.0, f64::max);
+            if !(size.is_finite() && size <= MAX_BODY_SIZE_M) {
+                return Err(ctx.err(
+                    path,
+                    None,
+                    format!(
+                        "has a shape {} m across, which no mass or inertia can be computed \
+                         for (from {:?} to {:?})",
+                        num(size),
+                        &bounds.min[..dim],
+                        &bounds.max[..dim]
+                    ),
+                    "check the shape's coordinates and the mesh's units (scale it to metres)",
+                ));
+            }
             let (field, value) = match (b.density_kg_m3, b.mass_kg) {
                 (Some(d), _) => ("density_kg_m3", d),
                 (_, m) => ("mass_kg", m.unwrap_or(0.0)),
@@ -606,6 +629,7 @@ fn series(
     })?;
     let columns = dim + 2;
     let (mut t, mut translation, mut angle) = (Vec::new(), Vec::new(), Vec::new());
+    let mut header = false;
     for (n, line) in text.lines().enumerate() {
         let line = line.trim();
         if line.is_empty() || line.starts_with('#') {
@@ -627,8 +651,19 @@ fn series(
         };
         let values = match values {
             Ok(v) => v,
-            // A header line (before any data) is skipped.
-            Err(_) if t.is_empty() => continue,
+            // One header line (before any data) is skipped.
+            Err(_) if t.is_empty() && !header => {
+                header = true;
+                continue;
+            }
+            // Other separators than the comma (issue 64: every row of a ';' file was taken
+            // for a header, and the file said to have no data rows).
+            Err(_) if line.contains([';', '\t']) || !line.contains(',') => {
+                return Err(bad(format!(
+                    "{line:?} is not {columns} comma-separated numbers (a CSV of this case \
+                     separates its columns by commas, not ';', tabs or spaces)"
+                )))
+            }
             Err(_) => return Err(bad(format!("{line:?} is not {columns} numbers"))),
         };
         if values.len() != columns || values.iter().any(|v| !v.is_finite()) {

@@ -297,6 +297,54 @@ fn obstacle_ranges(
 
 /// Each inlet's layout. Inlets: inside the tank, clear of fluid blocks and obstacles, on the
 /// lattice.
+/// The water inlet `i` brings has somewhere to go: a spacing beyond its buffer along its
+/// direction lies in the tank (and the given domain) and in no obstacle. An inlet pointing
+/// at a wall ran until the water it pushed into the wall was compressed beyond the stop limit,
+/// and the run blamed the sound speed (issue 64).
+fn inflow_has_room(ctx: &Ctx<'_>, case: &Case, i: usize, dx: f64) -> Result<(), CaseError> {
+    let (s, dim) = (&case.inlets[i], case.dim);
+    let a = s.axis;
+    let mut beyond = s.bx;
+    if s.sense > 0.0 {
+        beyond.min[a] = s.bx.max[a];
+        beyond.max[a] = s.bx.max[a] + dx;
+    } else {
+        beyond.max[a] = s.bx.min[a];
+        beyond.min[a] = s.bx.min[a] - dx;
+    }
+    let overlaps = |b: &Aabb| {
+        (0..dim).all(|k| beyond.max[k].min(b.max[k]) - beyond.min[k].max(b.min[k]) > TOL)
+    };
+    let outside = |b: &Aabb| inside(&beyond, b, dim).is_some();
+    let blocked = (case.tank.as_ref())
+        .filter(|t| outside(&t.inner))
+        .map(|_| "the tank's wall".to_string())
+        .or_else(|| {
+            case.domain
+                .filter(outside)
+                .map(|_| "the edge of [domain]".into())
+        })
+        .or_else(|| {
+            (case.obstacles.iter().position(overlaps)).map(|j| case.obstacle_paths[j].clone())
+        });
+    let Some(blocked) = blocked else {
+        return Ok(());
+    };
+    let sign = if s.sense > 0.0 { "+" } else { "-" };
+    Err(ctx.err(
+        &format!("inlet[{i}].direction"),
+        None,
+        format!(
+            "points ({sign}{}) from the buffer box ({}) at {blocked}: the water it brings would \
+             be pushed into it",
+            AXES[a],
+            fmt_box(&s.bx, dim)
+        ),
+        "point the direction from the buffer into the water (the buffer's face that the \
+         tank's interior lies beyond)",
+    ))
+}
+
 fn inlet_layouts(
     ctx: &Ctx<'_>,
     case: &Case,
@@ -323,6 +371,7 @@ fn inlet_layouts(
                 ));
             }
         }
+        inflow_has_room(ctx, case, i, lat.dx)?;
         let overlaps = |b: &Aabb| {
             (0..dim).all(|a| s.bx.max[a].min(b.max[a]) - s.bx.min[a].max(b.min[a]) > TOL)
         };
@@ -887,6 +936,46 @@ fn place_solids(
     Ok(Some((materials, of_particle)))
 }
 
+/// A free body's particles (`points`) lie in the tank and outside every obstacle: one placed
+/// through a wall is thrown out by the wall's forces at the first step, and the run went
+/// unstable blaming the sound speed (issue 64). Fixed and prescribed bodies may meet the walls
+/// (a building on the ground).
+fn free_body_clear_of_walls(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    i: usize,
+    points: &[[f64; 3]],
+) -> Result<(), CaseError> {
+    let dim = case.dim;
+    let within = |p: &[f64; 3], b: &Aabb, slack: f64| {
+        (0..dim).all(|a| b.min[a] - slack <= p[a] && p[a] <= b.max[a] + slack)
+    };
+    let in_wall = points.iter().find_map(|p| {
+        if case
+            .tank
+            .as_ref()
+            .is_some_and(|t| !within(p, &t.inner, TOL))
+        {
+            return Some((*p, "the tank's wall".to_string()));
+        }
+        (case.obstacles.iter().position(|o| within(p, o, -TOL)))
+            .map(|j| (*p, case.obstacle_paths[j].clone()))
+    });
+    let Some((p, wall)) = in_wall else {
+        return Ok(());
+    };
+    Err(ctx.err(
+        &format!("body[{i}]"),
+        None,
+        format!(
+            "is a free body with a particle at {:?}, inside {wall}: a body placed through a \
+             wall is thrown out of it at the first step",
+            &p[..dim]
+        ),
+        "place the body inside the tank, clear of the walls and obstacles",
+    ))
+}
+
 /// The bodies, their particles pushed onto `particles`: a moving tank's (`tank_particles`)
 /// first, then each `[[body]]`'s.
 fn bodies(
@@ -924,6 +1013,9 @@ fn bodies(
         let points = spec.shape.points(dx, dim, layers);
         if points.is_empty() {
             return Err(no_particles(ctx, i, &spec.shape, dx));
+        }
+        if matches!(spec.motion, Motion::Free { .. }) {
+            free_body_clear_of_walls(ctx, case, i, &points)?;
         }
         for pos in points {
             particles.push(Particle {
@@ -1136,7 +1228,14 @@ fn finish(
         outlets: case.outlets,
         warnings,
     };
-    super::runnable::check(ctx, &sc, Some(start.sound_path), &case.blocks, tank_moves)?;
+    let fast = super::runnable::check(
+        ctx,
+        &sc,
+        Some(start.sound_path),
+        &case.blocks,
+        (tank_moves, &case.obstacle_paths),
+    )?;
+    sc.warnings.extend(fast);
     // Probes that can never measure: said here, and NaN in their CSV (probe_reach.rs); those
     // that can but start inside a wall or body, said too.
     let blind = crate::probe_reach::unmeasurable(&sc);
@@ -1287,7 +1386,8 @@ pub(super) fn build_solid_case(
         outlets: Vec::new(),
         warnings: Vec::new(),
     };
-    super::runnable::check(ctx, &sc, None, &[], false)?;
+    // Without fluid no speed of sound to warn against.
+    super::runnable::check(ctx, &sc, None, &[], (false, &[]))?;
     Ok(sc)
 }
 

@@ -266,7 +266,7 @@ pub(crate) fn read_bounded(path: &Path, limit: u64) -> std::io::Result<String> {
         .read_to_string(&mut text)?;
     if text.len() as u64 > limit {
         return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
+            std::io::ErrorKind::FileTooLarge,
             format!("longer than {} MiB; is it the right file?", limit >> 20),
         ));
     }

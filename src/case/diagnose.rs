@@ -104,10 +104,16 @@ pub(super) fn schema(ctx: &Ctx<'_>, text: &str, index: &Index, err: &toml::de::E
             None => found_in_text(written.as_deref().unwrap_or("")),
         };
         let (meaning, example) = expectation(&path, rest);
+        // An integer where an integer goes is one out of the field's range (issue 64: "expected
+        // an integer, found an integer" for 10^20).
+        let problem = match meaning.starts_with(found) {
+            true => format!("out of range: expected {meaning}, found {found} beyond it"),
+            false => format!("wrong type: expected {meaning}, found {found}"),
+        };
         return ctx.err(
             &path,
             written,
-            format!("wrong type: expected {meaning}, found {found}"),
+            problem,
             match example {
                 Some(e) if e.starts_with('[') => format!("write it as {e}"),
                 Some(e) => format!("write it like `{e}`"),

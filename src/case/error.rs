@@ -6,9 +6,15 @@ use std::fmt;
 /// Why a case file could not be turned into a [`crate::scenario::Scenario`].
 #[derive(Debug, thiserror::Error)]
 pub enum CaseError {
-    /// The file could not be read.
+    /// The file could not be read (a missing file, no permission), or is not UTF-8 text (a
+    /// UTF-16 or binary file: issue 64, where the fix said to check the permissions).
     #[error(
-        "{file}: cannot read the case file: {source}; fix: check the path and its permissions"
+        "{file}: cannot read the case file: {source}; fix: {}",
+        match source.kind() {
+            std::io::ErrorKind::InvalidData => "save it as UTF-8 text (a case file is TOML, \
+                docs/cases.md); a UTF-16 file or a binary one is not a case file",
+            _ => "check the path and its permissions",
+        }
     )]
     Read {
         file: String,

@@ -8,7 +8,9 @@
 use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::validate::Block;
-use crate::scenario::{Kind, Scenario, Viscosity};
+use glam::DVec3;
+
+use crate::scenario::{Kind, Motion, MotionLaw, Scenario, Viscosity};
 
 /// The magnitudes a quantity the GPU multiplies and divides in f32 must lie between: a
 /// product or quotient of two such stays a normal f32 (1e±30, inside 1.2e-38 to 3.4e38).
@@ -31,19 +33,139 @@ struct Fastest {
     field: String,
 }
 
-/// Checks the built scenario `sc`: its f32 quantities, its time step and its schedule.
-/// `sound_field`: the field the speed of sound came from (None: solids alone); `blocks`: the
-/// fluid blocks (to name a fast one); `tank_moves`: the first body is the tank.
+/// Checks the built scenario `sc`: its f32 quantities, the speeds its motions reach against
+/// the speed of sound, its time step and its schedule. `sound_field`: the field the speed of
+/// sound came from (None: solids alone); `blocks`: the fluid blocks (to name a fast one);
+/// `tank_moves`: the first body is the tank. Returns a warning when a prescribed motion (its
+/// rotation included, which `warnings::fast_flow` cannot tell) is faster than c0/10.
 pub(super) fn check(
     ctx: &Ctx<'_>,
     sc: &Scenario,
     sound_field: Option<&str>,
     blocks: &[Block],
-    tank_moves: bool,
-) -> Result<(), CaseError> {
+    (tank_moves, obstacles): (bool, &[String]),
+) -> Result<Option<String>, CaseError> {
     f32_quantities(ctx, sc, sound_field)?;
-    let (dt, limit) = time_step(ctx, sc, sound_field, blocks, tank_moves)?;
-    schedule(ctx, sc, dt, &limit)
+    let prescribed = prescribed_speed(sc, tank_moves, obstacles);
+    let mut warning = None;
+    if let Some(sound) = sound_field {
+        below_sound(ctx, sc, sound, &prescribed)?;
+        let (u, c0) = (prescribed.speed, sc.physics.c0);
+        let field = prescribed.field.split(" (").next().unwrap_or_default();
+        let warned = sc.warnings.iter().any(|w| w.starts_with(field));
+        warning = (u > 0.1 * c0 && !warned).then(|| {
+            format!(
+                "{} moves its particles at up to {} m/s, more than c0/10 = {} m/s (c0 from \
+                 {sound}): the water it pushes is compressed by about (u/c0)² = {} %, more than \
+                 weakly compressible SPH allows; fix: raise {sound} so that c0 is at least {} \
+                 m/s, or check the motion (a rotation about a pivot far away sweeps its walls \
+                 fast)",
+                prescribed.field,
+                num(u),
+                num(0.1 * c0),
+                num((100.0 * (u / c0).powi(2)).round()),
+                num((10.0 * u).ceil())
+            )
+        });
+    }
+    let (dt, limit) = time_step(ctx, sc, sound_field, blocks, tank_moves, prescribed)?;
+    schedule(ctx, sc, dt, &limit)?;
+    Ok(warning)
+}
+
+/// The fastest a prescribed motion (the tank's, a body's) moves one of its particles over the
+/// run: the corners of each body's particles' box, at every 1/2000 of the run (or of a sine's
+/// period, when shorter). The tank carries its `obstacles` (their paths), named with it.
+fn prescribed_speed(sc: &Scenario, tank_moves: bool, obstacles: &[String]) -> Fastest {
+    let mut fastest = Fastest {
+        speed: 0.0,
+        field: "no motion".into(),
+    };
+    for (k, b) in sc.bodies.iter().enumerate() {
+        let Motion::Prescribed(law) = &b.motion else {
+            continue;
+        };
+        let span = match law.law {
+            MotionLaw::Sine { omega, .. } if omega > 0.0 => {
+                sc.time.end_s.min(std::f64::consts::TAU / omega)
+            }
+            _ => sc.time.end_s,
+        };
+        let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+        for p in &sc.particles[b.particles.clone()] {
+            for a in 0..3 {
+                (lo[a], hi[a]) = (lo[a].min(p.pos[a]), hi[a].max(p.pos[a]));
+            }
+        }
+        let corners = (0..8).map(|c: usize| {
+            DVec3::from_array([0, 1, 2].map(|a| if c >> a & 1 == 1 { hi[a] } else { lo[a] }))
+        });
+        const SAMPLES: usize = 2000;
+        let speed = corners
+            .flat_map(|c| (0..=SAMPLES).map(move |s| law.pose(c, span * s as f64 / SAMPLES as f64)))
+            .map(|pose| pose.velocity.length())
+            .fold(0.0, f64::max);
+        let field = match (k, tank_moves) {
+            (0, true) if obstacles.is_empty() => "tank.motion".to_string(),
+            (0, true) => format!("tank.motion (with {})", obstacles.join(", ")),
+            _ => format!("body[{}].motion", k - tank_moves as usize),
+        };
+        fastest = faster(fastest, Fastest { speed, field });
+    }
+    fastest
+}
+
+/// The fluid's flow, a body's motion and the water a prescribed motion pushes move below the
+/// speed of sound c0: at or above it weakly-compressible SPH has no solution, and a run went
+/// unstable at once blaming c0's coefficient (issue 64: a tank rolling about a pivot 100 m
+/// away moved its walls at 14 m/s, c0 = 20 m/s).
+fn below_sound(
+    ctx: &Ctx<'_>,
+    sc: &Scenario,
+    sound_field: &str,
+    prescribed: &Fastest,
+) -> Result<(), CaseError> {
+    let c0 = sc.physics.c0;
+    let fall = free_fall_speed(sc);
+    if fall >= c0 {
+        return Err(ctx.err(
+            sound_field,
+            None,
+            format!(
+                "gives a speed of sound c0 = {} m/s, not above sqrt(2 |g| H) = {} m/s (|g| from \
+                 physics.gravity_m_s2, H the fluid's height), the speed the water reaches \
+                 falling its own height: the hydrostatic pressure alone would compress it by a \
+                 fifth or more",
+                num(c0),
+                num(fall)
+            ),
+            format!(
+                "raise {sound_field} so that c0 is at least {} m/s (10 sqrt(|g| H))",
+                num(10.0 * fall / std::f64::consts::SQRT_2)
+            ),
+        ));
+    }
+    if prescribed.speed < c0 {
+        return Ok(());
+    }
+    let field = prescribed.field.split(" (").next().unwrap_or_default();
+    Err(ctx.err(
+        field,
+        None,
+        format!(
+            "{} moves its particles at up to {} m/s, not below the speed of sound c0 = {} m/s \
+             (from {sound_field}): weakly compressible SPH needs the flow and the walls to \
+             move at about c0 / 10 or less",
+            prescribed.field,
+            num(prescribed.speed),
+            num(c0)
+        ),
+        format!(
+            "check the motion (a rotation about a pivot far away sweeps its walls fast), or \
+             raise {sound_field} so that c0 is about {} m/s",
+            num(10.0 * prescribed.speed)
+        ),
+    ))
 }
 
 /// ρ0, c0, Tait's B, the particle mass, the kernel's gradient scale 1/h^(d+1), |g|, ν and the
@@ -128,11 +250,12 @@ fn time_step(
     sound_field: Option<&str>,
     blocks: &[Block],
     tank_moves: bool,
+    prescribed: Fastest,
 ) -> Result<(f64, String), CaseError> {
     let ph = &sc.physics;
     let cfl = sc.time.cfl;
     let wave = wave_speed(sc, sound_field);
-    let flow = fastest_flow(sc, blocks, tank_moves);
+    let flow = faster(fastest_flow(sc, blocks, tank_moves), prescribed);
     let mut dt = cfl * ph.h / (wave.speed + flow.speed);
     let mut limit = format!(
         "time.cfl × h / (c + |u|) = {} × {} m / ({} + {}) m/s, c from {}, |u| from {}",
@@ -186,6 +309,22 @@ fn time_step(
         "give realistic speeds (c0 about 10 times the fastest flow), time.cfl about 0.2 and \
          time.end_s in seconds",
     ))
+}
+
+/// sqrt(2 |g| H), H the fluid's height (its particles', inlets' included): the speed water
+/// falling its own height reaches, and the hydrostatic pressure's scale (ρ0 g H = ρ0 (that
+/// speed)² / 2).
+fn free_fall_speed(sc: &Scenario) -> f64 {
+    let v = sc.physics.dim as usize - 1;
+    let g = sc.physics.gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let water = sc
+        .particles
+        .iter()
+        .filter(|p| matches!(p.kind, Kind::Fluid | Kind::Inlet));
+    let (lo, hi) = water.fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+        (lo.min(p.pos[v]), hi.max(p.pos[v]))
+    });
+    (2.0 * g * (hi - lo).max(0.0)).sqrt()
 }
 
 /// The fastest wave: the fluid's sound speed, or an elastic solid's P wave.

@@ -1827,3 +1827,75 @@ fn a_case_beyond_the_hosts_memory_is_refused_before_it_is_built() {
     }
     super::load_str_within(BASE, "cases/t.toml", &[], &budget).unwrap();
 }
+
+/// What the loader checked field by field in f64 but a run could not take (issue 64), refused
+/// naming the field: the time step rounding to nothing in f32 (a Courant number of 1e-50, a
+/// sound speed of 1e40 c0's coefficient, a viscosity of 1e40), a density whose square is no
+/// f32, a probe interval of 1e-300 s or below a thousandth of the step, a speed of sound below
+/// the water's fall, a tank swept faster than sound by a far pivot, an inlet pointing at a
+/// wall, a free body placed through a wall.
+#[test]
+fn cases_a_run_cannot_step_are_refused_naming_the_field() {
+    let refused = |case: &str, sets: &[&str], words: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let Err(e) = super::load(std::path::Path::new(case), &sets) else {
+            panic!("{case} {sets:?} was accepted");
+        };
+        let msg = format!("{e:#}");
+        for w in words {
+            assert!(msg.contains(w), "{case} {sets:?}: `{w}` in {msg}");
+        }
+    };
+    let tank = "cases/hydrostatic_2d.toml";
+    refused(tank, &["time.cfl=1e-50"], &["time.cfl", "steps"]);
+    refused(
+        tank,
+        &["physics.sound_speed_coef=1e40"],
+        &["sound_speed_coef", "f32"],
+    );
+    let laminar = |nu: &str| {
+        BASE.to_string().replace(
+            "sound_speed_coef = 10.0",
+            &format!("sound_speed_coef = 10.0\nviscosity = \"laminar\"\nnu_m2_s = {nu}"),
+        )
+    };
+    assert_err(&laminar("1e40"), &[], None, &["physics.nu_m2_s", "f32"]);
+    assert_err(
+        &laminar("1e9"),
+        &[],
+        None,
+        &["physics.nu_m2_s", "0.125 h² / ν"],
+    );
+    refused(tank, &["physics.rho0_kg_m3=1e30"], &["rho0_kg_m3", "f32"]);
+    refused(tank, &["physics.rho0_kg_m3=1e-30"], &["rho0_kg_m3", "f32"]);
+    refused(
+        tank,
+        &["time.probe_every_s=1e-300"],
+        &["probe_every_s", "samples"],
+    );
+    refused(
+        tank,
+        &["time.probe_every_s=5e-8", "time.end_s=0.2"],
+        &["probe_every_s", "thousandth"],
+    );
+    refused(
+        tank,
+        &["physics.sound_speed_coef=0.5"],
+        &["sound_speed_coef", "sqrt(2 |g| H)"],
+    );
+    refused(
+        "cases/sloshing_2d.toml",
+        &["tank.motion.pivot_m=[1000.0, 0.0]"],
+        &["tank.motion", "speed of sound"],
+    );
+    refused(
+        "cases/water_injection_2d.toml",
+        &["inlet[0].direction=[-1.0, 0.0]"],
+        &["inlet[0].direction", "tank's wall"],
+    );
+    refused(
+        "cases/floating_box_2d.toml",
+        &["body[0].min_m=[-0.1, 0.27]"],
+        &["body[0]", "tank's wall"],
+    );
+}

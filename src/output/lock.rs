@@ -4,7 +4,9 @@
 //! while the first lives. The file is created with `create_new` (atomic: of two runs starting
 //! at once, one gets it) and removed when the run ends, on its error paths too (Drop; Ctrl-C
 //! and SIGTERM end a run normally, with a checkpoint). A run killed outright (SIGKILL, power
-//! loss) leaves it behind: a lock whose pid is no longer alive is taken over.
+//! loss) leaves it behind: a lock whose pid is no longer alive is taken over, and so is one
+//! whose pid now names another process (the lock holds the process's start time too: a
+//! reused pid was taken for "another wgsph run", issue 64).
 
 use std::fs::{File, OpenOptions};
 use std::io::{self, Write};
@@ -39,14 +41,16 @@ impl DirLock {
                 Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {}
                 Err(e) => return Err(OutputError::io("create", &path, e)),
             }
-            let holder = match read_pid(&path) {
+            let (holder, started) = match read_holder(&path) {
                 Ok(p) => p,
                 // Removed between our attempt and the read: try again.
                 Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
                 Err(e) => return Err(OutputError::io("read", &path, e)),
             };
             match holder {
-                Some(other) if alive(other) => {
+                Some(other)
+                    if alive(other) && started.is_none_or(|s| start_time(other) == Some(s)) =>
+                {
                     return Err(OutputError::Locked {
                         dir: dir.to_path_buf(),
                         pid: other,
@@ -79,14 +83,36 @@ impl Drop for DirLock {
     }
 }
 
+/// "pid start-time": the process and when it started (where that can be read).
 fn write_pid(f: &mut File, pid: u32) -> io::Result<()> {
-    writeln!(f, "{pid}")?;
+    match start_time(pid) {
+        Some(start) => writeln!(f, "{pid} {start}")?,
+        None => writeln!(f, "{pid}")?,
+    }
     f.sync_all()
 }
 
 /// The pid in a lock file; None when it holds none (empty or garbled).
 fn read_pid(path: &Path) -> io::Result<Option<u32>> {
-    Ok(std::fs::read_to_string(path)?.trim().parse().ok())
+    Ok(read_holder(path)?.0)
+}
+
+/// The pid in a lock file and its process's start time, where written (a lock of an older
+/// wgsph holds the pid alone).
+fn read_holder(path: &Path) -> io::Result<(Option<u32>, Option<u64>)> {
+    let text = std::fs::read_to_string(path)?;
+    let mut words = text.split_whitespace();
+    let pid = words.next().and_then(|w| w.parse().ok());
+    Ok((pid, words.next().and_then(|w| w.parse().ok())))
+}
+
+/// When process `pid` started (clock ticks since boot: /proc/PID/stat's 22nd field), on Linux;
+/// a pid that names another process after its own ended has another.
+fn start_time(pid: u32) -> Option<u64> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // After "pid (command)": state is field 3, so the start time is the 20th word after ')'.
+    let (_, rest) = stat.rsplit_once(')')?;
+    rest.split_whitespace().nth(19)?.parse().ok()
 }
 
 /// Whether a lock file without a pid is young enough to be a run still writing it.
@@ -204,6 +230,19 @@ mod tests {
             }
             let l = DirLock::acquire(&d).unwrap();
             assert_eq!(read_pid(&lock).unwrap(), Some(std::process::id()));
+            drop(l);
+        }
+        // A live pid that started at another time: the pid of a run that ended, reused.
+        #[cfg(target_os = "linux")]
+        {
+            let me = std::process::id();
+            let start = start_time(me).expect("this process's start time");
+            std::fs::write(&lock, format!("{me} {}\n", start + 1)).unwrap();
+            let l = DirLock::acquire(&d).expect("a reused pid holds no lock");
+            assert_eq!(
+                std::fs::read_to_string(&lock).unwrap(),
+                format!("{me} {start}\n")
+            );
             drop(l);
         }
         assert_eq!(

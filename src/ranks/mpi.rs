@@ -37,6 +37,12 @@ impl Ranks for Mpi {
 
     fn abort(&self, why: &anyhow::Error) -> ! {
         eprintln!("rank {} of {}: {why:#}", self.rank(), self.size());
+        // mpirun forwards a rank's output on its own schedule, and the abort tears the job
+        // down at once: a message every rank printed before aborting was lost in one job of
+        // four (issue 64). A moment's wait lets it through; a job that is failing loses
+        // nothing by it.
+        let _ = std::io::Write::flush(&mut std::io::stderr());
+        std::thread::sleep(std::time::Duration::from_millis(500));
         self.world.abort(1)
     }
 

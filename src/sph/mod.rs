@@ -168,7 +168,7 @@ pub struct Solver {
     pub max_excluded_fraction: f64,
     /// `time.density_variation_stop` (the check: [`DensityVariation::beyond_stop`]).
     density_variation_stop: f64,
-    /// Fluid particles at t = 0 (inlets' not yet joined).
+    /// Fluid particles at t = 0 and the inlets' buffers' (not those waiting to join).
     n_fluid_at_start: u64,
     /// Per-stage timestamps, while [`Solver::profile_steps`] runs.
     profiler: Option<Profiler>,
@@ -313,7 +313,10 @@ impl Solver {
             dormant_at_start: sc.dormant_count() as u32,
             max_excluded_fraction: 0.05,
             density_variation_stop: sc.time.density_variation_stop,
-            n_fluid_at_start: sc.count(Kind::Fluid) as u64,
+            // The buffers' particles become fluid without joining (issue 64: left out, an
+            // inlet's run could report "400 % of the fluid's particles").
+            n_fluid_at_start: (sc.count(Kind::Fluid) + sc.count(Kind::Inlet) - sc.dormant_count())
+                as u64,
             profiler: None,
             peaks: DensityPeaks::default(),
             batch_cap: (BATCH_PARTICLE_STEPS / n as u64).clamp(1, MAX_BATCH as u64) as u32,
@@ -771,11 +774,17 @@ impl Solver {
         }
         let excluded = self.excluded();
         if excluded as f64 > self.max_excluded_fraction * self.n_fluid as f64 {
+            // The count is of every kind: walls the case moves out of the domain count too
+            // (issue 64: "702 of 75 particles left the domain").
+            let walls = match excluded > self.n_fluid {
+                true => " (more than there are: walls or bodies the case moves left it too)",
+                false => "",
+            };
             return fail(format!(
-                "{} of {} fluid and solid particles left the domain (more than {:.0} %)",
-                excluded,
+                "{excluded} particles left the domain, more than {:.0} % of the case's {} fluid \
+                 and solid particles{walls}; check that the case keeps them in [domain]",
+                100.0 * self.max_excluded_fraction,
                 self.n_fluid,
-                100.0 * self.max_excluded_fraction
             ));
         }
         let density = self.density_variation();

@@ -11,9 +11,13 @@
 //! an unknown field, a vector of the wrong length); what must pass passes; an accepted case
 //! builds a sane scenario (`check_sane`).
 //!
-//! CPU only. Each property prints how many inputs it tried. CI runs the `CASES_*` below;
-//! `PROPTEST_CASES=100000 cargo test --release --test case_fuzz` runs longer (every property
-//! then tries that many), `PROPTEST_RNG_SEED=n` repeats a run.
+//! Since issue 64 the loader also refuses what a run could not step (f32 overflow and underflow
+//! of the derived quantities, intervals at both extremes, names that are paths), and a sample
+//! of accepted edits runs the solver a few steps (`accepted_edits_run_a_few_steps`, on the
+//! test adapter: lavapipe in CI); the rest is CPU only. Each property prints how many inputs
+//! it tried. CI runs the `CASES_*` below; `PROPTEST_CASES=100000 cargo test --release --test
+//! case_fuzz -- --skip accepted_edits` runs the loader longer (every property then tries that
+//! many; the solver's sample too, unless skipped), `CASE_FUZZ_SEED=n` repeats a run.
 
 mod check;
 #[path = "../common/mod.rs"]
