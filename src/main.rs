@@ -235,8 +235,8 @@ fn progress(quiet: bool, bars: &MultiProgress) -> Box<dyn Progress> {
     }
 }
 
-/// A flag set by Ctrl-C or SIGTERM: the run writes a checkpoint at the next probe time and
-/// stops. A second signal ends the process at once.
+/// A flag set by Ctrl-C or SIGTERM: the run writes a checkpoint after the batch of steps under
+/// way and stops. A second signal ends the process at once.
 fn interrupt_flag() -> Result<Arc<AtomicBool>> {
     let flag = Arc::new(AtomicBool::new(false));
     let seen = flag.clone();
@@ -244,7 +244,9 @@ fn interrupt_flag() -> Result<Arc<AtomicBool>> {
         if seen.swap(true, Ordering::Relaxed) {
             std::process::exit(130);
         }
-        eprintln!("interrupt: writing a checkpoint at the next probe time, then stopping");
+        eprintln!(
+            "interrupt: writing a checkpoint after the steps under way (seconds), then stopping"
+        );
     })
     .context("installing the Ctrl-C handler")?;
     Ok(flag)

@@ -43,7 +43,8 @@ pub struct RunOptions {
     pub checkpoint: CheckpointPolicy,
     /// The case file and overrides, recorded in checkpoints for `wgsph resume`.
     pub source: Option<CaseSource>,
-    /// Set (by a signal handler) to stop at the next probe time with a checkpoint.
+    /// Set (by a signal handler) to stop with a checkpoint after the batch of steps under way
+    /// (between two probe times, too).
     pub interrupt: Option<Arc<AtomicBool>>,
     /// Stop with a checkpoint at the first probe time at or after this simulated time, as if
     /// interrupted (batch jobs with a time limit split a run this way; so do the tests).

@@ -1249,3 +1249,94 @@ fn ranks_hold_the_water_with_a_total_lagrangian_gate_as_one_run() {
     }
     .check();
 }
+
+/// Sets the run's interrupt flag once the progress it hears has passed `at_steps` steps: every
+/// rank hears the same steps (they agree on each), as a signal reaches them at different ones.
+struct SignalAt {
+    at_steps: u64,
+    flag: std::sync::Arc<std::sync::atomic::AtomicBool>,
+}
+
+impl wgsph::progress::Progress for SignalAt {
+    fn update(&mut self, status: &wgsph::progress::RunStatus) {
+        if status.steps >= self.at_steps {
+            self.flag.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+    }
+
+    fn finish(&mut self, _: &wgsph::progress::RunStatus) {}
+}
+
+/// A signal between two probe times stops every rank at the same batch of steps, short of the
+/// probe time, with a checkpoint (issue 64: a run answered signals only at probe times); the
+/// resumed run over the ranks writes what the uninterrupted one writes, bit for bit (one probe
+/// interval: the whole run).
+#[test]
+fn a_signal_between_probe_times_stops_every_rank_and_resumes_bit_identically() {
+    let name = "a_signal_between_probe_times_stops_every_rank_and_resumes_bit_identically";
+    if !under_mpirun() {
+        let dir = common::Scratch::new("mpi-signal");
+        let folder = dir.to_string_lossy().into_owned();
+        let (ok, log) = mpirun_with(
+            name,
+            2,
+            Duration::from_secs(300),
+            &[("WGSPH_TEST_DIR", &folder)],
+        );
+        assert!(ok, "the 2-rank job failed:\n{log}");
+        assert!(log.contains("stopped between probe times"), "{log}");
+        return;
+    }
+    use wgsph::progress::LogLines;
+    use wgsph::run::{resume_on_ranks, run_on_ranks, RunOptions};
+    let ranks = Mpi::init().expect("MPI initialised once");
+    let ctx = GpuContext::for_rank(AdapterChoice::Cpu, ranks.rank()).unwrap();
+    let set: Vec<String> = [
+        "particles.dx_m=0.0146",
+        "time.end_s=0.08",
+        "time.output_every_s=0.08",
+        "time.probe_every_s=0.08",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let sc = wgsph::case::load(std::path::Path::new("cases/dam_break_2d.toml"), &set).unwrap();
+    let base = std::path::PathBuf::from(std::env::var("WGSPH_TEST_DIR").unwrap());
+    let (straight, split) = (base.join("straight"), base.join("split"));
+    let plain = RunOptions::default();
+    let a = run_on_ranks(
+        &ctx,
+        &sc,
+        &straight,
+        &plain,
+        &mut LogLines::default(),
+        &ranks,
+    )
+    .unwrap();
+    let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let signalled = RunOptions {
+        interrupt: Some(flag.clone()),
+        ..RunOptions::default()
+    };
+    let mut signal = SignalAt {
+        at_steps: a.summary.steps / 2,
+        flag,
+    };
+    let b = run_on_ranks(&ctx, &sc, &split, &signalled, &mut signal, &ranks).unwrap();
+    let t = b.interrupted_at_s.expect("the signal stops the run");
+    assert!(0.0 < t && t < 0.08, "stopped at t = {t} s");
+    assert!(
+        b.summary.steps < signal.at_steps + 64,
+        "{}",
+        b.summary.steps
+    );
+    let c = resume_on_ranks(&ctx, &sc, &split, &plain, &mut LogLines::default(), &ranks).unwrap();
+    assert_eq!(a.summary.steps, c.summary.steps);
+    if ranks.rank() == 0 {
+        assert_same_outputs(&straight, &split);
+        println!(
+            "stopped between probe times at t = {t} s, step {}",
+            b.summary.steps
+        );
+    }
+}

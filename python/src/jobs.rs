@@ -5,7 +5,8 @@
 //! Ctrl-C: Python's own SIGINT handler only notes the signal; `Python::check_signals` (which
 //! must run on the main thread, holding the GIL) then raises KeyboardInterrupt. We turn that
 //! into the engine's interrupt flag, the one the command's Ctrl-C handler sets: the run writes
-//! a checkpoint at its next probe time and stops, and only then is KeyboardInterrupt raised.
+//! a checkpoint after the batch of steps under way and stops, and only then is
+//! KeyboardInterrupt raised.
 //! No signal handler of ours is installed, so Python's (and Jupyter's) stay as they are.
 
 use std::path::PathBuf;
@@ -78,7 +79,7 @@ fn wait_for<T: Send + 'static>(
                 Some(flag) if signal.is_none() => {
                     flag.store(true, Ordering::Relaxed);
                     eprintln!(
-                        "interrupt: writing a checkpoint at the next probe time, then stopping \
+                        "interrupt: writing a checkpoint after the steps under way (seconds), then stopping \
                          (interrupt again to stop waiting for it)"
                     );
                     signal = Some(e);

@@ -1,4 +1,4 @@
-"""Ctrl-C in Python: SIGINT to a process inside wgsph.run stops the run at its next probe time
+"""Ctrl-C in Python: SIGINT to a process inside wgsph.run stops the run after the steps under way
 with a checkpoint and raises KeyboardInterrupt saying so; resume (the package's and the
 command's) continues it."""
 
@@ -52,7 +52,7 @@ def test_sigint_stops_with_a_checkpoint_and_resume_continues(tmp_path):
     assert proc.returncode == 130, (stdout, stderr)
     assert "KeyboardInterrupt: run interrupted at t = " in stdout, stdout
     assert str(out / "checkpoint.bin") in stdout and "wgsph.resume(" in stdout
-    assert "writing a checkpoint at the next probe time" in stderr
+    assert "writing a checkpoint after the steps under way" in stderr
     assert (out / "checkpoint.bin").is_file()
     run = wgsph.Run.open(out)
     assert run.status.startswith("interrupted"), run.status
