@@ -46,13 +46,18 @@ pub(super) fn check(
     (tank_moves, obstacles): (bool, &[String]),
 ) -> Result<Option<String>, CaseError> {
     f32_quantities(ctx, sc, sound_field)?;
-    let prescribed = prescribed_speed(sc, tank_moves, obstacles);
+    // The fastest a particle moves: set at the start (a block, an inlet, a free body's
+    // translation and spin) or by a prescribed motion over the run.
+    let moving = faster(
+        fastest_flow(sc, blocks, tank_moves),
+        prescribed_speed(sc, tank_moves, obstacles),
+    );
     let mut warning = None;
     if let Some(sound) = sound_field {
-        below_sound(ctx, sc, sound, &prescribed)?;
-        let (u, c0) = (prescribed.speed, sc.physics.c0);
-        let field = prescribed.field.split(" (").next().unwrap_or_default();
-        let warned = sc.warnings.iter().any(|w| w.starts_with(field));
+        below_sound(ctx, sc, sound, &moving)?;
+        let (u, c0) = (moving.speed, sc.physics.c0);
+        // `warnings::fast_flow` tells of the speeds it can see (not rotations).
+        let warned = sc.warnings.iter().any(|w| w.contains("c0/10"));
         warning = (u > 0.1 * c0 && !warned).then(|| {
             format!(
                 "{} moves its particles at up to {} m/s, more than c0/10 = {} m/s (c0 from \
@@ -60,7 +65,7 @@ pub(super) fn check(
                  weakly compressible SPH allows; fix: raise {sound} so that c0 is at least {} \
                  m/s, or check the motion (a rotation about a pivot far away sweeps its walls \
                  fast)",
-                prescribed.field,
+                moving.field,
                 num(u),
                 num(0.1 * c0),
                 num((100.0 * (u / c0).powi(2)).round()),
@@ -68,7 +73,7 @@ pub(super) fn check(
             )
         });
     }
-    let (dt, limit) = time_step(ctx, sc, sound_field, blocks, tank_moves, prescribed)?;
+    let (dt, limit) = time_step(ctx, sc, sound_field, moving)?;
     schedule(ctx, sc, dt, &limit)?;
     Ok(warning)
 }
@@ -115,10 +120,11 @@ fn prescribed_speed(sc: &Scenario, tank_moves: bool, obstacles: &[String]) -> Fa
     fastest
 }
 
-/// The fluid's flow, a body's motion and the water a prescribed motion pushes move below the
-/// speed of sound c0: at or above it weakly-compressible SPH has no solution, and a run went
-/// unstable at once blaming c0's coefficient (issue 64: a tank rolling about a pivot 100 m
-/// away moved its walls at 14 m/s, c0 = 20 m/s).
+/// The water is not so slow to sound that its own weight compresses it, and the fastest
+/// particle (`moving`: the flow, a body, what a prescribed motion pushes) moves below the speed
+/// of sound c0: at or above it weakly-compressible SPH has no solution, and a run went
+/// unstable at once blaming c0's coefficient (issue 64: a tank rolling about a pivot 1 km away,
+/// a free body spinning at 1000 rad/s).
 fn below_sound(
     ctx: &Ctx<'_>,
     sc: &Scenario,
@@ -248,14 +254,11 @@ fn time_step(
     ctx: &Ctx<'_>,
     sc: &Scenario,
     sound_field: Option<&str>,
-    blocks: &[Block],
-    tank_moves: bool,
-    prescribed: Fastest,
+    flow: Fastest,
 ) -> Result<(f64, String), CaseError> {
     let ph = &sc.physics;
     let cfl = sc.time.cfl;
     let wave = wave_speed(sc, sound_field);
-    let flow = faster(fastest_flow(sc, blocks, tank_moves), prescribed);
     let mut dt = cfl * ph.h / (wave.speed + flow.speed);
     let mut limit = format!(
         "time.cfl × h / (c + |u|) = {} × {} m / ({} + {}) m/s, c from {}, |u| from {}",

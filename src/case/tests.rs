@@ -1898,4 +1898,19 @@ fn cases_a_run_cannot_step_are_refused_naming_the_field() {
         &["body[0].min_m=[-0.1, 0.27]"],
         &["body[0]", "tank's wall"],
     );
+    let spinning = |w: &str| {
+        let spin = format!("body[0].motion.angular_velocity_rad_s=[{w}]");
+        ["body[0].motion.kind=\"free\"".to_string(), spin]
+    };
+    let box_case = std::path::Path::new("cases/floating_box_2d.toml");
+    for w in ["1e308", "1e3"] {
+        let Err(e) = super::load(box_case, &spinning(w)) else {
+            panic!("a body spinning at {w} rad/s was accepted");
+        };
+        let msg = format!("{e:#}");
+        assert!(
+            msg.contains("body[0].motion") && msg.contains("speed of sound"),
+            "{msg}"
+        );
+    }
 }
