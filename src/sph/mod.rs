@@ -113,6 +113,14 @@ impl DensityVariation {
     }
 }
 
+/// The steps that arrive `left` seconds ahead at steps of `dt`, and one more, from 1 to `cap`:
+/// counted in f64, as a probe time 2^32 steps away overflowed a count in u32 (issue 64).
+fn batch_steps(left: f32, dt: f32, cap: u32) -> u32 {
+    // NaN: `max` takes the other (no time left; a step of 1e-30 s).
+    let steps = (left.max(0.0) as f64 / (dt as f64).max(1e-30)).ceil() + 1.0;
+    (steps.min(cap as f64) as u32).max(1)
+}
+
 /// Why a run stopped before its end.
 #[derive(Debug, thiserror::Error)]
 #[error("run unstable at step {step}, t = {time_s:.6} s: {reason}")]
@@ -608,12 +616,10 @@ impl Solver {
     /// present dt, and one more. Steps recorded past the arrival take dt = 0: they move nothing
     /// but sort and compute the rates, and the time step, at the state arrived at, from which
     /// the next interval starts.
-    /// At most `batch_cap` steps (computed in f64: a probe time 2^32 steps away overflowed
-    /// the count, issue 64).
+    /// At most `batch_cap` steps ([`batch_steps`]).
     fn batch_to_target(&self) -> u32 {
-        let left = (self.state.t_target_rel - self.state.t_rel).max(0.0) as f64;
-        let steps = (left / (self.state.dt_cfl as f64).max(1e-30)).ceil() + 1.0;
-        (steps.min(self.batch_cap as f64) as u32).max(1)
+        let left = self.state.t_target_rel - self.state.t_rel;
+        batch_steps(left, self.state.dt_cfl, self.batch_cap)
     }
 
     /// Arrived at `t_target`: the host clock takes it exactly (the GPU's f32 clock is re-based
@@ -911,3 +917,22 @@ impl Solver {
 
 /// Kind word of an excluded particle, for callers filtering outputs.
 pub const EXCLUDED: u32 = KIND_EXCLUDED;
+
+#[cfg(test)]
+mod tests {
+    use super::batch_steps;
+
+    #[test]
+    fn a_batch_is_the_steps_to_the_target_and_one_more_within_its_cap() {
+        assert_eq!(batch_steps(1.0, 0.25, 64), 5);
+        assert_eq!(batch_steps(0.0, 0.25, 64), 1);
+        assert_eq!(batch_steps(-1.0, 0.25, 64), 1);
+        assert_eq!(batch_steps(1.0, 1e-3, 64), 64);
+        assert_eq!(batch_steps(1.0, 1e-3, 2), 2);
+        // 2^32 steps and more away, a step of 0 or NaN: the cap, not an overflow.
+        for (left, dt) in [(1.0, 1e-30), (f32::MAX, 1e-38), (1.0, 0.0), (1.0, f32::NAN)] {
+            assert_eq!(batch_steps(left, dt, 64), 64, "{left} / {dt}");
+        }
+        assert_eq!(batch_steps(f32::NAN, 1.0, 64), 1);
+    }
+}
