@@ -1914,3 +1914,48 @@ fn cases_a_run_cannot_step_are_refused_naming_the_field() {
         );
     }
 }
+
+/// The messages that misled a new user (issue 64, item 7) say what is wrong: an integer beyond
+/// the field's range ("expected an integer, found an integer"), a case file that is not UTF-8
+/// ("check the path and its permissions"), a motion series separated by ';' ("no data
+/// rows"), a body shape of no realistic size (blamed on its density).
+#[test]
+fn messages_that_misled_say_what_is_wrong() {
+    assert_err(
+        &base_with("[tank]", "[tank]\nlayers = 99999999999999999999"),
+        &[],
+        None,
+        &["tank.layers", "out of range", "1 to 8"],
+    );
+    let dir = std::env::temp_dir().join(format!("wgsph-misled-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let utf16: Vec<u8> = [0xff, 0xfe]
+        .into_iter()
+        .chain(BASE.encode_utf16().flat_map(u16::to_le_bytes))
+        .collect();
+    let file = dir.join("utf16.toml");
+    std::fs::write(&file, utf16).unwrap();
+    let msg = super::load(&file, &[]).unwrap_err().to_string();
+    assert!(
+        msg.contains("UTF-8") && !msg.contains("permissions"),
+        "{msg}"
+    );
+    std::fs::write(dir.join("m.csv"), "t;dx;dy;angle\n0;0;0;0\n1;0.1;0;0\n").unwrap();
+    let series = format!(
+        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"box\"\nmin_m = [0.6, 0.6]\nmax_m = [0.7, 0.7]\
+         \n[body.motion]\nkind = \"series\"\nfile = \"m.csv\"\n"
+    );
+    let case = dir.join("series.toml");
+    std::fs::write(&case, series).unwrap();
+    let msg = format!("{:#}", super::load(&case, &[]).unwrap_err());
+    assert!(
+        msg.contains("comma-separated") && msg.contains("line 2"),
+        "{msg}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    let huge = format!(
+        "{BASE}\n[[body]]\nname = \"b\"\nshape = \"polygon\"\nvertices_m = [[0.6, 0.6], \
+         [1e200, 0.6], [0.6, 0.7]]\ndensity_kg_m3 = 500.0\n"
+    );
+    assert_err(&huge, &[], None, &["body[0]", "1e200 m across", "units"]);
+}
