@@ -5,20 +5,18 @@ mod common;
 
 use bytemuck::Zeroable;
 use wgsph::gpu::kernel::Resolve;
-use wgsph::layout::{Params, Pos};
+use wgsph::layout::Params;
 use wgsph::sph::buffers::{CaseTables, InitialParticles, ParticleBuffers, TableSizes};
 
 fn buffers() -> ParticleBuffers {
     let ctx = common::gpu();
-    let pos = vec![Pos::default(); 4];
     ParticleBuffers::new(
         &ctx.device,
         &Params::zeroed(),
         8,
         &InitialParticles {
-            pos: &pos,
-            velrho: &[[0.0; 4]; 4],
-            code: &[0; 4],
+            capacity: 4,
+            wide_ids: false,
             body_particles: &[],
             body_motions: &[],
             solid: &[],

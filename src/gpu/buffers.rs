@@ -61,7 +61,7 @@ pub fn read<T: Pod>(
     });
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
     queue.submit([encoder.finish()]);
-    Ok(bytemuck::pod_collect_to_vec(&map_read(device, &staging)?))
+    map_read(device, &staging)
 }
 
 /// A host-mappable buffer that copies are made into, for [`map_read`].
@@ -75,8 +75,9 @@ pub fn readback_buffer(device: &wgpu::Device, label: &str, bytes: u64) -> wgpu::
 }
 
 /// Waits for the GPU and returns the contents of `staging` (a [`readback_buffer`] whose copies
-/// have been submitted); leaves it unmapped for reuse.
-pub fn map_read(device: &wgpu::Device, staging: &wgpu::Buffer) -> Result<Vec<u8>> {
+/// have been submitted) as elements of `T`, copied once from the mapping; leaves it unmapped
+/// for reuse.
+pub fn map_read<T: Pod>(device: &wgpu::Device, staging: &wgpu::Buffer) -> Result<Vec<T>> {
     let (tx, rx) = std::sync::mpsc::channel();
     staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
@@ -91,7 +92,7 @@ pub fn map_read(device: &wgpu::Device, staging: &wgpu::Buffer) -> Result<Vec<u8>
         .slice(..)
         .get_mapped_range()
         .map_err(|e| anyhow!("reading the mapped buffer failed: {e}"))?;
-    let out = view.to_vec();
+    let out = bytemuck::pod_collect_to_vec(&view);
     drop(view);
     staging.unmap();
     Ok(out)

@@ -446,7 +446,7 @@ impl PerspectiveView {
             t.color.size(),
         );
         self.queue.submit([encoder.finish()]);
-        let data = map_read(device, &t.staging)?;
+        let data = map_read::<u8>(device, &t.staging)?;
         let row = 4 * t.size.0 as usize;
         let mut rgba = Vec::with_capacity(row * t.size.1 as usize);
         for r in 0..t.size.1 as usize {

@@ -3,6 +3,7 @@
 
 use anyhow::{anyhow, Result};
 
+use super::initial::Packed;
 use crate::gpu::buffers::{storage, storage_init, uniform_init};
 use crate::gpu::kernel::Resolve;
 use crate::layout::{
@@ -146,10 +147,12 @@ const NO_SENSOR: WallSensor = WallSensor {
 };
 
 pub struct InitialParticles<'a> {
-    pub pos: &'a [Pos],
-    pub velrho: &'a [[f32; 4]],
-    /// The code words, then with wide ids the ids' high words (`Packed::code_words`).
-    pub code: &'a [u32],
+    /// The particles the arrays hold (a subdomain's entries, free ones included). The arrays
+    /// start zeroed: [`ParticleBuffers::write_particles`] writes them.
+    pub capacity: u32,
+    /// Whether ids are wide: the code buffer then holds each id's high word after the code
+    /// words (`IdSplit`).
+    pub wide_ids: bool,
     pub body_particles: &'a [BodyParticle],
     /// One per body (its particle range and workgroups; the motion comes with each step).
     pub body_motions: &'a [BodyMotion],
@@ -180,9 +183,10 @@ impl ParticleBuffers {
             mirror_planes: planes,
             wall_sensors: sensors,
         } = *tables;
-        let n = init.pos.len() as u32;
+        let n = init.capacity;
         let vec4 = 16 * n as u64;
         let words = 4 * n as u64;
+        let code_bytes = words * (1 + init.wide_ids as u64);
         let mut scan_sizes = vec![slots + 3];
         let block = 2 * crate::gpu::shader::WORKGROUP_SIZE;
         while *scan_sizes.last().unwrap() > block {
@@ -195,24 +199,15 @@ impl ParticleBuffers {
             .enumerate()
             .map(|(l, &s)| storage(device, &format!("scan level {}", l + 1), 4 * s as u64))
             .collect();
-        let zero_rates = vec![[0f32; 4]; init.pos.len()];
         Self {
             n,
             params: uniform_init(device, "params", params),
             state: storage_init(device, "sim state", &[SimState::default()]),
-            pos: [
-                storage_init(device, "pos A", init.pos),
-                storage(device, "pos B", vec4),
-            ],
-            velrho: [
-                storage_init(device, "velrho A", init.velrho),
-                storage(device, "velrho B", vec4),
-            ],
-            code: [
-                storage_init(device, "code A", init.code),
-                storage(device, "code B", 4 * init.code.len() as u64),
-            ],
-            rate: storage_init(device, "rate", &zero_rates),
+            pos: ["pos A", "pos B"].map(|l| storage(device, l, vec4)),
+            velrho: ["velrho A", "velrho B"].map(|l| storage(device, l, vec4)),
+            code: ["code A", "code B"].map(|l| storage(device, l, code_bytes)),
+            // The first step's predictor reads the last rates: zero (wgpu zeroes a buffer).
+            rate: storage(device, "rate", vec4),
             rate_sorted: storage(device, "rate sorted", vec4),
             local_perm: storage(device, "local rank / perm", words),
             provisional: storage(device, "provisional", words),
@@ -248,6 +243,29 @@ impl ParticleBuffers {
                 &sizes.pack(init.body_motions, planes, sensors, init.body_particles),
             ),
         }
+    }
+
+    /// Writes `packed`, the entries from `first` on in the arrays' order, into the arrays a
+    /// run starts from (parity 0). The queue holds a staging copy of the bytes until its next
+    /// submission: a large case is written in pieces (`Solver::build`).
+    pub fn write_particles(&self, queue: &wgpu::Queue, first: u32, packed: &Packed) {
+        let at = |bytes: usize| first as u64 * bytes as u64;
+        let write = |buffer: &wgpu::Buffer, offset: u64, bytes: &[u8]| {
+            if !bytes.is_empty() {
+                queue.write_buffer(buffer, offset, bytes);
+            }
+        };
+        let pos: &[u8] = bytemuck::cast_slice(&packed.pos);
+        write(&self.pos[0], at(std::mem::size_of::<Pos>()), pos);
+        write(
+            &self.velrho[0],
+            at(16),
+            bytemuck::cast_slice(&packed.velrho),
+        );
+        write(&self.code[0], at(4), bytemuck::cast_slice(&packed.code));
+        let high = packed.high_words();
+        let high_at = 4 * self.n as u64 + at(4);
+        write(&self.code[0], high_at, bytemuck::cast_slice(&high));
     }
 
     /// The buffers a pass binds, by WGSL name, with the particle arrays of parity `p`.

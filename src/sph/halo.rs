@@ -588,7 +588,7 @@ impl Halo {
     /// made: the counts, then the two messages, as they travel. Waits for the GPU.
     pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Packed> {
         let counts: HaloCounts =
-            bytemuck::pod_read_unaligned(&map_read(device, &self.counts_staging)?);
+            bytemuck::pod_read_unaligned(&map_read::<u8>(device, &self.counts_staging)?);
         let lower = message_words(&counts.sizes[..3], self.copies) as usize;
         let words = lower + message_words(&counts.sizes[3..], self.copies) as usize;
         if counts.fits == 0 {

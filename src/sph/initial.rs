@@ -1,8 +1,12 @@
 //! The initial particle arrays of a run, packed as the GPU stores them, and what the case holds
 //! (`Present`, the body and solid id ranges): pure functions of the scenario.
 
+use std::ops::Range;
+
 use anyhow::{bail, Result};
 
+use super::buffers::ParticleBuffers;
+use crate::gpu::GpuContext;
 use crate::grid::Grid;
 use crate::layout::{pack_block, IdSplit, Pos, SolidState, KIND_EXCLUDED};
 use crate::scenario::{Kind, Scenario};
@@ -78,11 +82,13 @@ pub struct Packed {
 }
 
 impl Packed {
-    /// The code buffer's words: the code words, then with wide ids the ids' high words.
-    pub fn code_words(&self) -> Vec<u32> {
-        let high = self.id.iter().map(|&id| self.ids.high(id));
-        let high = high.filter(|_| self.ids.wide);
-        self.code.iter().copied().chain(high).collect()
+    /// With wide ids, each entry's id's high word ([`IdSplit::high`]), which the code buffer
+    /// holds after its n code words; with narrow ids none.
+    pub fn high_words(&self) -> Vec<u32> {
+        match self.ids.wide {
+            true => self.id.iter().map(|&id| self.ids.high(id)).collect(),
+            false => Vec::new(),
+        }
     }
 }
 
@@ -95,16 +101,21 @@ pub fn id_split(sc: &Scenario) -> IdSplit {
 /// `sc`'s particles on `grid`: positions as block offsets, and inlet particles behind their
 /// buffers excluded (in no cell) until they join.
 pub fn pack(sc: &Scenario, grid: &Grid) -> Packed {
-    let n = sc.particles.len();
-    let ids = id_split(sc);
+    pack_range(sc, grid, 0..sc.particles.len())
+}
+
+/// The particles `ids` of `sc` packed as [`pack`] packs them all (entry k is particle
+/// `ids.start + k`).
+pub fn pack_range(sc: &Scenario, grid: &Grid, ids: Range<usize>) -> Packed {
+    let split = id_split(sc);
     let mut out = Packed {
-        pos: Vec::with_capacity(n),
-        velrho: Vec::with_capacity(n),
-        code: Vec::with_capacity(n),
-        id: (0..n as u32).collect(),
-        ids,
+        pos: Vec::with_capacity(ids.len()),
+        velrho: Vec::with_capacity(ids.len()),
+        code: Vec::with_capacity(ids.len()),
+        id: (ids.start as u32..ids.end as u32).collect(),
+        ids: split,
     };
-    for (id, p) in sc.particles.iter().enumerate() {
+    for (id, p) in sc.particles[ids.clone()].iter().enumerate() {
         let (off, b) = grid.to_block(p.pos);
         out.pos.push(Pos {
             off,
@@ -112,16 +123,43 @@ pub fn pack(sc: &Scenario, grid: &Grid) -> Packed {
         });
         let v = p.vel.map(|x| x as f32);
         out.velrho.push([v[0], v[1], v[2], p.rho as f32]);
-        out.code.push(ids.code_word(p.kind as u32, id as u32));
+        out.code
+            .push(split.code_word(p.kind as u32, (ids.start + id) as u32));
     }
     for inlet in &sc.inlets {
         for (k, id) in inlet.particles.clone().enumerate() {
-            if inlet.dormant(k) {
-                out.code[id] = ids.code_word(KIND_EXCLUDED, id as u32);
+            if inlet.dormant(k) && ids.contains(&id) {
+                out.code[id - ids.start] = split.code_word(KIND_EXCLUDED, id as u32);
             }
         }
     }
     out
+}
+
+/// Particles packed and written at a time by [`write_in_pieces`]: 2.5 MiB of packed arrays,
+/// small beside any case that needs pieces, and a wait for the GPU every 65 536 particles.
+pub const UPLOAD_PIECE: usize = 1 << 16;
+
+/// Packs `sc`'s particles on `grid` and writes them into `buffers` [`UPLOAD_PIECE`] at a time,
+/// waiting for the GPU after each piece: beside the case's particles the host holds one
+/// piece's packed arrays and the queue's staging copy of them (issue 64: it held the whole
+/// case's packed arrays, their code words again, a zeroed rate array and staging copies of
+/// them all, about 110 bytes a particle).
+pub fn write_in_pieces(
+    sc: &Scenario,
+    grid: &Grid,
+    buffers: &ParticleBuffers,
+    ctx: &GpuContext,
+) -> Result<()> {
+    let n = sc.particles.len();
+    for first in (0..n).step_by(UPLOAD_PIECE) {
+        let piece = pack_range(sc, grid, first..(first + UPLOAD_PIECE).min(n));
+        buffers.write_particles(&ctx.queue, first as u32, &piece);
+        ctx.queue.submit([]);
+        (ctx.device.poll(wgpu::PollType::wait_indefinitely()))
+            .map_err(|e| anyhow::anyhow!("GPU wait failed writing the particles: {e}"))?;
+    }
+    Ok(())
 }
 
 /// The id of the first body particle: bodies' particles must come last, body after body, in
@@ -237,7 +275,7 @@ mod tests {
         let grid = Grid::of(&sc).unwrap();
         let packed = pack(&sc, &grid);
         assert!(!packed.ids.wide);
-        assert_eq!(packed.code_words(), packed.code);
+        assert!(packed.high_words().is_empty());
         for (id, p) in sc.particles.iter().enumerate() {
             assert_eq!(packed.code[id] & crate::layout::ID_MASK, id as u32);
             assert_eq!(packed.code[id] >> KIND_SHIFT, p.kind as u32);
@@ -252,6 +290,34 @@ mod tests {
         }
     }
 
+    /// Packed in pieces, the water injection's particles are the whole packing's: positions,
+    /// velocities and densities, ids, and the inlet particles waiting behind their buffers
+    /// excluded in whichever piece holds them.
+    #[test]
+    fn pieces_pack_as_the_whole() {
+        let path = std::path::Path::new("cases/water_injection_2d.toml");
+        let sc = crate::case::load(path, &[]).unwrap();
+        let grid = Grid::of(&sc).unwrap();
+        let whole = pack(&sc, &grid);
+        let n = sc.particles.len();
+        let excluded = |code: &[u32]| {
+            code.iter()
+                .filter(|&&c| c >> KIND_SHIFT == KIND_EXCLUDED)
+                .count()
+        };
+        assert!(excluded(&whole.code) > 0);
+        let (first, last) = (sc.inlets[0].particles.start, sc.inlets[0].particles.end);
+        let cuts = [0, 1, first + 1, (first + last) / 2, last, n - 1, n];
+        for w in cuts.windows(2) {
+            let piece = pack_range(&sc, &grid, w[0]..w[1]);
+            let bytes = |x: &[Pos]| bytemuck::cast_slice::<Pos, u8>(x).to_vec();
+            assert_eq!(bytes(&piece.pos), bytes(&whole.pos[w[0]..w[1]]), "{w:?}");
+            assert_eq!(piece.velrho, whole.velrho[w[0]..w[1]], "{w:?}");
+            assert_eq!(piece.code, whole.code[w[0]..w[1]], "{w:?}");
+            assert_eq!(piece.id, whole.id[w[0]..w[1]], "{w:?}");
+        }
+    }
+
     /// With wide ids (forced with 4 low bits) a code word keeps an id's low bits and its kind,
     /// and the words after the n code words the rest: every id comes back from the two.
     #[test]
@@ -262,7 +328,7 @@ mod tests {
         let packed = pack(&sc, &Grid::of(&sc).unwrap());
         let n = sc.particles.len();
         assert!(packed.ids.wide && n > 1000);
-        let words = packed.code_words();
+        let words = [packed.code.clone(), packed.high_words()].concat();
         assert_eq!(words.len(), 2 * n);
         for (id, p) in sc.particles.iter().enumerate() {
             assert_eq!(packed.code[id] & crate::layout::ID_MASK, id as u32 & 15);

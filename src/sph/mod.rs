@@ -215,15 +215,17 @@ impl Solver {
             Some(_) => crate::decomposition::ranks_grid(sc)?,
             None => Grid::of(sc)?,
         };
-        let mut packed = initial::pack(sc, &grid);
+        // A subdomain packs the whole case to choose its own particles; a whole run packs and
+        // writes its particles in pieces once its buffers are made.
+        let mut packed = subdomain.is_some().then(|| initial::pack(sc, &grid));
         let mut capacity = n as u32;
-        let ranked = (subdomain.as_mut())
-            .map(|ctl| -> Result<_> {
-                let (own, waiting) = subdomain::exclude_others(&mut packed, &grid, ctl);
+        let ranked = (subdomain.as_mut().zip(packed.as_mut()))
+            .map(|(ctl, packed)| -> Result<_> {
+                let (own, waiting) = subdomain::exclude_others(packed, &grid, ctl);
                 capacity = subdomain::capacity(own, waiting, n as u32);
                 check_capacity(ctx, capacity as usize)?;
-                subdomain::resize(&mut packed, capacity as usize);
-                ctl.capacity = subdomain::starting_records(&packed, own, &grid, ctl);
+                subdomain::resize(packed, capacity as usize);
+                ctl.capacity = subdomain::starting_records(packed, own, &grid, ctl);
                 let window = subdomain::window(ctl, &grid);
                 grid = grid.for_subdomain((own + waiting) as usize, ctl.axis as usize, window);
                 let live = (n - sc.dormant_count()) as u64;
@@ -248,9 +250,8 @@ impl Solver {
             &params,
             grid.slots,
             &InitialParticles {
-                pos: &packed.pos,
-                velrho: &packed.velrho,
-                code: &packed.code_words(),
+                capacity,
+                wide_ids: initial::id_split(sc).wide,
                 body_particles: &bodies::body_particles(sc),
                 body_motions: &body_motions,
                 solid: &solid,
@@ -263,6 +264,11 @@ impl Solver {
             cfg.tables,
             ph.energy,
         );
+        match &packed {
+            Some(packed) => buffers.write_particles(&ctx.queue, 0, packed),
+            None => initial::write_in_pieces(sc, &grid, &buffers, ctx)?,
+        }
+        drop(packed);
         let passes = Passes::new(
             &device,
             sc,
@@ -490,7 +496,7 @@ impl Solver {
         encoder.copy_buffer_to_buffer(&self.buffers.state, 0, staging, 0, state_bytes);
         encoder.copy_buffer_to_buffer(loads, 0, staging, state_bytes, loads_bytes);
         self.queue.submit([encoder.finish()]);
-        let bytes = map_read(&self.device, staging);
+        let bytes = map_read::<u8>(&self.device, staging);
         // A lost device fails the wait; say why rather than how.
         self.faults.check()?;
         let bytes = bytes?;

@@ -122,7 +122,7 @@ impl Profiler {
         if self.open.is_empty() {
             return Ok(());
         }
-        let bytes = map_read(device, &self.staging)?;
+        let bytes = map_read::<u8>(device, &self.staging)?;
         let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes[..self.open.len() * 16]);
         for (k, name) in self.open.drain(..).enumerate() {
             // A timer that wraps or runs backwards between passes counts as zero, not as years.

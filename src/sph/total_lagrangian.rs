@@ -195,7 +195,7 @@ impl TotalLagrangian {
     /// The positions of the TL particles this process holds, by TL index (`None` for the
     /// others), as the last [`TotalLagrangian::copy_held`] copied them. Waits for the GPU.
     pub fn read_held(&self, device: &wgpu::Device) -> Result<Vec<Option<Pos>>> {
-        let bytes = map_read(device, &self.held_staging)?;
+        let bytes = map_read::<u8>(device, &self.held_staging)?;
         let (pos, held) = bytes.split_at(16 * self.n_tl as usize);
         let pos: Vec<Pos> = bytemuck::pod_collect_to_vec(pos);
         let held: Vec<u32> = bytemuck::pod_collect_to_vec(&held[..4 * self.n_tl as usize]);
