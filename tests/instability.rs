@@ -249,3 +249,24 @@ fn a_resumed_run_remembers_the_density_beyond_the_limit() {
         done.summary.warnings
     );
 }
+
+/// The density check's shares are of the fluid it counts: the fluid and the inlets' buffers,
+/// which become fluid without joining, and the particles that joined since (not those still
+/// waiting behind a buffer). Of the fluid at the start alone, an inlet's run read "400.0 % of
+/// the fluid's particles" (issue 64); here the count is the live fluid and buffer particles,
+/// at the start and after buffer particles have become fluid and others joined.
+#[test]
+fn the_density_shares_are_of_the_fluid_and_the_inlets_buffers() {
+    let path = std::path::Path::new("cases/water_injection_2d.toml");
+    let sc = wgsph::case::load(path, &[]).unwrap();
+    let mut solver = wgsph::sph::Solver::new(gpu(), &sc).unwrap();
+    let buffers = sc.count(Kind::Inlet) - sc.dormant_count();
+    assert!(buffers > 0);
+    for t in [0.0, 0.02] {
+        solver.advance_to(t).unwrap();
+        let p = solver.read_particles().unwrap();
+        let live = |k: Kind| p.kind.iter().filter(|&&c| c == k as u32).count() as u64;
+        let counted = live(Kind::Fluid) + live(Kind::Inlet);
+        assert_eq!(solver.fluid_counted(), counted, "t = {t} s");
+    }
+}

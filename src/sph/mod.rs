@@ -121,6 +121,21 @@ fn batch_steps(left: f32, dt: f32, cap: u32) -> u32 {
     (steps.min(cap as f64) as u32).max(1)
 }
 
+/// The stop of a run that lost more than `fraction` of its `fluid` fluid and solid particles
+/// out of the domain: `excluded` is of every kind, so walls the case moves out of the domain
+/// count too (issue 64: "702 of 75 particles left the domain").
+fn left_the_domain(excluded: u64, fluid: u64, fraction: f64) -> String {
+    let walls = match excluded > fluid {
+        true => " (more than there are: walls or bodies the case moves left it too)",
+        false => "",
+    };
+    format!(
+        "{excluded} particles left the domain, more than {:.0} % of the case's {fluid} fluid \
+         and solid particles{walls}; check that the case keeps them in [domain]",
+        100.0 * fraction,
+    )
+}
+
 /// Why a run stopped before its end.
 #[derive(Debug, thiserror::Error)]
 #[error("run unstable at step {step}, t = {time_s:.6} s: {reason}")]
@@ -361,19 +376,25 @@ impl Solver {
     /// How far the fluid went from the weakly-compressible regime in the steps since the
     /// peaks were last cleared ([`clear_density_peaks`](Self::clear_density_peaks)).
     pub fn density_variation(&self) -> DensityVariation {
-        let s = &self.state;
         let peaks = &self.peaks;
-        let joined = match &self.ranked {
-            Some(ranked) => ranked.joined,
-            None => s.inlet_joined as u64,
-        };
-        let fluid = (self.n_fluid_at_start + joined).saturating_sub(self.drained());
+        let fluid = self.fluid_counted();
         let share = |count: u32| count as f64 / fluid.max(1) as f64;
         DensityVariation {
             max: peaks.variation as f64,
             share_beyond_warn: share(peaks.beyond_warn),
             share_beyond_stop: share(peaks.beyond_stop),
         }
+    }
+
+    /// The fluid particles the density check's shares are of: those at the start and in the
+    /// inlets' buffers (which become fluid without joining), those that joined since, less
+    /// those drained.
+    pub fn fluid_counted(&self) -> u64 {
+        let joined = match &self.ranked {
+            Some(ranked) => ranked.joined,
+            None => self.state.inlet_joined as u64,
+        };
+        (self.n_fluid_at_start + joined).saturating_sub(self.drained())
     }
 
     /// Starts the density peaks anew (after the run has looked at them for a probe interval).
@@ -786,17 +807,10 @@ impl Solver {
         }
         let excluded = self.excluded();
         if excluded as f64 > self.max_excluded_fraction * self.n_fluid as f64 {
-            // The count is of every kind: walls the case moves out of the domain count too
-            // (issue 64: "702 of 75 particles left the domain").
-            let walls = match excluded > self.n_fluid {
-                true => " (more than there are: walls or bodies the case moves left it too)",
-                false => "",
-            };
-            return fail(format!(
-                "{excluded} particles left the domain, more than {:.0} % of the case's {} fluid \
-                 and solid particles{walls}; check that the case keeps them in [domain]",
-                100.0 * self.max_excluded_fraction,
+            return fail(left_the_domain(
+                excluded,
                 self.n_fluid,
+                self.max_excluded_fraction,
             ));
         }
         let density = self.density_variation();
@@ -926,7 +940,22 @@ pub const EXCLUDED: u32 = KIND_EXCLUDED;
 
 #[cfg(test)]
 mod tests {
-    use super::batch_steps;
+    use super::{batch_steps, left_the_domain};
+
+    /// More particles out of the domain than there are fluid and solid ones: the message says
+    /// that walls or bodies left too, rather than "702 of 75" (issue 64).
+    #[test]
+    fn a_stop_for_particles_out_of_the_domain_says_what_they_were() {
+        let fluid = left_the_domain(8, 75, 0.05);
+        assert!(fluid.starts_with("8 particles left the domain, more than 5 % of the case's 75"));
+        assert!(!fluid.contains("walls"), "{fluid}");
+        let walls = left_the_domain(702, 75, 0.05);
+        assert!(
+            walls.contains("walls or bodies the case moves left it too"),
+            "{walls}"
+        );
+        assert!(!walls.contains("702 of 75"), "{walls}");
+    }
 
     #[test]
     fn a_batch_is_the_steps_to_the_target_and_one_more_within_its_cap() {
