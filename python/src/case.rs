@@ -39,7 +39,7 @@ impl Case {
         path: Option<PathBuf>,
         overrides: Vec<String>,
     ) -> PyResult<Self> {
-        let sc = wgsph::case::load_str(&text, &file, &overrides).map_err(case_err)?;
+        let sc = scenario(&text, &file, &overrides).map_err(case_err)?;
         Ok(Case {
             text,
             file,
@@ -60,8 +60,24 @@ impl Case {
     /// This case's scenario with `more` overrides after its own (a resume's time control).
     pub fn with_more(&self, more: &[String]) -> Result<Scenario, wgsph::case::CaseError> {
         let all: Vec<String> = self.overrides.iter().chain(more).cloned().collect();
-        wgsph::case::load_str(&self.text, &self.file, &all)
+        scenario(&self.text, &self.file, &all)
     }
+}
+
+/// The scenario of a case's text with `overrides`, refused naming particles.dx_m before its
+/// particles are made when the host's memory cannot hold them (`sph::run_budget` without an
+/// adapter; issue 64): a run checks its device's own limit when it opens it.
+fn scenario(
+    text: &str,
+    file: &str,
+    overrides: &[String],
+) -> Result<Scenario, wgsph::case::CaseError> {
+    wgsph::case::load_str_within(text, file, overrides, &host_budget())
+}
+
+fn host_budget() -> wgsph::case::ParticleBudget {
+    let (n, why) = wgsph::sph::run_budget(None, wgsph::sph::host_memory_available());
+    wgsph::case::ParticleBudget::at_most(n as f64, why)
 }
 
 /// The names of the built-in cases: those whose name is their file's (a validation variant
@@ -122,15 +138,20 @@ impl Case {
     fn load(path: PathBuf) -> PyResult<Self> {
         // The engine's loader first: its bounded read and its messages for a file it cannot
         // read; the text it read is then read again to keep.
-        wgsph::case::load(&path, &[]).map_err(case_err)?;
+        let sc = wgsph::case::load_within(&path, &[], &host_budget()).map_err(case_err)?;
         let text = std::fs::read_to_string(&path).map_err(|e| {
             case_err(wgsph::case::CaseError::Read {
                 file: path.display().to_string(),
                 source: e,
             })
         })?;
-        let abs = std::path::absolute(&path).ok();
-        Self::build(text, path.display().to_string(), abs, Vec::new())
+        Ok(Case {
+            text,
+            file: path.display().to_string(),
+            path: std::path::absolute(&path).ok(),
+            overrides: Vec::new(),
+            scenario: Arc::new(sc),
+        })
     }
 
     /// A case from its TOML text; `file` is its name in messages (relative paths in the case
@@ -166,7 +187,7 @@ impl Case {
         let arg = format!("{field}={}", toml_value(field, value)?);
         let mut overrides = self.overrides.clone();
         overrides.push(arg);
-        let sc = wgsph::case::load_str(&self.text, &self.file, &overrides).map_err(case_err)?;
+        let sc = scenario(&self.text, &self.file, &overrides).map_err(case_err)?;
         self.overrides = overrides;
         self.scenario = Arc::new(sc);
         Ok(())

@@ -45,6 +45,21 @@ def test_load_errors_name_the_file():
         wgsph.Case.from_toml('name = "x"\ndimension = = 2\n', file="bad.toml")
 
 
+def test_a_case_beyond_the_hosts_memory_is_refused_before_it_is_built():
+    """A case more than the host's memory holds (issue 64: the loader built its particles and
+    the process aborted) is refused naming particles.dx_m and the host's memory, at once."""
+    with open("/proc/meminfo") as f:
+        kib = next(int(l.split()[1]) for l in f if l.startswith("MemAvailable:"))
+    fits = kib * 1024 / 250  # the engine's bytes a particle on the host (sph::run_budget)
+    if fits * 1.5 > 1.9e8:
+        pytest.skip("the host holds more particles than a run may have: its limit binds first")
+    dx = 1.0 / (1.5 * fits) ** (1 / 3)  # bench_fluid_cube: a cube of water 1 m wide
+    case = wgsph.Case.load(DAM_BREAK.parent / "bench_fluid_cube.toml")
+    with pytest.raises(wgsph.CaseError) as e:
+        case.set("particles.dx_m", dx)
+    assert "particles.dx_m" in str(e.value) and "host's memory" in str(e.value), str(e.value)
+
+
 def test_set_values_of_every_type():
     case = wgsph.Case.load(DAM_BREAK)
     case.set("particles.dx_m", 0.02)

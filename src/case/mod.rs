@@ -104,7 +104,8 @@ pub fn load_str_limited(
     load_str_within(text, file_name, overrides, &budget)
 }
 
-fn load_str_within(
+/// [`load_str`] with at most `budget` particles, refused before any is made.
+pub fn load_str_within(
     text: &str,
     file_name: &str,
     overrides: &[String],
