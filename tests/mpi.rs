@@ -28,16 +28,26 @@ fn mpirun(test: &str, ranks: u32, limit: Duration) -> (bool, String) {
     mpirun_with(test, ranks, limit, &[])
 }
 
-/// As [`mpirun`], with environment variables `env` set for every rank.
-fn mpirun_with(test: &str, ranks: u32, limit: Duration, env: &[(&str, &str)]) -> (bool, String) {
+/// `mpirun -np RANKS`, to be given the program.
+fn mpirun_np(ranks: u32) -> Command {
     common::one_lavapipe_thread_each();
-    let exe = std::env::current_exe().unwrap();
     let mut command = Command::new("mpirun");
     // Ranks waiting on a message yield their core: OpenMPI spins by default where it counts a
     // core a rank, and the harness runs two jobs at once on CI's two cores (this binary took
     // 504 s instead of 637 s on lavapipe, 2 cores, 2026-12-07).
     command.args(["--oversubscribe", "--mca", "mpi_yield_when_idle", "1"]);
     command.args(["-np", &ranks.to_string()]);
+    // OpenMPI refuses root without these (CI runs as root).
+    command
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
+    command
+}
+
+/// As [`mpirun`], with environment variables `env` set for every rank.
+fn mpirun_with(test: &str, ranks: u32, limit: Duration, env: &[(&str, &str)]) -> (bool, String) {
+    let exe = std::env::current_exe().unwrap();
+    let mut command = mpirun_np(ranks);
     for (k, v) in env {
         command.args(["-x", &format!("{k}={v}")]);
     }
@@ -52,9 +62,6 @@ fn mpirun_with(test: &str, ranks: u32, limit: Duration, env: &[(&str, &str)]) ->
             "--nocapture",
             "--test-threads=1",
         ])
-        // OpenMPI refuses root without these (CI runs as root).
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -528,27 +535,25 @@ fn on_one_rank(args: Vec<std::ffi::OsString>) {
 
 /// `mpirun -np 2 wgsph ARGS` on lavapipe with checkpoints every 0.015 s; its log.
 fn on_two_ranks(args: Vec<std::ffi::OsString>) -> String {
-    let o = mpirun_wgsph(args, &[]).output().unwrap();
+    let o = mpirun_wgsph(2, args, &[]).output().unwrap();
     let log = String::from_utf8_lossy(&o.stdout).to_string() + &String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{log}");
     log
 }
 
-/// `mpirun -np 2 [EXPORT] wgsph ARGS` as [`on_two_ranks`] runs it, `EXPORT` the variables of
-/// the test's environment to pass on to the ranks (`-x NAME`).
-fn mpirun_wgsph(args: Vec<std::ffi::OsString>, export: &[&str]) -> Command {
-    common::one_lavapipe_thread_each();
-    let mut command = Command::new("mpirun");
-    command.args(["--oversubscribe", "-np", "2"]);
+/// `mpirun -np RANKS [EXPORT] wgsph ARGS` as [`on_two_ranks`] runs it, `EXPORT` the variables
+/// of the test's environment to pass on to the ranks (`-x NAME`).
+fn mpirun_wgsph(ranks: u32, args: Vec<std::ffi::OsString>, export: &[&str]) -> Command {
+    let mut command = mpirun_np(ranks);
     for name in export {
         command.args(["-x", name]);
     }
-    command
-        .arg(env!("CARGO_BIN_EXE_wgsph"))
-        .args(args)
-        .args(["--adapter", "cpu", "--checkpoint-every", "0.015"])
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
+    command.arg(env!("CARGO_BIN_EXE_wgsph")).args(args).args([
+        "--adapter",
+        "cpu",
+        "--checkpoint-every",
+        "0.015",
+    ]);
     command
 }
 
@@ -923,7 +928,7 @@ fn killing_a_rank_ends_the_job_and_its_last_checkpoint_resumes() {
     );
     let (name, value) = ("WGSPH_KILL_TEST", std::process::id().to_string());
     let tag = format!("{name}={value}");
-    let mut job = mpirun_wgsph(dam_break("time.end_s=0.2", &two), &[name]);
+    let mut job = mpirun_wgsph(2, dam_break("time.end_s=0.2", &two), &[name]);
     let mut job = job
         .env(name, &value)
         .stdout(Stdio::piped())
@@ -980,6 +985,17 @@ fn killing_a_rank_ends_the_job_and_its_last_checkpoint_resumes() {
         stderr.contains("was written by a run over 2 rank(s); resume it on as many"),
         "{stderr}"
     );
+    // On three ranks, quiet, the message gets through mpirun before the abort ends the job (it
+    // was lost in one job of four: issue 64).
+    let o = (mpirun_wgsph(3, resume(&two, "0.03"), &[]).arg("-q"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        stderr.contains("was written by a run over 2 rank(s); resume it on as many"),
+        "{stderr}"
+    );
     on_two_ranks(resume(&two, "0.03"));
     on_one_rank(dam_break("time.end_s=0.03", &one));
     assert_same_outputs(&one, &two);
@@ -1026,13 +1042,10 @@ fn ranks_with_an_outlet_drain_what_one_run_drains() {
 /// its steps overlapped the exchange.
 #[test]
 fn bench_under_mpirun_reports_every_rank() {
-    common::one_lavapipe_thread_each();
-    let o = Command::new("mpirun")
-        .args(["--oversubscribe", "-np", "2", env!("CARGO_BIN_EXE_wgsph")])
+    let o = mpirun_np(2)
+        .arg(env!("CARGO_BIN_EXE_wgsph"))
         .args(["bench", "cases/dam_break_2d.toml", "--adapter", "cpu"])
         .args(["--steps", "20", "--warmup", "2"])
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .output()
         .unwrap();
     let (stdout, stderr) = (
