@@ -141,11 +141,11 @@ fn body(
     })
 }
 
-/// The mass of body `b` at `path` (of `shape`): from `density_kg_m3` or `mass_kg` (not both;
-/// neither: `None`), with a mass and moments of inertia that can be computed with.
 /// The largest body a case may hold, in metres across: a thousand kilometres.
 const MAX_BODY_SIZE_M: f64 = 1e6;
 
+/// The mass of body `b` at `path` (of `shape`): from `density_kg_m3` or `mass_kg` (not both;
+/// neither: `None`), with a mass and moments of inertia that can be computed with.
 fn mass(
     ctx: &Ctx<'_>,
     path: &str,

@@ -295,8 +295,6 @@ fn obstacle_ranges(
     Ok(obstacle_ranges)
 }
 
-/// Each inlet's layout. Inlets: inside the tank, clear of fluid blocks and obstacles, on the
-/// lattice.
 /// The water inlet `i` brings has somewhere to go: a spacing beyond its buffer along its
 /// direction lies in the tank (and the given domain) and in no obstacle. An inlet pointing
 /// at a wall ran until the water it pushed into the wall was compressed beyond the stop limit,
@@ -345,6 +343,8 @@ fn inflow_has_room(ctx: &Ctx<'_>, case: &Case, i: usize, dx: f64) -> Result<(), 
     ))
 }
 
+/// Each inlet's layout. Inlets: inside the tank, clear of fluid blocks and obstacles, on the
+/// lattice.
 fn inlet_layouts(
     ctx: &Ctx<'_>,
     case: &Case,
@@ -1159,16 +1159,7 @@ fn finish(
         .iter()
         .map(|(lo, hi)| [0, 1, 2].map(|a| hi[a] - lo[a] + 1.0))
         .collect();
-    let mut warnings = super::warnings::of(
-        &case,
-        dx,
-        h,
-        &obstacle_points,
-        super::warnings::Sound {
-            c0: start.c0,
-            field: start.sound_path,
-        },
-    );
+    let mut warnings = super::warnings::of(&case, dx, h, &obstacle_points);
     let physics = physics(&case, start, h);
     let mut probes = case.probes;
     super::probes::place_on_faces(

@@ -8,6 +8,7 @@
 use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::validate::Block;
+use super::warnings::round3;
 use glam::DVec3;
 
 use crate::scenario::{Kind, Motion, MotionLaw, Scenario, Viscosity};
@@ -36,8 +37,8 @@ struct Fastest {
 /// Checks the built scenario `sc`: its f32 quantities, the speeds its motions reach against
 /// the speed of sound, its time step and its schedule. `sound_field`: the field the speed of
 /// sound came from (None: solids alone); `blocks`: the fluid blocks (to name a fast one);
-/// `tank_moves`: the first body is the tank. Returns a warning when a prescribed motion (its
-/// rotation included, which `warnings::fast_flow` cannot tell) is faster than c0/10.
+/// `tank_moves`: the first body is the tank, which carries the `obstacles` (their paths).
+/// Returns the warning of a case with water whose fastest speed is beyond c0/10.
 pub(super) fn check(
     ctx: &Ctx<'_>,
     sc: &Scenario,
@@ -55,27 +56,33 @@ pub(super) fn check(
     let mut warning = None;
     if let Some(sound) = sound_field {
         below_sound(ctx, sc, sound, &moving)?;
-        let (u, c0) = (moving.speed, sc.physics.c0);
-        // `warnings::fast_flow` tells of the speeds it can see (not rotations).
-        let warned = sc.warnings.iter().any(|w| w.contains("c0/10"));
-        warning = (u > 0.1 * c0 && !warned).then(|| {
-            format!(
-                "{} moves its particles at up to {} m/s, more than c0/10 = {} m/s (c0 from \
-                 {sound}): the water it pushes is compressed by about (u/c0)² = {} %, more than \
-                 weakly compressible SPH allows; fix: raise {sound} so that c0 is at least {} \
-                 m/s, or check the motion (a rotation about a pivot far away sweeps its walls \
-                 fast)",
-                moving.field,
-                num(u),
-                num(0.1 * c0),
-                num((100.0 * (u / c0).powi(2)).round()),
-                num((10.0 * u).ceil())
-            )
-        });
+        let has_water = !blocks.is_empty() || !sc.inlets.is_empty();
+        warning = has_water
+            .then(|| beyond_a_tenth_of_sound(sc, sound, &moving))
+            .flatten();
     }
     let (dt, limit) = time_step(ctx, sc, sound_field, moving)?;
     schedule(ctx, sc, dt, &limit)?;
     Ok(warning)
+}
+
+/// The fastest speed a particle starts with or a prescribed motion reaches (`moving`) when it
+/// is more than c0/10: weakly compressible SPH then compresses the water by more than about
+/// (u/c0)² = 1 %. The speeds the flow reaches on its own (a dam break's fall) are not known.
+fn beyond_a_tenth_of_sound(sc: &Scenario, sound: &str, moving: &Fastest) -> Option<String> {
+    let (u, c0) = (moving.speed, sc.physics.c0);
+    (u > 0.1 * c0).then(|| {
+        format!(
+            "{} sets a speed of {} m/s, more than c0/10 = {} m/s (c0 from {sound}): the water \
+             is compressed by about (u/c0)² = {} %, more than weakly compressible SPH allows; \
+             fix: raise {sound} so that c0 is at least {} m/s (the time step shrinks with it)",
+            moving.field,
+            num(round3(u)),
+            num(round3(0.1 * c0)),
+            num(round3(100.0 * (u / c0).powi(2))),
+            num(round3(10.0 * u))
+        )
+    })
 }
 
 /// The fastest a prescribed motion (the tank's, a body's) moves one of its particles over the
@@ -129,7 +136,7 @@ fn below_sound(
     ctx: &Ctx<'_>,
     sc: &Scenario,
     sound_field: &str,
-    prescribed: &Fastest,
+    moving: &Fastest,
 ) -> Result<(), CaseError> {
     let c0 = sc.physics.c0;
     let fall = free_fall_speed(sc);
@@ -151,10 +158,10 @@ fn below_sound(
             ),
         ));
     }
-    if prescribed.speed < c0 {
+    if moving.speed < c0 {
         return Ok(());
     }
-    let field = prescribed.field.split(" (").next().unwrap_or_default();
+    let field = moving.field.split(" (").next().unwrap_or_default();
     Err(ctx.err(
         field,
         None,
@@ -162,14 +169,14 @@ fn below_sound(
             "{} moves its particles at up to {} m/s, not below the speed of sound c0 = {} m/s \
              (from {sound_field}): weakly compressible SPH needs the flow and the walls to \
              move at about c0 / 10 or less",
-            prescribed.field,
-            num(prescribed.speed),
+            moving.field,
+            num(moving.speed),
             num(c0)
         ),
         format!(
             "check the motion (a rotation about a pivot far away sweeps its walls fast), or \
              raise {sound_field} so that c0 is about {} m/s",
-            num(10.0 * prescribed.speed)
+            num(10.0 * moving.speed)
         ),
     ))
 }

@@ -6,29 +6,16 @@ use super::bodies::Shape;
 use super::check::{fmt_box, Treatment, AXES};
 use super::error::num;
 use super::validate::Case;
-use crate::scenario::{ContactGroup, Motion, MotionLaw};
-
-/// The speed of sound `c0` and the field it came from (`physics.sound_speed_m_s` or
-/// `physics.sound_speed_coef`).
-pub(super) struct Sound<'a> {
-    pub c0: f64,
-    pub field: &'a str,
-}
+use crate::scenario::ContactGroup;
 
 /// Every warning about `case` at spacing `dx` and smoothing length `h`; `obstacle_points`:
-/// the lattice points each obstacle holds along each axis.
-pub(super) fn of(
-    case: &Case,
-    dx: f64,
-    h: f64,
-    obstacle_points: &[[f64; 3]],
-    sound: Sound<'_>,
-) -> Vec<String> {
+/// the lattice points each obstacle holds along each axis. (A speed beyond c0/10 is warned
+/// of where the built case's motions are known: `runnable::check`.)
+pub(super) fn of(case: &Case, dx: f64, h: f64, obstacle_points: &[[f64; 3]]) -> Vec<String> {
     let mut out = rounded_blocks(case, dx);
     out.extend(rounded_obstacles(case, dx, obstacle_points));
     out.extend(shallow_walls(case, dx, h));
     out.extend(thin_ghosts(case, dx, h));
-    out.extend(fast_flow(case, sound));
     out.extend(idle_friction(case));
     out.extend(left_behind(case));
     out
@@ -92,69 +79,8 @@ fn idle_friction(case: &Case) -> Vec<String> {
     out
 }
 
-/// The fastest speed the case sets (a fluid block's or a free body's initial velocity, an
-/// inlet's, a prescribed translation's largest) when it is more than c0/10: weakly
-/// compressible SPH then compresses the water by more than about (u/c0)² = 1 %. The speeds
-/// the flow reaches on its own (a dam break's fall) and those of rotations are not known here.
-fn fast_flow(case: &Case, sound: Sound<'_>) -> Option<String> {
-    if case.blocks.is_empty() && case.inlets.is_empty() {
-        return None;
-    }
-    let norm = |v: &[f64; 3]| v.iter().map(|c| c * c).sum::<f64>().sqrt();
-    let moving = |path: String, m: &Motion| -> (String, f64) {
-        let speed = match m {
-            Motion::Free { velocity, .. } => norm(velocity),
-            Motion::Prescribed(p) => match &p.law {
-                MotionLaw::Fixed => 0.0,
-                MotionLaw::Sine {
-                    translation, omega, ..
-                } => norm(translation) * omega.abs(),
-                MotionLaw::Series { t, translation, .. } => t
-                    .windows(2)
-                    .zip(translation.windows(2))
-                    .map(|(t, d)| {
-                        let step = [0, 1, 2].map(|a| d[1][a] - d[0][a]);
-                        norm(&step) / (t[1] - t[0])
-                    })
-                    .fold(0.0, f64::max),
-            },
-        };
-        (path, speed)
-    };
-    let blocks = case
-        .blocks
-        .iter()
-        .enumerate()
-        .map(|(i, b)| (format!("fluid_block[{i}].velocity_m_s"), norm(&b.vel)));
-    let inlets = (case.inlets.iter().enumerate())
-        .map(|(i, s)| (format!("inlet[{i}].velocity_m_s"), s.speed));
-    let bodies = (case.bodies.iter().enumerate())
-        .map(|(i, b)| moving(format!("body[{i}].motion"), &b.motion));
-    let tank =
-        (case.tank.iter()).filter_map(|t| Some(moving("tank.motion".into(), t.motion.as_ref()?)));
-    let (field, u) = blocks
-        .chain(inlets)
-        .chain(bodies)
-        .chain(tank)
-        .filter(|(_, u)| u.is_finite())
-        .max_by(|a, b| a.1.total_cmp(&b.1))?;
-    (u > 0.1 * sound.c0).then(|| {
-        format!(
-            "{field} sets a speed of {} m/s, more than c0/10 = {} m/s (c0 from {}): the water \
-             is compressed by about (u/c0)² = {} %, more than weakly compressible SPH allows; \
-             fix: raise {} so that c0 is at least {} m/s (the time step shrinks with it)",
-            num(round3(u)),
-            num(round3(0.1 * sound.c0)),
-            sound.field,
-            num(round3(100.0 * (u / sound.c0).powi(2))),
-            sound.field,
-            num(round3(10.0 * u))
-        )
-    })
-}
-
 /// `x` to three significant digits, for messages.
-fn round3(x: f64) -> f64 {
+pub(super) fn round3(x: f64) -> f64 {
     significant(x, 3)
 }
 
