@@ -6,6 +6,7 @@ pub mod case;
 pub mod checkpoint;
 pub mod decomposition;
 pub mod eos;
+pub mod generate;
 pub mod gpu;
 pub mod grid;
 pub mod kernel;

@@ -928,6 +928,7 @@ impl<'a> Runner<'a> {
                 .as_ref()
                 .map(|s| s.path.to_string_lossy().into_owned()),
             ranks,
+            world_origin_m: sc.world_origin_m,
         };
         if self.first() {
             self.outputs.out.write_run_summary(&summary)?;

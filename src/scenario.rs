@@ -696,6 +696,10 @@ pub struct Scenario {
     /// Doubts about the case found while building it, each naming the part, the concern and a
     /// fix. The run goes on: `wgsph run` logs them and `DIR/run.json` lists them.
     pub warnings: Vec<String>,
+    /// The world coordinates of the scenario's (0, 0, 0): `terrain.origin_m` (a terrain's
+    /// positions are local, so that f32 keeps them to a fraction of dx), else zero. What the
+    /// run writes is in the scenario's coordinates; `run.json` records this origin.
+    pub world_origin_m: [f64; 3],
 }
 
 /// An outlet (`[[outlet]]`, docs/cases.md "Outlets"): a box that removes every fluid particle

@@ -17,6 +17,7 @@ use super::error::{num, CaseError};
 use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
 use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
+use super::terrain::Ground;
 use super::validate::{Block, Case, Sound, WallSettings};
 
 /// An obstacle's range of lattice indices: the first and the last, as floats.
@@ -53,7 +54,8 @@ pub(super) fn build(
     let total = particle_budget(ctx, &case, &geo, budget)?;
     let wall = geo.tank_cells.map(|n| geo.tank_wall(&case, n));
     let elastic = elastic_solids(ctx, &case, &budget.less(total))?;
-    let domain = domain(ctx, &case, &geo.lat, wall.as_ref())?;
+    let ground_box = geo.ground.map(|g| g.bounds);
+    let domain = domain(ctx, &case, &geo.lat, wall.as_ref(), ground_box.as_ref())?;
     let start = Start::of(ctx, &case, elastic.as_ref())?;
 
     let mut particles = fluid_particles(ctx, &case, &geo, elastic.as_ref(), &start, total)?;
@@ -80,6 +82,16 @@ pub(super) fn build(
         &rho,
         &mut particles,
     );
+    if let (Some(t), Some(g)) = (&case.terrain, &geo.ground) {
+        ground_particles(
+            &case,
+            t,
+            g,
+            (&geo.lat, &geo.obstacle_ranges),
+            &rho,
+            &mut particles,
+        );
+    }
     let mirror_planes = mirror_planes(&case, &geo.lat, wall.as_ref());
     let solids = place_solids(ctx, case.dim, elastic, &domain, &mut particles)?;
     let bodies = bodies(ctx, &case, &rho, tank_particles, &mut particles)?;
@@ -115,6 +127,8 @@ struct Geometry {
     h: f64,
     /// Each inlet's layout on the lattice.
     inlet_layouts: Vec<super::open_boundaries::Layout>,
+    /// The terrain's wall on the lattice.
+    ground: Option<Ground>,
 }
 
 impl Geometry {
@@ -133,6 +147,16 @@ impl Geometry {
         let obstacle_ranges = obstacle_ranges(ctx, case, &lat)?;
         let h = case.h_over_dx * case.dx;
         let inlet_layouts = inlet_layouts(ctx, case, &lat, h)?;
+        let ground = match &case.terrain {
+            Some(t) => Some(Ground::of(
+                ctx,
+                t,
+                &lat,
+                case.tank.as_ref().map(|t| &t.inner),
+                case.domain.as_ref(),
+            )?),
+            None => None,
+        };
         Ok(Geometry {
             layers,
             wall_layers,
@@ -142,6 +166,7 @@ impl Geometry {
             obstacle_ranges,
             h,
             inlet_layouts,
+            ground,
         })
     }
 
@@ -444,6 +469,9 @@ fn particle_budget(
         };
         parts.push((case.obstacle_paths[i].clone(), count));
     }
+    if let Some(g) = &geo.ground {
+        parts.push(("terrain".into(), g.count));
+    }
     let n_wall_parts = parts.len();
     for (i, b) in case.bodies.iter().enumerate() {
         parts.push((format!("body[{i}]"), b.shape.lattice_size(dx, dim)));
@@ -650,6 +678,8 @@ struct Blockers<'a> {
     obstacles: Vec<(Aabb, Aabb)>,
     /// The box of each elastic solid's particles.
     solids: Option<&'a [Aabb]>,
+    /// The ground, with its clip.
+    ground: Option<(&'a super::terrain::Terrain, &'a Ground)>,
 }
 
 impl Blockers<'_> {
@@ -686,7 +716,13 @@ impl Blockers<'_> {
                 .iter()
                 .position(|b| b.shape.near(p, 0.5 * case.dx * (1.0 - 1e-6), case.dim))
         };
+        // Fluid keeps half a spacing above the ground, as above a tank's floor.
+        let ground = || {
+            let (t, g) = self.ground?;
+            g.below(t, p, 0.5 * case.dx).then_some(("terrain", 0))
+        };
         match (obstacle, elastic_solid()) {
+            (None, None) if ground().is_some() => ground(),
             (Some(i), _) => Some(("obstacle", i)),
             (None, Some(i)) => Some(("solid", i)),
             (None, None) => body().map(|i| ("body", i)),
@@ -725,6 +761,7 @@ fn fluid_particles(
             })
             .collect(),
         solids: elastic.map(|e| e.extents.as_slice()),
+        ground: case.terrain.as_ref().zip(geo.ground.as_ref()),
     };
     // What the host cannot give is refused here rather than aborting the process (the budget
     // estimates what it can: `sph::run_budget`).
@@ -760,7 +797,10 @@ fn fluid_particles(
         }
         if particles.len() == start_len {
             // A block wholly inside solids is a mistake, and a case without fluid is empty.
-            let solid = first_blocker.map_or(String::new(), |(kind, j)| format!("{kind}[{j}]"));
+            let solid = first_blocker.map_or(String::new(), |(kind, j)| match kind {
+                "terrain" => "the terrain".into(),
+                _ => format!("{kind}[{j}]"),
+            });
             return Err(ctx.err(
                 &format!("fluid_block[{i}]"),
                 None,
@@ -860,6 +900,46 @@ fn wall_particles(
         }
     }
     tank_particles
+}
+
+/// The terrain's wall particles, column by column under the surface, pushed onto
+/// `particles`; those in an obstacle's particles' box are the obstacle's, those under a
+/// tank's inner box the tank floor's.
+fn ground_particles(
+    case: &Case,
+    terrain: &super::terrain::Terrain,
+    ground: &Ground,
+    (lat, obstacle_ranges): (&Lattice, &[IndexRange]),
+    rho: &BoundaryRho<'_>,
+    particles: &mut Vec<Particle>,
+) {
+    let dx = case.dx;
+    // Below the tank's inner box the tank's floor is the wall.
+    let floor = case
+        .tank
+        .as_ref()
+        .map_or(f64::NEG_INFINITY, |t| t.inner.min[2]);
+    let obstacles: Vec<Aabb> = obstacle_ranges
+        .iter()
+        .map(|(lo, hi)| Aabb {
+            min: lat.pos(lo.map(|c| c as i64)).map(|c| c - 0.5 * dx),
+            max: lat.pos(hi.map(|c| c as i64)).map(|c| c + 0.5 * dx),
+        })
+        .collect();
+    for (centre, column) in ground.columns(terrain, lat) {
+        for k in 0..column.count {
+            let pos = [centre[0], centre[1], column.particle_z(k, dx)];
+            if pos[2] < floor || obstacles.iter().any(|b| point_inside(pos, b, 3)) {
+                continue;
+            }
+            particles.push(Particle {
+                pos,
+                vel: [0.0; 3],
+                rho: rho.of(terrain.wall, pos),
+                kind: kind_of(terrain.wall),
+            });
+        }
+    }
 }
 
 /// Mirror planes on every face of the tank's inner box on the lattice (origin + n dx), the lid
@@ -1218,6 +1298,7 @@ fn finish(
         inlets,
         outlets: case.outlets,
         warnings,
+        world_origin_m: case.terrain.as_ref().map_or([0.0; 3], |t| t.origin),
     };
     let fast = super::runnable::check(
         ctx,
@@ -1376,6 +1457,7 @@ pub(super) fn build_solid_case(
         inlets: Vec::new(),
         outlets: Vec::new(),
         warnings: Vec::new(),
+        world_origin_m: [0.0; 3],
     };
     // Without fluid no speed of sound to warn against.
     super::runnable::check(ctx, &sc, None, &[], (false, &[]))?;

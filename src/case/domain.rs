@@ -17,9 +17,11 @@ pub(super) fn domain(
     case: &Case,
     lat: &Lattice,
     wall: Option<&TankWall>,
+    ground: Option<&Aabb>,
 ) -> Result<Domain, CaseError> {
     let dim = case.dim;
-    let solid = solid_boxes(case, lat, wall);
+    let mut solid = solid_boxes(case, lat, wall);
+    solid.extend(ground.map(|g| ("terrain".to_string(), *g)));
     let d = match case.domain {
         Some(d) => d,
         None => default_domain(case, wall, &solid),

@@ -18,7 +18,8 @@
 //! 3. geometry and size limits: `lattice.rs`, `mesh.rs`, `polygon.rs` (which uses `mesh.rs`)
 //!    and `limits.rs`;
 //! 4. the checks and particles of one kind of table each: `probes.rs`, `open_boundaries.rs`,
-//!    `solids.rs`, `bodies.rs`, and `friction.rs` (which names bodies and solids);
+//!    `solids.rs`, `bodies.rs`, `terrain.rs` (its geometry is `crate::generate`'s), and
+//!    `friction.rs` (which names bodies and solids);
 //! 5. `validate.rs`: the whole checked case (`Case`);
 //! 6. the build: `warnings.rs`, `domain.rs` and `runnable.rs` (the f32 range, time step and
 //!    schedule of the built case), used by `build.rs`;
@@ -44,6 +45,7 @@ mod probes;
 mod runnable;
 mod schema;
 mod solids;
+mod terrain;
 mod validate;
 mod warnings;
 

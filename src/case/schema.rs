@@ -14,6 +14,7 @@ pub(super) struct RawCase {
     pub physics: RawPhysics,
     pub time: RawTime,
     pub tank: Option<RawTank>,
+    pub terrain: Option<RawTerrain>,
     #[serde(default)]
     pub fluid_block: Vec<RawBlock>,
     #[serde(default)]
@@ -222,6 +223,28 @@ pub(super) struct RawTank {
     pub wall: Option<WallName>,
     pub slip: Option<SlipName>,
     pub motion: Option<RawMotion>,
+}
+
+/// The ground from an elevation grid: `[terrain]` (`docs/cases.md`, "Terrain").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawTerrain {
+    pub file: String,
+    pub origin_m: Option<Vec<f64>>,
+    pub nodata: Option<NodataName>,
+    pub nodata_elevation_m: Option<f64>,
+    pub layers: Option<i64>,
+    pub wall: Option<WallName>,
+    pub slip: Option<SlipName>,
+}
+
+/// What a terrain's cells without data become.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum NodataName {
+    Refuse,
+    Nearest,
+    Elevation,
 }
 
 /// A moving solid: `[[body]]` (`docs/cases.md`, "Bodies").

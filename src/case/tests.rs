@@ -1405,6 +1405,7 @@ fn nothing_panics_on_hostile_values() {
 mod open_boundaries;
 mod shapes;
 mod solids;
+mod terrain;
 mod walls;
 
 mod density_filter;

@@ -83,6 +83,8 @@ pub(super) struct Case {
     pub energy: bool,
     pub time: TimeControl,
     pub tank: Option<Tank>,
+    /// `[terrain]`: the ground from an elevation grid.
+    pub terrain: Option<super::terrain::Terrain>,
     pub blocks: Vec<Block>,
     pub obstacles: Vec<Aabb>,
     /// The wall treatment of each obstacle (never `Mirror`).
@@ -145,6 +147,15 @@ pub(super) fn validate(
 
     // Geometry.
     let tank = tank(ctx, raw, dim, case_dir)?;
+    let terrain = super::terrain::terrain(ctx, raw.terrain.as_ref(), dim, h_over_dx, case_dir)?;
+    if terrain.is_some() && tank.as_ref().is_some_and(|t| t.motion.is_some()) {
+        return Err(ctx.err(
+            "terrain",
+            None,
+            "the ground does not move, but the tank has a [tank.motion]",
+            "remove [tank.motion], or draw the moving ground as [[obstacle]] boxes",
+        ));
+    }
     let solids = solids(ctx, raw, dim)?;
     let blocks = blocks(ctx, raw, dim)?;
     let (obstacles, obstacle_walls, obstacle_paths) = obstacles(ctx, raw, dim)?;
@@ -191,6 +202,7 @@ pub(super) fn validate(
         energy,
         time,
         tank,
+        terrain,
         blocks,
         obstacles,
         obstacle_walls,

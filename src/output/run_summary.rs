@@ -60,6 +60,9 @@ pub struct RunSummary {
     /// A run over several ranks: each rank's part, in rank order (absent for one whole run).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ranks: Option<Vec<RankSummary>>,
+    /// The world coordinates of the positions' (0, 0, 0) (`Scenario::world_origin_m`).
+    #[serde(default)]
+    pub world_origin_m: [f64; 3],
 }
 
 /// One rank's part of a run over several ranks (`run.json`, `wgsph bench` under mpirun).
@@ -123,6 +126,7 @@ mod tests {
             fingerprint: Some("0123456789abcdef".into()),
             case_file: Some("/cases/x.toml".into()),
             ranks: None,
+            world_origin_m: [0.0; 3],
             case: "dam_break_2d".into(),
             adapter: "NVIDIA H100 \"quoted\"".into(),
             backend: "Vulkan".into(),

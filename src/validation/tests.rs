@@ -39,6 +39,7 @@ fn summary(case: &str, excluded: u64) -> RunSummary {
         fingerprint: None,
         case_file: None,
         ranks: None,
+        world_origin_m: [0.0; 3],
     }
 }
 

@@ -172,6 +172,7 @@ pub fn scenario(
         inlets: Vec::new(),
         outlets: Vec::new(),
         warnings: Vec::new(),
+        world_origin_m: [0.0; 3],
         domain,
         particles,
         probes,

@@ -1,0 +1,282 @@
+//! `[terrain]`: the ground from an elevation grid file (docs/cases.md, "Terrain"), read and
+//! checked field by field. The grid's geometry (the reader of the file's format, the surface,
+//! the wall's columns) is `crate::generate::terrain`'s; this file names the field and the fix.
+
+use std::path::Path;
+
+use crate::generate::terrain::{parse_asc, Column, ElevationGrid, GridError, NodataRule};
+
+use super::check::{number, read_bounded, treatment, vector, Aabb, Bound, Treatment};
+use super::error::{num, CaseError};
+use super::lattice::{range_points, Lattice};
+use super::locate::Ctx;
+use super::schema::{NodataName, RawTerrain, WallName};
+
+/// The largest grid file: 2 GiB of text (a 10 000 × 10 000 grid at up to 20 characters a
+/// value).
+const MAX_FILE_BYTES: u64 = 2 << 30;
+
+/// The ground, checked: its grid in the case's coordinates and its wall.
+#[derive(Debug, Clone)]
+pub(super) struct Terrain {
+    /// The grid, moved by −`origin`: every elevation given.
+    pub grid: ElevationGrid,
+    /// The world coordinates of the case's (0, 0, 0).
+    pub origin: [f64; 3],
+    pub wall: Treatment,
+    /// Wall-particle layers across the surface.
+    pub layers: u32,
+}
+
+/// `[terrain]` of a 3D case: the grid read relative to `case_dir`, with its cells without
+/// data filled as `nodata` says; the wall's treatment and layers (by default enough to cover
+/// the kernel support 2h).
+pub(super) fn terrain(
+    ctx: &Ctx<'_>,
+    raw: Option<&RawTerrain>,
+    dim: usize,
+    h_over_dx: f64,
+    case_dir: &Path,
+) -> Result<Option<Terrain>, CaseError> {
+    let Some(t) = raw else {
+        return Ok(None);
+    };
+    if dim != 3 {
+        return Err(ctx.err(
+            "terrain",
+            None,
+            "a terrain is the ground under a 3D case; this case is 2D",
+            "set dimension = 3, or draw a 2D ground as [[obstacle]] boxes or a polygon body",
+        ));
+    }
+    let wall = treatment(ctx, "terrain", t.wall, t.slip)?;
+    if t.wall == Some(WallName::Mirror) {
+        return Err(ctx.err(
+            "terrain.wall",
+            Some("\"mirror\"".into()),
+            "mirror ghosts are for the tank's straight faces, not a ground",
+            "use wall = \"dynamic\" (or \"fixed_ghost\" or \"repulsive\")",
+        ));
+    }
+    let support = (2.0 * h_over_dx).ceil().clamp(1.0, 8.0) as i64;
+    let layers = t.layers.unwrap_or(support);
+    if !(1..=8).contains(&layers) {
+        return Err(ctx.err(
+            "terrain.layers",
+            Some(layers.to_string()),
+            "must be between 1 and 8 (wall-particle layers across the surface)",
+            format!("leave it out: the default, {support}, covers the kernel support 2h"),
+        ));
+    }
+    let rule = nodata(ctx, t)?;
+    let grid = read_grid(ctx, &t.file, case_dir)?
+        .filled(rule)
+        .map_err(|e| grid_error(ctx, &t.file, case_dir, e))?;
+    let (sw, _) = grid.extent();
+    let origin = match &t.origin_m {
+        None => [sw[0], sw[1], 0.0],
+        Some(o) => vector(
+            ctx,
+            "terrain.origin_m",
+            o,
+            3,
+            "the world point at the case's origin",
+        )?,
+    };
+    Ok(Some(Terrain {
+        grid: grid.shifted(origin),
+        origin,
+        wall,
+        layers: layers as u32,
+    }))
+}
+
+/// `terrain.nodata` and `terrain.nodata_elevation_m`, together.
+fn nodata(ctx: &Ctx<'_>, t: &RawTerrain) -> Result<NodataRule, CaseError> {
+    match (t.nodata.unwrap_or(NodataName::Refuse), t.nodata_elevation_m) {
+        (NodataName::Elevation, Some(e)) => Ok(NodataRule::Elevation(number(
+            ctx,
+            "terrain.nodata_elevation_m",
+            e,
+            Bound::Closed(-1e7, 1e7),
+            "the elevation given to cells without data, in m",
+            "give an elevation in metres",
+        )?)),
+        (NodataName::Elevation, None) => Err(ctx.err(
+            "terrain.nodata",
+            Some("\"elevation\"".into()),
+            "needs the elevation to give: terrain.nodata_elevation_m is missing",
+            "add nodata_elevation_m = <m>, or set nodata = \"nearest\"",
+        )),
+        (_, Some(e)) => Err(ctx.err(
+            "terrain.nodata_elevation_m",
+            Some(num(e)),
+            "is only used with nodata = \"elevation\"",
+            "set nodata = \"elevation\", or remove nodata_elevation_m",
+        )),
+        (NodataName::Refuse, None) => Ok(NodataRule::Refuse),
+        (NodataName::Nearest, None) => Ok(NodataRule::Nearest),
+    }
+}
+
+/// The grid in `file` (relative to `case_dir`), by its extension.
+fn read_grid(ctx: &Ctx<'_>, file: &str, case_dir: &Path) -> Result<ElevationGrid, CaseError> {
+    let full = case_dir.join(file);
+    let refuse = |problem: String, fix: &str| {
+        ctx.err(
+            "terrain.file",
+            Some(format!("{file:?}")),
+            format!("{}: {problem}", full.display()),
+            fix,
+        )
+    };
+    let extension = full
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if extension.as_deref() != Some("asc") {
+        return Err(refuse(
+            "is not an ESRI ASCII grid (.asc), the format a terrain is read from".into(),
+            "export the elevation grid as an ESRI ASCII grid (gdal_translate -of AAIGrid in.tif \
+             out.asc)",
+        ));
+    }
+    match std::fs::metadata(&full) {
+        Ok(m) if m.is_file() => {}
+        Ok(_) => {
+            return Err(refuse(
+                "is not a regular file".into(),
+                "give the grid's file",
+            ))
+        }
+        Err(e) => {
+            return Err(refuse(
+                e.to_string(),
+                "give the path of the grid relative to the case file",
+            ))
+        }
+    }
+    let text = read_bounded(&full, MAX_FILE_BYTES).map_err(|e| {
+        refuse(
+            e.to_string(),
+            "give an ESRI ASCII grid (text); resample a larger one coarser",
+        )
+    })?;
+    parse_asc(&text).map_err(|e| grid_error(ctx, file, case_dir, e))
+}
+
+/// The grid's error, at `terrain.file` with the file and line.
+fn grid_error(ctx: &Ctx<'_>, file: &str, case_dir: &Path, e: GridError) -> CaseError {
+    let place = match e.line {
+        Some(l) => format!("{}, line {l}", case_dir.join(file).display()),
+        None => case_dir.join(file).display().to_string(),
+    };
+    ctx.err(
+        "terrain.file",
+        Some(format!("{file:?}")),
+        format!("{place}: {}", e.problem),
+        e.fix,
+    )
+}
+
+/// The terrain's wall on the case's lattice: the columns whose centres lie over the grid,
+/// inside the tank and the given domain (the clip), and what they hold.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Ground {
+    /// The first and last lattice index of the columns along x and y (z: 0).
+    lo: [f64; 3],
+    hi: [f64; 3],
+    /// Where the ground keeps fluid out, along x and y: the clip.
+    clip: ([f64; 2], [f64; 2]),
+    /// The wall particles (an upper bound: the points in obstacles are left out).
+    pub count: f64,
+    /// The box of the wall particles, the surface on top.
+    pub bounds: Aabb,
+}
+
+impl Ground {
+    /// The ground of `terrain` on `lat`, clipped to the tank's inner box and the domain when
+    /// given; an error when no column is left.
+    pub(super) fn of(
+        ctx: &Ctx<'_>,
+        terrain: &Terrain,
+        lat: &Lattice,
+        tank: Option<&Aabb>,
+        domain: Option<&Aabb>,
+    ) -> Result<Ground, CaseError> {
+        let (mut min, mut max) = terrain.grid.extent();
+        for b in tank.into_iter().chain(domain) {
+            for a in 0..2 {
+                min[a] = min[a].max(b.min[a]);
+                max[a] = max[a].min(b.max[a]);
+            }
+        }
+        // The lattice's columns within the clip: the range of points of a box one spacing
+        // high at the lattice's origin (z index 0).
+        let z0 = lat.origin[2];
+        let columns = Aabb {
+            min: [min[0], min[1], z0],
+            max: [max[0], max[1], z0 + lat.dx],
+        };
+        let Some((lo, hi)) = lat.range_in(&columns) else {
+            let (gmin, gmax) = terrain.grid.extent();
+            return Err(ctx.err(
+                "terrain.file",
+                None,
+                format!(
+                    "the grid covers x {} to {} m, y {} to {} m in the case's coordinates \
+                     (world minus terrain.origin_m), and no particle column of spacing dx = {} \
+                     m lies over it{}",
+                    num(gmin[0]),
+                    num(gmax[0]),
+                    num(gmin[1]),
+                    num(gmax[1]),
+                    num(lat.dx),
+                    if tank.is_some() || domain.is_some() {
+                        " inside the tank and the domain"
+                    } else {
+                        ""
+                    }
+                ),
+                "give the tank, the fluid and the domain in the case's coordinates (world \
+                 minus terrain.origin_m, by default the grid's south-west corner)",
+            ));
+        };
+        let mut ground = Ground {
+            lo,
+            hi,
+            clip: (min, max),
+            count: 0.0,
+            bounds: Aabb {
+                min: [min[0], min[1], f64::INFINITY],
+                max: [max[0], max[1], f64::NEG_INFINITY],
+            },
+        };
+        for (_, c) in ground.columns(terrain, lat) {
+            ground.count += c.count as f64;
+            ground.bounds.min[2] = ground.bounds.min[2].min(c.bottom(lat.dx) - 0.5 * lat.dx);
+            ground.bounds.max[2] = ground.bounds.max[2].max(c.surface);
+        }
+        Ok(ground)
+    }
+
+    /// Each column's centre (x, y; z is the lattice origin's) and its wall particles.
+    pub(super) fn columns<'a>(
+        &self,
+        terrain: &'a Terrain,
+        lat: &'a Lattice,
+    ) -> impl Iterator<Item = ([f64; 3], Column)> + 'a {
+        range_points(lat, self.lo, self.hi).map(move |idx| {
+            let p = lat.pos(idx);
+            let column = terrain.grid.column(p[0], p[1], lat.dx, terrain.layers);
+            (p, column)
+        })
+    }
+
+    /// Whether `p` lies over the ground's clip and less than `clearance` above the surface:
+    /// no place for fluid.
+    pub(super) fn below(&self, terrain: &Terrain, p: [f64; 3], clearance: f64) -> bool {
+        let (min, max) = self.clip;
+        (0..2).all(|a| min[a] <= p[a] && p[a] <= max[a])
+            && p[2] < terrain.grid.elevation(p[0], p[1]) + clearance
+    }
+}

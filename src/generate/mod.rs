@@ -1,0 +1,6 @@
+//! Turning a place into particles: the geometry of grounds, surfaces and fills, tested on its
+//! own without a GPU or a case file. The case file's reader and checker (`crate::case`) turns
+//! what this module reports into messages that name the field and the fix; the solver imports
+//! neither.
+
+pub mod terrain;
