@@ -11,6 +11,7 @@ use crate::scenario::{
 };
 
 use super::bodies::Shape;
+use super::buildings::{Raised, Site};
 use super::check::{fmt_box, inside, point_in, point_inside, Aabb, Treatment, AXES, TOL};
 use super::domain::domain;
 use super::error::{num, CaseError};
@@ -18,7 +19,7 @@ use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
 use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
 use super::terrain::Ground;
-use super::validate::{Block, Case, Sound, WallSettings};
+use super::validate::{Case, Sound, WallSettings};
 
 /// An obstacle's range of lattice indices: the first and the last, as floats.
 type IndexRange = ([f64; 3], [f64; 3]);
@@ -30,7 +31,7 @@ type Placed = (Vec<ElasticMaterial>, Vec<u32>);
 /// is that of the first stage that finds one):
 ///
 /// 1. the parts on the particle lattice, checked ([`Geometry::of`]: tank, fluid blocks,
-///    lattice, obstacles, inlets);
+///    lattice, obstacles, inlets, the terrain's ground, the fills' water);
 /// 2. the particle budget ([`particle_budget`]), before anything is allocated;
 /// 3. the elastic solids' particles ([`elastic_solids`]);
 /// 4. the domain ([`domain`]);
@@ -47,7 +48,8 @@ pub(super) fn build(
     budget: &ParticleBudget,
 ) -> Result<Scenario, CaseError> {
     let solids_alone = case.tank.is_none() && case.obstacles.is_empty() && case.bodies.is_empty();
-    if !case.solids.is_empty() && case.blocks.is_empty() && case.inlets.is_empty() && solids_alone {
+    let no_fluid = case.blocks.is_empty() && case.fills.is_empty() && case.inlets.is_empty();
+    if !case.solids.is_empty() && no_fluid && solids_alone {
         return build_solid_case(ctx, case, budget);
     }
     let geo = Geometry::of(ctx, &case)?;
@@ -55,8 +57,14 @@ pub(super) fn build(
     let wall = geo.tank_cells.map(|n| geo.tank_wall(&case, n));
     let elastic = elastic_solids(ctx, &case, &budget.less(total))?;
     let ground_box = geo.ground.map(|g| g.bounds);
-    let domain = domain(ctx, &case, &geo.lat, wall.as_ref(), ground_box.as_ref())?;
-    let start = Start::of(ctx, &case, elastic.as_ref())?;
+    let water = geo.water(&case);
+    let fills: Vec<Aabb> = geo.fills.iter().map(|f| f.water).collect();
+    let placed: Vec<(String, Aabb)> = (ground_box.map(|b| ("terrain".to_string(), b)))
+        .into_iter()
+        .chain(geo.raised.bounds.map(|b| ("buildings".to_string(), b)))
+        .collect();
+    let domain = domain(ctx, &case, &geo.lat, wall.as_ref(), (&placed, &fills))?;
+    let start = Start::of(ctx, &case, &water, elastic.as_ref())?;
 
     let mut particles = fluid_particles(ctx, &case, &geo, elastic.as_ref(), &start, total)?;
     // Inlets right after the fluid blocks (their particles become fluid).
@@ -70,7 +78,7 @@ pub(super) fn build(
         })
         .collect();
     let rho = BoundaryRho {
-        blocks: &case.blocks,
+        water: &water,
         start: &start,
         reach: geo.layers as f64 * case.dx + case.dx,
         v: case.dim - 1,
@@ -83,15 +91,15 @@ pub(super) fn build(
         &mut particles,
     );
     if let (Some(t), Some(g)) = (&case.terrain, &geo.ground) {
-        ground_particles(
-            &case,
-            t,
-            g,
-            (&geo.lat, &geo.obstacle_ranges),
-            &rho,
-            &mut particles,
-        );
+        let under = (&geo.obstacle_ranges[..], &geo.raised);
+        ground_particles(&case, t, g, (&geo.lat, under), &rho, &mut particles);
     }
+    particles.extend(geo.raised.points.iter().map(|&(pos, t)| Particle {
+        pos,
+        vel: [0.0; 3],
+        rho: rho.of(t, pos),
+        kind: kind_of(t),
+    }));
     let mirror_planes = mirror_planes(&case, &geo.lat, wall.as_ref());
     let solids = place_solids(ctx, case.dim, elastic, &domain, &mut particles)?;
     let bodies = bodies(ctx, &case, &rho, tank_particles, &mut particles)?;
@@ -99,6 +107,7 @@ pub(super) fn build(
 
     let built = Built {
         domain,
+        notes: geo.raised.notes.clone(),
         particles,
         bodies,
         solids,
@@ -129,6 +138,10 @@ struct Geometry {
     inlet_layouts: Vec<super::open_boundaries::Layout>,
     /// The terrain's wall on the lattice.
     ground: Option<Ground>,
+    /// The buildings' wall particles.
+    raised: Raised,
+    /// Each fill's water.
+    fills: Vec<super::fill::Filled>,
 }
 
 impl Geometry {
@@ -157,6 +170,14 @@ impl Geometry {
             )?),
             None => None,
         };
+        let raised = raise_buildings(ctx, case, &lat, ground.as_ref())?;
+        let fills = fills(
+            ctx,
+            case,
+            &lat,
+            (&obstacle_ranges, &raised),
+            ground.as_ref(),
+        )?;
         Ok(Geometry {
             layers,
             wall_layers,
@@ -167,7 +188,17 @@ impl Geometry {
             h,
             inlet_layouts,
             ground,
+            raised,
+            fills,
         })
+    }
+
+    /// The boxes of the water at the start: the fluid blocks' and the fills' (the tops of
+    /// their highest particles' cells).
+    fn water(&self, case: &Case) -> Vec<Aabb> {
+        (case.blocks.iter().map(|b| b.bx))
+            .chain(self.fills.iter().map(|f| f.water))
+            .collect()
     }
 
     /// The particle layers of a tank of `n` cells along each axis.
@@ -179,6 +210,101 @@ impl Geometry {
             dim: case.dim,
         }
     }
+}
+
+/// The buildings raised on the lattice, inside the tank's inner box, the domain and the
+/// terrain's columns, on the terrain or the tank's floor.
+fn raise_buildings(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    lat: &Lattice,
+    ground: Option<&Ground>,
+) -> Result<Raised, CaseError> {
+    if case.buildings.is_empty() {
+        return Ok(Raised::default());
+    }
+    let mut clip = ([f64::NEG_INFINITY; 2], [f64::INFINITY; 2]);
+    let boxes = (case.tank.as_ref().map(|t| t.inner).into_iter()).chain(case.domain);
+    let boxes = boxes.map(|b| ([b.min[0], b.min[1]], [b.max[0], b.max[1]]));
+    for (min, max) in boxes.chain(ground.map(|g| g.clip())) {
+        for a in 0..2 {
+            clip.0[a] = clip.0[a].max(min[a]);
+            clip.1[a] = clip.1[a].min(max[a]);
+        }
+    }
+    let site = Site {
+        terrain: case.terrain.as_ref(),
+        floor: case.tank.as_ref().map(|t| t.inner.min[2]),
+        clip,
+    };
+    super::buildings::raise(ctx, &case.buildings, lat, &site)
+}
+
+/// Each fill's water, spread from its seed within what holds it (the tank's inner box and the
+/// domain, else the terrain's columns) around the ground, obstacles, bodies, elastic solids
+/// (their boxes: their particles are made later) and the fluid blocks; its columns rest on
+/// the ground.
+fn fills(
+    ctx: &Ctx<'_>,
+    case: &Case,
+    lat: &Lattice,
+    (obstacle_ranges, raised): (&[IndexRange], &Raised),
+    ground: Option<&Ground>,
+) -> Result<Vec<super::fill::Filled>, CaseError> {
+    if case.fills.is_empty() {
+        return Ok(Vec::new());
+    }
+    let (dim, v) = (case.dim, case.dim - 1);
+    let blockers = Blockers::new(case, (lat, obstacle_ranges), (ground, raised), None);
+    // The fluid blocks' water is there already.
+    let blocked = |p: [f64; 3]| {
+        (case.solids.iter())
+            .position(|s| point_inside(p, &s.bx, dim))
+            .map(|j| format!("solid[{j}]"))
+            .or_else(|| {
+                (case.blocks.iter())
+                    .position(|b| point_inside(p, &b.bx, dim))
+                    .map(|j| format!("fluid_block[{j}]"))
+            })
+            .or_else(|| blockers.name_at(p))
+    };
+    let bound =
+        match (&case.tank, &case.domain, ground) {
+            (Some(t), d, _) => {
+                let mut b = t.inner;
+                if let Some(d) = d {
+                    for a in 0..dim {
+                        b.min[a] = b.min[a].max(d.min[a]);
+                        b.max[a] = b.max[a].min(d.max[a]);
+                    }
+                }
+                (b, "the tank's inner box")
+            }
+            (None, Some(d), _) => (*d, "the domain"),
+            (None, None, Some(g)) => {
+                let mut b = g.bounds;
+                b.max[v] = f64::INFINITY;
+                (b, "the terrain's columns")
+            }
+            (None, None, None) => return Err(ctx.err(
+                "fill[0]",
+                None,
+                "nothing holds the fill's water: a fill spreads inside a [tank], a [domain] or \
+                 over a [terrain]",
+                "add a [tank] or a [domain] around the water, or use a [[fluid_block]]",
+            )),
+        };
+    let mut fills = Vec::with_capacity(case.fills.len());
+    for (i, f) in case.fills.iter().enumerate() {
+        let mut filled = super::fill::filled(ctx, (i, f), lat, (&bound.0, bound.1), &blocked)?;
+        if let (Some(t), Some(g)) = (&case.terrain, ground) {
+            let points = std::mem::take(&mut filled.points);
+            filled.points = g.settle_all(t, points, case.dx, |p| blocked(p).is_none());
+            filled.water = super::fill::water_box(&filled.points, case.dx, dim);
+        }
+        fills.push(filled);
+    }
+    Ok(fills)
 }
 
 /// Tank cells along each axis (`None` without a tank): at least one, and not too many.
@@ -280,14 +406,23 @@ fn block_cells(ctx: &Ctx<'_>, case: &Case) -> Result<Vec<[f64; 3]>, CaseError> {
 
 /// The global lattice, continued by walls and obstacles.
 fn lattice(case: &Case) -> Lattice {
+    let v = case.dim - 1;
     Lattice {
         // The tank's inner corner, else the first fluid block's, else the first inlet's, else
-        // (solids and walls without fluid) the first solid's.
+        // the first fill's seed with a row of cells topped at its level, else (solids and
+        // walls without fluid) the first solid's.
         origin: match (&case.tank, case.blocks.first(), case.inlets.first()) {
             (Some(t), _, _) => t.inner.min,
             (None, Some(b), _) => b.bx.min,
             (None, None, Some(i)) => i.bx.min,
-            (None, None, None) => case.solids[0].bx.min,
+            (None, None, None) => match case.fills.first() {
+                Some(f) => {
+                    let mut o = f.seed;
+                    o[v] = f.level;
+                    o
+                }
+                None => case.solids[0].bx.min,
+            },
         },
         dx: case.dx,
         dim: case.dim,
@@ -447,6 +582,9 @@ fn particle_budget(
     for (i, n) in geo.block_cells.iter().enumerate() {
         parts.push((format!("fluid_block[{i}]"), n.iter().product()));
     }
+    for (i, f) in geo.fills.iter().enumerate() {
+        parts.push((format!("fill[{i}]"), f.points.len() as f64));
+    }
     for (i, l) in geo.inlet_layouts.iter().enumerate() {
         parts.push((format!("inlet[{i}]"), l.n_columns * l.layers as f64));
     }
@@ -471,6 +609,9 @@ fn particle_budget(
     }
     if let Some(g) = &geo.ground {
         parts.push(("terrain".into(), g.count));
+    }
+    if !geo.raised.points.is_empty() {
+        parts.push(("buildings".into(), geo.raised.points.len() as f64));
     }
     let n_wall_parts = parts.len();
     for (i, b) in case.bodies.iter().enumerate() {
@@ -548,10 +689,15 @@ struct Start {
 impl Start {
     /// Speed of sound and the hydrostatic start: c0, the Tait stiffness, inflow below c0, the
     /// particle mass.
-    fn of(ctx: &Ctx<'_>, case: &Case, elastic: Option<&Elastic>) -> Result<Start, CaseError> {
+    fn of(
+        ctx: &Ctx<'_>,
+        case: &Case,
+        water: &[Aabb],
+        elastic: Option<&Elastic>,
+    ) -> Result<Start, CaseError> {
         let (dim, dx) = (case.dim, case.dx);
         let g = case.gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
-        let c0 = sound_speed(ctx, case, g, elastic)?;
+        let c0 = sound_speed(ctx, case, (g, water), elastic)?;
         // The field the speed of sound came from, for the errors below.
         let (sound_path, sound_value) = match case.sound {
             Sound::Speed(c) => ("physics.sound_speed_m_s", c),
@@ -626,14 +772,14 @@ impl Start {
 fn sound_speed(
     ctx: &Ctx<'_>,
     case: &Case,
-    g: f64,
+    (g, water): (f64, &[Aabb]),
     elastic: Option<&Elastic>,
 ) -> Result<f64, CaseError> {
     let v = case.dim - 1;
     Ok(match case.sound {
         // Without fluid c0 is unused (the solids have their own sound speed); that one keeps
         // the checks below meaningful.
-        _ if case.blocks.is_empty() && case.inlets.is_empty() => elastic.map_or(1.0, |e| {
+        _ if water.is_empty() && case.inlets.is_empty() => elastic.map_or(1.0, |e| {
             e.materials
                 .iter()
                 .map(ElasticMaterial::sound_speed)
@@ -642,10 +788,9 @@ fn sound_speed(
         Sound::Speed(c) => c,
         Sound::Coef(k) => {
             let floor = |b: &Aabb| case.tank.as_ref().map_or(b.min[v], |t| t.inner.min[v]);
-            let depth = case
-                .blocks
+            let depth = water
                 .iter()
-                .map(|b| b.bx.max[v] - floor(&b.bx))
+                .map(|b| b.max[v] - floor(b))
                 .fold(0.0, f64::max);
             // Inflow faster than the fall speed sets the scale instead.
             let inflow = case.inlets.iter().map(|s| s.speed).fold(0.0, f64::max);
@@ -657,7 +802,7 @@ fn sound_speed(
                     format!(
                         "gives c0 = coef * max(sqrt(|g| * H), inlet speed) = {} m/s with |g| \
                          = {} m/s² (physics.gravity_m_s2) and H = {} m (the deepest fluid \
-                         block)",
+                         block or fill)",
                         num(c),
                         num(g),
                         num(depth)
@@ -680,9 +825,48 @@ struct Blockers<'a> {
     solids: Option<&'a [Aabb]>,
     /// The ground, with its clip.
     ground: Option<(&'a super::terrain::Terrain, &'a Ground)>,
+    /// The buildings.
+    raised: &'a Raised,
 }
 
-impl Blockers<'_> {
+impl<'a> Blockers<'a> {
+    fn new(
+        case: &'a Case,
+        (lat, obstacle_ranges): (&Lattice, &[IndexRange]),
+        (ground, raised): (Option<&'a Ground>, &'a Raised),
+        solids: Option<&'a [Aabb]>,
+    ) -> Blockers<'a> {
+        let obstacles = (case.obstacles.iter().zip(obstacle_ranges))
+            .map(|(o, (lo, hi))| {
+                let first = lat.pos(lo.map(|c| c as i64));
+                let last = lat.pos(hi.map(|c| c as i64));
+                (
+                    *o,
+                    Aabb {
+                        min: first,
+                        max: last,
+                    },
+                )
+            })
+            .collect();
+        Blockers {
+            case,
+            obstacles,
+            solids,
+            ground: case.terrain.as_ref().zip(ground),
+            raised,
+        }
+    }
+
+    /// What takes the place of fluid at `p`, as a message names it.
+    fn name_at(&self, p: [f64; 3]) -> Option<String> {
+        self.at(p).map(|(kind, j)| match kind {
+            "terrain" => "the terrain".into(),
+            "building" => format!("a building of buildings[{j}]"),
+            _ => format!("{kind}[{j}]"),
+        })
+    }
+
     /// Whether `p` lies in the user's box or within a spacing of the particles' box.
     fn covered(&self, p: [f64; 3], user: &Aabb, parts: &Aabb) -> bool {
         let (dim, dx) = (self.case.dim, self.case.dx);
@@ -721,8 +905,13 @@ impl Blockers<'_> {
             let (t, g) = self.ground?;
             g.below(t, p, 0.5 * case.dx).then_some(("terrain", 0))
         };
+        let building = || {
+            let (i, _) = self.raised.at(&case.buildings, p, case.dx)?;
+            Some(("building", i))
+        };
         match (obstacle, elastic_solid()) {
             (None, None) if ground().is_some() => ground(),
+            (None, None) if building().is_some() => building(),
             (Some(i), _) => Some(("obstacle", i)),
             (None, Some(i)) => Some(("solid", i)),
             (None, None) => body().map(|i| ("body", i)),
@@ -731,8 +920,8 @@ impl Blockers<'_> {
 }
 
 /// The fluid blocks' particles (room for `total` particles), minus what lies in (or within
-/// half a spacing of) an obstacle's particles, an elastic solid or a body; a block left
-/// without any is an error.
+/// half a spacing of) an obstacle's particles, an elastic solid or a body, then the fills';
+/// a block left without any is an error.
 fn fluid_particles(
     ctx: &Ctx<'_>,
     case: &Case,
@@ -742,27 +931,12 @@ fn fluid_particles(
     total: f64,
 ) -> Result<Vec<Particle>, CaseError> {
     let (dim, dx, v, lat) = (case.dim, case.dx, case.dim - 1, &geo.lat);
-    let blockers = Blockers {
+    let blockers = Blockers::new(
         case,
-        obstacles: case
-            .obstacles
-            .iter()
-            .zip(&geo.obstacle_ranges)
-            .map(|(o, (lo, hi))| {
-                let first = lat.pos(lo.map(|c| c as i64));
-                let last = lat.pos(hi.map(|c| c as i64));
-                (
-                    *o,
-                    Aabb {
-                        min: first,
-                        max: last,
-                    },
-                )
-            })
-            .collect(),
-        solids: elastic.map(|e| e.extents.as_slice()),
-        ground: case.terrain.as_ref().zip(geo.ground.as_ref()),
-    };
+        (lat, &geo.obstacle_ranges),
+        (geo.ground.as_ref(), &geo.raised),
+        elastic.map(|e| e.extents.as_slice()),
+    );
     // What the host cannot give is refused here rather than aborting the process (the budget
     // estimates what it can: `sph::run_budget`).
     let mut particles = Vec::new();
@@ -782,25 +956,27 @@ fn fluid_particles(
         let top = b.bx.max[v];
         let start_len = particles.len();
         let mut first_blocker = None;
+        let mut points = Vec::new();
         for pos in block_points(b.bx.min, n.map(|c| c as i64), dx, dim) {
             match blockers.at(pos) {
-                None => particles.push(Particle {
-                    pos,
-                    vel: b.vel,
-                    rho: start.rho_at(top - pos[v]),
-                    kind: Kind::Fluid,
-                }),
-                Some(s) => {
-                    first_blocker.get_or_insert(s);
+                None => points.push(pos),
+                Some(_) => {
+                    first_blocker = first_blocker.or_else(|| blockers.name_at(pos));
                 }
             }
         }
+        if let (Some(t), Some(g)) = (&case.terrain, &geo.ground) {
+            points = g.settle_all(t, points, dx, |p| blockers.at(p).is_none());
+        }
+        particles.extend(points.into_iter().map(|pos| Particle {
+            pos,
+            vel: b.vel,
+            rho: start.rho_at(top - pos[v]),
+            kind: Kind::Fluid,
+        }));
         if particles.len() == start_len {
             // A block wholly inside solids is a mistake, and a case without fluid is empty.
-            let solid = first_blocker.map_or(String::new(), |(kind, j)| match kind {
-                "terrain" => "the terrain".into(),
-                _ => format!("{kind}[{j}]"),
-            });
+            let solid = first_blocker.unwrap_or_default();
             return Err(ctx.err(
                 &format!("fluid_block[{i}]"),
                 None,
@@ -817,12 +993,28 @@ fn fluid_particles(
             ));
         }
     }
+    // The fills' water, less what the elastic solids' particles (made after the fills were
+    // spread) take.
+    for f in &geo.fills {
+        let top = f.water.max[v];
+        for &pos in &f.points {
+            if blockers.at(pos).is_none() {
+                particles.push(Particle {
+                    pos,
+                    vel: [0.0; 3],
+                    rho: start.rho_at(top - pos[v]),
+                    kind: Kind::Fluid,
+                });
+            }
+        }
+    }
     Ok(particles)
 }
 
 /// The start density of wall and body particles.
 struct BoundaryRho<'a> {
-    blocks: &'a [Block],
+    /// The boxes of the water at the start (`Geometry::water`).
+    water: &'a [Aabb],
     start: &'a Start,
     /// How far beside a fluid block a wall particle takes its hydrostatic density.
     reach: f64,
@@ -831,14 +1023,14 @@ struct BoundaryRho<'a> {
 }
 
 impl BoundaryRho<'_> {
-    /// Hydrostatic below the highest fluid block over `p` (within `reach`), else ρ0.
+    /// Hydrostatic below the highest water over `p` (within `reach`), else ρ0.
     fn wall(&self, p: [f64; 3]) -> f64 {
         let (v, reach) = (self.v, self.reach);
         let over = self
-            .blocks
+            .water
             .iter()
-            .filter(|b| (0..v).all(|a| b.bx.min[a] - reach <= p[a] && p[a] <= b.bx.max[a] + reach));
-        match over.map(|b| b.bx.max[v]).reduce(f64::max) {
+            .filter(|b| (0..v).all(|a| b.min[a] - reach <= p[a] && p[a] <= b.max[a] + reach));
+        match over.map(|b| b.max[v]).reduce(f64::max) {
             Some(top) => self.start.rho_at(top - p[v]),
             None => self.start.rho0,
         }
@@ -904,12 +1096,12 @@ fn wall_particles(
 
 /// The terrain's wall particles, column by column under the surface, pushed onto
 /// `particles`; those in an obstacle's particles' box are the obstacle's, those under a
-/// tank's inner box the tank floor's.
+/// tank's inner box the tank floor's, the columns in a building's footprint the building's.
 fn ground_particles(
     case: &Case,
     terrain: &super::terrain::Terrain,
     ground: &Ground,
-    (lat, obstacle_ranges): (&Lattice, &[IndexRange]),
+    (lat, (obstacle_ranges, raised)): (&Lattice, (&[IndexRange], &Raised)),
     rho: &BoundaryRho<'_>,
     particles: &mut Vec<Particle>,
 ) {
@@ -927,6 +1119,9 @@ fn ground_particles(
         })
         .collect();
     for (centre, column) in ground.columns(terrain, lat) {
+        if raised.covers(&case.buildings, centre[0], centre[1]) {
+            continue;
+        }
         for k in 0..column.count {
             let pos = [centre[0], centre[1], column.particle_z(k, dx)];
             if pos[2] < floor || obstacles.iter().any(|b| point_inside(pos, b, 3)) {
@@ -1203,6 +1398,8 @@ fn check_particles(
 /// What the stages of [`build`] made, for [`finish`].
 struct Built {
     domain: Domain,
+    /// Warnings of the build's stages (footprints left out).
+    notes: Vec<String>,
     particles: Vec<Particle>,
     bodies: Vec<Body>,
     /// The elastic materials and the solid of each particle (for the particles before the
@@ -1227,6 +1424,7 @@ fn finish(
     let tank_moves = case.tank_moves();
     let Built {
         domain,
+        notes,
         particles,
         bodies,
         solids,
@@ -1240,6 +1438,7 @@ fn finish(
         .map(|(lo, hi)| [0, 1, 2].map(|a| hi[a] - lo[a] + 1.0))
         .collect();
     let mut warnings = super::warnings::of(&case, dx, h, &obstacle_points);
+    warnings.extend(notes);
     let physics = physics(&case, start, h);
     let mut probes = case.probes;
     super::probes::place_on_faces(

@@ -17,14 +17,14 @@ pub(super) fn domain(
     case: &Case,
     lat: &Lattice,
     wall: Option<&TankWall>,
-    ground: Option<&Aabb>,
+    (placed, fills): (&[(String, Aabb)], &[Aabb]),
 ) -> Result<Domain, CaseError> {
     let dim = case.dim;
     let mut solid = solid_boxes(case, lat, wall);
-    solid.extend(ground.map(|g| ("terrain".to_string(), *g)));
+    solid.extend_from_slice(placed);
     let d = match case.domain {
         Some(d) => d,
-        None => default_domain(case, wall, &solid),
+        None => default_domain(case, wall, &solid, fills),
     };
     check_fluid_inside(ctx, case, &d)?;
     check_outlets(ctx, case, &d)?;
@@ -46,6 +46,7 @@ pub(super) fn domain(
                 .enumerate()
                 .map(|(i, s)| (format!("inlet[{i}]"), s.bx)),
         )
+        .chain((fills.iter().enumerate()).map(|(i, f)| (format!("fill[{i}]"), *f)))
         .collect();
     limits::grid_fits(
         ctx,
@@ -97,9 +98,14 @@ fn solid_boxes(case: &Case, lat: &Lattice, wall: Option<&TankWall>) -> Vec<(Stri
 }
 
 /// The default domain: the box around the solids (`solid`; without a tank also around the
-/// fluid, the elastic solids and the inlets), with room above an open top, and two spacings
+/// fluid blocks, the fills' water (`fills`), the elastic solids and the inlets), with room above an open top, and two spacings
 /// on every side.
-fn default_domain(case: &Case, wall: Option<&TankWall>, solid: &[(String, Aabb)]) -> Aabb {
+fn default_domain(
+    case: &Case,
+    wall: Option<&TankWall>,
+    solid: &[(String, Aabb)],
+    fills: &[Aabb],
+) -> Aabb {
     let (dim, dx) = (case.dim, case.dx);
     let v = dim - 1;
     let mut all: Vec<Aabb> = solid.iter().map(|(_, b)| *b).collect();
@@ -107,6 +113,7 @@ fn default_domain(case: &Case, wall: Option<&TankWall>, solid: &[(String, Aabb)]
         all.extend(case.blocks.iter().map(|b| b.bx));
         all.extend(case.solids.iter().map(|s| s.bx));
         all.extend(case.inlets.iter().map(|s| s.bx));
+        all.extend(fills);
     }
     let mut d = all[0];
     for b in &all[1..] {

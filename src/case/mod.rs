@@ -18,8 +18,9 @@
 //! 3. geometry and size limits: `lattice.rs`, `mesh.rs`, `polygon.rs` (which uses `mesh.rs`)
 //!    and `limits.rs`;
 //! 4. the checks and particles of one kind of table each: `probes.rs`, `open_boundaries.rs`,
-//!    `solids.rs`, `bodies.rs`, `terrain.rs` (its geometry is `crate::generate`'s), and
-//!    `friction.rs` (which names bodies and solids);
+//!    `solids.rs`, `bodies.rs`, `terrain.rs`, `buildings.rs` (which stands on the terrain),
+//!    `fill.rs` (the geometry of these three is `crate::generate`'s), and `friction.rs`
+//!    (which names bodies and solids);
 //! 5. `validate.rs`: the whole checked case (`Case`);
 //! 6. the build: `warnings.rs`, `domain.rs` and `runnable.rs` (the f32 range, time step and
 //!    schedule of the built case), used by `build.rs`;
@@ -28,11 +29,13 @@
 
 mod bodies;
 mod build;
+mod buildings;
 mod built_in;
 mod check;
 mod diagnose;
 mod domain;
 mod error;
+mod fill;
 mod friction;
 mod lattice;
 mod limits;

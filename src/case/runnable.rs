@@ -56,7 +56,7 @@ pub(super) fn check(
     let mut warning = None;
     if let Some(sound) = sound_field {
         below_sound(ctx, sc, sound, &moving)?;
-        let has_water = !blocks.is_empty() || !sc.inlets.is_empty();
+        let has_water = sc.count(Kind::Fluid) > 0 || !sc.inlets.is_empty();
         warning = has_water
             .then(|| beyond_a_tenth_of_sound(sc, sound, &moving))
             .flatten();

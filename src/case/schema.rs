@@ -16,7 +16,11 @@ pub(super) struct RawCase {
     pub tank: Option<RawTank>,
     pub terrain: Option<RawTerrain>,
     #[serde(default)]
+    pub buildings: Vec<RawBuildings>,
+    #[serde(default)]
     pub fluid_block: Vec<RawBlock>,
+    #[serde(default)]
+    pub fill: Vec<RawFill>,
     #[serde(default)]
     pub obstacle: Vec<RawObstacle>,
     pub domain: Option<RawBox>,
@@ -233,6 +237,26 @@ pub(super) struct RawTerrain {
     pub origin_m: Option<Vec<f64>>,
     pub nodata: Option<NodataName>,
     pub nodata_elevation_m: Option<f64>,
+    pub layers: Option<i64>,
+    pub wall: Option<WallName>,
+    pub slip: Option<SlipName>,
+}
+
+/// Water from a seed up to a level: `[[fill]]` (`docs/cases.md`, "Fills").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawFill {
+    pub seed_m: Vec<f64>,
+    pub level_m: f64,
+}
+
+/// Buildings from a GeoJSON file of footprints: `[[buildings]]` (`docs/cases.md`, "Buildings").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawBuildings {
+    pub file: String,
+    pub height_property: Option<String>,
+    pub default_height_m: Option<f64>,
     pub layers: Option<i64>,
     pub wall: Option<WallName>,
     pub slip: Option<SlipName>,

@@ -272,11 +272,75 @@ impl Ground {
         })
     }
 
-    /// Whether `p` lies over the ground's clip and less than `clearance` above the surface:
-    /// no place for fluid.
+    /// The columns' extent along x and y, (min, max).
+    pub(super) fn clip(&self) -> ([f64; 2], [f64; 2]) {
+        self.clip
+    }
+
+    /// Whether `p` lies over the ground's clip and less than `clearance` above the surface
+    /// (to rounding): no place for fluid.
     pub(super) fn below(&self, terrain: &Terrain, p: [f64; 3], clearance: f64) -> bool {
         let (min, max) = self.clip;
         (0..2).all(|a| min[a] <= p[a] && p[a] <= max[a])
-            && p[2] < terrain.grid.elevation(p[0], p[1]) + clearance
+            && p[2] < terrain.grid.elevation(p[0], p[1]) + clearance * (1.0 - 1e-9)
+    }
+}
+
+impl Ground {
+    /// Rests a lattice column of fluid on the ground: `column`, one column's fluid points from
+    /// the bottom up, moves as a whole so that its lowest point lies half a spacing above the
+    /// surface, as above a tank's floor (the lattice leaves a gap of up to a spacing more,
+    /// which the water would fall across and bounce on for seconds). It moves down when
+    /// the gap is half a spacing or less, else up, with a point added below where `open`
+    /// allows, so the column's water stays within half a spacing of its height. A column not
+    /// over the ground, or not resting on it (its lowest point a spacing or more above the
+    /// surface: on an obstacle, say), stays.
+    pub(super) fn settle(
+        &self,
+        terrain: &Terrain,
+        column: &mut Vec<[f64; 3]>,
+        dx: f64,
+        open: impl Fn([f64; 3]) -> bool,
+    ) {
+        let Some(&lowest) = column.first() else {
+            return;
+        };
+        let (min, max) = self.clip;
+        if !(0..2).all(|a| min[a] <= lowest[a] && lowest[a] <= max[a]) {
+            return;
+        }
+        let rest = terrain.grid.elevation(lowest[0], lowest[1]) + 0.5 * dx;
+        let gap = lowest[2] - rest;
+        if !(0.0..dx * (1.0 - 1e-9)).contains(&gap) || gap < 1e-9 * dx {
+            return;
+        }
+        if gap <= 0.5 * dx {
+            column.iter_mut().for_each(|p| p[2] -= gap);
+        } else {
+            column.iter_mut().for_each(|p| p[2] += dx - gap);
+            let below = [lowest[0], lowest[1], rest];
+            if open(below) {
+                column.insert(0, below);
+            }
+        }
+        column.retain(|p| open(*p));
+    }
+
+    /// [`Self::settle`] on each column of `points` (lattice points in the lattice's order:
+    /// a column's points follow each other, bottom up).
+    pub(super) fn settle_all(
+        &self,
+        terrain: &Terrain,
+        points: Vec<[f64; 3]>,
+        dx: f64,
+        open: impl Fn([f64; 3]) -> bool,
+    ) -> Vec<[f64; 3]> {
+        let mut settled = Vec::with_capacity(points.len());
+        for column in points.chunk_by(|a, b| a[0] == b[0] && a[1] == b[1]) {
+            let mut column = column.to_vec();
+            self.settle(terrain, &mut column, dx, &open);
+            settled.extend(column);
+        }
+        settled
     }
 }

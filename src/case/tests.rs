@@ -1402,6 +1402,8 @@ fn nothing_panics_on_hostile_values() {
     assert!(n > 100);
 }
 
+mod buildings;
+mod fill;
 mod open_boundaries;
 mod shapes;
 mod solids;

@@ -85,7 +85,11 @@ pub(super) struct Case {
     pub tank: Option<Tank>,
     /// `[terrain]`: the ground from an elevation grid.
     pub terrain: Option<super::terrain::Terrain>,
+    /// `[[buildings]]`: buildings from their footprints.
+    pub buildings: Vec<super::buildings::Buildings>,
     pub blocks: Vec<Block>,
+    /// `[[fill]]`: water from a seed up to a level.
+    pub fills: Vec<super::fill::Fill>,
     pub obstacles: Vec<Aabb>,
     /// The wall treatment of each obstacle (never `Mirror`).
     pub obstacle_walls: Vec<Treatment>,
@@ -131,11 +135,13 @@ pub(super) fn validate(
 ) -> Result<Case, CaseError> {
     let dim = dimension(ctx, raw)?;
     // Before the physics: without fluid or solids nothing else of the case matters.
-    if raw.fluid_block.is_empty() && raw.solid.is_empty() && raw.inlet.is_empty() {
+    let no_fluid = raw.fluid_block.is_empty() && raw.fill.is_empty() && raw.inlet.is_empty();
+    if no_fluid && raw.solid.is_empty() {
         return Err(ctx.err(
             "fluid_block",
             None,
-            "no fluid: at least one [[fluid_block]] (or [[inlet]] or [[solid]]) is required",
+            "no fluid: at least one [[fluid_block]] (or [[fill]], [[inlet]] or [[solid]]) is \
+             required",
             "add a [[fluid_block]] table with min_m and max_m",
         ));
     }
@@ -157,7 +163,19 @@ pub(super) fn validate(
         ));
     }
     let solids = solids(ctx, raw, dim)?;
+    let origin = terrain.as_ref().map_or([0.0; 3], |t| t.origin);
+    let buildings =
+        super::buildings::validate(ctx, &raw.buildings, (dim, h_over_dx), case_dir, origin)?;
+    if !buildings.is_empty() && terrain.is_none() && tank.is_none() {
+        return Err(ctx.err(
+            "buildings[0]",
+            None,
+            "buildings stand on the ground: a [terrain], or a tank's floor",
+            "add a [terrain] (or a [tank]) under the buildings",
+        ));
+    }
     let blocks = blocks(ctx, raw, dim)?;
+    let fills = super::fill::validate(ctx, &raw.fill, dim)?;
     let (obstacles, obstacle_walls, obstacle_paths) = obstacles(ctx, raw, dim)?;
     let mut walls = wall_settings(ctx, raw)?;
     let domain = match &raw.domain {
@@ -203,7 +221,9 @@ pub(super) fn validate(
         time,
         tank,
         terrain,
+        buildings,
         blocks,
+        fills,
         obstacles,
         obstacle_walls,
         obstacle_paths,
@@ -423,7 +443,11 @@ fn sound(ctx: &Ctx<'_>, raw: &RawCase) -> Result<Sound, CaseError> {
         )?),
         // A solid-only case has no fluid to give a sound speed to (unused; see
         // build_solid_case in build.rs).
-        (None, None) if raw.fluid_block.is_empty() && !raw.solid.is_empty() => Sound::Speed(1.0),
+        (None, None)
+            if raw.fluid_block.is_empty() && raw.fill.is_empty() && !raw.solid.is_empty() =>
+        {
+            Sound::Speed(1.0)
+        }
         (None, None) => {
             return Err(ctx.err(
                 "physics.sound_speed_coef",

@@ -3,4 +3,6 @@
 //! what this module reports into messages that name the field and the fix; the solver imports
 //! neither.
 
+pub mod fill;
+pub mod footprint;
 pub mod terrain;

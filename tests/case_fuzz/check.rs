@@ -337,9 +337,12 @@ pub(crate) fn expectation(seed: &Seed, node: &Node, new: Option<&Value>) -> Expe
     let old = &node.value;
     let Some(new) = new else {
         // Elastic solids may stand without fluid (alone, or in a tank, among obstacles and
-        // bodies, which they touch), and inlets bring their own: then the fluid is not required.
+        // bodies, which they touch), and inlets and fills bring their own: then the fluid
+        // blocks are not required.
         let solids_without_fluid = node.path == "fluid_block"
-            && (seed.doc.contains_key("solid") || seed.doc.contains_key("inlet"));
+            && ["solid", "inlet", "fill"]
+                .iter()
+                .any(|k| seed.doc.contains_key(*k));
         return if required(&node.path) && !solids_without_fluid {
             Expect::Reject
         } else if matches!(generic(&node.path).as_str(), "name" | "probe" | "probe[]") {

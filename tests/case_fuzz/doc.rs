@@ -193,7 +193,7 @@ pub(crate) fn vector_len(path: &str, dim: usize) -> Option<usize> {
     let key = g.rsplit('.').next().unwrap_or(&g);
     match key {
         "min_m" | "max_m" | "gravity_m_s2" | "velocity_m_s" | "center_m" | "point_m" | "face_m"
-        | "base_m" | "origin_m" | "pivot_m" | "translation_m" => Some(dim),
+        | "base_m" | "origin_m" | "pivot_m" | "translation_m" | "seed_m" => Some(dim),
         "normal" if g.starts_with("probe") => Some(dim),
         "axis" if g == "motion.axis" => Some(3),
         "axis" => Some(dim),
@@ -223,6 +223,9 @@ pub(crate) fn required(path: &str) -> bool {
             | "obstacle[].max_m"
             | "domain.min_m"
             | "domain.max_m"
+            | "terrain.file"
+            | "fill[].seed_m"
+            | "fill[].level_m"
             | "probe[].name"
             | "probe[].kind"
             | "probe[].point_m"

@@ -90,29 +90,58 @@ fn the_ground_follows_the_grid_and_the_water_lies_on_it() {
         .filter(|p| (surface(p.pos[0]) - 0.5 * dx - p.pos[2]).abs() < 1e-9)
         .count();
     assert_eq!(tops, 15 * 15);
-    // The block's lattice points half a spacing or more above the surface are fluid, the
-    // others not.
+    // The water rests on the ground: each column's lowest particle half a spacing above the
+    // surface, the others a spacing apart, up to within half a spacing of the block's top.
     let fluid: Vec<&Particle> = s
         .particles
         .iter()
         .filter(|p| p.kind == Kind::Fluid)
         .collect();
-    assert!(fluid
-        .iter()
-        .all(|p| p.pos[2] >= surface(p.pos[0]) + 0.5 * dx - 1e-9));
-    let expected: usize = (0..15)
-        .map(|i| {
-            let x = (i as f64 + 0.5) * dx;
-            let rows = (0..8).filter(|k| (*k as f64 + 0.5) * dx >= surface(x) + 0.5 * dx);
-            15 * rows.count()
-        })
-        .sum();
-    assert_eq!(fluid.len(), expected);
+    assert_columns_rest_on(&fluid, surface, 0.32, 15 * 15);
     // f32 keeps the local positions to well under a spacing.
     assert!(s
         .particles
         .iter()
         .all(|p| p.pos.iter().all(|c| c.abs() < 10.0)));
+}
+
+/// Each of the `columns` columns of `fluid`: its lowest particle half a spacing above
+/// `surface`, the others a spacing apart, its top particle's cell within half a spacing of
+/// `level`.
+pub(super) fn assert_columns_rest_on(
+    fluid: &[&Particle],
+    surface: impl Fn(f64) -> f64,
+    level: f64,
+    columns: usize,
+) {
+    let dx = 0.04;
+    let mut by_column: Vec<(i64, i64, Vec<f64>)> = Vec::new();
+    for p in fluid {
+        let key = (
+            (p.pos[0] / dx).floor() as i64,
+            (p.pos[1] / dx).floor() as i64,
+        );
+        match by_column.iter_mut().find(|c| (c.0, c.1) == key) {
+            Some(c) => c.2.push(p.pos[2]),
+            None => by_column.push((key.0, key.1, vec![p.pos[2]])),
+        }
+    }
+    assert_eq!(by_column.len(), columns);
+    for (i, _, mut z) in by_column {
+        z.sort_by(f64::total_cmp);
+        let x = (i as f64 + 0.5) * dx;
+        assert!(
+            (z[0] - surface(x) - 0.5 * dx).abs() < 1e-9,
+            "x = {x}: lowest {}",
+            z[0]
+        );
+        assert!(
+            z.windows(2).all(|w| (w[1] - w[0] - dx).abs() < 1e-9),
+            "x = {x}: {z:?}"
+        );
+        let top = z[z.len() - 1] + 0.5 * dx;
+        assert!((top - level).abs() <= 0.5 * dx + 1e-9, "x = {x}: top {top}");
+    }
 }
 
 #[test]
