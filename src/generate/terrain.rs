@@ -4,9 +4,9 @@
 //!
 //! The wall follows the surface column by column: on the case's lattice of spacing dx, the
 //! column at (x, y) holds particles at z_s(x, y) − (k + ½) dx, k = 0 … n − 1, so a gentle
-//! slope is a smooth wall, not a staircase of whole cells. The depth n covers the kernel
-//! support across the surface (L layers measured along the normal: L √(1 + |∇z|²) vertically)
-//! and closes the side of a step down to a lower neighbour (its surface and L layers more).
+//! slope is a smooth wall, not a staircase of whole cells. The depth n reaches every point of
+//! the ground within L spacings of the surface (L layers across it): L √(1 + |∇z|²) spacings
+//! under a uniform slope, the foot of a step plus L under its edge.
 
 /// Most cells a grid may have (8 bytes each on the host: 1.2 GiB).
 pub const MAX_CELLS: usize = 150_000_000;
@@ -417,20 +417,27 @@ impl ElevationGrid {
     }
 
     /// The column of wall particles at (x, y) on a lattice of spacing `dx`, `layers` deep
-    /// across the surface.
+    /// across the surface: down to the lowest point within `layers` spacings of the surface
+    /// around it, sampled on the lattice (the points of the ground in the kernel's reach of
+    /// water anywhere above).
     pub fn column(&self, x: f64, y: f64, dx: f64, layers: u32) -> Column {
         let surface = self.elevation(x, y);
-        let [gx, gy] = self.gradient(x, y);
-        let layers = f64::from(layers);
-        let across = (layers * (1.0 + gx * gx + gy * gy).sqrt() - 1e-9).ceil();
-        let lowest_neighbour = [-1.0, 0.0, 1.0]
-            .iter()
-            .flat_map(|&i| [-1.0, 0.0, 1.0].map(|j| self.elevation(x + i * dx, y + j * dx)))
-            .fold(surface, f64::min);
-        let step = ((surface - lowest_neighbour) / dx - 1e-9).ceil().max(0.0) + layers;
+        let l = i64::from(layers);
+        let mut lowest = f64::INFINITY;
+        for i in -l..=l {
+            for j in -l..=l {
+                let r2 = i * i + j * j;
+                if r2 <= l * l {
+                    let below = ((l * l - r2) as f64).sqrt() * dx;
+                    let z = self.elevation(x + i as f64 * dx, y + j as f64 * dx) - below;
+                    lowest = lowest.min(z);
+                }
+            }
+        }
+        let depth = ((surface - lowest) / dx - 1e-9).ceil();
         Column {
             surface,
-            count: across.max(step) as usize,
+            count: depth.max(f64::from(layers)) as usize,
         }
     }
 }

@@ -176,3 +176,34 @@ fn bad_buildings_are_refused_naming_the_field_and_the_fix() {
         assert!(e.contains("fix:"), "no fix in: {e}");
     }
 }
+
+/// The shipped town (cases/town_flood_3d.toml) is built from its files: the ground's grid in
+/// world coordinates with a cell without data, six footprints (one without a height), the
+/// reservoir filled behind the gate only.
+#[test]
+fn the_town_is_built_from_its_files() {
+    let s = load(Path::new("cases/town_flood_3d.toml"), &[]).unwrap();
+    assert_eq!(s.world_origin_m, [2_600_000.0, 1_200_000.0, 431.0]);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let fluid: Vec<&Particle> = s
+        .particles
+        .iter()
+        .filter(|p| p.kind == Kind::Fluid)
+        .collect();
+    assert!(fluid.len() > 500, "{}", fluid.len());
+    assert!(fluid
+        .iter()
+        .all(|p| p.pos[0] < 1.44 && p.pos[2] <= 0.55 + 1e-9));
+    let text = std::fs::read_to_string("cases/town/buildings.geojson").unwrap();
+    let footprints = crate::generate::footprint::parse_geojson(&text, "height").unwrap();
+    assert_eq!(footprints.len(), 6);
+    for f in footprints {
+        let f = f.shifted(s.world_origin_m);
+        let walls = s
+            .particles
+            .iter()
+            .filter(|p| p.kind == Kind::Wall && f.contains(p.pos[0], p.pos[1]))
+            .count();
+        assert!(walls > 20, "feature {}: {walls} particles", f.feature);
+    }
+}
