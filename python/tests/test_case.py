@@ -1,6 +1,8 @@
 """Cases from Python: loading, `set` with the command's checks and messages, to_toml, and the
 errors of the other calls' arguments."""
 
+import json
+
 import pytest
 
 import wgsph
@@ -114,3 +116,16 @@ def test_argument_errors(tmp_path, tiny_case):
         wgsph.Run.open(tmp_path)
     with pytest.raises(wgsph.WgsphError, match="checkpoint"):
         wgsph.resume(tmp_path)
+
+
+def test_a_real_place_loads_with_its_files(tmp_path):
+    """The town (issue 59): its elevation grid, footprints and gate series are found beside the
+    case file, and Python builds the particles the command builds."""
+    town = DAM_BREAK.parent / "town_flood_3d.toml"
+    case = wgsph.Case.load(town)
+    short = ["time.end_s=0.002", "time.output_every_s=0.002", "time.probe_every_s=0.002"]
+    cli("run", town, *[a for s in short for a in ("--set", s)], "--out", tmp_path / "run", "-q")
+    summary = json.loads((tmp_path / "run" / "run.json").read_text())
+    assert case.particles["fluid"] == summary["particles_fluid"] > 500
+    assert case.particles["boundary"] == summary["particles_wall"]
+    assert summary["world_origin_m"] == [2600000.0, 1200000.0, 431.0]

@@ -296,7 +296,7 @@ fn fills(
         };
     let mut fills = Vec::with_capacity(case.fills.len());
     for (i, f) in case.fills.iter().enumerate() {
-        let mut filled = super::fill::filled(ctx, (i, f), lat, (&bound.0, bound.1), &blocked)?;
+        let mut filled = super::fill::filled(ctx, (i, f), lat, (&bound.0, bound.1), blocked)?;
         if let (Some(t), Some(g)) = (&case.terrain, ground) {
             let points = std::mem::take(&mut filled.points);
             filled.points = g.settle_all(t, points, case.dx, |p| blocked(p).is_none());

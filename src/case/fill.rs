@@ -97,8 +97,8 @@ pub(super) fn filled(
         ));
     }
     let mut seed = [0i64; 3];
-    for a in 0..dim {
-        seed[a] = ((fill.seed[a] - lat.origin[a]) / dx - 0.5).round() as i64;
+    for (a, s) in seed.iter_mut().enumerate().take(dim) {
+        *s = ((fill.seed[a] - lat.origin[a]) / dx - 0.5).round() as i64;
     }
     if fill.seed[v] > fill.level {
         return Err(ctx.err(

@@ -90,7 +90,7 @@ mod tests {
             lo: [0, 0, 0],
             hi: [9, 2, 5],
         };
-        let open = |p: [i64; 3]| p[2] <= 3 && !(p[0] == 4);
+        let open = |p: [i64; 3]| p[2] <= 3 && p[0] != 4;
         let west = flood(&bound, [1, 1, 1], open);
         assert_eq!(west.len(), 4 * 3 * 4);
         assert!(west.iter().all(|p| p[0] < 4 && p[2] <= 3));

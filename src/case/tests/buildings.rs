@@ -22,7 +22,7 @@ const FOOTPRINT: &str = r#"{"type": "FeatureCollection", "features": [
 fn folder(test: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("wgsph_buildings_{test}_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let rows = vec![vec!["0.05"; 12].join(" "); 8].join("\n");
+    let rows = vec![["0.05"; 12].join(" "); 8].join("\n");
     std::fs::write(dir.join("ground.asc"), format!("{GROUND}{rows}\n")).unwrap();
     std::fs::write(dir.join("town.geojson"), FOOTPRINT).unwrap();
     dir
