@@ -52,7 +52,7 @@ pub(super) fn build(
     if !case.solids.is_empty() && no_fluid && solids_alone {
         return build_solid_case(ctx, case, budget);
     }
-    let geo = Geometry::of(ctx, &case)?;
+    let geo = Geometry::of(ctx, &case, budget)?;
     let total = particle_budget(ctx, &case, &geo, budget)?;
     let wall = geo.tank_cells.map(|n| geo.tank_wall(&case, n));
     let elastic = elastic_solids(ctx, &case, &budget.less(total))?;
@@ -147,7 +147,7 @@ struct Geometry {
 impl Geometry {
     /// Checks the tank, the fluid blocks, the obstacles and the inlets against each other and
     /// the lattice, in this order.
-    fn of(ctx: &Ctx<'_>, case: &Case) -> Result<Geometry, CaseError> {
+    fn of(ctx: &Ctx<'_>, case: &Case, budget: &ParticleBudget) -> Result<Geometry, CaseError> {
         let layers = case.tank.as_ref().map_or(3, |t| t.layers as i64);
         let wall_layers = case.tank.as_ref().map_or(layers, |t| match t.wall {
             Treatment::Dynamic | Treatment::FixedGhost { .. } => layers,
@@ -165,19 +165,14 @@ impl Geometry {
                 ctx,
                 t,
                 &lat,
-                case.tank.as_ref().map(|t| &t.inner),
-                case.domain.as_ref(),
+                (case.tank.as_ref().map(|t| &t.inner), case.domain.as_ref()),
+                budget,
             )?),
             None => None,
         };
-        let raised = raise_buildings(ctx, case, &lat, ground.as_ref())?;
-        let fills = fills(
-            ctx,
-            case,
-            &lat,
-            (&obstacle_ranges, &raised),
-            ground.as_ref(),
-        )?;
+        let raised = raise_buildings(ctx, case, &lat, ground.as_ref(), budget)?;
+        let under = (&obstacle_ranges[..], &raised);
+        let fills = fills(ctx, case, &lat, under, (ground.as_ref(), budget))?;
         Ok(Geometry {
             layers,
             wall_layers,
@@ -219,6 +214,7 @@ fn raise_buildings(
     case: &Case,
     lat: &Lattice,
     ground: Option<&Ground>,
+    budget: &ParticleBudget,
 ) -> Result<Raised, CaseError> {
     if case.buildings.is_empty() {
         return Ok(Raised::default());
@@ -237,7 +233,7 @@ fn raise_buildings(
         floor: case.tank.as_ref().map(|t| t.inner.min[2]),
         clip,
     };
-    super::buildings::raise(ctx, &case.buildings, lat, &site)
+    super::buildings::raise(ctx, &case.buildings, lat, &site, budget)
 }
 
 /// Each fill's water, spread from its seed within what holds it (the tank's inner box and the
@@ -249,7 +245,7 @@ fn fills(
     case: &Case,
     lat: &Lattice,
     (obstacle_ranges, raised): (&[IndexRange], &Raised),
-    ground: Option<&Ground>,
+    (ground, budget): (Option<&Ground>, &ParticleBudget),
 ) -> Result<Vec<super::fill::Filled>, CaseError> {
     if case.fills.is_empty() {
         return Ok(Vec::new());
@@ -278,13 +274,13 @@ fn fills(
                         b.max[a] = b.max[a].min(d.max[a]);
                     }
                 }
-                (b, "the tank's inner box")
+                (b, "the tank's inner box (tank.min_m to tank.max_m)")
             }
-            (None, Some(d), _) => (*d, "the domain"),
+            (None, Some(d), _) => (*d, "the domain (domain.min_m to domain.max_m)"),
             (None, None, Some(g)) => {
                 let mut b = g.bounds;
                 b.max[v] = f64::INFINITY;
-                (b, "the terrain's columns")
+                (b, "the terrain's columns (terrain.file)")
             }
             (None, None, None) => return Err(ctx.err(
                 "fill[0]",
@@ -296,7 +292,8 @@ fn fills(
         };
     let mut fills = Vec::with_capacity(case.fills.len());
     for (i, f) in case.fills.iter().enumerate() {
-        let mut filled = super::fill::filled(ctx, (i, f), lat, (&bound.0, bound.1), blocked)?;
+        let holder = (&bound.0, bound.1);
+        let mut filled = super::fill::filled(ctx, (i, f), lat, holder, (blocked, budget))?;
         if let (Some(t), Some(g)) = (&case.terrain, ground) {
             let points = std::mem::take(&mut filled.points);
             filled.points = g.settle_all(t, points, case.dx, |p| blocked(p).is_none());
@@ -409,15 +406,21 @@ fn lattice(case: &Case) -> Lattice {
     let v = case.dim - 1;
     Lattice {
         // The tank's inner corner, else the first fluid block's, else the first inlet's, else
-        // the first fill's seed with a row of cells topped at its level, else (solids and
-        // walls without fluid) the first solid's.
+        // for fills the terrain's corner (or the domain's, or the first fill's seed) with a row
+        // of cells topped at the first fill's level, else (solids and walls without fluid)
+        // the first solid's.
         origin: match (&case.tank, case.blocks.first(), case.inlets.first()) {
             (Some(t), _, _) => t.inner.min,
             (None, Some(b), _) => b.bx.min,
             (None, None, Some(i)) => i.bx.min,
             (None, None, None) => match case.fills.first() {
                 Some(f) => {
-                    let mut o = f.seed;
+                    let terrain = case.terrain.as_ref().map(|t| t.grid.extent().0);
+                    let mut o = match (terrain, case.domain) {
+                        (Some(sw), _) => [sw[0], sw[1], 0.0],
+                        (None, Some(d)) => d.min,
+                        (None, None) => f.seed,
+                    };
                     o[v] = f.level;
                     o
                 }

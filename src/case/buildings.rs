@@ -6,11 +6,12 @@ use std::path::Path;
 
 use crate::generate::footprint::{parse_geojson, Footprint, FootprintError};
 
-use super::check::{number, read_bounded, treatment, Aabb, Bound, Treatment};
+use super::check::{number, particle_wall, read_bounded, support_layers, Aabb, Bound, Treatment};
 use super::error::{num, CaseError};
 use super::lattice::{range_points, Lattice};
+use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
-use super::schema::{RawBuildings, WallName};
+use super::schema::RawBuildings;
 use super::terrain::Terrain;
 
 /// The largest footprint file: 1 GiB of GeoJSON.
@@ -47,25 +48,8 @@ pub(super) fn validate(
                 "set dimension = 3, or draw a 2D building as an [[obstacle]]",
             ));
         }
-        let wall = treatment(ctx, &path, b.wall, b.slip)?;
-        if b.wall == Some(WallName::Mirror) {
-            return Err(ctx.err(
-                &format!("{path}.wall"),
-                Some("\"mirror\"".into()),
-                "mirror ghosts are for the tank's straight faces, not buildings",
-                "use wall = \"dynamic\" (or \"fixed_ghost\" or \"repulsive\")",
-            ));
-        }
-        let support = (2.0 * h_over_dx).ceil().clamp(1.0, 8.0) as i64;
-        let layers = b.layers.unwrap_or(support);
-        if !(1..=8).contains(&layers) {
-            return Err(ctx.err(
-                &format!("{path}.layers"),
-                Some(layers.to_string()),
-                "must be between 1 and 8 (wall-particle layers of the walls and roofs)",
-                format!("leave it out: the default, {support}, covers the kernel support 2h"),
-            ));
-        }
+        let wall = particle_wall(ctx, &path, (b.wall, b.slip), "buildings")?;
+        let layers = support_layers(ctx, &path, b.layers, h_over_dx)?;
         let default = match b.default_height_m {
             None => None,
             Some(h) => Some(number(
@@ -102,7 +86,7 @@ pub(super) fn validate(
         out.push(Buildings {
             footprints: resolved,
             wall,
-            layers: layers as u32,
+            layers,
             file: b.file.clone(),
         });
     }
@@ -183,19 +167,24 @@ pub(super) struct Site<'a> {
 /// Each building of `tables` raised on the lattice: a footprint's columns (centres inside it
 /// and the clip) hold its walls (within `layers` spacings of the outline) from `layers`
 /// spacings under the lowest ground beneath it up to its roof, the ground's mean elevation
-/// beneath it plus its height; the columns further in hold the roof's `layers` layers.
+/// beneath it plus its height; the columns further in hold the roof's `layers` layers. An
+/// error as soon as they hold more particles than `budget`.
 pub(super) fn raise(
     ctx: &Ctx<'_>,
     tables: &[Buildings],
     lat: &Lattice,
     site: &Site<'_>,
+    budget: &ParticleBudget,
 ) -> Result<Raised, CaseError> {
     let dx = lat.dx;
     let mut raised = Raised::default();
     for (i, b) in tables.iter().enumerate() {
         let mut left_out = 0;
         for (j, f) in b.footprints.iter().enumerate() {
-            let columns = columns(f, lat, site.clip);
+            let columns = columns(f, lat, site.clip, |n| {
+                let count = ("the buildings", raised.points.len() as f64 + n);
+                limits::part_fits(ctx, (dx, 3), count, budget)
+            })?;
             let ground: Vec<f64> = columns
                 .iter()
                 .map(|c| match site.terrain {
@@ -217,14 +206,24 @@ pub(super) fn raise(
                 (None, _) => lowest,
             };
             let z = |height: f64| lat.origin[2] + height;
-            let (k_lo, k_hi) = (
-                ((bottom - lat.origin[2]) / dx - 0.5).ceil() as i64,
-                ((roof - lat.origin[2]) / dx - 1.0 + 1e-9).floor() as i64,
-            );
-            if k_hi < k_lo {
+            // The layers' indices, the wall's full height counted against the budget before any
+            // is made (and kept within the lattice's index range: a building that far away is
+            // refused by the domain's check).
+            let lo = ((bottom - lat.origin[2]) / dx - 0.5).ceil();
+            let hi = ((roof - lat.origin[2]) / dx - 1.0 + 1e-9).floor();
+            // (NaN: no layer either.)
+            if hi.partial_cmp(&lo).is_none_or(|o| o.is_lt()) {
                 left_out += 1;
                 continue;
             }
+            let at_most = raised.points.len() as f64 + columns.len() as f64 * (hi - lo + 1.0);
+            let part = match site.terrain {
+                // Their heights count from the ground's elevations, less terrain.origin_m's.
+                Some(_) => "the buildings (on the terrain's elevations less terrain.origin_m)",
+                None => "the buildings",
+            };
+            limits::part_fits(ctx, (dx, 3), (part, at_most), budget)?;
+            let (k_lo, k_hi) = (lo.clamp(-1e15, 1e15) as i64, hi.clamp(-1e15, 1e15) as i64);
             let roof_layers = (k_hi - b.layers as i64 + 1).max(k_lo);
             for c in &columns {
                 let wall = f.distance_to_outline(c[0], c[1]) < depth;
@@ -285,8 +284,14 @@ pub(super) fn raise(
     Ok(raised)
 }
 
-/// The lattice's columns (centres, z unused) inside the footprint and the clip.
-fn columns(f: &Footprint, lat: &Lattice, clip: ([f64; 2], [f64; 2])) -> Vec<[f64; 3]> {
+/// The lattice's columns (centres, z unused) inside the footprint and the clip; `fits` judges
+/// the number of columns of its box first (each column holds a particle at least).
+fn columns(
+    f: &Footprint,
+    lat: &Lattice,
+    clip: ([f64; 2], [f64; 2]),
+    fits: impl Fn(f64) -> Result<(), CaseError>,
+) -> Result<Vec<[f64; 3]>, CaseError> {
     let (min, max) = f.bounds();
     let z0 = lat.origin[2];
     let b = Aabb {
@@ -294,12 +299,13 @@ fn columns(f: &Footprint, lat: &Lattice, clip: ([f64; 2], [f64; 2])) -> Vec<[f64
         max: [max[0].min(clip.1[0]), max[1].min(clip.1[1]), z0 + lat.dx],
     };
     let Some((lo, hi)) = lat.range_in(&b) else {
-        return Vec::new();
+        return Ok(Vec::new());
     };
-    range_points(lat, lo, hi)
+    fits((hi[0] - lo[0] + 1.0) * (hi[1] - lo[1] + 1.0))?;
+    Ok(range_points(lat, lo, hi)
         .map(|idx| lat.pos(idx))
         .filter(|p| f.contains(p[0], p[1]))
-        .collect()
+        .collect())
 }
 
 /// The box of all the footprints, (min, max).

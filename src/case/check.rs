@@ -27,6 +27,46 @@ pub(super) fn file_safe(name: &str) -> bool {
             .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
 }
 
+/// The wall treatment of the particle wall at `path` (`what` it is, for the message): any but
+/// mirror ghosts, which are the tank's straight faces.
+pub(super) fn particle_wall(
+    ctx: &Ctx<'_>,
+    path: &str,
+    (wall, slip): (Option<WallName>, Option<SlipName>),
+    what: &str,
+) -> Result<Treatment, CaseError> {
+    if wall == Some(WallName::Mirror) {
+        return Err(ctx.err(
+            &format!("{path}.wall"),
+            Some("\"mirror\"".into()),
+            format!("mirror ghosts are for the tank's straight faces, not {what}"),
+            "use wall = \"dynamic\" (or \"fixed_ghost\" or \"repulsive\")",
+        ));
+    }
+    treatment(ctx, path, wall, slip)
+}
+
+/// `path.layers` of a particle wall, 1 to 8: by default enough to cover the kernel support 2h
+/// (⌈2 h/dx⌉).
+pub(super) fn support_layers(
+    ctx: &Ctx<'_>,
+    path: &str,
+    given: Option<i64>,
+    h_over_dx: f64,
+) -> Result<u32, CaseError> {
+    let support = (2.0 * h_over_dx).ceil().clamp(1.0, 8.0) as i64;
+    let layers = given.unwrap_or(support);
+    if !(1..=8).contains(&layers) {
+        return Err(ctx.err(
+            &format!("{path}.layers"),
+            Some(layers.to_string()),
+            "must be between 1 and 8 (wall-particle layers)",
+            format!("leave it out: the default, {support}, covers the kernel support 2h"),
+        ));
+    }
+    Ok(layers as u32)
+}
+
 /// An axis-aligned box (3 components; in 2D the third is 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Aabb {

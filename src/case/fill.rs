@@ -8,6 +8,7 @@ use crate::generate::fill::{flood, IndexBox};
 use super::check::{number, vector, Aabb, Bound};
 use super::error::{num, CaseError};
 use super::lattice::Lattice;
+use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
 use super::schema::RawFill;
 
@@ -55,13 +56,14 @@ pub(super) struct Filled {
 
 /// The lattice points of fill `i`: those within `bound` whose cells lie below the level,
 /// connected to the seed's point through points no `blocked` names. An error when the seed's
-/// point is outside, above the level or blocked.
+/// point is outside, above the level or blocked, or when the water would hold more particles
+/// than `budget` (found as it spreads).
 pub(super) fn filled(
     ctx: &Ctx<'_>,
     (i, fill): (usize, &Fill),
     lat: &Lattice,
     (bound, holder): (&Aabb, &str),
-    blocked: impl Fn([f64; 3]) -> Option<String>,
+    (blocked, budget): (impl Fn([f64; 3]) -> Option<String>, &ParticleBudget),
 ) -> Result<Filled, CaseError> {
     let (dim, dx, v) = (lat.dim, lat.dx, lat.dim - 1);
     let path = format!("fill[{i}]");
@@ -74,7 +76,8 @@ pub(super) fn filled(
             &format!("{path}.level_m"),
             Some(num(fill.level)),
             format!(
-                "leaves no water: no particle of spacing dx = {} m fits below it inside {holder}",
+                "leaves no water: no particle of spacing particles.dx_m = {} m fits below it \
+                 inside {holder}",
                 num(dx)
             ),
             "raise the level above the ground",
@@ -113,8 +116,9 @@ pub(super) fn filled(
             &seed_path,
             seed_value,
             format!(
-                "lies outside {holder}, or within half a spacing of the level: the water has \
-                 nowhere to start"
+                "lies outside {holder}, or within half a spacing (particles.dx_m / 2 = {} m) of \
+                 the level: the water has nowhere to start",
+                num(0.5 * dx)
             ),
             "put the seed in the water: inside the tank (or domain), below level_m",
         ));
@@ -124,17 +128,22 @@ pub(super) fn filled(
             &seed_path,
             seed_value,
             format!(
-                "lies in {what} (its nearest particle, at {:?}, is no place for water): the \
-                 water has nowhere to start",
+                "lies in {what} (its nearest particle at particles.dx_m = {} m, at {:?}, is no \
+                 place for water): the water has nowhere to start",
+                num(dx),
                 &lat.pos(seed)[..dim]
             ),
-            "put the seed in the open water, above the ground and clear of walls and bodies",
+            "put the seed in the open water, a few spacings above the ground and clear of \
+             walls and bodies",
         ));
     }
-    let points: Vec<[f64; 3]> = flood(&index, seed, |p| blocked(lat.pos(p)).is_none())
-        .into_iter()
-        .map(|p| lat.pos(p))
-        .collect();
+    let limit = budget.particles.min(1e15) as usize;
+    let Some(points) = flood(&index, seed, limit, |p| blocked(lat.pos(p)).is_none()) else {
+        let water = format!("{path}'s water inside {holder}");
+        let count = (water.as_str(), limit as f64);
+        return Err(limits::too_many(ctx, (dx, dim), count, budget));
+    };
+    let points: Vec<[f64; 3]> = points.into_iter().map(|p| lat.pos(p)).collect();
     Ok(Filled {
         water: water_box(&points, dx, dim),
         points,

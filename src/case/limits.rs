@@ -77,6 +77,42 @@ fn fmt_limit(n: f64) -> String {
     }
 }
 
+/// `count` particles of one part of the case (`part`, as a message names it) within the
+/// budget, checked before they are made: a terrain, buildings or a fill of a case whose dx is
+/// far too small would otherwise take minutes to find out how many they are.
+pub(super) fn part_fits(
+    ctx: &Ctx<'_>,
+    (dx, dim): (f64, usize),
+    (part, count): (&str, f64),
+    budget: &ParticleBudget,
+) -> Result<(), CaseError> {
+    if count <= budget.particles {
+        return Ok(());
+    }
+    Err(too_many(ctx, (dx, dim), (part, count), budget))
+}
+
+/// The error of a part of the case (`part`) that would create more than `count` particles,
+/// beyond `budget`.
+pub(super) fn too_many(
+    ctx: &Ctx<'_>,
+    (dx, dim): (f64, usize),
+    (part, count): (&str, f64),
+    budget: &ParticleBudget,
+) -> CaseError {
+    ctx.err(
+        "particles.dx_m",
+        Some(num(dx)),
+        format!(
+            "{part} alone would create more than {} particles, more than {} ({} limit)",
+            fmt_count(count),
+            fmt_limit(budget.particles),
+            budget.why
+        ),
+        format!("increase particles.dx_m (the count scales as 1/dx^{dim}) or shrink {part}"),
+    )
+}
+
 /// The tank's inner box is `len` m, `spacings` dx, along `axis`.
 pub(super) fn tank_length(
     ctx: &Ctx<'_>,

@@ -162,13 +162,22 @@ fn below_sound(
         return Ok(());
     }
     let field = moving.field.split(" (").next().unwrap_or_default();
+    // A coefficient's c0 is coef sqrt(|g| H): a tiny gravity makes it tiny (found by the case
+    // fuzzing: sloshing_2d with |g| = 1.5e-13 m/s²).
+    let from = match sound_field {
+        "physics.sound_speed_coef" => format!(
+            "{sound_field} and |physics.gravity_m_s2| = {} m/s²",
+            num(sc.physics.gravity.iter().map(|g| g * g).sum::<f64>().sqrt())
+        ),
+        _ => sound_field.to_string(),
+    };
     Err(ctx.err(
         field,
         None,
         format!(
             "{} moves its particles at up to {} m/s, not below the speed of sound c0 = {} m/s \
-             (from {sound_field}): weakly compressible SPH needs the flow and the walls to \
-             move at about c0 / 10 or less",
+             (from {from}): weakly compressible SPH needs the flow and the walls to move at \
+             about c0 / 10 or less",
             moving.field,
             num(moving.speed),
             num(c0)

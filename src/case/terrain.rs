@@ -6,11 +6,14 @@ use std::path::Path;
 
 use crate::generate::terrain::{parse_asc, Column, ElevationGrid, GridError, NodataRule};
 
-use super::check::{number, read_bounded, treatment, vector, Aabb, Bound, Treatment};
+use super::check::{
+    number, particle_wall, read_bounded, support_layers, vector, Aabb, Bound, Treatment,
+};
 use super::error::{num, CaseError};
 use super::lattice::{range_points, Lattice};
+use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
-use super::schema::{NodataName, RawTerrain, WallName};
+use super::schema::{NodataName, RawTerrain};
 
 /// The largest grid file: 2 GiB of text (a 10 000 × 10 000 grid at up to 20 characters a
 /// value).
@@ -49,25 +52,8 @@ pub(super) fn terrain(
             "set dimension = 3, or draw a 2D ground as [[obstacle]] boxes or a polygon body",
         ));
     }
-    let wall = treatment(ctx, "terrain", t.wall, t.slip)?;
-    if t.wall == Some(WallName::Mirror) {
-        return Err(ctx.err(
-            "terrain.wall",
-            Some("\"mirror\"".into()),
-            "mirror ghosts are for the tank's straight faces, not a ground",
-            "use wall = \"dynamic\" (or \"fixed_ghost\" or \"repulsive\")",
-        ));
-    }
-    let support = (2.0 * h_over_dx).ceil().clamp(1.0, 8.0) as i64;
-    let layers = t.layers.unwrap_or(support);
-    if !(1..=8).contains(&layers) {
-        return Err(ctx.err(
-            "terrain.layers",
-            Some(layers.to_string()),
-            "must be between 1 and 8 (wall-particle layers across the surface)",
-            format!("leave it out: the default, {support}, covers the kernel support 2h"),
-        ));
-    }
+    let wall = particle_wall(ctx, "terrain", (t.wall, t.slip), "a ground")?;
+    let layers = support_layers(ctx, "terrain", t.layers, h_over_dx)?;
     let rule = nodata(ctx, t)?;
     let grid = read_grid(ctx, &t.file, case_dir)?
         .filled(rule)
@@ -87,7 +73,7 @@ pub(super) fn terrain(
         grid: grid.shifted(origin),
         origin,
         wall,
-        layers: layers as u32,
+        layers,
     }))
 }
 
@@ -195,13 +181,14 @@ pub(super) struct Ground {
 
 impl Ground {
     /// The ground of `terrain` on `lat`, clipped to the tank's inner box and the domain when
-    /// given; an error when no column is left.
+    /// given; an error when no column is left, or when its columns alone hold more particles
+    /// than `budget` (checked before they are counted).
     pub(super) fn of(
         ctx: &Ctx<'_>,
         terrain: &Terrain,
         lat: &Lattice,
-        tank: Option<&Aabb>,
-        domain: Option<&Aabb>,
+        (tank, domain): (Option<&Aabb>, Option<&Aabb>),
+        budget: &ParticleBudget,
     ) -> Result<Ground, CaseError> {
         let (mut min, mut max) = terrain.grid.extent();
         for b in tank.into_iter().chain(domain) {
@@ -210,6 +197,12 @@ impl Ground {
                 max[a] = max[a].min(b.max[a]);
             }
         }
+        // Columns beyond the budget are refused before any is counted (at a tiny dx the index
+        // range itself overflows).
+        let across = (0..2).map(|a| ((max[a] - min[a]) / lat.dx).max(0.0) + 1.0);
+        let layers = f64::from(terrain.layers);
+        let at_least = ("the terrain", across.product::<f64>() * layers);
+        limits::part_fits(ctx, (lat.dx, 3), at_least, budget)?;
         // The lattice's columns within the clip: the range of points of a box one spacing
         // high at the lattice's origin (z index 0).
         let z0 = lat.origin[2];
@@ -224,8 +217,8 @@ impl Ground {
                 None,
                 format!(
                     "the grid covers x {} to {} m, y {} to {} m in the case's coordinates \
-                     (world minus terrain.origin_m), and no particle column of spacing dx = {} \
-                     m lies over it{}",
+                     (world minus terrain.origin_m), and no particle column of spacing \
+                     particles.dx_m = {} m lies over it{}",
                     num(gmin[0]),
                     num(gmax[0]),
                     num(gmin[1]),

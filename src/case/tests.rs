@@ -36,6 +36,26 @@ kind = "pressure"
 point_m = [0.5, 0.05]
 "#;
 
+/// A fresh folder for one test's files (`test`: unique among the case tests).
+fn folder(test: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("wgsph_case_{test}_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The case text `text` loaded as `dir/c.toml`, so that the files it names are found beside it.
+fn load_in(dir: &std::path::Path, text: &str) -> Result<Scenario, CaseError> {
+    load_str(text, dir.join("c.toml").to_str().unwrap(), &[])
+}
+
+/// The head of a 3D case at spacing `dx`: particles, physics and time (0.1 s).
+fn head_3d(dx: f64) -> String {
+    format!(
+        "dimension = 3\n[particles]\ndx_m = {dx}\n[physics]\nsound_speed_coef = 10.0\n[time]\n\
+         end_s = 0.1\noutput_every_s = 0.05\n"
+    )
+}
+
 fn sets(s: &[&str]) -> Vec<String> {
     s.iter().map(|s| s.to_string()).collect()
 }

@@ -39,10 +39,15 @@ impl IndexBox {
 }
 
 /// The points of `bound` connected to `seed` by steps to one of the six neighbours through
-/// points where `open` holds, `seed` included, in the box's order (x, then y, then z). `seed`
-/// must be open and in the box; the box's points are marked in a bitset (one bit each), so
-/// the caller bounds [`IndexBox::points`].
-pub fn flood(bound: &IndexBox, seed: [i64; 3], open: impl Fn([i64; 3]) -> bool) -> Vec<[i64; 3]> {
+/// points where `open` holds, `seed` included, in the box's order (x, then y, then z); `None`
+/// as soon as they are more than `limit`. `seed` must be open and in the box; the box's points
+/// are marked in a bitset (one bit each), so the caller bounds [`IndexBox::points`].
+pub fn flood(
+    bound: &IndexBox,
+    seed: [i64; 3],
+    limit: usize,
+    open: impl Fn([i64; 3]) -> bool,
+) -> Option<Vec<[i64; 3]>> {
     debug_assert!(bound.contains(seed) && open(seed));
     let mut reached = vec![0u64; bound.points().div_ceil(64) as usize];
     let mut mark = |i: u64| {
@@ -62,6 +67,9 @@ pub fn flood(bound: &IndexBox, seed: [i64; 3], open: impl Fn([i64; 3]) -> bool) 
                 if bound.contains(q) && open(q) && mark(bound.index(q)) {
                     stack.push(q);
                     count += 1;
+                    if count > limit {
+                        return None;
+                    }
                 }
             }
         }
@@ -75,7 +83,7 @@ pub fn flood(bound: &IndexBox, seed: [i64; 3], open: impl Fn([i64; 3]) -> bool) 
             bits &= bits - 1;
         }
     }
-    points
+    Some(points)
 }
 
 #[cfg(test)]
@@ -91,13 +99,17 @@ mod tests {
             hi: [9, 2, 5],
         };
         let open = |p: [i64; 3]| p[2] <= 3 && p[0] != 4;
-        let west = flood(&bound, [1, 1, 1], open);
+        let west = flood(&bound, [1, 1, 1], 1000, open).unwrap();
         assert_eq!(west.len(), 4 * 3 * 4);
         assert!(west.iter().all(|p| p[0] < 4 && p[2] <= 3));
         assert!(west.windows(2).all(|w| w[0] < w[1]), "in the box's order");
         // An opening in the wall at the bottom joins the two halves.
         let open = |p: [i64; 3]| p[2] <= 3 && !(p[0] == 4 && p[2] > 0);
-        assert_eq!(flood(&bound, [1, 1, 1], open).len(), 9 * 3 * 4 + 3);
+        assert_eq!(
+            flood(&bound, [1, 1, 1], 1000, open).unwrap().len(),
+            9 * 3 * 4 + 3
+        );
+        assert_eq!(flood(&bound, [1, 1, 1], 110, open), None, "over the limit");
     }
 
     #[test]

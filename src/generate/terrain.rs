@@ -383,15 +383,6 @@ impl ElevationGrid {
         (min, max)
     }
 
-    /// The lowest and the highest elevation (NaN-free once [`Self::filled`]).
-    pub fn range(&self) -> (f64, f64) {
-        self.z
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &z| {
-                (lo.min(z), hi.max(z))
-            })
-    }
-
     /// The surface's elevation at (x, y): bilinear between the four nearest cells' centres,
     /// held beyond the outermost centres.
     pub fn elevation(&self, x: f64, y: f64) -> f64 {

@@ -19,9 +19,8 @@ const FOOTPRINT: &str = r#"{"type": "FeatureCollection", "features": [
      [[1000.44, 2000.32], [1000.6, 2000.32], [1000.6, 2000.48], [1000.44, 2000.48], [1000.44, 2000.32]]]}}
 ]}"#;
 
-fn folder(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("wgsph_buildings_{test}_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+fn town(test: &str) -> PathBuf {
+    let dir = folder(test);
     let rows = vec![["0.05"; 12].join(" "); 8].join("\n");
     std::fs::write(dir.join("ground.asc"), format!("{GROUND}{rows}\n")).unwrap();
     std::fs::write(dir.join("town.geojson"), FOOTPRINT).unwrap();
@@ -30,15 +29,7 @@ fn folder(test: &str) -> PathBuf {
 
 fn case(buildings: &str) -> String {
     format!(
-        r#"
-dimension = 3
-[particles]
-dx_m = {DX}
-[physics]
-sound_speed_coef = 10.0
-[time]
-end_s = 0.1
-output_every_s = 0.05
+        r#"{}
 [tank]
 min_m = [0.0, 0.0, 0.0]
 max_m = [1.2, 0.8, 0.4]
@@ -50,12 +41,9 @@ file = "town.geojson"
 [[fill]]
 seed_m = [0.1, 0.1, 0.1]
 level_m = 0.15
-"#
+"#,
+        head_3d(DX)
     )
-}
-
-fn load_in(dir: &Path, text: &str) -> Result<Scenario, CaseError> {
-    load_str(text, dir.join("c.toml").to_str().unwrap(), &[])
 }
 
 /// Inside the footprint: the square less the courtyard (their edges halfway between the
@@ -71,7 +59,7 @@ fn in_yard(x: f64, y: f64) -> bool {
 
 #[test]
 fn a_building_stands_on_the_ground_and_the_water_stays_out_of_it() {
-    let dir = folder("stand");
+    let dir = town("buildings_stand");
     let s = load_in(&dir, &case("height_property = \"h\"")).unwrap();
     let inside_tank = |p: &&Particle| (0..2).all(|a| 0.0 < p.pos[a] && p.pos[a] < [1.2, 0.8][a]);
     let walls: Vec<&Particle> = s
@@ -127,7 +115,7 @@ fn a_building_stands_on_the_ground_and_the_water_stays_out_of_it() {
 
 #[test]
 fn bad_buildings_are_refused_naming_the_field_and_the_fix() {
-    let dir = folder("bad");
+    let dir = town("buildings_bad");
     std::fs::write(
         dir.join("far.geojson"),
         FOOTPRINT

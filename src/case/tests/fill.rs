@@ -27,9 +27,8 @@ fn write_basins(dir: &Path) {
     std::fs::write(dir.join("basins.asc"), text).unwrap();
 }
 
-fn folder(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("wgsph_fill_{test}_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+fn basins(test: &str) -> PathBuf {
+    let dir = folder(test);
     write_basins(&dir);
     dir
 }
@@ -37,27 +36,16 @@ fn folder(test: &str) -> PathBuf {
 /// The basins in a tank 1.2 m × 0.4 m, with `fill` (and any other tables) appended.
 fn case(more: &str) -> String {
     format!(
-        r#"
-dimension = 3
-[particles]
-dx_m = {DX}
-[physics]
-sound_speed_coef = 10.0
-[time]
-end_s = 0.1
-output_every_s = 0.05
+        r#"{}
 [tank]
 min_m = [0.0, 0.0, 0.0]
 max_m = [1.2, 0.4, 0.6]
 [terrain]
 file = "basins.asc"
 {more}
-"#
+"#,
+        head_3d(DX)
     )
-}
-
-fn load_in(dir: &Path, text: &str) -> Result<Scenario, CaseError> {
-    load_str(text, dir.join("c.toml").to_str().unwrap(), &[])
 }
 
 /// The grid as the terrain reads it.
@@ -68,7 +56,7 @@ fn grid(dir: &Path) -> crate::generate::terrain::ElevationGrid {
 
 #[test]
 fn water_fills_the_seeds_basin_below_the_level_and_nowhere_else() {
-    let dir = folder("basins");
+    let dir = basins("fill_basins");
     let level = 0.25;
     let s = load_in(
         &dir,
@@ -119,7 +107,7 @@ fn water_fills_the_seeds_basin_below_the_level_and_nowhere_else() {
 
 #[test]
 fn water_flows_around_an_obstacle_and_a_body_not_into_them() {
-    let dir = folder("around");
+    let dir = basins("fill_around");
     let s = load_in(
         &dir,
         &case(
@@ -140,7 +128,7 @@ fn water_flows_around_an_obstacle_and_a_body_not_into_them() {
 
 #[test]
 fn a_seed_with_nowhere_to_start_is_refused() {
-    let dir = folder("seeds");
+    let dir = basins("fill_seeds");
     let cases: [(&str, &[&str]); 5] = [
         (
             "seed_m = [0.6, 0.2, 0.2]\nlevel_m = 0.3",

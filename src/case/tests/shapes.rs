@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::case::mesh::tests::cuboid;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A 3D tank half full, with one body described by `body` (a `[[body]]` table's lines).
 fn case(body: &str) -> String {
@@ -31,13 +31,6 @@ density_kg_m3 = 500.0
     )
 }
 
-/// A fresh folder for one test's files.
-fn folder(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("wgsph_mesh_{test}_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 /// Writes the triangles as a binary STL (f32 coordinates).
 fn write_stl(path: &Path, (v, f): &(Vec<[f64; 3]>, Vec<[usize; 3]>)) {
     let tris: Vec<stl_io::Triangle> = f
@@ -51,17 +44,12 @@ fn write_stl(path: &Path, (v, f): &(Vec<[f64; 3]>, Vec<[usize; 3]>)) {
     stl_io::write_stl(&mut out, tris.iter()).unwrap();
 }
 
-/// The case text `text` loaded as `dir/c.toml`, so that files are found beside it.
-fn load_in(dir: &Path, text: &str) -> Result<Scenario, CaseError> {
-    load_str(text, dir.join("c.toml").to_str().unwrap(), &[])
-}
-
 /// A cuboid drawn as an STL (on coordinates that f32 holds exactly) is the same body as the
 /// box of those corners: the same particles, fluid and domain, the same mass and centre, and
 /// the inertia to rounding. Filled and as a shell of fixed ghosts.
 #[test]
 fn a_cuboid_mesh_is_the_box_body() {
-    let dir = folder("cuboid");
+    let dir = folder("mesh_cuboid");
     let (lo, hi) = ([0.375, 0.3125, 0.375], [0.625, 0.6875, 0.75]);
     write_stl(&dir.join("hull.stl"), &cuboid(lo, hi));
     for extra in ["", "layers = 2\nwall = \"fixed_ghost\""] {
@@ -105,7 +93,7 @@ fn a_cuboid_mesh_is_the_box_body() {
 /// inside the surface, and no fluid left within dx/2 of it.
 #[test]
 fn a_turned_mesh_body_takes_its_mass_properties_from_its_surface() {
-    let dir = folder("turned");
+    let dir = folder("mesh_turned");
     let (v, f) = cuboid([-0.15, -0.1, -0.1], [0.15, 0.1, 0.1]);
     let a = 0.5f64;
     let turn = |p: [f64; 3]| {
@@ -180,7 +168,7 @@ fn has(e: &str, words: &[&str]) {
 
 #[test]
 fn bad_mesh_bodies_are_refused_naming_the_file() {
-    let dir = folder("bad");
+    let dir = folder("mesh_bad");
     let e = |text: &str| refusal(load_in(&dir, text), text);
     has(
         &e(&case("shape = \"mesh\"\nfile = \"none.stl\"")),
@@ -391,7 +379,7 @@ fn thin_fixed_ghost_parts_load_with_a_warning() {
     assert!(warnings(&obstacle(0.9375)).is_empty());
 
     // A mesh, in 3D: a plate 0.125 m thick, and a block 0.4 m thick.
-    let dir = folder("thin");
+    let dir = folder("mesh_thin");
     let mesh_case = |lo, hi| {
         write_stl(&dir.join("hull.stl"), &cuboid(lo, hi));
         load_in(

@@ -1,7 +1,5 @@
 //! `[terrain]`: ground from an ESRI ASCII grid under a tank of water.
 
-use std::path::{Path, PathBuf};
-
 use super::*;
 
 /// World coordinates of the grid's south-west corner (UTM-like: f32 would keep them to 0.5 m).
@@ -22,26 +20,11 @@ fn tilted_grid() -> String {
     text
 }
 
-/// A fresh folder for one test's files.
-fn folder(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("wgsph_terrain_{test}_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 /// Water 0.32 m deep in a 0.6 m tank whose floor is the grid `ground.asc`, plus `terrain`
 /// lines in `[terrain]`.
 fn case(terrain: &str) -> String {
     format!(
-        r#"
-dimension = 3
-[particles]
-dx_m = 0.04
-[physics]
-sound_speed_coef = 10.0
-[time]
-end_s = 0.1
-output_every_s = 0.05
+        r#"{}
 [tank]
 min_m = [0.0, 0.0, 0.0]
 max_m = [0.6, 0.6, 0.48]
@@ -51,12 +34,9 @@ file = "ground.asc"
 [[fluid_block]]
 min_m = [0.0, 0.0, 0.0]
 max_m = [0.6, 0.6, 0.32]
-"#
+"#,
+        head_3d(0.04)
     )
-}
-
-fn load_in(dir: &Path, text: &str) -> Result<Scenario, CaseError> {
-    load_str(text, dir.join("c.toml").to_str().unwrap(), &[])
 }
 
 /// The surface over x: the plane between the outermost cells' centres, held beyond them.
@@ -66,7 +46,7 @@ fn surface(x: f64) -> f64 {
 
 #[test]
 fn the_ground_follows_the_grid_and_the_water_lies_on_it() {
-    let dir = folder("tilted");
+    let dir = folder("terrain_tilted");
     std::fs::write(dir.join("ground.asc"), tilted_grid()).unwrap();
     let s = load_in(&dir, &case("")).unwrap();
     assert_eq!(s.world_origin_m, [WEST, SOUTH, 0.0]);
@@ -146,7 +126,7 @@ pub(super) fn assert_columns_rest_on(
 
 #[test]
 fn an_origin_and_cells_without_data_are_taken_as_the_case_says() {
-    let dir = folder("nodata");
+    let dir = folder("terrain_nodata");
     let holed = tilted_grid().replacen("0.0625", "-9999", 1);
     std::fs::write(
         dir.join("ground.asc"),
@@ -203,7 +183,7 @@ max_m = [0.6, 0.32]
 
 #[test]
 fn bad_terrains_are_refused_naming_the_field_and_the_fix() {
-    let dir = folder("bad");
+    let dir = folder("terrain_bad");
     std::fs::write(dir.join("ground.asc"), tilted_grid()).unwrap();
     std::fs::write(dir.join("ground.tif"), "II*").unwrap();
     std::fs::write(
