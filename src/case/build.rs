@@ -296,7 +296,9 @@ fn fills(
         let mut filled = super::fill::filled(ctx, (i, f), lat, holder, (blocked, budget))?;
         if let (Some(t), Some(g)) = (&case.terrain, ground) {
             let points = std::mem::take(&mut filled.points);
-            filled.points = g.settle_all(t, points, case.dx, |p| blocked(p).is_none());
+            // Moved up, a column stays in what holds it (its top may stand below the level).
+            let open = |p: [f64; 3]| blocked(p).is_none() && point_inside(p, &bound.0, dim);
+            filled.points = g.settle_all(t, points, case.dx, open);
             filled.water = super::fill::water_box(&filled.points, case.dx, dim);
         }
         fills.push(filled);
