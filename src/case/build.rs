@@ -865,11 +865,7 @@ impl<'a> Blockers<'a> {
 
     /// What takes the place of fluid at `p`, as a message names it.
     fn name_at(&self, p: [f64; 3]) -> Option<String> {
-        self.at(p).map(|(kind, j)| match kind {
-            "terrain" => "the terrain".into(),
-            "building" => format!("a building of buildings[{j}]"),
-            _ => format!("{kind}[{j}]"),
-        })
+        self.at(p).map(name_of)
     }
 
     /// Whether `p` lies in the user's box or within a spacing of the particles' box.
@@ -915,12 +911,21 @@ impl<'a> Blockers<'a> {
             Some(("building", i))
         };
         match (obstacle, elastic_solid()) {
-            (None, None) if ground().is_some() => ground(),
-            (None, None) if building().is_some() => building(),
             (Some(i), _) => Some(("obstacle", i)),
             (None, Some(i)) => Some(("solid", i)),
-            (None, None) => body().map(|i| ("body", i)),
+            (None, None) => ground()
+                .or_else(building)
+                .or_else(|| body().map(|i| ("body", i))),
         }
+    }
+}
+
+/// A blocker as [`Blockers::at`] gives it, as a message names it.
+fn name_of((kind, j): (&str, usize)) -> String {
+    match kind {
+        "terrain" => "the terrain".into(),
+        "building" => format!("a building of buildings[{j}]"),
+        _ => format!("{kind}[{j}]"),
     }
 }
 
@@ -965,8 +970,8 @@ fn fluid_particles(
         for pos in block_points(b.bx.min, n.map(|c| c as i64), dx, dim) {
             match blockers.at(pos) {
                 None => points.push(pos),
-                Some(_) => {
-                    first_blocker = first_blocker.or_else(|| blockers.name_at(pos));
+                Some(s) => {
+                    first_blocker.get_or_insert(s);
                 }
             }
         }
@@ -981,7 +986,7 @@ fn fluid_particles(
         }));
         if particles.len() == start_len {
             // A block wholly inside solids is a mistake, and a case without fluid is empty.
-            let solid = first_blocker.unwrap_or_default();
+            let solid = first_blocker.map_or(String::new(), name_of);
             return Err(ctx.err(
                 &format!("fluid_block[{i}]"),
                 None,

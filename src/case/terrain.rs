@@ -270,16 +270,18 @@ impl Ground {
         self.clip
     }
 
+    /// Whether `p` lies over the ground's clip.
+    fn over(&self, p: [f64; 3]) -> bool {
+        let (min, max) = self.clip;
+        (0..2).all(|a| min[a] <= p[a] && p[a] <= max[a])
+    }
+
     /// Whether `p` lies over the ground's clip and less than `clearance` above the surface
     /// (to rounding): no place for fluid.
     pub(super) fn below(&self, terrain: &Terrain, p: [f64; 3], clearance: f64) -> bool {
-        let (min, max) = self.clip;
-        (0..2).all(|a| min[a] <= p[a] && p[a] <= max[a])
-            && p[2] < terrain.grid.elevation(p[0], p[1]) + clearance * (1.0 - 1e-9)
+        self.over(p) && p[2] < terrain.grid.elevation(p[0], p[1]) + clearance * (1.0 - 1e-9)
     }
-}
 
-impl Ground {
     /// Rests a lattice column of fluid on the ground: `column`, one column's fluid points from
     /// the bottom up, moves as a whole so that its lowest point lies half a spacing above the
     /// surface, as above a tank's floor (the lattice leaves a gap of up to a spacing more,
@@ -295,16 +297,12 @@ impl Ground {
         dx: f64,
         open: impl Fn([f64; 3]) -> bool,
     ) {
-        let Some(&lowest) = column.first() else {
+        let Some(&lowest) = column.first().filter(|p| self.over(**p)) else {
             return;
         };
-        let (min, max) = self.clip;
-        if !(0..2).all(|a| min[a] <= lowest[a] && lowest[a] <= max[a]) {
-            return;
-        }
         let rest = terrain.grid.elevation(lowest[0], lowest[1]) + 0.5 * dx;
         let gap = lowest[2] - rest;
-        if !(0.0..dx * (1.0 - 1e-9)).contains(&gap) || gap < 1e-9 * dx {
+        if !(1e-9 * dx..dx * (1.0 - 1e-9)).contains(&gap) {
             return;
         }
         if gap <= 0.5 * dx {
