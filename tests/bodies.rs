@@ -587,7 +587,8 @@ fn a_probe_attached_to_the_tank_moves_with_it_2d() {
 
 #[test]
 fn a_probe_attached_to_the_tank_moves_with_it_3d() {
-    probe_moves_with_the_tank("cases/sloshing_3d.toml", "0.04", 0.25, 2);
+    // The probe's pose is the tank's, whatever the spacing: 0.06 m keeps it a CI test.
+    probe_moves_with_the_tank("cases/sloshing_3d.toml", "0.06", 0.25, 2);
 }
 
 fn probe_moves_with_the_tank(case: &str, dx: &str, t1: f64, up: usize) {

@@ -1227,7 +1227,7 @@ fn ranks_bend_a_total_lagrangian_plate_as_one_run() {
 /// Lagrangian): the gate's interface pressure comes from the water around it
 /// as a ghost's does (a halo of two layers), and its stress crosses the cut with its halo
 /// copies (325 and 85 of its particles on the two ranks). Every particle equals one whole run's
-/// bit for bit after 300 steps.
+/// bit for bit after 100 steps.
 #[test]
 fn ranks_hold_the_water_with_an_elastic_gate_as_one_run() {
     Comparison {
@@ -1238,7 +1238,7 @@ fn ranks_hold_the_water_with_an_elastic_gate_as_one_run() {
             "time.overlap_exchange=\"always\"",
         ],
         ranks: 2,
-        steps: 300,
+        steps: 100,
         ..Default::default()
     }
     .check();
@@ -1247,14 +1247,14 @@ fn ranks_hold_the_water_with_an_elastic_gate_as_one_run() {
 /// The same gate as the case ships it, total-Lagrangian: the ranks share the gate's predicted
 /// positions each step (`Solver::share_tl_positions`), each computes the whole gate's stresses
 /// and accelerates its own particles. Every particle equals one whole run's bit for bit after
-/// 300 steps.
+/// 100 steps.
 #[test]
 fn ranks_hold_the_water_with_a_total_lagrangian_gate_as_one_run() {
     Comparison {
         test: "ranks_hold_the_water_with_a_total_lagrangian_gate_as_one_run",
         case: "cases/elastic_gate_2d.toml",
         ranks: 2,
-        steps: 300,
+        steps: 100,
         ..Default::default()
     }
     .check();

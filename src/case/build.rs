@@ -47,12 +47,15 @@ pub(super) fn build(
     case: Case,
     budget: &ParticleBudget,
 ) -> Result<Scenario, CaseError> {
-    let solids_alone = case.tank.is_none() && case.obstacles.is_empty() && case.bodies.is_empty();
+    let solids_alone = case.tank.is_none()
+        && case.obstacles.is_empty()
+        && case.surfaces.is_empty()
+        && case.bodies.is_empty();
     let no_fluid = case.blocks.is_empty() && case.fills.is_empty() && case.inlets.is_empty();
     if !case.solids.is_empty() && no_fluid && solids_alone {
         return build_solid_case(ctx, case, budget);
     }
-    let geo = Geometry::of(ctx, &case, budget)?;
+    let mut geo = Geometry::of(ctx, &case, budget)?;
     let total = particle_budget(ctx, &case, &geo, budget)?;
     let wall = geo.tank_cells.map(|n| geo.tank_wall(&case, n));
     let elastic = elastic_solids(ctx, &case, &budget.less(total))?;
@@ -62,6 +65,10 @@ pub(super) fn build(
     let placed: Vec<(String, Aabb)> = (ground_box.map(|b| ("terrain".to_string(), b)))
         .into_iter()
         .chain(geo.raised.bounds.map(|b| ("buildings".to_string(), b)))
+        .chain(geo.surface_walls.iter().enumerate().map(|(i, w)| {
+            let box_of = super::fill::water_box(w, case.dx, 3);
+            (format!("surface[{i}]"), box_of)
+        }))
         .collect();
     let domain = domain(ctx, &case, &geo.lat, wall.as_ref(), (&placed, &fills))?;
     let start = Start::of(ctx, &case, &water, elastic.as_ref())?;
@@ -71,7 +78,7 @@ pub(super) fn build(
     let inlets: Vec<_> = case
         .inlets
         .iter()
-        .zip(geo.inlet_layouts)
+        .zip(std::mem::take(&mut geo.inlet_layouts))
         .map(|(s, l)| {
             let rho_at = |depth| start.rho_at(depth);
             super::open_boundaries::build(s, l, &geo.lat, case.gravity, &rho_at, &mut particles)
@@ -94,6 +101,7 @@ pub(super) fn build(
         let under = (&geo.obstacle_ranges[..], &geo.raised);
         ground_particles(&case, t, g, (&geo.lat, under), &rho, &mut particles);
     }
+    surface_particles(&case, &geo, &rho, &mut particles);
     particles.extend(geo.raised.points.iter().map(|&(pos, t)| Particle {
         pos,
         vel: [0.0; 3],
@@ -107,7 +115,11 @@ pub(super) fn build(
 
     let built = Built {
         domain,
-        notes: geo.raised.notes.clone(),
+        notes: (geo.raised.notes.iter())
+            .chain(&geo.surface_notes)
+            .chain(geo.fills.iter().flat_map(|f| &f.notes))
+            .cloned()
+            .collect(),
         particles,
         bodies,
         solids,
@@ -142,6 +154,9 @@ struct Geometry {
     raised: Raised,
     /// Each fill's water.
     fills: Vec<super::fill::Filled>,
+    /// Each surface's wall particles, and what was noticed making them.
+    surface_walls: Vec<Vec<[f64; 3]>>,
+    surface_notes: Vec<String>,
 }
 
 impl Geometry {
@@ -171,6 +186,9 @@ impl Geometry {
             None => None,
         };
         let raised = raise_buildings(ctx, case, &lat, ground.as_ref(), budget)?;
+        let clip = holder(case);
+        let (surface_walls, surface_notes) =
+            super::surface::walls(ctx, (&case.surfaces, h), &lat, clip.as_ref(), budget)?;
         let under = (&obstacle_ranges[..], &raised);
         let fills = fills(ctx, case, &lat, under, (ground.as_ref(), budget))?;
         Ok(Geometry {
@@ -185,6 +203,8 @@ impl Geometry {
             ground,
             raised,
             fills,
+            surface_walls,
+            surface_notes,
         })
     }
 
@@ -306,6 +326,20 @@ fn fills(
     Ok(fills)
 }
 
+/// What holds the fluid: the tank's inner box cut by the domain, or either alone.
+fn holder(case: &Case) -> Option<Aabb> {
+    match (case.tank.as_ref().map(|t| t.inner), case.domain) {
+        (Some(mut b), Some(d)) => {
+            for a in 0..case.dim {
+                b.min[a] = b.min[a].max(d.min[a]);
+                b.max[a] = b.max[a].min(d.max[a]);
+            }
+            Some(b)
+        }
+        (b, d) => b.or(d),
+    }
+}
+
 /// Tank cells along each axis (`None` without a tank): at least one, and not too many.
 fn tank_cells(ctx: &Ctx<'_>, case: &Case) -> Result<Option<[f64; 3]>, CaseError> {
     let Some(t) = &case.tank else {
@@ -421,9 +455,9 @@ fn lattice(case: &Case) -> Lattice {
                     let mut o = match (terrain, case.domain) {
                         (Some(sw), _) => [sw[0], sw[1], 0.0],
                         (None, Some(d)) => d.min,
-                        (None, None) => f.seed,
+                        (None, None) => f.anchor(),
                     };
-                    o[v] = f.level;
+                    o[v] = f.top();
                     o
                 }
                 None => case.solids[0].bx.min,
@@ -617,6 +651,9 @@ fn particle_budget(
     }
     if !geo.raised.points.is_empty() {
         parts.push(("buildings".into(), geo.raised.points.len() as f64));
+    }
+    for (i, w) in geo.surface_walls.iter().enumerate() {
+        parts.push((format!("surface[{i}]"), w.len() as f64));
     }
     let n_wall_parts = parts.len();
     for (i, b) in case.bodies.iter().enumerate() {
@@ -821,7 +858,7 @@ fn sound_speed(
 }
 
 /// What takes the place of fluid: the obstacles (the user's box and that of its particles),
-/// the elastic solids and the bodies.
+/// the elastic solids, the ground, the buildings, the surfaces and the bodies.
 struct Blockers<'a> {
     case: &'a Case,
     /// Each obstacle's box and the box of its particles.
@@ -910,11 +947,19 @@ impl<'a> Blockers<'a> {
             let (i, _) = self.raised.at(&case.buildings, p, case.dx)?;
             Some(("building", i))
         };
+        let surface = || {
+            // Fluid keeps half a spacing off the surface, as off the ground.
+            let clearance = 0.5 * case.dx * (1.0 - 1e-6);
+            (case.surfaces.iter())
+                .position(|s| s.blocks(p, case.dx, clearance))
+                .map(|i| ("surface", i))
+        };
         match (obstacle, elastic_solid()) {
             (Some(i), _) => Some(("obstacle", i)),
             (None, Some(i)) => Some(("solid", i)),
             (None, None) => ground()
                 .or_else(building)
+                .or_else(surface)
                 .or_else(|| body().map(|i| ("body", i))),
         }
     }
@@ -1142,6 +1187,39 @@ fn ground_particles(
                 vel: [0.0; 3],
                 rho: rho.of(terrain.wall, pos),
                 kind: kind_of(terrain.wall),
+            });
+        }
+    }
+}
+
+/// The surfaces' wall particles, pushed onto `particles`: those in an obstacle's particles'
+/// box are the obstacle's, those under the terrain's surface the ground's, and a point
+/// of two surfaces is the first's.
+fn surface_particles(
+    case: &Case,
+    geo: &Geometry,
+    rho: &BoundaryRho<'_>,
+    particles: &mut Vec<Particle>,
+) {
+    let blockers = Blockers::new(
+        case,
+        (&geo.lat, &geo.obstacle_ranges),
+        (geo.ground.as_ref(), &geo.raised),
+        None,
+    );
+    let mut seen = HashSet::new();
+    for (s, points) in case.surfaces.iter().zip(&geo.surface_walls) {
+        for &pos in points {
+            let first = blockers.at(pos);
+            let taken = matches!(first, Some(("obstacle" | "terrain" | "building", _)));
+            if taken || !seen.insert(pos.map(f64::to_bits)) {
+                continue;
+            }
+            particles.push(Particle {
+                pos,
+                vel: [0.0; 3],
+                rho: rho.of(s.wall, pos),
+                kind: kind_of(s.wall),
             });
         }
     }

@@ -299,16 +299,22 @@ pub(super) fn fmt_box(b: &Aabb, dim: usize) -> String {
 
 /// The text of the file at `path`, or an error if it is longer than `limit` bytes.
 pub(crate) fn read_bounded(path: &Path, limit: u64) -> std::io::Result<String> {
+    String::from_utf8(read_bytes_bounded(path, limit)?)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+}
+
+/// The bytes of the file at `path`, or an error if it is longer than `limit` bytes.
+pub(crate) fn read_bytes_bounded(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
-    let mut text = String::new();
+    let mut bytes = Vec::new();
     std::fs::File::open(path)?
         .take(limit + 1)
-        .read_to_string(&mut text)?;
-    if text.len() as u64 > limit {
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
         return Err(std::io::Error::new(
             std::io::ErrorKind::FileTooLarge,
             format!("longer than {} MiB; is it the right file?", limit >> 20),
         ));
     }
-    Ok(text)
+    Ok(bytes)
 }

@@ -8,9 +8,11 @@
 //! mesh drawn on round numbers. Triangles are bucketed by the columns of a grid in x–y, so a
 //! line or a small ball meets only the triangles of the columns it touches.
 
-use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
+
+use crate::generate::surface::Edges;
+use crate::generate::triangle::{cross, distance, dot, sub};
 
 use super::check::Aabb;
 
@@ -302,7 +304,7 @@ impl Mesh {
                 if apart {
                     continue;
                 }
-                let d = distance_to_triangle(p, tri);
+                let d = distance(p, tri);
                 if d < best {
                     best = d;
                     found = true;
@@ -372,9 +374,7 @@ impl Mesh {
                 for j in range[1].0..=range[1].1 as usize {
                     for i in range[0].0..=range[0].1 as usize {
                         let idx = i + n[0] * (j + n[1] * k);
-                        if !near[idx]
-                            && distance_to_triangle([at(0, i), at(1, j), at(2, k)], tri) < reach
-                        {
+                        if !near[idx] && distance([at(0, i), at(1, j), at(2, k)], tri) < reach {
                             near[idx] = true;
                         }
                     }
@@ -394,57 +394,28 @@ pub(super) fn odd_above(z: f64, crossings: &[f64]) -> bool {
 /// Every edge must be shared by exactly two triangles that run along it in opposite
 /// directions: then the surface is closed and its orientation is consistent.
 fn check_closed(file: &str, v: &[[f64; 3]], faces: &[[usize; 3]]) -> Result<(), MeshError> {
-    // Directed edges (from, to) and how often each occurs, in the order first seen.
-    let mut count: HashMap<(usize, usize), u32> = HashMap::new();
-    let mut order = Vec::new();
-    for f in faces {
-        for e in 0..3 {
-            let (a, b) = (f[e], f[(e + 1) % 3]);
-            if a == b {
-                // A collapsed edge of a degenerate triangle bounds nothing.
-                continue;
-            }
-            let c = count.entry((a, b)).or_insert(0);
-            if *c == 0 {
-                order.push((a, b));
-            }
-            *c += 1;
-        }
-    }
-    let uses = |a: usize, b: usize| count.get(&(a, b)).copied().unwrap_or(0);
-    let (mut open, mut crowded, mut same_way) = (Vec::new(), Vec::new(), None);
-    for &(a, b) in &order {
-        let (along, back) = (uses(a, b), uses(b, a));
-        match along + back {
-            1 => open.push((a, b)),
-            2 if back == 0 => same_way = same_way.or(Some((a, b))),
-            2 => {}
-            // Each undirected edge once, from its first-seen direction.
-            _ if back == 0 || (a, b) < (b, a) => crowded.push((a, b)),
-            _ => {}
-        }
-    }
-    if let Some(&(a, b)) = open.first() {
+    let edges = Edges::of(v, faces);
+    if let Some((from, to)) = edges.open_example {
         return Err(MeshError::Open {
             file: file.into(),
-            count: open.len(),
-            from: v[a],
-            to: v[b],
+            count: edges.open,
+            from,
+            to,
         });
     }
-    if let Some(&(a, b)) = crowded.first() {
+    if let Some((from, to)) = edges.crowded_example {
         return Err(MeshError::NonManifold {
             file: file.into(),
-            count: crowded.len(),
-            from: v[a],
-            to: v[b],
+            count: edges.crowded,
+            from,
+            to,
         });
     }
-    if let Some((a, b)) = same_way {
+    if let Some((from, to)) = edges.same_way_example {
         return Err(MeshError::Inconsistent {
             file: file.into(),
-            from: v[a],
-            to: v[b],
+            from,
+            to,
         });
     }
     Ok(())
@@ -556,123 +527,11 @@ fn orient(a: [f64; 3], b: [f64; 3], x: f64, y: f64) -> f64 {
     (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-/// Distance from `p` to the closest point of the triangle (Ericson, Real-Time Collision
-/// Detection, 2005, §5.1.5: the Voronoi region of `p` among the vertices, edges and face).
-fn distance_to_triangle(p: [f64; 3], [a, b, c]: &[[f64; 3]; 3]) -> f64 {
-    let (ab, ac, ap) = (sub(*b, *a), sub(*c, *a), sub(p, *a));
-    let at = |s: f64, t: f64| {
-        let q = [0, 1, 2].map(|k| a[k] + s * ab[k] + t * ac[k]);
-        let d = sub(p, q);
-        dot(d, d).sqrt()
-    };
-    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return at(0.0, 0.0);
-    }
-    let bp = sub(p, *b);
-    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return at(1.0, 0.0);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return at(d1 / (d1 - d3), 0.0);
-    }
-    let cp = sub(p, *c);
-    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return at(0.0, 1.0);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return at(0.0, d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return at(1.0 - w, w);
-    }
-    let denom = va + vb + vc;
-    at(vb / denom, vc / denom)
-}
-
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
 
-    /// The box [lo, hi] as 8 vertices and 12 outward triangles.
-    pub(in crate::case) fn cuboid(lo: [f64; 3], hi: [f64; 3]) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
-        let v = (0..8)
-            .map(|i| [0, 1, 2].map(|a| if i >> a & 1 == 1 { hi[a] } else { lo[a] }))
-            .collect();
-        let f = vec![
-            [0, 2, 3],
-            [0, 3, 1],
-            [4, 5, 7],
-            [4, 7, 6],
-            [0, 1, 5],
-            [0, 5, 4],
-            [2, 6, 7],
-            [2, 7, 3],
-            [0, 4, 6],
-            [0, 6, 2],
-            [1, 3, 7],
-            [1, 7, 5],
-        ];
-        (v, f)
-    }
-
-    /// A latitude–longitude sphere of `rings` bands and `sectors` sectors.
-    fn globe(
-        c: [f64; 3],
-        r: f64,
-        rings: usize,
-        sectors: usize,
-    ) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
-        use std::f64::consts::PI;
-        let mut v = vec![[c[0], c[1], c[2] + r]];
-        for k in 1..rings {
-            let th = PI * k as f64 / rings as f64;
-            for j in 0..sectors {
-                let ph = 2.0 * PI * j as f64 / sectors as f64;
-                v.push([
-                    c[0] + r * th.sin() * ph.cos(),
-                    c[1] + r * th.sin() * ph.sin(),
-                    c[2] + r * th.cos(),
-                ]);
-            }
-        }
-        v.push([c[0], c[1], c[2] - r]);
-        let south = v.len() - 1;
-        let at = |k: usize, j: usize| 1 + (k - 1) * sectors + j % sectors;
-        let mut f = Vec::new();
-        for j in 0..sectors {
-            f.push([0, at(1, j), at(1, j + 1)]);
-            for k in 1..rings - 1 {
-                let (a, b, c, d) = (at(k, j), at(k, j + 1), at(k + 1, j), at(k + 1, j + 1));
-                f.push([a, c, d]);
-                f.push([a, d, b]);
-            }
-            f.push([south, at(rings - 1, j + 1), at(rings - 1, j)]);
-        }
-        (v, f)
-    }
+    pub(in crate::case) use crate::generate::surface::tests::{cuboid, globe};
 
     fn mesh(vf: (Vec<[f64; 3]>, Vec<[usize; 3]>)) -> Mesh {
         Mesh::new("test.stl", &vf.0, &vf.1).unwrap()
@@ -869,7 +728,7 @@ pub(super) mod tests {
                     })
                     .fold(f64::MAX, f64::min)
             };
-            let got = distance_to_triangle(p, &t);
+            let got = distance(p, &t);
             assert!((got - want).abs() < 1e-9 * (1.0 + want), "{got} vs {want}");
         }
     }

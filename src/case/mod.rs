@@ -48,6 +48,7 @@ mod probes;
 mod runnable;
 mod schema;
 mod solids;
+mod surface;
 mod terrain;
 mod validate;
 mod warnings;

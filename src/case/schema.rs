@@ -23,6 +23,8 @@ pub(super) struct RawCase {
     pub fill: Vec<RawFill>,
     #[serde(default)]
     pub obstacle: Vec<RawObstacle>,
+    #[serde(default)]
+    pub surface: Vec<RawSurface>,
     pub domain: Option<RawBox>,
     pub walls: Option<RawWalls>,
     #[serde(default)]
@@ -242,12 +244,33 @@ pub(super) struct RawTerrain {
     pub slip: Option<SlipName>,
 }
 
-/// Water from a seed up to a level: `[[fill]]` (`docs/cases.md`, "Fills").
+/// Water from a seed up to a level, inside a closed mesh or in a polygon's prism: `[[fill]]`
+/// (`docs/cases.md`, "Fills").
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawFill {
-    pub seed_m: Vec<f64>,
-    pub level_m: f64,
+    pub seed_m: Option<Vec<f64>>,
+    pub mesh: Option<String>,
+    pub polygon_m: Option<Vec<Vec<f64>>>,
+    pub level_m: Option<f64>,
+    pub scale: Option<f64>,
+    pub rotate_deg: Option<Vec<f64>>,
+    pub translate_m: Option<Vec<f64>>,
+}
+
+/// A wall from a triangle mesh file, open or closed: `[[surface]]` (`docs/cases.md`,
+/// "Surfaces").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSurface {
+    pub file: String,
+    pub scale: Option<f64>,
+    pub rotate_deg: Option<Vec<f64>>,
+    pub translate_m: Option<Vec<f64>>,
+    pub flip: Option<bool>,
+    pub layers: Option<i64>,
+    pub wall: Option<WallName>,
+    pub slip: Option<SlipName>,
 }
 
 /// Buildings from a GeoJSON file of footprints: `[[buildings]]` (`docs/cases.md`, "Buildings").

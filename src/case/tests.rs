@@ -1427,6 +1427,7 @@ mod fill;
 mod open_boundaries;
 mod shapes;
 mod solids;
+mod surfaces;
 mod terrain;
 mod walls;
 

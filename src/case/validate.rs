@@ -90,6 +90,8 @@ pub(super) struct Case {
     pub blocks: Vec<Block>,
     /// `[[fill]]`: water from a seed up to a level.
     pub fills: Vec<super::fill::Fill>,
+    /// `[[surface]]`: walls from mesh files.
+    pub surfaces: Vec<super::surface::SurfaceWall>,
     pub obstacles: Vec<Aabb>,
     /// The wall treatment of each obstacle (never `Mirror`).
     pub obstacle_walls: Vec<Treatment>,
@@ -175,7 +177,8 @@ pub(super) fn validate(
         ));
     }
     let blocks = blocks(ctx, raw, dim)?;
-    let fills = super::fill::validate(ctx, &raw.fill, dim)?;
+    let fills = super::fill::validate(ctx, &raw.fill, (dim, dx), case_dir)?;
+    let surfaces = super::surface::validate(ctx, &raw.surface, (dim, dx, h_over_dx), case_dir)?;
     let (obstacles, obstacle_walls, obstacle_paths) = obstacles(ctx, raw, dim)?;
     let mut walls = wall_settings(ctx, raw)?;
     let domain = match &raw.domain {
@@ -224,6 +227,7 @@ pub(super) fn validate(
         buildings,
         blocks,
         fills,
+        surfaces,
         obstacles,
         obstacle_walls,
         obstacle_paths,

@@ -25,6 +25,11 @@ impl IndexBox {
         (0..3).all(|a| self.lo[a] <= p[a] && p[a] <= self.hi[a])
     }
 
+    /// Every point, in the order x, then y, then z.
+    pub fn iter(&self) -> impl Iterator<Item = [i64; 3]> + '_ {
+        (0..self.points()).map(|i| self.point(i))
+    }
+
     fn index(&self, p: [i64; 3]) -> u64 {
         let [_, ny, nz] = self.size();
         let r = [0, 1, 2].map(|a| (p[a] - self.lo[a]) as u64);

@@ -5,4 +5,7 @@
 
 pub mod fill;
 pub mod footprint;
+pub mod mesh_file;
+pub mod surface;
 pub mod terrain;
+pub mod triangle;

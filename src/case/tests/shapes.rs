@@ -32,7 +32,7 @@ density_kg_m3 = 500.0
 }
 
 /// Writes the triangles as a binary STL (f32 coordinates).
-fn write_stl(path: &Path, (v, f): &(Vec<[f64; 3]>, Vec<[usize; 3]>)) {
+pub(super) fn write_stl(path: &Path, (v, f): &(Vec<[f64; 3]>, Vec<[usize; 3]>)) {
     let tris: Vec<stl_io::Triangle> = f
         .iter()
         .map(|t| stl_io::Triangle {
