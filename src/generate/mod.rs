@@ -5,4 +5,5 @@
 
 pub mod fill;
 pub mod footprint;
+pub mod geotiff;
 pub mod terrain;
