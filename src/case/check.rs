@@ -305,10 +305,27 @@ pub(crate) fn read_bounded(path: &Path, limit: u64) -> std::io::Result<String> {
         .take(limit + 1)
         .read_to_string(&mut text)?;
     if text.len() as u64 > limit {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::FileTooLarge,
-            format!("longer than {} MiB; is it the right file?", limit >> 20),
-        ));
+        return Err(too_large(limit));
     }
     Ok(text)
+}
+
+/// The bytes of the file at `path`, or an error if it has more than `limit`.
+pub(crate) fn read_bytes_bounded(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(limit + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(limit));
+    }
+    Ok(bytes)
+}
+
+fn too_large(limit: u64) -> std::io::Error {
+    std::io::Error::new(
+        std::io::ErrorKind::FileTooLarge,
+        format!("longer than {} MiB; is it the right file?", limit >> 20),
+    )
 }

@@ -84,6 +84,20 @@ fn small_file(geo: &Geo) -> Vec<u8> {
     geotiff::<colortype::Gray32Float>((3, 2), &SMALL, geo, Compression::Uncompressed)
 }
 
+/// `grid` as a north-up GeoTIFF of f64 samples (PixelIsArea), as the case's tests give one.
+pub(crate) fn geotiff_of(grid: &ElevationGrid) -> Vec<u8> {
+    let (min, max) = grid.extent();
+    let rows_from_north: Vec<f64> = grid.z.chunks(grid.ncols).rev().flatten().copied().collect();
+    let geo = Geo {
+        scale: Some(vec![grid.cell[0], grid.cell[1], 0.0]),
+        tie_points: Some(vec![0.0, 0.0, 0.0, min[0], max[1], 0.0]),
+        raster_type: Some(1),
+        ..Geo::default()
+    };
+    let size = (grid.ncols as u32, grid.nrows as u32);
+    geotiff::<colortype::Gray64Float>(size, &rows_from_north, &geo, Compression::Uncompressed)
+}
+
 /// A GeoTIFF of `ncols` × `nrows` f32 samples in uncompressed `tile` × `tile` tiles (GDAL's
 /// TILED=YES), `value(col, row)` from the north-west; the edge tiles padded past the image.
 fn tiled(ncols: u32, nrows: u32, tile: u32, value: impl Fn(u32, u32) -> f32, geo: &Geo) -> Vec<u8> {
