@@ -303,7 +303,7 @@ pub(crate) fn read_bounded(path: &Path, limit: u64) -> std::io::Result<String> {
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
 }
 
-/// The bytes of the file at `path`, or an error if it is longer than `limit` bytes.
+/// The bytes of the file at `path`, or an error if it has more than `limit`.
 pub(crate) fn read_bytes_bounded(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
     let mut bytes = Vec::new();
@@ -311,10 +311,14 @@ pub(crate) fn read_bytes_bounded(path: &Path, limit: u64) -> std::io::Result<Vec
         .take(limit + 1)
         .read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::FileTooLarge,
-            format!("longer than {} MiB; is it the right file?", limit >> 20),
-        ));
+        return Err(too_large(limit));
     }
     Ok(bytes)
+}
+
+fn too_large(limit: u64) -> std::io::Error {
+    std::io::Error::new(
+        std::io::ErrorKind::FileTooLarge,
+        format!("longer than {} MiB; is it the right file?", limit >> 20),
+    )
 }

@@ -1,13 +1,16 @@
 //! `[terrain]`: the ground from an elevation grid file (docs/cases.md, "Terrain"), read and
-//! checked field by field. The grid's geometry (the reader of the file's format, the surface,
-//! the wall's columns) is `crate::generate::terrain`'s; this file names the field and the fix.
+//! checked field by field. The grid's geometry (the readers of the files' formats, the surface,
+//! the wall's columns) is `crate::generate::terrain`'s and `crate::generate::geotiff`'s; this
+//! file names the field and the fix.
 
 use std::path::Path;
 
+use crate::generate::geotiff::parse_geotiff;
 use crate::generate::terrain::{parse_asc, Column, ElevationGrid, GridError, NodataRule};
 
 use super::check::{
-    number, particle_wall, read_bounded, support_layers, vector, Aabb, Bound, Treatment,
+    number, particle_wall, read_bounded, read_bytes_bounded, support_layers, vector, Aabb, Bound,
+    Treatment,
 };
 use super::error::{num, CaseError};
 use super::lattice::{range_points, Lattice};
@@ -15,8 +18,8 @@ use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
 use super::schema::{NodataName, RawTerrain};
 
-/// The largest grid file: 2 GiB of text (a 10 000 × 10 000 grid at up to 20 characters a
-/// value).
+/// The largest grid file: 2 GiB (a 10 000 × 10 000 ESRI ASCII grid at up to 20 characters a
+/// value; a GeoTIFF of the most cells a grid may have, as f64, is 1.2 GB).
 const MAX_FILE_BYTES: u64 = 2 << 30;
 
 /// The ground, checked: its grid in the case's coordinates and its wall.
@@ -105,6 +108,14 @@ fn nodata(ctx: &Ctx<'_>, t: &RawTerrain) -> Result<NodataRule, CaseError> {
     }
 }
 
+/// The formats a terrain is read from.
+enum GridFormat {
+    /// ESRI ASCII grid (`.asc`).
+    Asc,
+    /// Single-band GeoTIFF (`.tif`, `.tiff`).
+    GeoTiff,
+}
+
 /// The grid in `file` (relative to `case_dir`), by its extension.
 fn read_grid(ctx: &Ctx<'_>, file: &str, case_dir: &Path) -> Result<ElevationGrid, CaseError> {
     let full = case_dir.join(file);
@@ -119,13 +130,18 @@ fn read_grid(ctx: &Ctx<'_>, file: &str, case_dir: &Path) -> Result<ElevationGrid
     let extension = full
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
-    if extension.as_deref() != Some("asc") {
-        return Err(refuse(
-            "is not an ESRI ASCII grid (.asc), the format a terrain is read from".into(),
-            "export the elevation grid as an ESRI ASCII grid (gdal_translate -of AAIGrid in.tif \
-             out.asc)",
-        ));
-    }
+    let format =
+        match extension.as_deref() {
+            Some("asc") => GridFormat::Asc,
+            Some("tif" | "tiff") => GridFormat::GeoTiff,
+            _ => return Err(refuse(
+                "is neither an ESRI ASCII grid (.asc) nor a GeoTIFF (.tif, .tiff), the formats \
+                 a terrain is read from"
+                    .into(),
+                "export the elevation grid as a GeoTIFF or an ESRI ASCII grid (gdal_translate \
+                 -of GTiff in out.tif, or gdal_translate -of AAIGrid in out.asc)",
+            )),
+        };
     match std::fs::metadata(&full) {
         Ok(m) if m.is_file() => {}
         Ok(_) => {
@@ -141,13 +157,27 @@ fn read_grid(ctx: &Ctx<'_>, file: &str, case_dir: &Path) -> Result<ElevationGrid
             ))
         }
     }
-    let text = read_bounded(&full, MAX_FILE_BYTES).map_err(|e| {
-        refuse(
-            e.to_string(),
-            "give an ESRI ASCII grid (text); resample a larger one coarser",
-        )
-    })?;
-    parse_asc(&text).map_err(|e| grid_error(ctx, file, case_dir, e))
+    let grid = match format {
+        GridFormat::Asc => {
+            let text = read_bounded(&full, MAX_FILE_BYTES).map_err(|e| {
+                refuse(
+                    e.to_string(),
+                    "give an ESRI ASCII grid (text); resample a larger one coarser",
+                )
+            })?;
+            parse_asc(&text)
+        }
+        GridFormat::GeoTiff => {
+            let bytes = read_bytes_bounded(&full, MAX_FILE_BYTES).map_err(|e| {
+                refuse(
+                    e.to_string(),
+                    "give a GeoTIFF elevation grid; resample a larger one coarser (gdalwarp -tr)",
+                )
+            })?;
+            parse_geotiff(&bytes)
+        }
+    };
+    grid.map_err(|e| grid_error(ctx, file, case_dir, e))
 }
 
 /// The grid's error, at `terrain.file` with the file and line.

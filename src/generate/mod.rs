@@ -5,6 +5,7 @@
 
 pub mod fill;
 pub mod footprint;
+pub mod geotiff;
 pub mod mesh_file;
 pub mod surface;
 pub mod terrain;

@@ -42,7 +42,8 @@ impl GridError {
         }
     }
 
-    fn whole(problem: impl Into<String>, fix: impl Into<String>) -> GridError {
+    /// An error of the whole file (no line to blame).
+    pub(super) fn whole(problem: impl Into<String>, fix: impl Into<String>) -> GridError {
         GridError {
             line: None,
             problem: problem.into(),

@@ -1,4 +1,5 @@
-//! `[terrain]`: ground from an ESRI ASCII grid under a tank of water.
+//! `[terrain]`: ground from an ESRI ASCII grid (or the same as a GeoTIFF) under a tank of
+//! water.
 
 use super::*;
 
@@ -83,6 +84,34 @@ fn the_ground_follows_the_grid_and_the_water_lies_on_it() {
         .particles
         .iter()
         .all(|p| p.pos.iter().all(|c| c.abs() < 10.0)));
+}
+
+#[test]
+fn a_geotiff_ground_is_the_ascii_grid_of_the_same_cells() {
+    let dir = folder("terrain_geotiff");
+    let grid = crate::generate::terrain::parse_asc(&tilted_grid()).unwrap();
+    std::fs::write(dir.join("ground.asc"), tilted_grid()).unwrap();
+    std::fs::write(
+        dir.join("ground.TIF"),
+        crate::generate::geotiff::tests::geotiff_of(&grid),
+    )
+    .unwrap();
+    let from_asc = load_in(&dir, &case("")).unwrap();
+    let from_tif = load_in(&dir, &case("").replace("ground.asc", "ground.TIF")).unwrap();
+    // The corner comes back from the tie point within rounding of the world coordinates.
+    for a in 0..3 {
+        assert!((from_tif.world_origin_m[a] - from_asc.world_origin_m[a]).abs() < 1e-6);
+    }
+    assert_eq!(from_tif.particles.len(), from_asc.particles.len());
+    for (t, a) in from_tif.particles.iter().zip(&from_asc.particles) {
+        assert_eq!(t.kind, a.kind);
+        assert!(
+            (0..3).all(|k| (t.pos[k] - a.pos[k]).abs() < 1e-6),
+            "{:?} {:?}",
+            t.pos,
+            a.pos
+        );
+    }
 }
 
 /// Each of the `columns` columns of `fluid`: its lowest particle half a spacing above
@@ -191,15 +220,25 @@ fn bad_terrains_are_refused_naming_the_field_and_the_fix() {
         tilted_grid().replace("ncols 6", "ncols 7"),
     )
     .unwrap();
-    let cases: [(String, &[&str]); 9] = [
+    let cases: [(String, &[&str]); 10] = [
         (TWO_D.to_string(), &["terrain", "2D", "dimension = 3"]),
         (
             case("").replace("ground.asc", "none.asc"),
             &["terrain.file", "none.asc", "relative to the case file"],
         ),
         (
+            case("").replace("ground.asc", "ground.xyz"),
+            &[
+                "terrain.file",
+                "ground.xyz",
+                "(.asc)",
+                "(.tif, .tiff)",
+                "gdal_translate",
+            ],
+        ),
+        (
             case("").replace("ground.asc", "ground.tif"),
-            &["terrain.file", "ESRI ASCII grid", "gdal_translate"],
+            &["terrain.file", "ground.tif", "tiff crate", "gdal_translate"],
         ),
         (
             case("").replace("ground.asc", "short.asc"),
