@@ -273,7 +273,7 @@ fn fills(
     let (dim, v) = (case.dim, case.dim - 1);
     let blockers = Blockers::new(case, (lat, obstacle_ranges), (ground, raised), None);
     // The fluid blocks' water is there already.
-    let blocked = |p: [f64; 3]| {
+    let fixed = |p: [f64; 3]| {
         (case.solids.iter())
             .position(|s| point_inside(p, &s.bx, dim))
             .map(|j| format!("solid[{j}]"))
@@ -284,26 +284,21 @@ fn fills(
             })
             .or_else(|| blockers.name_at(p))
     };
+    let holder_name = match (&case.tank, &case.domain) {
+        (Some(_), _) => "the tank's inner box (tank.min_m to tank.max_m)",
+        (None, Some(_)) => "the domain (domain.min_m to domain.max_m)",
+        (None, None) => "the terrain's columns (terrain.file)",
+    };
     let bound =
-        match (&case.tank, &case.domain, ground) {
-            (Some(t), d, _) => {
-                let mut b = t.inner;
-                if let Some(d) = d {
-                    for a in 0..dim {
-                        b.min[a] = b.min[a].max(d.min[a]);
-                        b.max[a] = b.max[a].min(d.max[a]);
-                    }
-                }
-                (b, "the tank's inner box (tank.min_m to tank.max_m)")
-            }
-            (None, Some(d), _) => (*d, "the domain (domain.min_m to domain.max_m)"),
-            (None, None, Some(g)) => {
+        match (holder(case), ground) {
+            (Some(b), _) => b,
+            (None, Some(g)) => {
                 let mut b = g.bounds;
                 b.max[v] = f64::INFINITY;
-                (b, "the terrain's columns (terrain.file)")
+                b
             }
-            (None, None, None) => return Err(ctx.err(
-                "fill[0]",
+            (None, None) => return Err(ctx.err(
+                &format!("fill[{}]", case.fills[0].index),
                 None,
                 "nothing holds the fill's water: a fill spreads inside a [tank], a [domain] or \
                  over a [terrain]",
@@ -311,16 +306,23 @@ fn fills(
             )),
         };
     let mut fills = Vec::with_capacity(case.fills.len());
-    for (i, f) in case.fills.iter().enumerate() {
-        let holder = (&bound.0, bound.1);
-        let mut filled = super::fill::filled(ctx, (i, f), lat, holder, (blocked, budget))?;
+    // The lattice points of the fills before, which a later fill's water goes around.
+    let mut earlier: std::collections::HashMap<[u64; 3], usize> = Default::default();
+    for f in &case.fills {
+        let blocked = |p: [f64; 3]| {
+            fixed(p).or_else(|| (earlier.get(&p.map(f64::to_bits))).map(|j| format!("fill[{j}]")))
+        };
+        let holder = (&bound, holder_name);
+        let mut filled = super::fill::filled(ctx, f, lat, holder, (&blocked, budget))?;
+        let on_lattice = filled.points.clone();
         if let (Some(t), Some(g)) = (&case.terrain, ground) {
             let points = std::mem::take(&mut filled.points);
             // Moved up, a column stays in what holds it (its top may stand below the level).
-            let open = |p: [f64; 3]| blocked(p).is_none() && point_inside(p, &bound.0, dim);
+            let open = |p: [f64; 3]| blocked(p).is_none() && point_inside(p, &bound, dim);
             filled.points = g.settle_all(t, points, case.dx, open);
             filled.water = super::fill::water_box(&filled.points, case.dx, dim);
         }
+        earlier.extend(on_lattice.iter().map(|p| (p.map(f64::to_bits), f.index)));
         fills.push(filled);
     }
     Ok(fills)

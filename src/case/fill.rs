@@ -23,6 +23,8 @@ const MAX_BOX_POINTS: u64 = 1 << 32;
 /// A fill, checked: where its water is and the level it stands at.
 #[derive(Debug, Clone)]
 pub(super) struct Fill {
+    /// Its place among the file's `[[fill]]` tables, as messages name it.
+    pub index: usize,
     pub region: Region,
     /// The water's top; a mesh's water may be left without one (all of the inside).
     pub level: Option<f64>,
@@ -71,6 +73,7 @@ pub(super) fn validate(
 ) -> Result<Vec<Fill>, CaseError> {
     raw.iter()
         .enumerate()
+        .filter(|(_, f)| f.enabled != Some(false))
         .map(|(i, f)| {
             let path = format!("fill[{i}]");
             let level = match f.level_m {
@@ -117,10 +120,20 @@ pub(super) fn validate(
                         three_d(ctx, &path, dim, "polygon_m")?;
                         Region::Prism(prism(ctx, &path, polygon)?)
                     }
+                    (None, None, None) => {
+                        return Err(ctx.err(
+                            &format!("{path}.seed_m"),
+                            None,
+                            "is missing: a fill needs one place for its water, seed_m, mesh or \
+                         polygon_m",
+                            "give seed_m (water spread from a point), mesh (inside a closed mesh) \
+                         or polygon_m (over a polygon), with level_m",
+                        ))
+                    }
                     _ => return Err(ctx.err(
                         &path,
                         None,
-                        "needs one place for its water: seed_m, mesh or polygon_m",
+                        "has more than one place for its water: seed_m, mesh or polygon_m",
                         "give exactly one of seed_m (water spread from a point), mesh (inside a \
                          closed mesh) or polygon_m (over a polygon), with level_m",
                     )),
@@ -133,7 +146,11 @@ pub(super) fn validate(
                     "add level_m = <elevation in m>",
                 ));
             }
-            Ok(Fill { region, level })
+            Ok(Fill {
+                index: i,
+                region,
+                level,
+            })
         })
         .collect()
 }
@@ -187,20 +204,20 @@ pub(super) struct Filled {
     pub notes: Vec<String>,
 }
 
-/// The lattice points of fill `i` within `bound` whose cells lie below the level and where
+/// The lattice points of `fill` within `bound` whose cells lie below the level and where
 /// no `blocked` names something: connected to the seed's point, inside the mesh, or over the
 /// polygon. An error when that leaves no water (or a seed outside, above the level or
 /// blocked), or when the water would hold more particles than `budget` (found as it
 /// spreads).
 pub(super) fn filled(
     ctx: &Ctx<'_>,
-    (i, fill): (usize, &Fill),
+    fill: &Fill,
     lat: &Lattice,
     (bound, holder): (&Aabb, &str),
     (blocked, budget): (impl Fn([f64; 3]) -> Option<String>, &ParticleBudget),
 ) -> Result<Filled, CaseError> {
     let (dim, dx, v) = (lat.dim, lat.dx, lat.dim - 1);
-    let path = format!("fill[{i}]");
+    let path = format!("fill[{}]", fill.index);
     let mut below = *bound;
     below.max[v] = below.max[v].min(fill.top() - 0.5 * dx);
     let Some((lo, hi)) = lat.range_in(&below) else {

@@ -256,6 +256,8 @@ pub(super) struct RawFill {
     pub scale: Option<f64>,
     pub rotate_deg: Option<Vec<f64>>,
     pub translate_m: Option<Vec<f64>>,
+    /// `false` leaves the fill out (a case with and without a wet bed, `--set`).
+    pub enabled: Option<bool>,
 }
 
 /// A wall from a triangle mesh file, open or closed: `[[surface]]` (`docs/cases.md`,

@@ -226,6 +226,7 @@ pub(crate) fn required(path: &str) -> bool {
             | "terrain.file"
             | "fill[].seed_m"
             | "fill[].level_m"
+            | "surface[].file"
             | "probe[].name"
             | "probe[].kind"
             | "probe[].point_m"

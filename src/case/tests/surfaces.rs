@@ -254,7 +254,11 @@ fn bad_meshes_are_refused_with_the_file_and_the_fix() {
         ),
         (
             "[[fill]]\nseed_m = [0.1, 0.1, 0.1]\nmesh = \"box.stl\"\nlevel_m = 0.2",
-            &["fill[0]", "seed_m, mesh or polygon_m"],
+            &[
+                "fill[0]",
+                "more than one place",
+                "seed_m, mesh or polygon_m",
+            ],
         ),
         (
             "[[fill]]\npolygon_m = [[0.0, 0.0], [0.5, 0.0]]\nlevel_m = 0.2",
@@ -308,4 +312,34 @@ fn a_thin_plate_and_a_closed_box_are_reported() {
         "{:?}",
         s.warnings
     );
+}
+
+/// A later fill's water goes around an earlier one's (a wet bed poured after the reservoir
+/// beside it), and a fill left out by `enabled = false` is not made.
+#[test]
+fn a_later_fill_goes_around_the_water_of_an_earlier_one() {
+    let head = format!(
+        "{}[tank]\nmin_m = [0.0, 0.0, 0.0]\nmax_m = [1.0, 0.5, 0.5]\n\
+         [[fill]]\npolygon_m = [[0.0, 0.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5]]\nlevel_m = 0.25\n\
+         [[fill]]\nseed_m = [0.75, 0.25, 0.05]\nlevel_m = 0.125\n",
+        head_3d(DX)
+    );
+    let both = load_str(&head, "c.toml", &[]).unwrap();
+    let fluid: Vec<[f64; 3]> = (both.particles.iter())
+        .filter(|p| p.kind == Kind::Fluid)
+        .map(|p| p.pos)
+        .collect();
+    let mut keys: Vec<_> = fluid.iter().map(|p| p.map(f64::to_bits)).collect();
+    keys.sort();
+    keys.dedup();
+    assert_eq!(keys.len(), fluid.len(), "two fills put water on one point");
+    // 8 × 8 × 4 under the reservoir's level, 8 × 8 × 2 beside it.
+    assert_eq!(fluid.len(), 8 * 8 * 4 + 8 * 8 * 2);
+    let without = load_str(&head, "c.toml", &sets(&["fill[1].enabled=false"])).unwrap();
+    let count = without
+        .particles
+        .iter()
+        .filter(|p| p.kind == Kind::Fluid)
+        .count();
+    assert_eq!(count, 8 * 8 * 4);
 }
