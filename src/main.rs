@@ -311,7 +311,14 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
             // The adapter first: the case is refused before its particles are made when it
             // holds more than the adapter and the host's memory do.
             let ctx = (!several).then(|| context(cli.adapter)).transpose()?;
+            let started = std::time::Instant::now();
             let sc = load_case(&case, &set, ctx.as_ref())?;
+            let case_build_s = started.elapsed().as_secs_f64();
+            log::info!(
+                "{}: {} particles built in {case_build_s:.2} s",
+                sc.name,
+                sc.particles.len()
+            );
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
             let options = RunOptions {
                 snapshot_png: snapshots.then(|| snapshot_field.unwrap_or_default()),
@@ -322,6 +329,7 @@ fn run(cli: Cli, bars: &MultiProgress) -> Result<ExitCode> {
                     overrides: set,
                 }),
                 interrupt: Some(interrupt_flag()?),
+                case_build_s: Some(case_build_s),
                 ..Default::default()
             };
             let Some(ctx) = ctx else {

@@ -49,6 +49,9 @@ pub struct RunOptions {
     /// Stop with a checkpoint at the first probe time at or after this simulated time, as if
     /// interrupted (batch jobs with a time limit split a run this way; so do the tests).
     pub halt_at_s: Option<f64>,
+    /// Seconds the case took to read and build into particles, for run.json
+    /// (`case_build_s`).
+    pub case_build_s: Option<f64>,
     /// Test hook: destroys the GPU device at the first probe interval after this simulated
     /// time, as a driver reset would.
     #[cfg(feature = "test-hooks")]
@@ -929,6 +932,7 @@ impl<'a> Runner<'a> {
                 .map(|s| s.path.to_string_lossy().into_owned()),
             ranks,
             world_origin_m: sc.world_origin_m,
+            case_build_s: self.options.case_build_s,
         };
         if self.first() {
             self.outputs.out.write_run_summary(&summary)?;

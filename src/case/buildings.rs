@@ -256,7 +256,8 @@ pub(super) fn raise(
                 Some(format!("{:?}", b.file)),
                 format!(
                     "none of its {n} footprints covers a particle column of the model: they \
-                     span x {} to {} m, y {} to {} m in the case's coordinates, the model x {} \
+                     span x {} to {} m, y {} to {} m in the case's coordinates, the model (the \
+                     tank's inner box tank.min_m to tank.max_m, the domain and the terrain) x {} \
                      to {} m, y {} to {} m",
                     num(min[0]),
                     num(max[0]),

@@ -71,33 +71,32 @@ pub(super) fn validate(
     (dim, dx): (usize, f64),
     case_dir: &Path,
 ) -> Result<Vec<Fill>, CaseError> {
-    raw.iter()
-        .enumerate()
-        .filter(|(_, f)| f.enabled != Some(false))
-        .map(|(i, f)| {
-            let path = format!("fill[{i}]");
-            let level = match f.level_m {
-                None => None,
-                Some(l) => Some(number(
-                    ctx,
-                    &format!("{path}.level_m"),
-                    l,
-                    Bound::Closed(-1e7, 1e7),
-                    "the water's level, an elevation in m",
-                    "give the level the water stands at",
-                )?),
-            };
-            let moved = f.scale.is_some() || f.rotate_deg.is_some() || f.translate_m.is_some();
-            if moved && f.mesh.is_none() {
-                return Err(ctx.err(
-                    &path,
-                    None,
-                    "scale, rotate_deg and translate_m place a fill's mesh, and it has none",
-                    "remove them, or give the mesh they place",
-                ));
-            }
-            let region =
-                match (&f.seed_m, &f.mesh, &f.polygon_m) {
+    let checked: Vec<(Fill, bool)> =
+        raw.iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let path = format!("fill[{i}]");
+                let level = match f.level_m {
+                    None => None,
+                    Some(l) => Some(number(
+                        ctx,
+                        &format!("{path}.level_m"),
+                        l,
+                        Bound::Closed(-1e7, 1e7),
+                        "the water's level, an elevation in m",
+                        "give the level the water stands at",
+                    )?),
+                };
+                let moved = f.scale.is_some() || f.rotate_deg.is_some() || f.translate_m.is_some();
+                if moved && f.mesh.is_none() {
+                    return Err(ctx.err(
+                        &path,
+                        None,
+                        "scale, rotate_deg and translate_m place a fill's mesh, and it has none",
+                        "remove them, or give the mesh they place",
+                    ));
+                }
+                let region = match (&f.seed_m, &f.mesh, &f.polygon_m) {
                     (Some(seed), None, None) => Region::Seed(vector(
                         ctx,
                         &format!("{path}.seed_m"),
@@ -138,21 +137,26 @@ pub(super) fn validate(
                          closed mesh) or polygon_m (over a polygon), with level_m",
                     )),
                 };
-            if level.is_none() && !matches!(region, Region::Mesh(..)) {
-                return Err(ctx.err(
-                    &format!("{path}.level_m"),
-                    None,
-                    "is missing: the water stands at a level",
-                    "add level_m = <elevation in m>",
-                ));
-            }
-            Ok(Fill {
-                index: i,
-                region,
-                level,
+                if level.is_none() && !matches!(region, Region::Mesh(..)) {
+                    return Err(ctx.err(
+                        &format!("{path}.level_m"),
+                        None,
+                        "is missing: the water stands at a level",
+                        "add level_m = <elevation in m>",
+                    ));
+                }
+                let fill = Fill {
+                    index: i,
+                    region,
+                    level,
+                };
+                Ok((fill, f.enabled != Some(false)))
             })
-        })
-        .collect()
+            .collect::<Result<_, CaseError>>()?;
+    // A fill left out is checked all the same, as a case with it would be.
+    Ok((checked.into_iter())
+        .filter_map(|(fill, enabled)| enabled.then_some(fill))
+        .collect())
 }
 
 fn three_d(ctx: &Ctx<'_>, path: &str, dim: usize, field: &str) -> Result<(), CaseError> {
@@ -175,25 +179,22 @@ fn prism(ctx: &Ctx<'_>, path: &str, polygon: &[Vec<f64>]) -> Result<Footprint, C
         let c = vector(ctx, &format!("{field}[{k}]"), corner, 2, "a corner [x, y]")?;
         ring.push([c[0], c[1]]);
     }
-    let twice_area: f64 = (0..ring.len())
-        .map(|k| {
-            let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
-            a[0] * b[1] - b[0] * a[1]
-        })
-        .sum();
-    if ring.len() < 3 || twice_area == 0.0 || !twice_area.is_finite() {
-        return Err(ctx.err(
-            &field,
-            None,
-            format!("has {} corners and encloses no area", ring.len()),
-            "give three or more [x, y] corners of the water's outline",
-        ));
-    }
-    Ok(Footprint {
+    let corners = ring.len();
+    let outline = Footprint {
         rings: vec![ring],
         height: None,
         feature: 0,
-    })
+    };
+    let area = outline.outline_area();
+    if corners < 3 || area == 0.0 || !area.is_finite() {
+        return Err(ctx.err(
+            &field,
+            None,
+            format!("has {corners} corners and encloses no area"),
+            "give three or more [x, y] corners of the water's outline",
+        ));
+    }
+    Ok(outline)
 }
 
 /// A fill's water: its points, the box of their cells and what was noticed on the way.
@@ -262,6 +263,9 @@ pub(super) fn filled(
             (flood(&index, start, limit, open), Vec::new())
         }
         Region::Mesh(mesh, open_edges) => {
+            // Refused before any point is visited: the water's volume in cells.
+            let cells = mesh.signed_volume().abs() / dx.powi(3);
+            limits::part_fits(ctx, (dx, dim), (path.as_str(), cells), budget)?;
             let (min, max) = mesh.bounds();
             let inside = lat
                 .range_in(&Aabb { min, max })
@@ -303,6 +307,10 @@ pub(super) fn filled(
             ((water.len() <= limit).then_some(water), notes)
         }
         Region::Prism(outline) => {
+            // Refused before any point is visited: the prism's volume in cells.
+            let height = fill.top() - bound.min[v];
+            let cells = outline.outline_area() * height.max(0.0) / dx.powi(3);
+            limits::part_fits(ctx, (dx, dim), (path.as_str(), cells), budget)?;
             let mut water = Vec::new();
             for p in index.iter() {
                 let x = lat.pos(p);

@@ -231,6 +231,9 @@ pub(super) fn walls(
             }
         }
         let depth = s.layers as f64 * dx;
+        // Refused before any point is visited: the wall's volume, area × depth, in cells.
+        let estimate = s.surface.area() * depth / dx.powi(3);
+        limits::part_fits(ctx, (dx, 3), (path.as_str(), estimate), budget)?;
         let limit = budget.particles.min(1e15) as usize;
         let Some(indices) = s.surface.wall(lat.origin, dx, depth, limit) else {
             let count = (path.as_str(), budget.particles + 1.0);
@@ -252,15 +255,11 @@ pub(super) fn walls(
                 "move the surface into the domain, or decrease particles.dx_m",
             ));
         }
-        if s.closed {
-            notes.push(if s.surface.signed_volume() > 0.0 {
-                format!("{path} is closed and its faces look out: its wall is inside it")
-            } else {
-                format!(
-                    "{path} is closed and its faces look in: its wall surrounds it and water \
-                     may stand inside (set flip = true for a solid)"
-                )
-            });
+        if s.closed && s.surface.signed_volume() < 0.0 {
+            notes.push(format!(
+                "{path} is closed and its faces look in: its wall surrounds it and water may \
+                 stand inside (set flip = true for a solid)"
+            ));
         }
         if let Some((t, at)) = s.surface.thinnest(2.0 * h) {
             notes.push(format!(

@@ -137,13 +137,14 @@ pub(super) fn validate(
 ) -> Result<Case, CaseError> {
     let dim = dimension(ctx, raw)?;
     // Before the physics: without fluid or solids nothing else of the case matters.
-    let no_fluid = raw.fluid_block.is_empty() && raw.fill.is_empty() && raw.inlet.is_empty();
+    let no_fill = raw.fill.iter().all(|f| f.enabled == Some(false));
+    let no_fluid = raw.fluid_block.is_empty() && no_fill && raw.inlet.is_empty();
     if no_fluid && raw.solid.is_empty() {
         return Err(ctx.err(
             "fluid_block",
             None,
-            "no fluid: at least one [[fluid_block]] (or [[fill]], [[inlet]] or [[solid]]) is \
-             required",
+            "no fluid: at least one [[fluid_block]] (or [[fill]] left enabled, [[inlet]] or \
+             [[solid]]) is required",
             "add a [[fluid_block]] table with min_m and max_m",
         ));
     }
@@ -448,7 +449,9 @@ fn sound(ctx: &Ctx<'_>, raw: &RawCase) -> Result<Sound, CaseError> {
         // A solid-only case has no fluid to give a sound speed to (unused; see
         // build_solid_case in build.rs).
         (None, None)
-            if raw.fluid_block.is_empty() && raw.fill.is_empty() && !raw.solid.is_empty() =>
+            if raw.fluid_block.is_empty()
+                && raw.fill.iter().all(|f| f.enabled == Some(false))
+                && !raw.solid.is_empty() =>
         {
             Sound::Speed(1.0)
         }

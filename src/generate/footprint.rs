@@ -226,6 +226,19 @@ impl Footprint {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// The area inside the outline (the first ring), holes not taken out: the shoelace
+    /// formula.
+    pub fn outline_area(&self) -> f64 {
+        let ring = &self.rings[0];
+        let twice: f64 = (0..ring.len())
+            .map(|k| {
+                let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
+                a[0] * b[1] - b[0] * a[1]
+            })
+            .sum();
+        0.5 * twice.abs()
+    }
+
     /// The box of the outline, (min, max).
     pub fn bounds(&self) -> ([f64; 2], [f64; 2]) {
         let all = self.rings.iter().flatten();

@@ -63,6 +63,10 @@ pub struct RunSummary {
     /// The world coordinates of the positions' (0, 0, 0) (`Scenario::world_origin_m`).
     #[serde(default)]
     pub world_origin_m: [f64; 3],
+    /// Seconds the case took to read and build into particles (issue 59), where the run knows
+    /// it (`wgsph run`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub case_build_s: Option<f64>,
 }
 
 /// One rank's part of a run over several ranks (`run.json`, `wgsph bench` under mpirun).
@@ -127,6 +131,7 @@ mod tests {
             case_file: Some("/cases/x.toml".into()),
             ranks: None,
             world_origin_m: [0.0; 3],
+            case_build_s: Some(1.25),
             case: "dam_break_2d".into(),
             adapter: "NVIDIA H100 \"quoted\"".into(),
             backend: "Vulkan".into(),

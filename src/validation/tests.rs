@@ -40,6 +40,7 @@ fn summary(case: &str, excluded: u64) -> RunSummary {
         case_file: None,
         ranks: None,
         world_origin_m: [0.0; 3],
+        case_build_s: None,
     }
 }
 

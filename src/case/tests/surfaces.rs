@@ -289,7 +289,7 @@ fn bad_meshes_are_refused_with_the_file_and_the_fix() {
 }
 
 /// A plate thinner than the kernel's support is built, with a warning that says where and
-/// how thin; a closed box says which way it faces.
+/// how thin; a closed box whose faces look in says so.
 #[test]
 fn a_thin_plate_and_a_closed_box_are_reported() {
     let dir = folder("surface_thin");
@@ -308,7 +308,17 @@ fn a_thin_plate_and_a_closed_box_are_reported() {
         s.warnings
     );
     assert!(
-        s.warnings.iter().any(|w| w.contains("faces look out")),
+        !s.warnings.iter().any(|w| w.contains("faces look")),
+        "{:?}",
+        s.warnings
+    );
+    let s = load_in(
+        &dir,
+        &tank("[[surface]]\nfile = \"plate.stl\"\nflip = true\n"),
+    )
+    .unwrap();
+    assert!(
+        s.warnings.iter().any(|w| w.contains("faces look in")),
         "{:?}",
         s.warnings
     );
