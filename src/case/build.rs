@@ -102,12 +102,12 @@ pub(super) fn build(
         ground_particles(&case, t, g, (&geo.lat, under), &rho, &mut particles);
     }
     surface_particles(&case, &geo, &rho, &mut particles);
-    particles.extend(geo.raised.points.iter().map(|&(pos, t)| Particle {
-        pos,
-        vel: [0.0; 3],
-        rho: rho.of(t, pos),
-        kind: kind_of(t),
-    }));
+    particles.extend(
+        geo.raised
+            .points
+            .iter()
+            .map(|&(pos, t)| rho.particle(t, pos)),
+    );
     let mirror_planes = mirror_planes(&case, &geo.lat, wall.as_ref());
     let solids = place_solids(ctx, case.dim, elastic, &domain, &mut particles)?;
     let bodies = bodies(ctx, &case, &rho, tank_particles, &mut particles)?;
@@ -1093,6 +1093,16 @@ impl BoundaryRho<'_> {
         }
     }
 
+    /// A wall particle of treatment `t` at rest at `pos`.
+    fn particle(&self, t: Treatment, pos: [f64; 3]) -> Particle {
+        Particle {
+            pos,
+            vel: [0.0; 3],
+            rho: self.of(t, pos),
+            kind: kind_of(t),
+        }
+    }
+
     /// The start density of a particle of treatment `t` at `pos`. Repulsive particles carry no
     /// pressure: ρ0.
     fn of(&self, t: Treatment, pos: [f64; 3]) -> f64 {
@@ -1117,12 +1127,7 @@ fn wall_particles(
     let tank_moves = case.tank_moves();
     let mut tank_particles = Vec::new();
     let mut push_wall = |pos: [f64; 3], t: Treatment| {
-        let p = Particle {
-            pos,
-            vel: [0.0; 3],
-            rho: rho.of(t, pos),
-            kind: kind_of(t),
-        };
+        let p = rho.particle(t, pos);
         if tank_moves {
             tank_particles.push(p);
         } else {
@@ -1184,12 +1189,7 @@ fn ground_particles(
             if pos[2] < floor || obstacles.iter().any(|b| point_inside(pos, b, 3)) {
                 continue;
             }
-            particles.push(Particle {
-                pos,
-                vel: [0.0; 3],
-                rho: rho.of(terrain.wall, pos),
-                kind: kind_of(terrain.wall),
-            });
+            particles.push(rho.particle(terrain.wall, pos));
         }
     }
 }
@@ -1217,12 +1217,7 @@ fn surface_particles(
             if taken || !seen.insert(pos.map(f64::to_bits)) {
                 continue;
             }
-            particles.push(Particle {
-                pos,
-                vel: [0.0; 3],
-                rho: rho.of(s.wall, pos),
-                kind: kind_of(s.wall),
-            });
+            particles.push(rho.particle(s.wall, pos));
         }
     }
 }

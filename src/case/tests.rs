@@ -56,6 +56,18 @@ fn head_3d(dx: f64) -> String {
     )
 }
 
+/// Asserts that `result` is an error whose message holds every one of `words` and a fix.
+fn assert_refused(result: Result<Scenario, CaseError>, words: &[&str], input: &str) {
+    let e = match result {
+        Ok(_) => panic!("accepted: {input}"),
+        Err(e) => e.to_string(),
+    };
+    for w in words {
+        assert!(e.contains(w), "`{w}` expected in: {e}");
+    }
+    assert!(e.contains("fix:"), "no fix in: {e}");
+}
+
 fn sets(s: &[&str]) -> Vec<String> {
     s.iter().map(|s| s.to_string()).collect()
 }

@@ -150,14 +150,7 @@ fn a_seed_with_nowhere_to_start_is_refused() {
     ];
     for (fill, words) in cases {
         let text = case(&format!("[[fill]]\n{fill}"));
-        let e = match load_in(&dir, &text) {
-            Ok(_) => panic!("accepted: {fill}"),
-            Err(e) => e.to_string(),
-        };
-        for w in words {
-            assert!(e.contains(w), "`{w}` expected in: {e}");
-        }
-        assert!(e.contains("fix:"), "no fix in: {e}");
+        assert_refused(load_in(&dir, &text), words, fill);
     }
     // Nothing to hold the water: no tank, domain or terrain.
     let e = load_str(
