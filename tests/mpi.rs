@@ -657,7 +657,7 @@ fn ranks_write_the_waiting_inlet_particles_as_one_run() {
 fn ranks_write_the_particles_that_left_the_domain_as_one_run() {
     let (excluded, two) = two_ranks_write_what_one_run_writes(
         "left",
-        ("cases/dam_break_2d.toml", "0.01"),
+        ("cases/dam_break_2d.toml", "0.0146"),
         &["time.end_s=0.29", "physics.gravity_m_s2=[0.0, 9.81]"],
         &["p_right_wall.csv"],
     );

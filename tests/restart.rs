@@ -278,14 +278,14 @@ fn resume_is_bit_identical_for_a_body_moving_through_the_cells() {
 #[test]
 fn resume_is_bit_identical_for_elastic_plates_of_both_formulations() {
     let set: Vec<String> = [
-        "time.end_s=0.04",
-        "time.output_every_s=0.01",
-        "time.probe_every_s=0.005",
+        "time.end_s=0.02",
+        "time.output_every_s=0.005",
+        "time.probe_every_s=0.0025",
     ]
     .map(String::from)
     .to_vec();
     let sc = wgsph::case::load_str(&common::both_plates_case(), "plates.toml", &set).unwrap();
-    split_run_matches("plates", &sc, 0.02);
+    split_run_matches("plates", &sc, 0.01);
 }
 
 /// Velocity inlets place their particles from the time alone (and count the joined ones in
@@ -296,12 +296,12 @@ fn resume_is_bit_identical_for_an_injection() {
         "cases/water_injection_2d.toml",
         &[
             "particles.dx_m=0.01",
-            "time.end_s=0.2",
-            "time.output_every_s=0.05",
+            "time.end_s=0.1",
+            "time.output_every_s=0.025",
             "time.probe_every_s=0.01",
         ],
     );
-    split_run_matches("injection", &sc, 0.1);
+    split_run_matches("injection", &sc, 0.05);
 }
 
 fn wgsph() -> Command {

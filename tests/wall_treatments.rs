@@ -276,8 +276,8 @@ fn mirror_free_slip() {
 #[test]
 fn dynamic_boundary() {
     let o = &shipped_tank().0;
-    assert_steady(&o);
-    assert_floor_within_bound(&o);
+    assert_steady(o);
+    assert_floor_within_bound(o);
     assert_eq!((o.excluded, o.lost), (0, 0));
     assert!(o.margin > -0.5 * 0.02, "fluid crossed a wall: {}", o.margin);
 }

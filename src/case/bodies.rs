@@ -10,14 +10,14 @@ use std::sync::Arc;
 use crate::scenario::{Motion, MotionLaw, Prescribed};
 
 use super::check::{
-    aabb, file_safe, initial_velocity, number, read_bounded, treatment, vector, Aabb, Bound,
-    Treatment, MAX_NAME_BYTES,
+    aabb, file_safe, initial_velocity, number, read_bounded, read_mesh, treatment, vector, Aabb,
+    Bound, Treatment, MAX_NAME_BYTES,
 };
 use super::error::{num, CaseError};
 use super::locate::Ctx;
-use super::mesh::Mesh;
-use super::polygon::Polygon;
 use super::schema::{MotionName, RawBody, RawMotion, ShapeName};
+use crate::generate::mesh::Mesh;
+use crate::generate::polygon::Polygon;
 
 #[derive(Debug, Clone, PartialEq)]
 pub(super) enum Shape {
@@ -281,14 +281,11 @@ fn shape(
         _ => {}
     }
     if let Some(file) = &b.file {
-        let mesh = Mesh::read(&case_dir.join(file)).map_err(|e| {
-            ctx.err(
-                &format!("{path}.file"),
-                Some(format!("{file:?}")),
-                e.to_string(),
-                e.fix(),
-            )
-        })?;
+        let field = format!("{path}.file");
+        let triangles = read_mesh(ctx, &field, case_dir, file)?;
+        let full = case_dir.join(file).display().to_string();
+        let mesh = Mesh::new(&full, &triangles.vertices, &triangles.faces)
+            .map_err(|e| ctx.err(&field, Some(format!("{file:?}")), e.to_string(), e.fix()))?;
         return Ok(Shape::Mesh(Arc::new(mesh)));
     }
     if let Some(corners) = &b.vertices_m {

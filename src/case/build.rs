@@ -15,11 +15,11 @@ use super::buildings::{Raised, Site};
 use super::check::{fmt_box, inside, point_in, point_inside, Aabb, Treatment, AXES, TOL};
 use super::domain::domain;
 use super::error::{num, CaseError};
-use super::lattice::{block_points, cells, range_points, Lattice, TankWall};
 use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
 use super::terrain::Ground;
 use super::validate::{Case, Sound, WallSettings};
+use crate::generate::lattice::{block_points, cells, range_points, Lattice, TankWall};
 
 /// An obstacle's range of lattice indices: the first and the last, as floats.
 type IndexRange = ([f64; 3], [f64; 3]);

@@ -8,11 +8,11 @@ use crate::generate::footprint::{parse_geojson, Footprint, FootprintError};
 
 use super::check::{number, particle_wall, read_bounded, support_layers, Aabb, Bound, Treatment};
 use super::error::{num, CaseError};
-use super::lattice::{range_points, Lattice};
 use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
 use super::schema::RawBuildings;
 use super::terrain::Terrain;
+use crate::generate::lattice::{range_points, Lattice};
 
 /// The largest footprint file: 1 GiB of GeoJSON.
 const MAX_FILE_BYTES: u64 = 1 << 30;

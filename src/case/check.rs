@@ -9,6 +9,8 @@
 
 use std::path::Path;
 
+use crate::generate::mesh_file::{parse, IndexedTriangles, MeshFormat};
+
 use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::schema::{SlipName, WallName};
@@ -67,12 +69,7 @@ pub(super) fn support_layers(
     Ok(layers as u32)
 }
 
-/// An axis-aligned box (3 components; in 2D the third is 0).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Aabb {
-    pub min: [f64; 3],
-    pub max: [f64; 3],
-}
+pub(super) use crate::generate::aabb::Aabb;
 
 /// Allowed range of a number.
 #[derive(Clone, Copy)]
@@ -301,6 +298,48 @@ pub(super) fn fmt_box(b: &Aabb, dim: usize) -> String {
 pub(crate) fn read_bounded(path: &Path, limit: u64) -> std::io::Result<String> {
     String::from_utf8(read_bytes_bounded(path, limit)?)
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+}
+
+/// The largest mesh file (about five million triangles in binary STL).
+const MAX_MESH_BYTES: u64 = 256 << 20;
+
+/// The triangles of the mesh file `file` (relative to `case_dir`) that the field `field`
+/// names: STL or Wavefront OBJ by its extension. An error names the field, the file's path, the
+/// line (OBJ) and a fix.
+pub(super) fn read_mesh(
+    ctx: &Ctx<'_>,
+    field: &str,
+    case_dir: &Path,
+    file: &str,
+) -> Result<IndexedTriangles, CaseError> {
+    let full = case_dir.join(file);
+    let refuse = |problem: String, fix: &str| {
+        ctx.err(
+            field,
+            Some(format!("{file:?}")),
+            format!("{}{problem}", full.display()),
+            fix,
+        )
+    };
+    let extension = full.extension().map(|e| e.to_string_lossy().to_string());
+    let Some(format) = extension.as_deref().and_then(MeshFormat::of_extension) else {
+        return Err(refuse(
+            ": is not an STL (.stl) or Wavefront OBJ (.obj) file, the formats a mesh is read \
+             from"
+                .into(),
+            "export the surface as STL or OBJ",
+        ));
+    };
+    let bytes = read_bytes_bounded(&full, MAX_MESH_BYTES).map_err(|e| {
+        refuse(
+            format!(": cannot read it: {e}"),
+            "give the path of the mesh relative to the case file",
+        )
+    })?;
+    parse(&bytes, format).map_err(|e| {
+        let line = e.line.map_or(String::new(), |l| format!(", line {l}"));
+        refuse(format!("{line}: {}", e.problem), &e.fix)
+    })
 }
 
 /// The bytes of the file at `path`, or an error if it has more than `limit`.

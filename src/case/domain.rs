@@ -6,10 +6,10 @@ use crate::scenario::{Domain, Motion, ProbeKind};
 
 use super::check::{fmt_box, inside, point_inside, Aabb, AXES, TOL};
 use super::error::{num, CaseError};
-use super::lattice::{Lattice, TankWall};
 use super::limits;
 use super::locate::Ctx;
 use super::validate::Case;
+use crate::generate::lattice::{Lattice, TankWall};
 
 /// The given domain, or the default one; checks that fluid, walls and probes lie inside it.
 pub(super) fn domain(

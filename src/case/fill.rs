@@ -11,11 +11,11 @@ use crate::generate::surface::Surface;
 
 use super::check::{number, vector, Aabb, Bound};
 use super::error::{num, CaseError};
-use super::lattice::Lattice;
 use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
 use super::schema::RawFill;
 use super::surface::{placed, MeshFields};
+use crate::generate::lattice::Lattice;
 
 /// Most lattice points a fill's box may hold (one bit each while the water spreads: 512 MiB).
 const MAX_BOX_POINTS: u64 = 1 << 32;

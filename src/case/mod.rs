@@ -15,12 +15,12 @@
 //!    `overrides.rs` (`--set`) use only these;
 //! 2. `check.rs`: the checking primitives: boxes, the checks of one number, vector or box,
 //!    wall treatments, inside tests, how a box is written in a message, bounded file reads;
-//! 3. geometry and size limits: `lattice.rs`, `mesh.rs`, `polygon.rs` (which uses `mesh.rs`)
-//!    and `limits.rs`;
+//! 3. size limits: `limits.rs`;
 //! 4. the checks and particles of one kind of table each: `probes.rs`, `open_boundaries.rs`,
 //!    `solids.rs`, `bodies.rs`, `terrain.rs`, `buildings.rs` (which stands on the terrain),
-//!    `fill.rs` (the geometry of these three is `crate::generate`'s), and `friction.rs`
-//!    (which names bodies and solids);
+//!    `surface.rs`, `fill.rs`, and `friction.rs` (which names bodies and solids). Their
+//!    geometry (lattices, boxes, polygons, closed and open meshes, terrains, footprints, fills)
+//!    is `crate::generate`'s, which knows nothing of case files;
 //! 5. `validate.rs`: the whole checked case (`Case`);
 //! 6. the build: `warnings.rs`, `domain.rs` and `runnable.rs` (the f32 range, time step and
 //!    schedule of the built case), used by `build.rs`;
@@ -37,13 +37,10 @@ mod domain;
 mod error;
 mod fill;
 mod friction;
-mod lattice;
 mod limits;
 mod locate;
-mod mesh;
 mod open_boundaries;
 mod overrides;
-mod polygon;
 mod probes;
 mod runnable;
 mod schema;

@@ -7,9 +7,9 @@
 
 use super::check::{aabb, number, vector, Aabb, Bound, AXES};
 use super::error::{num, CaseError};
-use super::lattice::{range_points, Lattice};
 use super::locate::Ctx;
 use super::schema::{InletPressureName, RawInlet, RawOutlet};
+use crate::generate::lattice::{range_points, Lattice};
 use crate::scenario::{Inlet, InletPressure, Kind, Outlet, Particle};
 
 /// An `[[inlet]]` as checked against the case, before the lattice is known.

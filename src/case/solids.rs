@@ -6,10 +6,10 @@ use crate::scenario::{distinct_materials, ElasticMaterial, Kind, Particle, Solid
 
 use super::check::{aabb, number, point_in, vector, Aabb, Bound};
 use super::error::{num, CaseError};
-use super::lattice::Lattice;
 use super::limits::ParticleBudget;
 use super::locate::Ctx;
 use super::schema::{RawSolid, SolidFormulationName, SolidVelocityName};
+use crate::generate::lattice::Lattice;
 use crate::layout::MAX_SOLID_MATERIALS;
 
 /// Initial velocity of a cantilever in its first bending mode (Gray, Monaghan & Swift 2001,

@@ -5,20 +5,16 @@
 
 use std::path::Path;
 
-use crate::generate::mesh_file::{parse, MeshFormat};
 use crate::generate::surface::{Edges, Placement, Surface};
 
 use super::check::{
-    number, particle_wall, read_bytes_bounded, support_layers, vector, Aabb, Bound, Treatment,
+    number, particle_wall, read_mesh, support_layers, vector, Aabb, Bound, Treatment,
 };
 use super::error::{num, CaseError};
-use super::lattice::Lattice;
 use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
 use super::schema::RawSurface;
-
-/// The largest mesh file (about five million triangles in binary STL).
-const MAX_FILE_BYTES: u64 = 256 << 20;
+use crate::generate::lattice::Lattice;
 
 /// A surface wall, checked: the placed mesh, how its edges are shared and its treatment.
 #[derive(Debug, Clone)]
@@ -105,8 +101,9 @@ pub(super) fn placed(
     (case_dir, dx, flip): (&Path, f64, bool),
 ) -> Result<(Surface, Edges), CaseError> {
     let placement = placement(ctx, path, fields)?;
-    let full = case_dir.join(fields.file);
     let file_path = format!("{path}.file");
+    let mesh = read_mesh(ctx, &file_path, case_dir, fields.file)?;
+    let full = case_dir.join(fields.file);
     let refuse = |problem: String, fix: &str| {
         ctx.err(
             &file_path,
@@ -115,25 +112,6 @@ pub(super) fn placed(
             fix,
         )
     };
-    let extension = full.extension().map(|e| e.to_string_lossy().to_string());
-    let Some(format) = extension.as_deref().and_then(MeshFormat::of_extension) else {
-        return Err(refuse(
-            ": is not an STL (.stl) or Wavefront OBJ (.obj) file, the formats a mesh is read \
-             from"
-                .into(),
-            "export the surface as STL or OBJ",
-        ));
-    };
-    let bytes = read_bytes_bounded(&full, MAX_FILE_BYTES).map_err(|e| {
-        refuse(
-            format!(": {e}"),
-            "give the path of the mesh relative to the case file",
-        )
-    })?;
-    let mesh = parse(&bytes, format).map_err(|e| {
-        let line = e.line.map_or(String::new(), |l| format!(", line {l}"));
-        refuse(format!("{line}: {}", e.problem), &e.fix)
-    })?;
     let mut faces = mesh.faces;
     if flip {
         faces.iter_mut().for_each(|f| f.swap(1, 2));

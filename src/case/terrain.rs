@@ -13,10 +13,10 @@ use super::check::{
     Treatment,
 };
 use super::error::{num, CaseError};
-use super::lattice::{range_points, Lattice};
 use super::limits::{self, ParticleBudget};
 use super::locate::Ctx;
 use super::schema::{NodataName, RawTerrain};
+use crate::generate::lattice::{range_points, Lattice};
 
 /// The largest grid file: 2 GiB (a 10 000 × 10 000 ESRI ASCII grid at up to 20 characters a
 /// value; a GeoTIFF of the most cells a grid may have, as f64, is 1.2 GB).

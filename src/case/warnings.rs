@@ -105,7 +105,7 @@ fn rounded_blocks(case: &Case, dx: f64) -> Vec<String> {
     for (i, b) in case.blocks.iter().enumerate() {
         for (a, axis) in AXES.iter().enumerate().take(case.dim) {
             let len = b.bx.max[a] - b.bx.min[a];
-            let n = super::lattice::cells(len, dx);
+            let n = crate::generate::lattice::cells(len, dx);
             let filled = n * dx;
             if (filled - len).abs() <= BLOCK_ROUNDING * len {
                 continue;

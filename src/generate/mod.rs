@@ -3,10 +3,14 @@
 //! what this module reports into messages that name the field and the fix; the solver imports
 //! neither.
 
+pub mod aabb;
 pub mod fill;
 pub mod footprint;
 pub mod geotiff;
+pub mod lattice;
+pub mod mesh;
 pub mod mesh_file;
+pub mod polygon;
 pub mod surface;
 pub mod terrain;
 pub mod triangle;

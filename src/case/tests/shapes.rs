@@ -2,7 +2,7 @@
 //! "polygon"` bodies: their particles and mass properties, and the loader's errors.
 
 use super::*;
-use crate::case::mesh::tests::cuboid;
+use crate::generate::surface::tests::cuboid;
 use std::path::Path;
 
 /// A 3D tank half full, with one body described by `body` (a `[[body]]` table's lines).
@@ -44,18 +44,31 @@ pub(super) fn write_stl(path: &Path, (v, f): &(Vec<[f64; 3]>, Vec<[usize; 3]>)) 
     stl_io::write_stl(&mut out, tris.iter()).unwrap();
 }
 
-/// A cuboid drawn as an STL (on coordinates that f32 holds exactly) is the same body as the
-/// box of those corners: the same particles, fluid and domain, the same mass and centre, and
-/// the inertia to rounding. Filled and as a shell of fixed ghosts.
+/// A cuboid drawn as an STL or a Wavefront OBJ (on coordinates that f32 holds exactly) is the
+/// same body as the box of those corners: the same particles, fluid and domain, the same mass
+/// and centre, and the inertia to rounding. Filled and as a shell of fixed ghosts.
 #[test]
 fn a_cuboid_mesh_is_the_box_body() {
     let dir = folder("mesh_cuboid");
     let (lo, hi) = ([0.375, 0.3125, 0.375], [0.625, 0.6875, 0.75]);
-    write_stl(&dir.join("hull.stl"), &cuboid(lo, hi));
-    for extra in ["", "layers = 2\nwall = \"fixed_ghost\""] {
+    let (v, f) = cuboid(lo, hi);
+    write_stl(&dir.join("hull.stl"), &(v.clone(), f.clone()));
+    let obj: String = (v.iter().map(|p| format!("v {} {} {}\n", p[0], p[1], p[2])))
+        .chain(
+            f.iter()
+                .map(|t| format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1)),
+        )
+        .collect();
+    std::fs::write(dir.join("hull.obj"), obj).unwrap();
+    let files = ["hull.stl", "hull.obj"];
+    for (file, extra) in files.iter().flat_map(|f| {
+        ["", "layers = 2\nwall = \"fixed_ghost\""]
+            .into_iter()
+            .map(move |e| (f, e))
+    }) {
         let mesh = load_in(
             &dir,
-            &case(&format!("shape = \"mesh\"\nfile = \"hull.stl\"\n{extra}")),
+            &case(&format!("shape = \"mesh\"\nfile = \"{file}\"\n{extra}")),
         )
         .unwrap();
         let bx = load_in(

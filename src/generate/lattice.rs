@@ -2,27 +2,27 @@
 //! at cell centres, `origin + (i + 0.5) dx` for integer i. 2D cases use the x and y axes and
 //! put every particle at z = 0.
 
-use super::check::Aabb;
+use super::aabb::Aabb;
 
 /// Largest magnitude an index may take; larger boxes are refused by the particle-count check
 /// before any index is used.
 const MAX_INDEX: f64 = 1e15;
 
 /// Number of cells of size `dx` that best fill `len`: round(len / dx); may be huge.
-pub(super) fn cells(len: f64, dx: f64) -> f64 {
+pub(crate) fn cells(len: f64, dx: f64) -> f64 {
     (len / dx).round()
 }
 
 /// A cell-centred lattice.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Lattice {
+pub(crate) struct Lattice {
     pub origin: [f64; 3],
     pub dx: f64,
     pub dim: usize,
 }
 
 impl Lattice {
-    pub(super) fn pos(&self, idx: [i64; 3]) -> [f64; 3] {
+    pub(crate) fn pos(&self, idx: [i64; 3]) -> [f64; 3] {
         let mut p = [0.0; 3];
         for a in 0..self.dim {
             p[a] = self.origin[a] + (idx[a] as f64 + 0.5) * self.dx;
@@ -32,7 +32,7 @@ impl Lattice {
 
     /// The inclusive index range of the lattice points inside `b` (with a relative tolerance of
     /// 1e-9 dx), as float indices; `None` when no point is inside.
-    pub(super) fn range_in(&self, b: &Aabb) -> Option<([f64; 3], [f64; 3])> {
+    pub(crate) fn range_in(&self, b: &Aabb) -> Option<([f64; 3], [f64; 3])> {
         let (mut lo, mut hi) = ([0.0; 3], [0.0; 3]);
         for a in 0..self.dim {
             lo[a] = ((b.min[a] - self.origin[a]) / self.dx - 0.5 - 1e-9).ceil();
@@ -48,7 +48,7 @@ impl Lattice {
 }
 
 /// Points of a box of `n` cells per axis starting at `min` (n[a] = 1 for the unused axis in 2D).
-pub(super) fn block_points(min: [f64; 3], n: [i64; 3], dx: f64, dim: usize) -> Vec<[f64; 3]> {
+pub(crate) fn block_points(min: [f64; 3], n: [i64; 3], dx: f64, dim: usize) -> Vec<[f64; 3]> {
     let lat = Lattice {
         origin: min,
         dx,
@@ -66,7 +66,7 @@ pub(super) fn block_points(min: [f64; 3], n: [i64; 3], dx: f64, dim: usize) -> V
 }
 
 /// Points of the lattice range `lo..=hi` (float indices from [`Lattice::range_in`]).
-pub(super) fn range_points(
+pub(crate) fn range_points(
     lat: &Lattice,
     lo: [f64; 3],
     hi: [f64; 3],
@@ -85,7 +85,7 @@ pub(super) fn range_points(
 /// The wall of a tank whose inner box holds `n` cells per axis from the lattice origin:
 /// `layers` layers outside the inner box on every side (the lid only when `!open_top`).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct TankWall {
+pub(crate) struct TankWall {
     pub n: [i64; 3],
     pub layers: i64,
     pub open_top: bool,
@@ -94,7 +94,7 @@ pub(super) struct TankWall {
 
 impl TankWall {
     /// Index range (exclusive end) of the outer box along `a`.
-    pub(super) fn outer(&self, a: usize) -> (i64, i64) {
+    pub(crate) fn outer(&self, a: usize) -> (i64, i64) {
         if a >= self.dim {
             (0, 1)
         } else if a == self.dim - 1 && self.open_top {
@@ -104,7 +104,7 @@ impl TankWall {
         }
     }
 
-    pub(super) fn contains(&self, idx: [i64; 3]) -> bool {
+    pub(crate) fn contains(&self, idx: [i64; 3]) -> bool {
         let in_outer = (0..self.dim).all(|a| {
             let (lo, hi) = self.outer(a);
             lo <= idx[a] && idx[a] < hi
@@ -114,7 +114,7 @@ impl TankWall {
     }
 
     /// Number of wall particles, as a float (for the size check before building).
-    pub(super) fn count(&self) -> f64 {
+    pub(crate) fn count(&self) -> f64 {
         let outer: f64 = (0..self.dim)
             .map(|a| (self.outer(a).1 - self.outer(a).0) as f64)
             .product();
@@ -124,7 +124,7 @@ impl TankWall {
 
     /// All wall lattice indices, each once. Walks the columns so that the cost is the wall's
     /// size, not the tank's volume.
-    pub(super) fn indices(&self) -> Vec<[i64; 3]> {
+    pub(crate) fn indices(&self) -> Vec<[i64; 3]> {
         let v = self.dim - 1;
         let (xl, xh) = self.outer(0);
         let (yl, yh) = if v == 2 { self.outer(1) } else { (0, 1) };

@@ -2,14 +2,14 @@
 //! the area's mass properties at uniform density, the particles in layers that follow the
 //! outline, which points lie inside it and how far a point is from its outline. Inside means an
 //! odd number of edge crossings on the vertical line above the point (the even–odd rule), the
-//! lines going through points shifted by a fixed tiny offset as for meshes (src/case/mesh.rs),
+//! lines going through points shifted by a fixed tiny offset as for meshes (`mesh.rs`),
 //! so a line does not run exactly through a vertex drawn on round numbers.
 
-use super::check::Aabb;
+use super::aabb::Aabb;
 
 /// What is wrong with an outline: a problem and the index of a vertex or edge to look at.
 #[derive(Debug, PartialEq)]
-pub(super) enum PolygonError {
+pub(crate) enum PolygonError {
     /// Fewer than three vertices.
     TooFew(usize),
     /// Vertex `at` repeats vertex `of`, the one before it.
@@ -42,7 +42,7 @@ impl std::fmt::Display for PolygonError {
 
 /// A simple polygon, counter-clockwise, and the area it bounds.
 #[derive(Debug, Clone, PartialEq)]
-pub(super) struct Polygon {
+pub(crate) struct Polygon {
     vertices: Vec<[f64; 2]>,
     bounds: Aabb,
     area: f64,
@@ -53,7 +53,7 @@ pub(super) struct Polygon {
 
 impl Polygon {
     /// The polygon through `vertices` in order (either sense; the last joins the first).
-    pub(super) fn new(vertices: &[[f64; 2]]) -> Result<Polygon, PolygonError> {
+    pub(crate) fn new(vertices: &[[f64; 2]]) -> Result<Polygon, PolygonError> {
         let n = vertices.len();
         if n < 3 {
             return Err(PolygonError::TooFew(n));
@@ -127,21 +127,21 @@ impl Polygon {
         })
     }
 
-    pub(super) fn bounds(&self) -> Aabb {
+    pub(crate) fn bounds(&self) -> Aabb {
         self.bounds
     }
 
-    pub(super) fn area(&self) -> f64 {
+    pub(crate) fn area(&self) -> f64 {
         self.area
     }
 
-    pub(super) fn centroid(&self) -> [f64; 3] {
+    pub(crate) fn centroid(&self) -> [f64; 3] {
         [self.centroid[0], self.centroid[1], 0.0]
     }
 
     /// The inertia tensor about the centroid of a uniform plate of `mass` in the x–y plane
     /// (only its zz term moves a 2D body).
-    pub(super) fn inertia(&self, mass: f64) -> [[f64; 3]; 3] {
+    pub(crate) fn inertia(&self, mass: f64) -> [[f64; 3]; 3] {
         let k = mass / self.area;
         let s = &self.second;
         [
@@ -160,7 +160,7 @@ impl Polygon {
     fn crossings(&self, x: f64) -> Vec<f64> {
         let size =
             (self.bounds.max[0] - self.bounds.min[0]).max(self.bounds.max[1] - self.bounds.min[1]);
-        let x = x + super::mesh::LINE_SHIFT[0] * size;
+        let x = x + crate::generate::mesh::LINE_SHIFT[0] * size;
         let mut y: Vec<f64> = self
             .edges()
             .filter(|(a, b)| (a[0] < x) != (b[0] < x))
@@ -171,12 +171,12 @@ impl Polygon {
     }
 
     /// Whether `p` is inside the area.
-    pub(super) fn contains(&self, p: [f64; 3]) -> bool {
-        super::mesh::odd_above(p[1], &self.crossings(p[0]))
+    pub(crate) fn contains(&self, p: [f64; 3]) -> bool {
+        crate::generate::mesh::odd_above(p[1], &self.crossings(p[0]))
     }
 
     /// The distance from `p` to the outline.
-    pub(super) fn distance(&self, p: [f64; 3]) -> f64 {
+    pub(crate) fn distance(&self, p: [f64; 3]) -> f64 {
         self.edges()
             .map(|(a, b)| {
                 let (ab, ap) = ([b[0] - a[0], b[1] - a[1]], [p[0] - a[0], p[1] - a[1]]);
@@ -195,7 +195,7 @@ impl Polygon {
     /// dx apart, from the first corner. Points nearer than d to another part of the outline
     /// (where the layers from two sides meet) are left out. A rectangle whose sides are whole
     /// multiples of dx gets a box body's lattice, ring by ring.
-    pub(super) fn points(&self, dx: f64, depth: Option<f64>) -> Vec<[f64; 3]> {
+    pub(crate) fn points(&self, dx: f64, depth: Option<f64>) -> Vec<[f64; 3]> {
         let mut out = Vec::new();
         for k in 0.. {
             let d = (k as f64 + 0.5) * dx;
@@ -231,7 +231,7 @@ impl Polygon {
     /// that can hold one, before any is left out. A point d inside has a disc of radius d
     /// inside, so 2d is at most the bounding box's smaller side and π d² at most the area; the
     /// sum stops early once it passes `cap` (a budget it is checked against).
-    pub(super) fn particle_bound(&self, dx: f64, depth: Option<f64>, cap: f64) -> f64 {
+    pub(crate) fn particle_bound(&self, dx: f64, depth: Option<f64>, cap: f64) -> f64 {
         let side =
             (self.bounds.max[0] - self.bounds.min[0]).min(self.bounds.max[1] - self.bounds.min[1]);
         let deepest = (0.5 * side).min((self.area / std::f64::consts::PI).sqrt());

@@ -1,4 +1,4 @@
-//! Closed triangle meshes (STL files) as the shape of a 3D body: reading and checking the file,
+//! Closed triangle meshes as the shape of a 3D body: checking that the triangles bound a solid,
 //! the solid's mass properties at uniform density, which points lie inside it and how far a
 //! point is from its surface.
 //!
@@ -8,29 +8,19 @@
 //! mesh drawn on round numbers. Triangles are bucketed by the columns of a grid in x–y, so a
 //! line or a small ball meets only the triangles of the columns it touches.
 
-use std::io::Read;
-use std::path::Path;
-
 use crate::generate::surface::Edges;
 use crate::generate::triangle::{cross, distance, dot, sub};
 
-use super::check::Aabb;
+use super::aabb::Aabb;
 
 /// How far, relative to the shape's size, the lines that count crossings are moved off the
 /// points they go through (x, y): far below a spacing, off any round number (also a
 /// polygon's).
-pub(super) const LINE_SHIFT: [f64; 2] = [2.718_281_8e-9, 1.414_213_5e-9];
+pub(crate) const LINE_SHIFT: [f64; 2] = [2.718_281_8e-9, 1.414_213_5e-9];
 
-/// The largest STL file read (about five million triangles in binary).
-const MAX_BYTES: u64 = 256 << 20;
-
-/// What is wrong with a mesh file; the messages name the file and say where.
+/// What is wrong with a mesh as a body's shape; the messages name the file and say where.
 #[derive(Debug, thiserror::Error)]
-pub(super) enum MeshError {
-    #[error("cannot read {file}: {reason}")]
-    Read { file: String, reason: String },
-    #[error("{file} is not an STL file stl_io can read: {reason}")]
-    Format { file: String, reason: String },
+pub(crate) enum MeshError {
     #[error("{file} has no triangles")]
     Empty { file: String },
     #[error("{file} has a vertex with a coordinate that is not a finite number")]
@@ -70,11 +60,10 @@ pub(super) enum MeshError {
 
 impl MeshError {
     /// What the user can do about it.
-    pub(super) fn fix(&self) -> &'static str {
+    pub(crate) fn fix(&self) -> &'static str {
         match self {
-            MeshError::Read { .. } => "give the path of an STL file relative to the case file",
-            MeshError::Format { .. } | MeshError::Empty { .. } | MeshError::NotFinite { .. } => {
-                "export the body as an ASCII or binary STL of its closed surface, in metres"
+            MeshError::Empty { .. } | MeshError::NotFinite { .. } => {
+                "export the body's closed surface as an STL or OBJ file, in metres"
             }
             MeshError::Open { .. } | MeshError::NonManifold { .. } => {
                 "export one closed, watertight surface (repair it in the CAD tool or with a mesh \
@@ -90,7 +79,7 @@ impl MeshError {
 
 /// A closed, consistently oriented triangle surface and the solid it bounds.
 #[derive(Clone, PartialEq)]
-pub(super) struct Mesh {
+pub(crate) struct Mesh {
     /// The triangles, counter-clockwise seen from outside.
     tris: Vec<[[f64; 3]; 3]>,
     bounds: Aabb,
@@ -125,40 +114,8 @@ struct Columns {
 }
 
 impl Mesh {
-    /// Reads an ASCII or binary STL file and checks that it bounds a solid.
-    pub(super) fn read(path: &Path) -> Result<Mesh, MeshError> {
-        let file = path.display().to_string();
-        let read_err = |reason: String| MeshError::Read {
-            file: file.clone(),
-            reason,
-        };
-        let meta = std::fs::metadata(path).map_err(|e| read_err(e.to_string()))?;
-        if !meta.is_file() {
-            return Err(read_err("it is not a regular file".into()));
-        }
-        if meta.len() > MAX_BYTES {
-            return Err(read_err(format!(
-                "it has {} bytes, more than the {} MiB a mesh may have",
-                meta.len(),
-                MAX_BYTES >> 20
-            )));
-        }
-        let mut bytes = Vec::new();
-        std::fs::File::open(path)
-            .and_then(|f| f.take(MAX_BYTES + 1).read_to_end(&mut bytes))
-            .map_err(|e| read_err(e.to_string()))?;
-        let stl =
-            stl_io::read_stl(&mut std::io::Cursor::new(bytes)).map_err(|e| MeshError::Format {
-                file: file.clone(),
-                reason: e.to_string(),
-            })?;
-        let vertices: Vec<[f64; 3]> = stl.vertices.iter().map(|v| v.0.map(f64::from)).collect();
-        let faces: Vec<[usize; 3]> = stl.faces.iter().map(|f| f.vertices).collect();
-        Mesh::new(&file, &vertices, &faces)
-    }
-
     /// The mesh of indexed triangles; `file` names it in errors.
-    pub(super) fn new(
+    pub(crate) fn new(
         file: &str,
         vertices: &[[f64; 3]],
         faces: &[[usize; 3]],
@@ -216,21 +173,21 @@ impl Mesh {
         })
     }
 
-    pub(super) fn bounds(&self) -> Aabb {
+    pub(crate) fn bounds(&self) -> Aabb {
         self.bounds
     }
 
-    pub(super) fn volume(&self) -> f64 {
+    pub(crate) fn volume(&self) -> f64 {
         self.volume
     }
 
-    pub(super) fn centroid(&self) -> [f64; 3] {
+    pub(crate) fn centroid(&self) -> [f64; 3] {
         self.centroid
     }
 
     /// Inertia tensor about the centroid of the solid of uniform density and `mass`:
     /// I = (mass / V) (tr S 1 − S) with S the second moment.
-    pub(super) fn inertia(&self, mass: f64) -> [[f64; 3]; 3] {
+    pub(crate) fn inertia(&self, mass: f64) -> [[f64; 3]; 3] {
         let s = &self.second_moment;
         let trace = s[0][0] + s[1][1] + s[2][2];
         let k = mass / self.volume;
@@ -272,7 +229,7 @@ impl Mesh {
     }
 
     /// Whether `p` is inside the solid.
-    pub(super) fn contains(&self, p: [f64; 3]) -> bool {
+    pub(crate) fn contains(&self, p: [f64; 3]) -> bool {
         odd_above(p[2], &self.crossings(p[0], p[1]))
     }
 
@@ -286,7 +243,7 @@ impl Mesh {
     }
 
     /// The distance from `p` to the surface if it is less than `reach`.
-    pub(super) fn distance_within(&self, p: [f64; 3], reach: f64) -> Option<f64> {
+    pub(crate) fn distance_within(&self, p: [f64; 3], reach: f64) -> Option<f64> {
         let mut best = reach;
         let mut found = false;
         for k in self.columns.around(p[0], p[1], reach) {
@@ -318,7 +275,7 @@ impl Mesh {
     /// bounding box (whose cells cover it), keeping the points inside the surface and, with
     /// `depth`, less than `depth` from it. A cuboid whose sides are whole multiples of `dx`
     /// gets a box body's lattice.
-    pub(super) fn points(&self, dx: f64, depth: Option<f64>) -> Vec<[f64; 3]> {
+    pub(crate) fn points(&self, dx: f64, depth: Option<f64>) -> Vec<[f64; 3]> {
         let (n, origin) = self.lattice(dx);
         let at = |a: usize, i: usize| origin[a] + (i as f64 + 0.5) * dx;
         let near = depth.map(|d| self.near_lattice(n, origin, dx, d));
@@ -346,7 +303,7 @@ impl Mesh {
 
     /// Cells of size `dx` along each axis that cover the bounding box (a whole multiple of
     /// `dx`, to rounding, is covered exactly), centred on it, and the corner of the first.
-    pub(super) fn lattice(&self, dx: f64) -> ([usize; 3], [f64; 3]) {
+    pub(crate) fn lattice(&self, dx: f64) -> ([usize; 3], [f64; 3]) {
         let b = &self.bounds;
         let n = [0, 1, 2].map(|a| ((b.max[a] - b.min[a]) / dx - 1e-9).ceil().max(1.0) as usize);
         let origin = [0, 1, 2].map(|a| 0.5 * (b.min[a] + b.max[a]) - 0.5 * n[a] as f64 * dx);
@@ -386,8 +343,8 @@ impl Mesh {
 }
 
 /// Whether an odd number of the ascending `crossings` lie above `z`: inside, by the even–odd
-/// rule (also a polygon's, src/case/polygon.rs).
-pub(super) fn odd_above(z: f64, crossings: &[f64]) -> bool {
+/// rule (also a polygon's, `polygon.rs`).
+pub(crate) fn odd_above(z: f64, crossings: &[f64]) -> bool {
     (crossings.len() - crossings.partition_point(|&c| c <= z)) % 2 == 1
 }
 
@@ -528,10 +485,11 @@ fn orient(a: [f64; 3], b: [f64; 3], x: f64, y: f64) -> f64 {
 }
 
 #[cfg(test)]
-pub(super) mod tests {
+mod tests {
     use super::*;
 
-    pub(in crate::case) use crate::generate::surface::tests::{cuboid, globe};
+    use crate::generate::mesh_file::{parse, MeshFormat};
+    use crate::generate::surface::tests::{cuboid, globe};
 
     fn mesh(vf: (Vec<[f64; 3]>, Vec<[usize; 3]>)) -> Mesh {
         Mesh::new("test.stl", &vf.0, &vf.1).unwrap()
@@ -780,12 +738,8 @@ pub(super) mod tests {
                 }
             })
             .collect();
-        let dir = std::env::temp_dir().join(format!("wgsph_mesh_{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let binary = dir.join("globe.stl");
-        let mut out = std::fs::File::create(&binary).unwrap();
-        stl_io::write_stl(&mut out, tris.iter()).unwrap();
-        drop(out);
+        let mut binary = Vec::new();
+        stl_io::write_stl(&mut binary, tris.iter()).unwrap();
         let mut ascii = String::from("solid globe\n");
         for t in &tris {
             ascii += "facet normal 0 0 0\nouter loop\n";
@@ -795,16 +749,14 @@ pub(super) mod tests {
             ascii += "endloop\nendfacet\n";
         }
         ascii += "endsolid globe\n";
-        let text = dir.join("globe_ascii.stl");
-        std::fs::write(&text, ascii).unwrap();
-        let a = Mesh::read(&binary).unwrap();
-        let b = Mesh::read(&text).unwrap();
-        std::fs::remove_dir_all(&dir).ok();
+        let read = |bytes: &[u8]| {
+            let file = parse(bytes, MeshFormat::Stl).unwrap();
+            Mesh::new("globe.stl", &file.vertices, &file.faces).unwrap()
+        };
+        let (a, b) = (read(&binary), read(ascii.as_bytes()));
         // The f32 coordinates of the file against the f64 mesh.
         let exact = mesh((v, f));
         assert!(close(a.volume(), exact.volume(), 1e-6));
         assert_eq!(a, b);
-        let missing = Mesh::read(&dir.join("none.stl")).unwrap_err();
-        assert!(matches!(missing, MeshError::Read { .. }), "{missing}");
     }
 }
