@@ -175,18 +175,12 @@ impl Geometry {
         let obstacle_ranges = obstacle_ranges(ctx, case, &lat)?;
         let h = case.h_over_dx * case.dx;
         let inlet_layouts = inlet_layouts(ctx, case, &lat, h)?;
+        let clip = holder(case);
         let ground = match &case.terrain {
-            Some(t) => Some(Ground::of(
-                ctx,
-                t,
-                &lat,
-                (case.tank.as_ref().map(|t| &t.inner), case.domain.as_ref()),
-                budget,
-            )?),
+            Some(t) => Some(Ground::of(ctx, t, &lat, clip.as_ref(), budget)?),
             None => None,
         };
         let raised = raise_buildings(ctx, case, &lat, ground.as_ref(), budget)?;
-        let clip = holder(case);
         let (surface_walls, surface_notes) =
             super::surface::walls(ctx, (&case.surfaces, h), &lat, clip.as_ref(), budget)?;
         let under = (&obstacle_ranges[..], &raised);
@@ -240,9 +234,8 @@ fn raise_buildings(
         return Ok(Raised::default());
     }
     let mut clip = ([f64::NEG_INFINITY; 2], [f64::INFINITY; 2]);
-    let boxes = (case.tank.as_ref().map(|t| t.inner).into_iter()).chain(case.domain);
-    let boxes = boxes.map(|b| ([b.min[0], b.min[1]], [b.max[0], b.max[1]]));
-    for (min, max) in boxes.chain(ground.map(|g| g.clip())) {
+    let held = holder(case).map(|b| ([b.min[0], b.min[1]], [b.max[0], b.max[1]]));
+    for (min, max) in held.into_iter().chain(ground.map(|g| g.clip())) {
         for a in 0..2 {
             clip.0[a] = clip.0[a].max(min[a]);
             clip.1[a] = clip.1[a].min(max[a]);

@@ -210,18 +210,19 @@ pub(super) struct Ground {
 }
 
 impl Ground {
-    /// The ground of `terrain` on `lat`, clipped to the tank's inner box and the domain when
-    /// given; an error when no column is left, or when its columns alone hold more particles
-    /// than `budget` (checked before they are counted).
+    /// The ground of `terrain` on `lat`, clipped in plan to `holder` (what holds the water:
+    /// the tank's inner box cut by the domain) when given; an error when no column is left, or
+    /// when its columns alone hold more particles than `budget` (checked before they are
+    /// counted).
     pub(super) fn of(
         ctx: &Ctx<'_>,
         terrain: &Terrain,
         lat: &Lattice,
-        (tank, domain): (Option<&Aabb>, Option<&Aabb>),
+        holder: Option<&Aabb>,
         budget: &ParticleBudget,
     ) -> Result<Ground, CaseError> {
         let (mut min, mut max) = terrain.grid.extent();
-        for b in tank.into_iter().chain(domain) {
+        if let Some(b) = holder {
             for a in 0..2 {
                 min[a] = min[a].max(b.min[a]);
                 max[a] = max[a].min(b.max[a]);
@@ -254,7 +255,7 @@ impl Ground {
                     num(gmin[1]),
                     num(gmax[1]),
                     num(lat.dx),
-                    if tank.is_some() || domain.is_some() {
+                    if holder.is_some() {
                         " inside the tank and the domain"
                     } else {
                         ""
