@@ -11,9 +11,42 @@ use std::ops::Range;
 use anyhow::{bail, Result};
 use glam::DVec3;
 
-use crate::grid::{CellEdge, Grid};
-use crate::scenario::{Kind, Motion, Particle, Probe, ProbeKind, Scenario};
-use crate::sph::halo::halo_layers;
+use crate::grid::Grid;
+use crate::scenario::CellEdge;
+use crate::scenario::{InletPressure, Kind, Motion, Particle, Probe, ProbeKind, Scenario};
+
+/// Cell layers of halo `sc` needs. Cells are the kernel support 2h, so one layer holds every
+/// particle a neighbour's particle reaches. Fixed ghosts (and elastic solid particles, for
+/// their interface pressure) take their pressure and velocity from
+/// the fluid within a support of them (`fluid_at`) earlier in the same step, so a ghost copy
+/// next to the cut needs the fluid one layer further: two layers, of which the outer one's
+/// copies (wrong values, read by no own particle) only serve the inner one's. (The density
+/// filter, which reads corrected neighbours, swaps them again: `Solver::filter_over_ranks`.)
+///
+/// An extrapolated inlet buffer (`inlet_pressure`) takes its pressure from the fluid around its
+/// mirror image across the inlet's plane, up to twice the buffer's depth away, plus a support:
+/// the halo then reaches that far past the layer next to the cut.
+pub fn halo_layers(sc: &Scenario) -> u32 {
+    let ghosts = [Kind::GhostNoSlip, Kind::GhostFreeSlip];
+    let ghost_layers = match sc.particles.iter().any(|p| ghosts.contains(&p.kind)) {
+        true => 2,
+        false => 1,
+    };
+    // An elastic solid's interface pressure comes from the fluid around it as a ghost's does.
+    let ghost_layers = match sc.solids.is_some() {
+        true => 2,
+        false => ghost_layers,
+    };
+    let cell = 2.0 * sc.physics.h;
+    let mirror_layers = sc
+        .inlets
+        .iter()
+        .filter(|i| i.pressure == InletPressure::Extrapolated)
+        .map(|i| 1 + ((2.0 * i.thickness + cell) / cell).ceil() as u32)
+        .max()
+        .unwrap_or(1);
+    ghost_layers.max(mirror_layers)
+}
 
 /// A step's work of a particle that moves (fluid, solid, inlet), the unit of the balance.
 pub const MOVING_WEIGHT: f64 = 1.0;

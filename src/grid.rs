@@ -13,28 +13,7 @@ use std::ops::Range;
 use anyhow::{bail, Result};
 
 use crate::layout::MAX_BLOCK;
-use crate::scenario::{Domain, Scenario};
-
-/// The edge of the neighbour grid's cells (`[particles] cell` of a case).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CellEdge {
-    /// The kernel support 2h: a particle's neighbours are in the 3^d cells around its own.
-    Support,
-    /// h: the 5^d cells around, whose union hugs the support's sphere closer. A particle tests
-    /// the particles of 125 h³ for a sphere of 33.5 h³ in 3D, against 216 h³ with cells of 2h
-    /// (25 h² against 36 h² for a disc of 12.6 h² in 2D).
-    Half,
-}
-
-impl CellEdge {
-    /// The name a case file gives it.
-    pub fn name(self) -> &'static str {
-        match self {
-            CellEdge::Support => "2h",
-            CellEdge::Half => "h",
-        }
-    }
-}
+use crate::scenario::{CellEdge, Domain, Scenario};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Grid {

@@ -465,6 +465,29 @@ pub struct TlPair {
     pub pad1: u32,
 }
 
+/// The particle arrays as the GPU stores them, in id order.
+pub struct Packed {
+    pub pos: Vec<Pos>,
+    /// (v, ρ)
+    pub velrho: Vec<[f32; 4]>,
+    /// Kind and id (`IdSplit::code_word`).
+    pub code: Vec<u32>,
+    /// Each entry's whole id.
+    pub id: Vec<u32>,
+    pub ids: IdSplit,
+}
+
+impl Packed {
+    /// With wide ids, each entry's id's high word ([`IdSplit::high`]), which the code buffer
+    /// holds after its n code words; with narrow ids none.
+    pub fn high_words(&self) -> Vec<u32> {
+        match self.ids.wide {
+            true => self.id.iter().map(|&id| self.ids.high(id)).collect(),
+            false => Vec::new(),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -718,8 +741,8 @@ mod tests {
             r::GHOST_NO_SLIP,
             r::GHOST_FREE_SLIP,
             r::REPULSIVE,
-            r::elastic::SOLID,
-            r::elastic::SOLID_CLAMPED,
+            r::SOLID,
+            r::SOLID_CLAMPED,
             r::INLET,
         ];
         let wgsl = [

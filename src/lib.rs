@@ -11,9 +11,12 @@ pub mod gpu;
 pub mod grid;
 pub mod kernel;
 pub mod lagrangian;
+#[cfg(test)]
+mod layers;
 pub mod layout;
 pub mod logging;
 pub mod output;
+pub mod particles;
 pub mod plot;
 pub mod probe_reach;
 pub mod progress;

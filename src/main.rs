@@ -13,7 +13,8 @@ use indicatif::MultiProgress;
 use wgsph::checkpoint::{CaseSource, CheckpointPolicy};
 use wgsph::gpu::context::list_adapters;
 use wgsph::gpu::{AdapterChoice, GpuContext};
-use wgsph::plot::snapshot::{SnapshotField, SnapshotPainter};
+use wgsph::plot::color_scale::SnapshotField;
+use wgsph::plot::snapshot::SnapshotPainter;
 use wgsph::probe_reach::sig;
 use wgsph::progress::{LogLines, Progress, ProgressBarView};
 use wgsph::resume::ResumePlan;
@@ -725,11 +726,11 @@ fn print_error_row(e: &wgsph::plot::ErrorSummary) {
     );
 }
 
-/// The estimated bytes a particle-step moves (src/sph/traffic.rs), and the stages it leaves out.
-fn print_traffic(traffic: &wgsph::sph::traffic::Traffic) {
+/// The estimated bytes a particle-step moves (src/bench/traffic.rs), and the stages it leaves out.
+fn print_traffic(traffic: &wgsph::bench::traffic::Traffic) {
     let total = traffic.total();
     println!(
-        "bytes/particle-step  {:.0} read, {:.0} written (estimate: src/sph/traffic.rs)",
+        "bytes/particle-step  {:.0} read, {:.0} written (estimate: src/bench/traffic.rs)",
         total.read, total.written
     );
     // Counted without caches: a GPU's caches serve most of the neighbour loops' loads.
@@ -748,7 +749,7 @@ fn print_traffic(traffic: &wgsph::sph::traffic::Traffic) {
 /// estimated bytes per particle-step and the bandwidth they imply over its time.
 fn print_stages(
     times: &[wgsph::sph::profile::StageTime],
-    traffic: &wgsph::sph::traffic::Traffic,
+    traffic: &wgsph::bench::traffic::Traffic,
     steps: u64,
     particles: u64,
 ) {

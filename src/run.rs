@@ -19,7 +19,8 @@ use crate::gpu::GpuContext;
 use crate::output::{
     FirstPositions, OutputDir, ParticleFile, Piece, ProbeWriter, RunSummary, SNAPSHOTS_DIR,
 };
-use crate::plot::snapshot::{draw_particle_file, SnapshotField, SnapshotPainter};
+use crate::plot::color_scale::SnapshotField;
+use crate::plot::snapshot::{draw_particle_file, SnapshotPainter};
 use crate::progress::{Progress, RunStatus};
 use crate::ranks::Ranks;
 use crate::scenario::{Kind, OutputBoundary, ProbeKind, Scenario};
@@ -795,7 +796,7 @@ impl<'a> Runner<'a> {
     }
 
     /// Every rank's part of the run, on rank 0 (every rank together); None for one whole run.
-    fn rank_summaries(&self) -> Result<Option<Vec<crate::output::RankSummary>>> {
+    fn rank_summaries(&self) -> Result<Option<Vec<crate::ranks::RankSummary>>> {
         let Some(r) = self.ranks else {
             return Ok(None);
         };

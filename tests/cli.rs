@@ -1030,8 +1030,8 @@ fn surface_meshes_the_water_of_a_3d_run() {
 /// to the same bytes. Then `run --snapshots` and `plot --snapshots` draw the same PNGs.
 #[test]
 fn snapshots_3d_are_perspective_views_of_the_particles() {
+    use wgsph::plot::color_scale::SnapshotField;
     use wgsph::plot::perspective::{PerspectiveView, PICTURE};
-    use wgsph::plot::snapshot::SnapshotField;
     let set = ["particles.dx_m=0.04".to_string()];
     let sc = wgsph::case::load(std::path::Path::new("cases/hydrostatic_3d.toml"), &set).unwrap();
     let view = PerspectiveView::for_scenario(common::gpu(), &sc, SnapshotField::Pressure).unwrap();

@@ -11,7 +11,7 @@ mod common;
 use common::*;
 use wgsph::layout::{SymRate, ID_MASK, KIND_SHIFT};
 use wgsph::reference::elastic::{self, SolidRef};
-use wgsph::reference::{RefParticle, Space};
+use wgsph::reference::{is_solid, RefParticle, Space};
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
 
@@ -131,7 +131,7 @@ fn in_gpu_order<T: Copy>(solver: &Solver, by_id: &[T], other: T) -> Vec<T> {
     let base = solver.solid_id_base();
     code.iter()
         .map(|&c| {
-            if elastic::is_solid(c >> KIND_SHIFT) {
+            if is_solid(c >> KIND_SHIFT) {
                 by_id[((c & ID_MASK) - base) as usize]
             } else {
                 other
@@ -504,7 +504,7 @@ fn solid_contact_matches_reference() {
         let boundary = wgsph::reference::interaction::rates(ph, &sc.walls, &space, &parts);
         let mut groups: [Vec<(usize, [f64; 3])>; 4] = Default::default();
         for i in 0..parts.len() {
-            let (want, group) = if elastic::is_solid(parts[i].kind) {
+            let (want, group) = if is_solid(parts[i].kind) {
                 let s = solids[i].expect("solid").rate;
                 let c = contact[i];
                 let touching = c.iter().any(|x| *x != 0.0);
@@ -650,7 +650,7 @@ fn fluid_solid_interface_matches_reference() {
         let fluid = wgsph::reference::interaction::rates(ph, &sc.walls, &space, &parts);
         let p_g = wgsph::reference::ghost::solid_interface_pressure(ph, &sc.walls, &space, &parts);
         let on_solid: Vec<f64> = (0..parts.len())
-            .filter(|&i| elastic::is_solid(parts[i].kind))
+            .filter(|&i| is_solid(parts[i].kind))
             .map(|i| p_g[i])
             .collect();
         assert!(
@@ -828,7 +828,7 @@ fn solids_of_both_formulations_match_their_references() {
         let n_tl = parts
             .iter()
             .zip(&solid)
-            .filter(|(p, s)| elastic::is_solid(p.kind) && s.body == 1)
+            .filter(|(p, s)| is_solid(p.kind) && s.body == 1)
             .count();
         assert_eq!(
             ul.len() + n_tl,

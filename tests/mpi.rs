@@ -10,10 +10,11 @@ use std::time::{Duration, Instant};
 
 use wgsph::decomposition::{cut_axis, layer_load, slabs_for, Slabs};
 use wgsph::gpu::{AdapterChoice, GpuContext};
-use wgsph::grid::{CellEdge, Grid};
+use wgsph::grid::Grid;
 use wgsph::layout::{unpack_block, KIND_EXCLUDED, KIND_SHIFT};
 use wgsph::output::{particle_files, ParticleFile, RunSummary};
 use wgsph::ranks::{Mpi, Ranks};
+use wgsph::scenario::CellEdge;
 use wgsph::scenario::{Domain, Kind, Particle, Scenario};
 use wgsph::sph::Solver;
 
@@ -1108,7 +1109,7 @@ fn a_body_crossing_the_cut_moves_as_in_one_run() {
 
 /// The 2D dam break in a tank of fixed ghost walls (the seed's interface, MLS ghosts): a ghost
 /// takes its values from the fluid around it earlier in the step, so the halo is two cell layers
-/// thick (`halo::halo_layers`). From cuts at equal numbers of layers, moved at step 100, every
+/// thick (`decomposition::halo_layers`). From cuts at equal numbers of layers, moved at step 100, every
 /// particle equals one whole run's bit for bit after 300 steps. Both ranks' packing buffers,
 /// made for their starting halos, grow on the way (`Halo::reserve`). Steps 10 to 19 overlap
 /// the exchange (`time.overlap_exchange = "auto"`'s first trial), the ghosts interpolated after
@@ -1156,7 +1157,7 @@ fn ranks_filter_the_density_as_one_run() {
 
 /// The 2D dam break with a nozzle in its right wall shooting a jet to the left at 1.5 m/s, its
 /// buffer's pressure extrapolated from the water at the mirror images (so the halo reaches as
-/// far as they do, `halo::halo_layers`; with one layer, 890 particles differ). The case is cut
+/// far as they do, `decomposition::halo_layers`; with one layer, 890 particles differ). The case is cut
 /// along the vertical. From cuts at equal numbers of layers, rank 0 holds every
 /// inlet particle waiting to join (ids kept, apart from the free entries the arrivals fill);
 /// at step 100 the ranks move the cut through the nozzle, and from then on rank 0 wakes the

@@ -133,7 +133,7 @@ pub(super) struct RawParticles {
     pub id_low_bits: Option<u32>,
 }
 
-/// The neighbour grid's cell edge (`crate::grid::CellEdge`).
+/// The neighbour grid's cell edge (`crate::scenario::CellEdge`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 pub(super) enum CellName {
     #[serde(rename = "2h")]

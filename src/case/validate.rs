@@ -2,7 +2,7 @@
 //! options that go together, defaults. Produces a [`Case`] in SI with 3-component vectors.
 //! Geometric checks that need several fields at once live in `build.rs` and `domain.rs`.
 
-use crate::grid::CellEdge;
+use crate::scenario::CellEdge;
 use crate::scenario::{
     DeltaSphForm, DensityFilter, FrictionPair, GhostCorrection, KernelKind, OutputBoundary,
     OverlapExchange, Probe, RepulsiveForm, TimeControl, Viscosity, DEFAULT_FRICTION_SLIP,

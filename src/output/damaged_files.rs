@@ -4,10 +4,11 @@
 //! the undamaged file reads back. The checkpoint's reader is tried the same way in
 //! `checkpoint.rs`, the probe tables' in `plot`.
 
-use super::particle_file::{ParticleFile, Particles};
+use super::particle_file::ParticleFile;
 use super::test_util::survives_damage;
 use super::vtu::{pvtu_pieces, reader::Vtu, write_pvtu, write_triangles_vtu, write_vtu};
 use super::{RunSummary, SurfaceMesh};
+use crate::particles::Particles;
 
 fn particles(n: u32) -> Particles {
     Particles {

@@ -35,14 +35,15 @@ use std::fmt;
 use std::io;
 use std::path::{Path, PathBuf};
 
+pub use crate::particles::Particles;
 pub use atomic::write_atomic;
 pub use lock::{DirLock, LOCK_FILE};
 pub use manifest::{
     adopt_unlisted_outputs, clear_for_new_run, is_run_output, write_listed, Manifest, MANIFEST_FILE,
 };
-pub use particle_file::{particle_files, FirstPositions, ParticleFile, Particles};
+pub use particle_file::{particle_files, FirstPositions, ParticleFile};
 pub use probes_csv::ProbeWriter;
-pub use run_summary::{RankSummary, RunSummary};
+pub use run_summary::RunSummary;
 
 /// Name of the series file inside the output directory.
 pub const PVD_FILE: &str = "particles.pvd";

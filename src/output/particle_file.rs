@@ -6,24 +6,8 @@ use std::path::{Path, PathBuf};
 
 use super::vtu::{pvtu_pieces, reader::Vtu};
 use super::{particle_file_name, pieces_file_name, OutputError, Snapshot, PARTICLES_DIR};
+use crate::particles::Particles;
 use crate::scenario::Kind;
-
-/// Particles read back for output, in id order.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Particles {
-    pub pos: Vec<[f64; 3]>,
-    pub vel: Vec<[f32; 3]>,
-    pub rho: Vec<f32>,
-    pub pressure: Vec<f32>,
-    /// 0 fluid, 1 wall, 15 excluded.
-    pub kind: Vec<u32>,
-    pub id: Vec<u32>,
-    /// Specific internal energy [J/kg], when the energy equation is on.
-    pub energy: Option<Vec<f32>>,
-    /// Deviatoric stress τ (xx, yy, zz, xy, xz, yz) [Pa], when the case has solids (zeros for
-    /// other particles).
-    pub stress: Option<Vec<[f32; 6]>>,
-}
 
 /// The particle files' names of the six components of [`Particles::stress`].
 const STRESS_NAMES: [&str; 6] = ["tau_xx", "tau_yy", "tau_zz", "tau_xy", "tau_xz", "tau_yz"];

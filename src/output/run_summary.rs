@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use super::{write_atomic, OutputError};
+use crate::ranks::RankSummary;
 
 /// Summary of a run, written as JSON at the end (and possibly on stop). Non-finite floats are
 /// written as `null` (JSON has no NaN).
@@ -67,34 +68,6 @@ pub struct RunSummary {
     /// it (`wgsph run`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub case_build_s: Option<f64>,
-}
-
-/// One rank's part of a run over several ranks (`run.json`, `wgsph bench` under mpirun).
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct RankSummary {
-    pub adapter: String,
-    /// The particles this rank owned at the end.
-    pub own_particles: u64,
-    /// Halo copies, migrants and their bytes sent to the neighbours, per step.
-    pub halo_particles_per_step: f64,
-    pub migrants_per_step: f64,
-    pub halo_bytes_per_step: f64,
-    /// Wall seconds per step in each part of the step.
-    pub seconds_per_step: crate::sph::subdomain::Split,
-    /// Times the cuts moved.
-    pub rebalances: u32,
-    /// Entries of this rank's slot table, sized by its own particles or cells
-    /// (`Grid::for_subdomain`).
-    #[serde(default)]
-    pub hash_slots: u64,
-    /// The share of the rank's steps that overlapped the exchange with its interior's sums
-    /// (`time.overlap_exchange`, where the case allows; a resume may change it).
-    #[serde(default)]
-    pub overlapped: f64,
-    /// The share of those steps whose exchange ended while those sums were still running:
-    /// the exchange wholly hidden behind them.
-    #[serde(default)]
-    pub exchange_hidden: f64,
 }
 
 impl RunSummary {

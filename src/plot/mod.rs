@@ -13,6 +13,7 @@
 //! plotters' pure-Rust `ab_glyph` path: no system font or library is needed.
 
 pub mod animation;
+pub mod color_scale;
 pub mod perspective;
 pub mod snapshot;
 

@@ -15,7 +15,7 @@ use anyhow::{anyhow, bail, Result};
 use glam::{DMat4, DVec3};
 use plotters::prelude::*;
 
-use super::snapshot::{draw_colorbar, ColorScale, SnapshotField, BACKGROUND};
+use super::color_scale::{draw_colorbar, ColorScale, SnapshotField, BACKGROUND, COLORBAR_WIDTH};
 use super::{register_font, write_png};
 use crate::gpu::buffers::{map_read, readback_buffer};
 use crate::gpu::GpuContext;
@@ -29,7 +29,6 @@ pub const PICTURE: (u32, u32) = (960, 600);
 /// without multisampling, which not every adapter offers for every format.
 const SUPERSAMPLING: u32 = 2;
 const TITLE_HEIGHT: u32 = 34;
-const COLORBAR_WIDTH: u32 = 130;
 /// Vertical field of view.
 const FOV_Y_DEG: f64 = 30.0;
 /// Where the camera stands, from the centre of what it looks at (x along the tank, z up):

@@ -5,6 +5,9 @@
 
 use anyhow::Result;
 
+mod summary;
+pub use summary::{RankSummary, Split};
+
 #[cfg(feature = "mpi")]
 mod mpi;
 #[cfg(feature = "mpi")]

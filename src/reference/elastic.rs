@@ -1,11 +1,8 @@
 //! Twin of shaders/elastic.wgsl (hypoelastic solid particles, Gray, Monaghan & Swift 2001),
 //! brute force over all pairs, f64. The equations: docs/equations.md eqs. 7, 8, 25–27.
 
-use super::{dot, kernel, RefParticle, Space};
+use super::{dot, is_solid, kernel, RefParticle, Space};
 use crate::scenario::{ContactGroup, ElasticMaterial, Physics, SolidFormulation};
-
-pub const SOLID: u32 = crate::scenario::Kind::Solid as u32;
-pub const SOLID_CLAMPED: u32 = crate::scenario::Kind::SolidClamped as u32;
 
 type M3 = [[f64; 3]; 3];
 
@@ -22,10 +19,6 @@ pub struct SolidRef {
 pub struct ElasticRates {
     pub rate: [f64; 4],
     pub dtau: [f64; 6],
-}
-
-pub fn is_solid(kind: u32) -> bool {
-    kind == SOLID || kind == SOLID_CLAMPED
 }
 
 /// τ as a symmetric 3×3 matrix.

@@ -105,7 +105,7 @@ pub fn solid_interface_pressure(
     parts
         .iter()
         .map(|s| {
-            if super::elastic::is_solid(s.kind) {
+            if super::is_solid(s.kind) {
                 fluid_at(ph, walls, space, parts, s.pos, ph.gravity).0
             } else {
                 0.0

@@ -204,7 +204,7 @@ pub fn contact_group(p: &RefParticle) -> ContactGroup {
 /// The velocity a particle presents in contact: a solid particle's own, a boundary particle's
 /// wall velocity (a body's rigid velocity at it; zero for fixed walls).
 pub fn contact_velocity(p: &RefParticle) -> [f64; 3] {
-    if super::elastic::is_solid(p.kind) {
+    if super::is_solid(p.kind) {
         p.vel
     } else {
         p.wall_vel
@@ -265,7 +265,7 @@ pub fn interaction(
             let reacts = on_body
                 || (walls.reactions
                     && !matches!(pi.kind, FLUID | EXCLUDED | INLET)
-                    && !super::elastic::is_solid(pi.kind));
+                    && !super::is_solid(pi.kind));
             if pi.kind == WALL || reacts {
                 (
                     boundary_rates(ph, walls, space, parts, i, reacts, on_body),
@@ -340,7 +340,7 @@ pub(crate) fn boundary_rates(
         } else if pi.body.is_some()
             && pj.kind != EXCLUDED
             && pj.kind != INLET
-            && !super::elastic::is_solid(pj.kind)
+            && !super::is_solid(pj.kind)
             && pj.body != pi.body
             && !(pi.body_kinematic && (pj.body.is_none() || pj.body_kinematic))
         {
@@ -380,7 +380,7 @@ pub(crate) fn fluid_rates(
             add(&mut r, [f[0], f[1], f[2], 0.0]);
             continue;
         }
-        if super::elastic::is_solid(pj.kind) {
+        if super::is_solid(pj.kind) {
             // Fluid–solid pairs: super::elastic::interface_rates.
             continue;
         }

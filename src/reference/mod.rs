@@ -17,7 +17,7 @@ pub mod probes;
 pub mod total_lagrangian;
 
 use crate::kernel;
-use crate::scenario::{Physics, Viscosity};
+use crate::scenario::{Kind, Physics, Viscosity};
 
 /// A particle as the reference sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,13 +42,21 @@ pub struct RefParticle {
     pub wall_acc: [f64; 3],
 }
 
-pub const FLUID: u32 = 0;
-pub const WALL: u32 = 1;
-pub const GHOST_NO_SLIP: u32 = 2;
-pub const GHOST_FREE_SLIP: u32 = 3;
-pub const REPULSIVE: u32 = 4;
-pub const INLET: u32 = crate::scenario::Kind::Inlet as u32;
+/// The particle kinds as the GPU's code word holds them (`Kind`), and the excluded mark.
+pub const FLUID: u32 = Kind::Fluid as u32;
+pub const WALL: u32 = Kind::Wall as u32;
+pub const GHOST_NO_SLIP: u32 = Kind::GhostNoSlip as u32;
+pub const GHOST_FREE_SLIP: u32 = Kind::GhostFreeSlip as u32;
+pub const REPULSIVE: u32 = Kind::Repulsive as u32;
+pub const SOLID: u32 = Kind::Solid as u32;
+pub const SOLID_CLAMPED: u32 = Kind::SolidClamped as u32;
+pub const INLET: u32 = Kind::Inlet as u32;
 pub const EXCLUDED: u32 = crate::layout::KIND_EXCLUDED;
+
+/// An elastic solid's particle, free or clamped.
+pub fn is_solid(kind: u32) -> bool {
+    kind == SOLID || kind == SOLID_CLAMPED
+}
 
 /// Tait equation of state, P = B((ρ/ρ0)^γ − 1).
 pub fn pressure(ph: &Physics, rho: f64) -> f64 {

@@ -146,9 +146,7 @@ pub fn wall_pressure(
     let sum: f64 = parts
         .iter()
         .zip(rates)
-        .filter(|(p, _)| {
-            !matches!(p.kind, FLUID | EXCLUDED | INLET) && !super::elastic::is_solid(p.kind)
-        })
+        .filter(|(p, _)| !matches!(p.kind, FLUID | EXCLUDED | INLET) && !super::is_solid(p.kind))
         .filter(|(p, _)| patch.holds(p.pos, ph.h) && !elsewhere(p))
         .map(|(_, r)| (0..3).map(|a| r[a] * patch.normal[a]).sum::<f64>())
         .sum();

@@ -3,9 +3,9 @@
 
 use anyhow::{anyhow, Result};
 
-use super::initial::Packed;
 use crate::gpu::buffers::{storage, storage_init, uniform_init};
 use crate::gpu::kernel::Resolve;
+use crate::layout::Packed;
 use crate::layout::{
     BodyMotion, BodyParticle, MirrorPlane, Params, Pos, ProbeDef, SimState, SolidState, WallSensor,
 };

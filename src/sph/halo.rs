@@ -11,7 +11,7 @@ use crate::gpu::buffers::{map_read, read, readback_buffer, storage, uniform_init
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
 use crate::layout::{HaloArrivals, HaloCounts, HaloCtl, HaloRecord, Pos};
-use crate::scenario::{InletPressure, Kind, Scenario};
+use crate::scenario::Scenario;
 use bytemuck::{Pod, Zeroable};
 
 pub const SHADER: Shader = Shader {
@@ -19,39 +19,6 @@ pub const SHADER: Shader = Shader {
     source: include_str!("../../shaders/halo.wgsl"),
     libs: &[PARTICLE_ID, SLAB],
 };
-
-/// Cell layers of halo `sc` needs. Cells are the kernel support 2h, so one layer holds every
-/// particle a neighbour's particle reaches. Fixed ghosts (and elastic solid particles, for
-/// their interface pressure) take their pressure and velocity from
-/// the fluid within a support of them (`fluid_at`) earlier in the same step, so a ghost copy
-/// next to the cut needs the fluid one layer further: two layers, of which the outer one's
-/// copies (wrong values, read by no own particle) only serve the inner one's. (The density
-/// filter, which reads corrected neighbours, swaps them again: `Solver::filter_over_ranks`.)
-///
-/// An extrapolated inlet buffer (`inlet_pressure`) takes its pressure from the fluid around its
-/// mirror image across the inlet's plane, up to twice the buffer's depth away, plus a support:
-/// the halo then reaches that far past the layer next to the cut.
-pub fn halo_layers(sc: &Scenario) -> u32 {
-    let ghosts = [Kind::GhostNoSlip, Kind::GhostFreeSlip];
-    let ghost_layers = match sc.particles.iter().any(|p| ghosts.contains(&p.kind)) {
-        true => 2,
-        false => 1,
-    };
-    // An elastic solid's interface pressure comes from the fluid around it as a ghost's does.
-    let ghost_layers = match sc.solids.is_some() {
-        true => 2,
-        false => ghost_layers,
-    };
-    let cell = 2.0 * sc.physics.h;
-    let mirror_layers = sc
-        .inlets
-        .iter()
-        .filter(|i| i.pressure == InletPressure::Extrapolated)
-        .map(|i| 1 + ((2.0 * i.thickness + cell) / cell).ceil() as u32)
-        .max()
-        .unwrap_or(1);
-    ghost_layers.max(mirror_layers)
-}
 
 /// Records the packing buffer of `sc`'s subdomains holds per particle of the arrays: a
 /// particle packs at most two (a halo copy each way from a slab as thin as its halo, or one
@@ -102,7 +69,7 @@ fn bindings<'a>(
         .with("restore_index", restore_index)
 }
 
-/// Rank `rank`'s part of `slabs` with a halo of `layers` ([`halo_layers`]): what `halo_pack`
+/// Rank `rank`'s part of `slabs` with a halo of `layers` ([`halo_layers`](crate::decomposition::halo_layers)): what `halo_pack`
 /// needs to know (the records' capacity is the pass's own, set by [`Halo::new`]).
 pub fn control(slabs: &Slabs, rank: usize, layers: u32) -> HaloCtl {
     let own = slabs.range(rank);

@@ -8,7 +8,7 @@ use anyhow::{bail, Result};
 use super::buffers::ParticleBuffers;
 use crate::gpu::GpuContext;
 use crate::grid::Grid;
-use crate::layout::{pack_block, IdSplit, Pos, SolidState, KIND_EXCLUDED};
+use crate::layout::{pack_block, IdSplit, Packed, Pos, SolidState, KIND_EXCLUDED};
 use crate::scenario::{Kind, Scenario};
 
 /// What a case holds, for the branches of the pair sums: the kernels leave out the terms of the
@@ -66,29 +66,6 @@ impl Present {
             lone_solid: sc.solids.as_ref().is_some_and(|s| s.materials.len() == 1)
                 && sc.particles.iter().all(|p| p.kind.is_solid()),
         })
-    }
-}
-
-/// The particle arrays as the GPU stores them, in id order.
-pub struct Packed {
-    pub pos: Vec<Pos>,
-    /// (v, ρ)
-    pub velrho: Vec<[f32; 4]>,
-    /// Kind and id (`IdSplit::code_word`).
-    pub code: Vec<u32>,
-    /// Each entry's whole id.
-    pub id: Vec<u32>,
-    pub ids: IdSplit,
-}
-
-impl Packed {
-    /// With wide ids, each entry's id's high word ([`IdSplit::high`]), which the code buffer
-    /// holds after its n code words; with narrow ids none.
-    pub fn high_words(&self) -> Vec<u32> {
-        match self.ids.wide {
-            true => self.id.iter().map(|&id| self.ids.high(id)).collect(),
-            false => Vec::new(),
-        }
     }
 }
 

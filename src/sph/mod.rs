@@ -31,7 +31,6 @@ pub mod shader;
 pub mod state;
 pub mod subdomain;
 pub mod total_lagrangian;
-pub mod traffic;
 
 use anyhow::{bail, Result};
 
@@ -145,7 +144,7 @@ pub struct Unstable {
     pub reason: String,
 }
 
-pub use crate::output::Particles;
+pub use crate::particles::Particles;
 
 /// (positions, (v, ρ), code words) as stored on the GPU; with wide ids the code words are
 /// followed by the ids' high words (`Solver::ids`).

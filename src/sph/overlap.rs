@@ -160,7 +160,8 @@ impl Overlap {
 mod tests {
     use super::*;
     use crate::decomposition::{cut_axis, layer_load, random_fluid, Slabs};
-    use crate::grid::{CellEdge, Grid};
+    use crate::grid::Grid;
+    use crate::scenario::CellEdge;
     use crate::scenario::{Domain, Particle};
 
     /// No particle that [`reads_no_arrival`] says may be summed early reads, directly (within

@@ -14,7 +14,6 @@ use std::ops::Range;
 
 use anyhow::{bail, ensure, Context, Result};
 
-use super::initial::Packed;
 use super::passes::Passes;
 use super::profile::Recorder;
 use super::Solver;
@@ -24,9 +23,10 @@ use crate::decomposition::{
 };
 use crate::gpu::GpuContext;
 use crate::grid::Grid;
+use crate::layout::Packed;
 use crate::layout::{unpack_block, HaloCtl, IdSplit, Pos, KIND_EXCLUDED, KIND_SHIFT};
-use crate::output::RankSummary;
 use crate::ranks::Ranks;
+use crate::ranks::{RankSummary, Split};
 use crate::scenario::{Kind, Scenario};
 
 /// A subdomain's counts, over all ranks where they say so (a checkpoint keeps them).
@@ -86,31 +86,6 @@ struct Interior {
 
 /// Steps between two looks at the ranks' balance (`Solver::rebalance`).
 pub const REBALANCE_EVERY: u64 = 100;
-
-/// Where a subdomain's step time goes, in seconds summed over steps.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Split {
-    /// The GPU up to the exchange (predictors, packing) and reading the records back.
-    pub pack: f64,
-    /// Swapping the records with the neighbours (waiting for the slower one included).
-    pub exchange: f64,
-    /// Writing the received particles and the GPU from the sort to the time step.
-    pub compute: f64,
-    /// Agreeing on the time step and the counts (waiting for the slowest rank included).
-    pub agree: f64,
-}
-
-impl std::ops::Sub for Split {
-    type Output = Split;
-    fn sub(self, o: Split) -> Split {
-        Split {
-            pack: self.pack - o.pack,
-            exchange: self.exchange - o.exchange,
-            compute: self.compute - o.compute,
-            agree: self.agree - o.agree,
-        }
-    }
-}
 
 impl Ranked {
     /// A subdomain of a run of `live` particles, with `own` of them first in its arrays and
@@ -243,7 +218,7 @@ impl Solver {
             slabs.ranks(),
             ranks.size()
         );
-        let ctl = halo::control(slabs, ranks.rank(), halo::halo_layers(sc));
+        let ctl = halo::control(slabs, ranks.rank(), crate::decomposition::halo_layers(sc));
         ensure!(
             (0..slabs.ranks()).all(|r| slabs.range(r).len() as u32 >= ctl.layers),
             "the cuts {slabs:?} leave a slab thinner than the {} cell layers of halo this case \

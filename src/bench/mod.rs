@@ -2,6 +2,8 @@
 //! per particle beside what it costs, the figures that predict a GPU's speed from its
 //! bandwidth and show a regression on any adapter.
 
+pub mod traffic;
+
 use std::time::Instant;
 
 use anyhow::{Context, Result};
@@ -12,8 +14,8 @@ use crate::layout::KIND_EXCLUDED;
 use crate::output::Particles;
 use crate::scenario::{Kind, Scenario};
 use crate::sph::profile::StageTime;
-use crate::sph::traffic::{StepCounts, Traffic};
 use crate::sph::Solver;
+use traffic::{StepCounts, Traffic};
 
 /// The neighbour search's work in one state of the particles: per particle in the grid, and
 /// per fluid particle (whose loop, `fluid_rates`, does the most per neighbour).
@@ -167,7 +169,7 @@ pub struct BenchReport {
     /// What the traffic estimate counted with: the work, the kinds' shares, the slots.
     pub counts: StepCounts,
     /// Bytes read and written per particle-step by each stage, estimated from the work
-    /// (src/sph/traffic.rs).
+    /// (src/bench/traffic.rs).
     pub traffic: Traffic,
     /// Each stage's GPU time over as many steps again, when asked for.
     pub stages: Option<Vec<StageTime>>,
@@ -289,7 +291,7 @@ pub struct RankedBenchReport {
     pub wall_s: f64,
     pub simulated_s: f64,
     /// Each rank's part of the timed steps (its adapter named on rank 0 only).
-    pub ranks: Vec<crate::output::RankSummary>,
+    pub ranks: Vec<crate::ranks::RankSummary>,
 }
 
 impl RankedBenchReport {
@@ -339,7 +341,7 @@ pub fn measure_ranked(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::CellEdge;
+    use crate::scenario::CellEdge;
     use crate::scenario::Domain;
 
     /// Every particle within the support of another is in a slot `slots_around` visits from

@@ -71,7 +71,7 @@ pub struct StepCounts {
     /// The density filter's period in steps, if the case has one.
     pub density_filter_every: Option<u32>,
     /// Candidates and neighbours per particle (all live, and fluid).
-    pub work: crate::bench::NeighbourWork,
+    pub work: super::NeighbourWork,
 }
 
 impl StepCounts {
