@@ -58,6 +58,7 @@ fn modules(src: &Path) -> BTreeMap<Vec<String>, PathBuf> {
 /// The module paths `text` (of the module `at`) names, relative paths made absolute.
 fn named_paths(text: &str, at: &[String]) -> Vec<Vec<String>> {
     let mut out = Vec::new();
+    let parent = at[..at.len().saturating_sub(1)].to_vec();
     for line in text.lines() {
         let code = line.trim_start();
         if code.starts_with("#[cfg(test)]") {
@@ -67,8 +68,7 @@ fn named_paths(text: &str, at: &[String]) -> Vec<Vec<String>> {
             continue;
         }
         let code = code.split("//").next().unwrap_or("");
-        let parent = at[..at.len().saturating_sub(1)].to_vec();
-        for (prefix, base) in [("crate::", Vec::new()), ("super::", parent)] {
+        for (prefix, base) in [("crate::", Vec::new()), ("super::", parent.clone())] {
             for (k, _) in code.match_indices(prefix) {
                 let before = code[..k].chars().last();
                 if before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == ':') {
