@@ -2,8 +2,7 @@
 //! antisymmetric in the pair, so total momentum changes only by gravity: the centroid falls as
 //! ½gt² and the mean velocity is gt, whatever the block does internally.
 
-mod common;
-use common::*;
+use crate::common::*;
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
 

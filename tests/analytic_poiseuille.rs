@@ -3,8 +3,7 @@
 //! series solution (tests/data/analytic_poiseuille_startup.csv: d = 1, ν = 100, F = 1000,
 //! u_max = 1.25; the same parameters as jax-sph's validation).
 
-mod common;
-use common::*;
+use crate::common::*;
 use wgsph::scenario::*;
 use wgsph::sph::Solver;
 

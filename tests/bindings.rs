@@ -1,15 +1,13 @@
 //! Bindings by name: a pass asks for each WGSL global by its name and gets the buffer of the
 //! right parity, or an error; it cannot bind a wrong buffer or rebind a shared one.
 
-mod common;
-
 use bytemuck::Zeroable;
 use wgsph::gpu::kernel::Resolve;
 use wgsph::layout::Params;
 use wgsph::sph::buffers::{CaseTables, InitialParticles, ParticleBuffers, TableSizes};
 
 fn buffers() -> ParticleBuffers {
-    let ctx = common::gpu();
+    let ctx = crate::common::gpu();
     ParticleBuffers::new(
         &ctx.device,
         &Params::zeroed(),
@@ -76,7 +74,7 @@ fn an_unknown_name_or_a_particle_array_without_parity_is_an_error() {
     assert!(err.contains("no buffer"), "{err}");
     assert!(b.unparitied().resolve("pos").is_err());
     assert!(b.unparitied().resolve("state").is_ok());
-    let own = wgsph::gpu::buffers::storage(&common::gpu().device, "own", 16);
+    let own = wgsph::gpu::buffers::storage(&crate::common::gpu().device, "own", 16);
     let with = b.at(1).with("terms", &own);
     assert!(same(with.resolve("terms").unwrap(), &own));
 }
@@ -85,6 +83,6 @@ fn an_unknown_name_or_a_particle_array_without_parity_is_an_error() {
 #[should_panic(expected = "shared buffer's name")]
 fn a_pass_cannot_rebind_a_shared_buffer() {
     let b = buffers();
-    let own = wgsph::gpu::buffers::storage(&common::gpu().device, "own", 16);
+    let own = wgsph::gpu::buffers::storage(&crate::common::gpu().device, "own", 16);
     let _ = b.at(0).with("velrho", &own);
 }

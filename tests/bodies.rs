@@ -2,8 +2,7 @@
 //! particles, the interaction rows of body particles (fluid force and contact), the per-body
 //! force and torque sums; and a body in free flight, whose motion is known exactly.
 
-mod common;
-use common::*;
+use crate::common::*;
 use glam::DVec3;
 use wgsph::body::Pose;
 use wgsph::layout::ID_MASK;

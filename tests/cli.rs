@@ -1,17 +1,15 @@
 //! The `wgsph` command as a user runs it: a short real run writes every output; bad case files
 //! fail with a message naming file, line and field, never a panic.
 
-mod common;
-
 use std::process::Command;
 
 fn wgsph() -> Command {
-    common::one_lavapipe_thread_each();
+    crate::common::one_lavapipe_thread_each();
     Command::new(env!("CARGO_BIN_EXE_wgsph"))
 }
 
-fn temp_dir(name: &str) -> common::Scratch {
-    common::Scratch::new(&format!("cli-{name}"))
+fn temp_dir(name: &str) -> crate::common::Scratch {
+    crate::common::Scratch::new(&format!("cli-{name}"))
 }
 
 #[test]
@@ -67,7 +65,7 @@ fn run_hydrostatic(
     name: &str,
     rust_log: &str,
     args: &[&str],
-) -> (std::process::Output, common::Scratch) {
+) -> (std::process::Output, crate::common::Scratch) {
     let out = temp_dir(name);
     let o = wgsph()
         .args(["run", "cases/hydrostatic_2d.toml"])
@@ -212,7 +210,7 @@ fn plot_snapshots_draws_from_the_particle_files_what_the_run_drew() {
 /// pictures drawn from them afterwards are the run's own.
 /// `hydrostatic_3d` at dx = 0.04 m to `end_s`, an output every 0.01 s, with `args`, in a
 /// scratch folder named after `name`; the run must succeed.
-fn run_tank_3d(name: &str, end_s: &str, args: &[&str]) -> common::Scratch {
+fn run_tank_3d(name: &str, end_s: &str, args: &[&str]) -> crate::common::Scratch {
     let out = temp_dir(name);
     let o = wgsph()
         .args(["run", "cases/hydrostatic_3d.toml", "--quiet"])
@@ -949,7 +947,7 @@ fn a_locked_output_folder_is_refused_and_a_stale_lock_taken_over() {
     std::fs::write(&lock, format!("{me}\n")).unwrap();
     let sc = wgsph::case::load(std::path::Path::new("cases/hydrostatic_2d.toml"), &[]).unwrap();
     let Err(e) = wgsph::run::resume(
-        common::gpu(),
+        crate::common::gpu(),
         &sc,
         &out,
         &Default::default(),
@@ -1034,7 +1032,8 @@ fn snapshots_3d_are_perspective_views_of_the_particles() {
     use wgsph::plot::perspective::{PerspectiveView, PICTURE};
     let set = ["particles.dx_m=0.04".to_string()];
     let sc = wgsph::case::load(std::path::Path::new("cases/hydrostatic_3d.toml"), &set).unwrap();
-    let view = PerspectiveView::for_scenario(common::gpu(), &sc, SnapshotField::Pressure).unwrap();
+    let view =
+        PerspectiveView::for_scenario(crate::common::gpu(), &sc, SnapshotField::Pressure).unwrap();
     let n = sc.particles.len();
     let pos: Vec<[f64; 3]> = sc.particles.iter().map(|p| p.pos).collect();
     let kind: Vec<u32> = sc.particles.iter().map(|p| p.kind as u32).collect();

@@ -3,8 +3,7 @@
 //! MLS (and not by Shepard near a free surface), isolated particles, the every-N-steps cadence,
 //! and the hydrostatic tank with each filter.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::Path;
 use wgsph::reference::{self, RefParticle};
 use wgsph::scenario::*;

@@ -1,8 +1,7 @@
 //! The same input on the same adapter gives bit-identical results (no float atomics; the sort
 //! orders each slot by code word: kind, then particle id).
 
-mod common;
-use common::gpu;
+use crate::common::gpu;
 use std::path::Path;
 use wgsph::sph::Solver;
 

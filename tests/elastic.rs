@@ -7,8 +7,7 @@
 // Component loops written as in the equations read better than iterator chains here.
 #![allow(clippy::needless_range_loop)]
 
-mod common;
-use common::*;
+use crate::common::*;
 use wgsph::layout::{SymRate, ID_MASK, KIND_SHIFT};
 use wgsph::reference::elastic::{self, SolidRef};
 use wgsph::reference::{is_solid, RefParticle, Space};

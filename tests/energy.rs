@@ -2,8 +2,7 @@
 //! kinetic + internal energy in a closed block (pressure work and artificial-viscosity heating
 //! appear in both the momentum and the energy sums, so their total is constant).
 
-mod common;
-use common::*;
+use crate::common::*;
 use wgsph::reference;
 use wgsph::scenario::*;
 use wgsph::sph::Solver;

@@ -1,8 +1,7 @@
 //! A run that goes unstable stops with a message naming the step and the time, and keeps the
 //! outputs written before (run.json says why it stopped).
 
-mod common;
-use common::*;
+use crate::common::*;
 use wgsph::scenario::*;
 
 #[test]
@@ -34,7 +33,7 @@ fn unstable_run_stops_with_step_time_and_keeps_outputs() {
     sc.time.end_s = 0.5;
     sc.time.output_every_s = 0.01;
     sc.time.probe_every_s = 0.01;
-    let dir = common::Scratch::new("unstable");
+    let dir = crate::common::Scratch::new("unstable");
     let report = wgsph::run::run(
         gpu(),
         &sc,
@@ -119,7 +118,7 @@ fn listed_snapshots(dir: &std::path::Path) -> Vec<(f64, String)> {
 /// comes back; the run completes with exit status 0 and says so in run.json.
 #[test]
 fn a_run_beyond_the_weakly_compressible_limit_warns_and_completes() {
-    let dir = common::Scratch::new("density-warn");
+    let dir = crate::common::Scratch::new("density-warn");
     let report = dam_break(
         &dir,
         &[
@@ -151,7 +150,7 @@ fn a_run_beyond_the_weakly_compressible_limit_warns_and_completes() {
 /// rows after the last sound time.
 #[test]
 fn a_run_far_beyond_the_limit_stops_and_keeps_only_sound_outputs() {
-    let dir = common::Scratch::new("density-stop");
+    let dir = crate::common::Scratch::new("density-stop");
     let report = dam_break(
         &dir,
         &[
@@ -207,7 +206,7 @@ fn a_run_far_beyond_the_limit_stops_and_keeps_only_sound_outputs() {
 /// run stops at its first probe interval, naming the limit and the fix.
 #[test]
 fn a_run_with_too_slow_a_sound_speed_stops_at_once() {
-    let dir = common::Scratch::new("density-slow");
+    let dir = crate::common::Scratch::new("density-slow");
     let report = dam_break(&dir, &["physics.sound_speed_coef=2"]);
     let msg = format!("{:#}", report.stopped.expect("the run must stop"));
     assert!(
@@ -222,7 +221,7 @@ fn a_run_with_too_slow_a_sound_speed_stops_at_once() {
 /// still says the fluid went beyond the limit, with the largest variation of the first part.
 #[test]
 fn a_resumed_run_remembers_the_density_beyond_the_limit() {
-    let dir = common::Scratch::new("density-resume");
+    let dir = crate::common::Scratch::new("density-resume");
     let sc = dam_break_case(&[
         "physics.sound_speed_coef=5",
         "time.density_variation_warn=0.04",

@@ -1,8 +1,7 @@
 //! Layer 1: every GPU pass against the f64 CPU reference (src/reference) on random particle
 //! sets, 2D and 3D, both kernels, both viscosities, both δ-SPH forms, dense and sparse (hash-colliding) grids.
 
-mod common;
-use common::*;
+use crate::common::*;
 use wgsph::grid::Grid;
 use wgsph::layout::{unpack_block, ID_MASK, KIND_EXCLUDED, KIND_SHIFT};
 use wgsph::reference::{self, RefParticle};

@@ -1,9 +1,6 @@
 //! Runs over several ranks under a real `mpirun` (feature `mpi`; CI installs OpenMPI). Each
 //! test launches its own binary under `mpirun -np N`, filtered to itself; the launched copies
 //! see OpenMPI's `OMPI_COMM_WORLD_SIZE` and play their rank instead.
-#![cfg(feature = "mpi")]
-
-mod common;
 
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -31,7 +28,7 @@ fn mpirun(test: &str, ranks: u32, limit: Duration) -> (bool, String) {
 
 /// `mpirun -np RANKS`, to be given the program.
 fn mpirun_np(ranks: u32) -> Command {
-    common::one_lavapipe_thread_each();
+    crate::common::one_lavapipe_thread_each();
     let mut command = Command::new("mpirun");
     // Ranks waiting on a message yield their core: OpenMPI spins by default where it counts a
     // core a rank, and the harness runs two jobs at once on CI's two cores (this binary took
@@ -48,6 +45,9 @@ fn mpirun_np(ranks: u32) -> Command {
 /// As [`mpirun`], with environment variables `env` set for every rank.
 fn mpirun_with(test: &str, ranks: u32, limit: Duration, env: &[(&str, &str)]) -> (bool, String) {
     let exe = std::env::current_exe().unwrap();
+    // The harness's name of the test: its path in this binary (`mpi::name`).
+    let (_, module) = module_path!().split_once("::").unwrap();
+    let test = &format!("{module}::{test}");
     let mut command = mpirun_np(ranks);
     for (k, v) in env {
         command.args(["-x", &format!("{k}={v}")]);
@@ -89,7 +89,7 @@ fn particles_and_grid() -> (Vec<Particle>, Grid) {
         max: [3.0, 0.8, 0.6],
     };
     let grid = Grid::new(&domain, h, 3, 100_000, [false; 3], Some(CellEdge::Support)).unwrap();
-    let mut rng = common::Rng(7);
+    let mut rng = crate::common::Rng(7);
     let mut uniform = |scale: f64| rng.range(0.0, scale);
     let particles = (0..4000)
         .map(|k| Particle {
@@ -325,13 +325,13 @@ impl Comparison {
         if !self.tables.is_empty() {
             self.write_case();
         }
-        let out = common::Scratch::new(&format!("mpi-{}", self.test));
+        let out = crate::common::Scratch::new(&format!("mpi-{}", self.test));
         std::fs::create_dir_all(&*out).unwrap();
         let dir = out.to_str().unwrap();
         let limit = Duration::from_secs(600);
         let (ok, log) = mpirun_with(self.test, self.ranks, limit, &[("WGSPH_MPI_OUT", dir)]);
         assert!(ok, "the {}-rank job failed:\n{log}", self.ranks);
-        let mut whole = Solver::new(common::gpu(), &self.scenario()).unwrap();
+        let mut whole = Solver::new(crate::common::gpu(), &self.scenario()).unwrap();
         // In the same calls as the ranks: each rebases the f32 clock (which the inlets read).
         let at = self.restore_at.unwrap_or(0);
         whole.run_steps(at).unwrap();
@@ -526,7 +526,7 @@ fn resume(dir: &std::path::Path, end: &str) -> Vec<std::ffi::OsString> {
 
 /// One whole run of `args` on lavapipe.
 fn on_one_rank(args: Vec<std::ffi::OsString>) {
-    common::one_lavapipe_thread_each();
+    crate::common::one_lavapipe_thread_each();
     let o = Command::new(env!("CARGO_BIN_EXE_wgsph"))
         .args(args)
         .args(["--adapter", "cpu"])
@@ -692,8 +692,8 @@ fn a_probe_on_a_sinking_box_over_two_ranks_reads_what_one_run_reads() {
     let dam_break = std::fs::read_to_string("cases/dam_break_2d.toml").unwrap();
     std::fs::write(&case, dam_break + "\n" + tables).unwrap();
     let (one, two) = (
-        common::Scratch::new("mpi-sinker-one"),
-        common::Scratch::new("mpi-sinker-two"),
+        crate::common::Scratch::new("mpi-sinker-one"),
+        crate::common::Scratch::new("mpi-sinker-two"),
     );
     let args = |out: &std::path::Path, end: &str| -> Vec<std::ffi::OsString> {
         let mut args: Vec<std::ffi::OsString> = vec!["run".into(), case.clone().into()];
@@ -728,8 +728,8 @@ fn two_ranks_write_what_one_run_writes(
     tables: &[&str],
 ) -> (usize, RunSummary) {
     let (one, two) = (
-        common::Scratch::new(&format!("mpi-{tag}-one")),
-        common::Scratch::new(&format!("mpi-{tag}-two")),
+        crate::common::Scratch::new(&format!("mpi-{tag}-one")),
+        crate::common::Scratch::new(&format!("mpi-{tag}-two")),
     );
     let args = |out: &std::path::Path| -> Vec<std::ffi::OsString> {
         let mut args: Vec<std::ffi::OsString> = vec!["run".into(), case.into()];
@@ -761,8 +761,8 @@ fn two_ranks_write_what_one_run_writes(
 #[test]
 fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
     let (one, two) = (
-        common::Scratch::new("mpi-run-one"),
-        common::Scratch::new("mpi-run-two"),
+        crate::common::Scratch::new("mpi-run-one"),
+        crate::common::Scratch::new("mpi-run-two"),
     );
     on_one_rank(dam_break("time.end_s=0.06", &one));
     let mut overlapping = dam_break("time.end_s=0.04", &two);
@@ -822,8 +822,8 @@ fn a_run_over_two_ranks_writes_what_one_whole_run_writes() {
 #[test]
 fn ranks_write_the_walls_once_and_draw_what_one_run_draws() {
     let (one, two) = (
-        common::Scratch::new("mpi-walls-one"),
-        common::Scratch::new("mpi-walls-two"),
+        crate::common::Scratch::new("mpi-walls-one"),
+        crate::common::Scratch::new("mpi-walls-two"),
     );
     let walls_once = |end: &str, out: &std::path::Path| {
         let mut args = dam_break(end, out);
@@ -927,8 +927,8 @@ fn processes_of_rank(tag: &str, rank: usize) -> Vec<u32> {
 #[test]
 fn killing_a_rank_ends_the_job_and_its_last_checkpoint_resumes() {
     let (one, two) = (
-        common::Scratch::new("mpi-kill-one"),
-        common::Scratch::new("mpi-kill-two"),
+        crate::common::Scratch::new("mpi-kill-one"),
+        crate::common::Scratch::new("mpi-kill-two"),
     );
     let (name, value) = ("WGSPH_KILL_TEST", std::process::id().to_string());
     let tag = format!("{name}={value}");
@@ -1289,7 +1289,7 @@ impl wgsph::progress::Progress for SignalAt {
 fn a_signal_between_probe_times_stops_every_rank_and_resumes_bit_identically() {
     let name = "a_signal_between_probe_times_stops_every_rank_and_resumes_bit_identically";
     if !under_mpirun() {
-        let dir = common::Scratch::new("mpi-signal");
+        let dir = crate::common::Scratch::new("mpi-signal");
         let folder = dir.to_string_lossy().into_owned();
         let (ok, log) = mpirun_with(
             name,

@@ -5,20 +5,18 @@
 //! checkpoint to the same result; Ctrl-C (SIGINT) checkpoints and stops; a lost GPU device and
 //! a case too large for the adapter give clear errors instead of panics.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use common::gpu;
+use crate::common::gpu;
 use wgsph::progress::LogLines;
 use wgsph::run::RunOptions;
 use wgsph::scenario::{Motion, Scenario};
 
-fn temp_dir(name: &str) -> common::Scratch {
-    common::Scratch::new(&format!("restart-{name}"))
+fn temp_dir(name: &str) -> crate::common::Scratch {
+    crate::common::Scratch::new(&format!("restart-{name}"))
 }
 
 fn load(case: &str, set: &[&str]) -> Scenario {
@@ -284,7 +282,8 @@ fn resume_is_bit_identical_for_elastic_plates_of_both_formulations() {
     ]
     .map(String::from)
     .to_vec();
-    let sc = wgsph::case::load_str(&common::both_plates_case(), "plates.toml", &set).unwrap();
+    let sc =
+        wgsph::case::load_str(&crate::common::both_plates_case(), "plates.toml", &set).unwrap();
     split_run_matches("plates", &sc, 0.01);
 }
 
@@ -305,7 +304,7 @@ fn resume_is_bit_identical_for_an_injection() {
 }
 
 fn wgsph() -> Command {
-    common::one_lavapipe_thread_each();
+    crate::common::one_lavapipe_thread_each();
     Command::new(env!("CARGO_BIN_EXE_wgsph"))
 }
 
@@ -521,7 +520,7 @@ fn resume_refuses_a_different_case() {
 
 #[test]
 fn a_lost_device_stops_the_solver_with_a_message() {
-    common::one_lavapipe_thread_each();
+    crate::common::one_lavapipe_thread_each();
     let ctx =
         wgsph::gpu::GpuContext::new(wgsph::gpu::AdapterChoice::resolve(None).unwrap()).unwrap();
     let sc = load("cases/hydrostatic_2d.toml", &["time.end_s=0.05"]);
@@ -553,7 +552,7 @@ fn a_device_lost_mid_run_keeps_the_last_checkpoint_and_resumes() {
     let straight = temp_dir("lost-straight");
     run_to_end(&sc, &straight);
     // Its own device: this one gets destroyed.
-    common::one_lavapipe_thread_each();
+    crate::common::one_lavapipe_thread_each();
     let ctx =
         wgsph::gpu::GpuContext::new(wgsph::gpu::AdapterChoice::resolve(None).unwrap()).unwrap();
     let dir = temp_dir("lost");
@@ -586,7 +585,7 @@ fn a_device_lost_mid_run_keeps_the_last_checkpoint_and_resumes() {
 
 #[test]
 fn a_case_too_large_for_the_adapter_fails_before_the_run_starts() {
-    common::one_lavapipe_thread_each();
+    crate::common::one_lavapipe_thread_each();
     let ctx = wgsph::gpu::GpuContext::with_limits(
         wgsph::gpu::AdapterChoice::resolve(None).unwrap(),
         |l| l.max_storage_buffer_binding_size = 16 * 1000,

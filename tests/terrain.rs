@@ -3,8 +3,7 @@
 //! particles and as fixed ghosts. The water must stay above the ground (no leakage through
 //! it) and, once settled, press on it with the weight of the water above.
 
-mod common;
-use common::gpu;
+use crate::common::gpu;
 use std::path::{Path, PathBuf};
 use wgsph::scenario::Scenario;
 use wgsph::sph::Solver;

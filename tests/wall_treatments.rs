@@ -4,8 +4,7 @@
 //! docs/validation.md. And the tank with a submerged inlet in its wall, whose buffer takes the
 //! water's pressure (`pressure = "extrapolated"`).
 
-mod common;
-use common::gpu;
+use crate::common::gpu;
 use std::path::Path;
 use wgsph::scenario::{Kind, Scenario};
 use wgsph::sph::Solver;

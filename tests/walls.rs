@@ -1,8 +1,7 @@
 //! Wall treatments on the GPU against the f64 reference: fixed ghosts (Shepard and MLS,
 //! no-slip and free-slip), repulsive particles, mirror planes; ghost interpolation properties.
 
-mod common;
-use common::*;
+use crate::common::*;
 use wgsph::reference;
 use wgsph::scenario::*;
 use wgsph::sph::Solver;

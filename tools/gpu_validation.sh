@@ -8,8 +8,8 @@
 #
 # Usage: tools/gpu_validation.sh WORK_DIR [BUDGET_S]
 #   WGSPH             the engine (default target/release/wgsph; build it from this checkout)
-#   VALIDATION_TESTS  the validation test binary, for the 3D sloshing test (built by
-#                     `cargo test --release --test validation --no-run`); skipped without it
+#   VALIDATION_TESTS  the integration test binary, for the 3D sloshing test (built by
+#                     `cargo test --release --test all --no-run`); skipped without it
 #   ITEMS             the items to run, in order (default: all, as listed below)
 #   ITEM_CAP_S        the most one item may take (default 300)
 # Writes WORK_DIR/summary.txt (one line per item: name, exit status, seconds, then the
@@ -59,7 +59,7 @@ command_of() {
     validate:*) echo "$wgsph validate --full --case ${item#validate:} --out $work/validate" ;;
     sloshing_3d)
         [ -n "$tests" ] || return 1
-        echo "$tests --ignored --exact sloshing::sloshing_3d_transducers_follow_the_experiment --nocapture"
+        echo "$tests --ignored --exact validation::sloshing::sloshing_3d_transducers_follow_the_experiment --nocapture"
         ;;
     # The street with and without its building to 10 s (docs/validation.md, "Street flood").
     street_flood_3d) echo "$wgsph run cases/street_flood_3d.toml --set time.end_s=10 --out $dir" ;;

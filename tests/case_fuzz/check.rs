@@ -12,9 +12,9 @@ use wgsph::grid::Grid;
 use wgsph::layout::Params;
 use wgsph::scenario::{Kind, Motion, RepulsiveForm, Scenario};
 
-use crate::doc::{generic, last_key, path_of, required, vector_len, Node, Seed, Seg};
-use crate::values::{finite_number, is_number};
-use crate::MAX_PARTICLES;
+use super::doc::{generic, last_key, path_of, required, vector_len, Node, Seed, Seg};
+use super::values::{finite_number, is_number};
+use super::MAX_PARTICLES;
 
 // What the loads of the current property gave: (accepted, refused, edits that the toml crate
 // could not write, so never loaded). Each property runs on its own test thread.
@@ -326,7 +326,7 @@ pub(crate) fn run<S: Strategy>(
     if let Err(e) = result {
         panic!(
             "{name}: {e}\nreplay with: CASE_FUZZ_SEED={seed} PROPTEST_CASES={} cargo test \
-             --test case_fuzz {name}",
+             --test all case_fuzz::{name}",
             config.cases
         );
     }

@@ -83,7 +83,7 @@ fn lobovsky_sensor1_first_impact_matches_experiment() {
 /// time within 3 % and the averaged peak within 30 % of the experiment (the full mode's bounds).
 /// Measured: see docs/validation.md (impact +5.0 %, averaged peak +29.8 %, just inside). Kept
 /// visible rather than loosened; run with
-/// `cargo test --release --test validation lobovsky -- --ignored --nocapture`.
+/// `cargo test --release --test all validation::lobovsky -- --ignored --nocapture`.
 #[test]
 #[ignore = "not met at dx = 0.01 m: impact +5.0 % (docs/validation.md)"]
 fn lobovsky_sensor1_impact_within_3_percent_and_peak_within_30_percent() {
@@ -93,7 +93,7 @@ fn lobovsky_sensor1_impact_within_3_percent_and_peak_within_30_percent() {
 
 /// The same bounds at the full mode's resolution, dx = 0.005 m (H/dx = 60, the probes half the
 /// new spacing from the wall): measured impact +0.96 %, averaged peak +10.3 % (raw p* 18.9).
-/// Run with `cargo test --release --test validation lobovsky_sensor1_fine -- --ignored
+/// Run with `cargo test --release --test all lobovsky_sensor1_fine -- --ignored
 /// --nocapture`.
 #[test]
 #[ignore = "run time: 15 600 steps of 8 900 particles, 250 s on lavapipe (passes: impact +0.96 %, peak +10.3 %)"]

@@ -20,8 +20,6 @@
 //! many; the solver's sample too, unless skipped), `CASE_FUZZ_SEED=n` repeats a run.
 
 mod check;
-#[path = "../common/mod.rs"]
-mod common;
 mod doc;
 mod values;
 
@@ -227,7 +225,7 @@ fn accepted_edits_run_a_few_steps() {
             ran.set(ran.get() + 1);
             let what = format!("{change:?} of {} in {}", node.path, seed.file);
             let steps = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                let mut solver = wgsph::sph::Solver::new(common::gpu(), &sc)?;
+                let mut solver = wgsph::sph::Solver::new(crate::common::gpu(), &sc)?;
                 solver.run_steps(3)?;
                 solver.sample_probes()?;
                 solver.read_particles()?;

@@ -2,9 +2,6 @@
 //! validation runs side by side (on a software adapter each is mostly one core's work).
 //! The modules name their experiments; docs/validation.md records the numbers they print.
 
-#[path = "../common/mod.rs"]
-mod common;
-
 mod bodies;
 mod cases;
 mod contact;
