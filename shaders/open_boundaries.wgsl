@@ -9,17 +9,29 @@
 
 struct InletDef {
     normal: vec3<f32>,          // unit, the direction of the inflow
-    speed: f32,                 // [m/s] > 0
+    first_segment: u32,         // its inflow's first piece in `inflow_segments`
     thickness: f32,             // buffer depth behind the plane [m]
     spacing: f32,               // between layers [m]
     first_id: u32,              // its first particle's id
     n_columns: u32,
     first_column: u32,          // its first entry in `inlet_columns`
+    n_segments: u32,            // its inflow's pieces (1 for a constant speed)
     pad0: u32,
     pad1: u32,
-    pad2: u32,
     surface: vec3<f32>,         // the buffer's highest point (domain coordinates)
     pressure: u32,              // INLET_ZERO, INLET_HYDROSTATIC or INLET_EXTRAPOLATED
+}
+
+// A piece of an inlet's inflow speed in time, from its knot t on (src/hydrograph.rs): with
+// τ = t' − t, u(t') = speed · (1, τ, τ², τ³) and D(t') = distance + τ moved · (1, τ, τ², τ³),
+// the distance travelled since t = 0 (D = ∫ u, so a particle's place is a function of time).
+struct InflowSegment {
+    t: f32,
+    distance: f32,
+    pad0: u32,
+    pad1: u32,
+    speed: vec4<f32>,
+    moved: vec4<f32>,
 }
 
 // InletDef.pressure: ρ0; the density of ρ0 g·(x − surface) below the surface; the fluid's.
@@ -44,6 +56,7 @@ struct OutletDef {
 @group(0) @binding(6) var<storage, read> inlet_columns: array<Pos>;
 @group(0) @binding(7) var<storage, read> outlets: array<OutletDef>;
 @group(0) @binding(8) var<storage, read> cell_start: array<u32>;
+@group(0) @binding(9) var<storage, read> inflow_segments: array<InflowSegment>;
 
 // The inlet whose particle `id` is (ids are consecutive per inlet, inlets in id order).
 fn inlet_of(id: u32) -> u32 {
@@ -54,10 +67,36 @@ fn inlet_of(id: u32) -> u32 {
     return n;
 }
 
-// Signed distance of inlet particle k (of `inlet`) from the plane at time t.
-fn inlet_distance(inlet: InletDef, k: u32, t: f32) -> f32 {
+// The inflow of `inlet` at time t ≥ 0: its speed u(t) and the distance D(t) it has carried the
+// water (the last piece whose knot is at or before t; the first piece's knot is 0).
+struct Inflow {
+    speed: f32,
+    distance: f32,
+}
+
+fn inflow_at(inlet: InletDef, t: f32) -> Inflow {
+    var lo = inlet.first_segment;
+    var hi = inlet.first_segment + inlet.n_segments;
+    while (hi - lo > 1u) {
+        let mid = (lo + hi) / 2u;
+        if (inflow_segments[mid].t <= t) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let s = inflow_segments[lo];
+    let tau = t - s.t;
+    let u = s.speed[0] + tau * (s.speed[1] + tau * (s.speed[2] + tau * s.speed[3]));
+    let d = s.distance + tau * (s.moved[0] + tau * (s.moved[1] + tau * (s.moved[2] + tau * s.moved[3])));
+    return Inflow(u, d);
+}
+
+// Signed distance of inlet particle k (of `inlet`) from the plane when its inflow has carried
+// the water `travelled`.
+fn inlet_distance(inlet: InletDef, k: u32, travelled: f32) -> f32 {
     let layer = f32(k / inlet.n_columns);
-    return -(layer + 0.5) * inlet.spacing + inlet.speed * t;
+    return -(layer + 0.5) * inlet.spacing + travelled;
 }
 
 @compute @workgroup_size(WG)
@@ -75,7 +114,8 @@ fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     }
     let inlet = inlets[inlet_of(id)];
     let k = id - inlet.first_id;
-    let s = inlet_distance(inlet, k, state.t_base + state.t_rel + state.dt);
+    let inflow = inflow_at(inlet, state.t_base + state.t_rel + state.dt);
+    let s = inlet_distance(inlet, k, inflow.distance);
     if (kind == KIND_EXCLUDED) {
         if (s < -inlet.thickness || s >= 0.0) {
             return;
@@ -95,7 +135,7 @@ fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         rho = velrho[i].w;
     }
     pos[i] = placed;
-    velrho[i] = vec4<f32>(inlet.speed * inlet.normal, rho);
+    velrho[i] = vec4<f32>(inflow.speed * inlet.normal, rho);
     code[i] = with_kind(c, select(KIND_INLET, KIND_FLUID, s >= 0.0));
 }
 

@@ -1,6 +1,6 @@
 // Probes, sampled on the GPU so that no particle data leaves it: pressure at a point, wave
-// gauges and wall pressure (one invocation per probe, walking the cell list), and the surge
-// front (a max over fluid particles). Results are f32 bit patterns in `probe_out`, read back
+// gauges and wall pressure (one invocation per probe, walking the cell list), the surge
+// front (a max over fluid particles) and the discharge through a section (a sum over them). Results are f32 bit patterns in `probe_out`, read back
 // by the host.
 
 struct ProbeDef {
@@ -21,6 +21,7 @@ const PROBE_HEIGHT: u32 = 1u;
 const PROBE_FRONT: u32 = 2u;
 const PROBE_WALL_PRESSURE: u32 = 3u;
 const PROBE_FRONT_CONTINUOUS: u32 = 4u;
+const PROBE_DISCHARGE: u32 = 5u;
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;
@@ -30,6 +31,9 @@ const PROBE_FRONT_CONTINUOUS: u32 = 4u;
 @group(0) @binding(6) var<storage, read_write> probe_out: array<atomic<u32>>;
 @group(0) @binding(9) var<storage, read> rate: array<vec4<f32>>;
 @group(0) @binding(10) var<storage, read_write> front_bins: array<atomic<u32>>;
+// The discharge probes' sums over each workgroup: workgroup g's of discharge probe `def.bins`
+// (of `def.words`) at g · def.words + def.bins.
+@group(0) @binding(11) var<storage, read_write> discharge_sums: array<f32>;
 
 struct KernelSums {
     volume: f32,        // Σ_j W V_j over fluid (the Shepard denominator)
@@ -378,4 +382,91 @@ fn track_points(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         tracked_pos[lo] = pos[k];
         tracked_held[lo] = 1u;
     }
+}
+
+// Discharge through a section (docs/equations.md eq. 33): Q = Σ_j V_j (u_j·n) w(d_j) over the
+// fluid, d_j = (x_j − from)·n the distance to the section, w the kernel's 1D form (Wendland
+// C2, ∫ w dd = 1, support 2h), for the particles whose place along the section,
+// s_j = (x_j − from)·t, lies within it. `def.point` is `from`, `def.axis` the section's normal n
+// (horizontal: t = (−n_y, n_x, 0)), `def.radius` its length.
+fn section_weight(d: f32) -> f32 {
+    let q = abs(d) / params.h;
+    if (q >= 2.0) {
+        return 0.0;
+    }
+    let a = 1.0 - 0.5 * q;
+    return 5.0 / (8.0 * params.h) * a * a * a * (1.5 * q + 1.0);
+}
+
+fn discharge_contribution(def: ProbeDef, i: u32) -> f32 {
+    if (code_kind(code[i]) != KIND_FLUID) {
+        return 0.0;
+    }
+    let rel = domain_pos(pos[i]) - def.point;
+    let along = dot(rel, vec3<f32>(-def.axis.y, def.axis.x, 0.0));
+    if (along < 0.0 || along > def.radius) {
+        return 0.0;
+    }
+    let vr = velrho[i];
+    return params.mass / vr.w * dot(vr.xyz, def.axis) * section_weight(dot(rel, def.axis));
+}
+
+var<workgroup> wg_sum: array<f32, WG>;
+
+// The sum of `v` over the workgroup, in a fixed tree order (the same particles in the same
+// order give the same bits). Barriers: call it in uniform control flow.
+fn workgroup_sum(li: u32, v: f32) -> f32 {
+    wg_sum[li] = v;
+    workgroupBarrier();
+    for (var s = WG / 2u; s > 0u; s >>= 1u) {
+        if (li < s) {
+            wg_sum[li] += wg_sum[li + s];
+        }
+        workgroupBarrier();
+    }
+    let total = wg_sum[0];
+    workgroupBarrier();
+    return total;
+}
+
+// Each workgroup's share of every discharge probe, at its linear index among the workgroups.
+@compute @workgroup_size(WG)
+fn probe_discharge_sums(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    let i = linear_index(gid, nwg);
+    let group = i / WG;
+    for (var k = 0u; k < params.n_probes; k++) {
+        let def = probes[k];
+        if (def.kind != PROBE_DISCHARGE) {
+            continue;
+        }
+        var q = 0.0;
+        if (i < params.n_particles) {
+            q = discharge_contribution(def, i);
+        }
+        let total = workgroup_sum(li, q);
+        let slot = group * def.words + def.bins;
+        if (li == 0u && slot < arrayLength(&discharge_sums)) {
+            discharge_sums[slot] = total;
+        }
+    }
+}
+
+// One invocation a discharge probe: its workgroups' sums, in their order.
+@compute @workgroup_size(WG)
+fn probe_discharge_total(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let k = gid.x;
+    if (k >= params.n_probes || probes[k].kind != PROBE_DISCHARGE) {
+        return;
+    }
+    let def = probes[k];
+    let groups = min((params.n_particles + WG - 1u) / WG, arrayLength(&discharge_sums) / def.words);
+    var q = 0.0;
+    for (var g = 0u; g < groups; g++) {
+        q += discharge_sums[g * def.words + def.bins];
+    }
+    atomicStore(&probe_out[k], bitcast<u32>(q));
 }

@@ -194,6 +194,15 @@ pub fn probe_layers(sc: &Scenario, grid: &Grid, axis: usize) -> Result<Vec<Optio
                     p.name
                 );
             }
+            if matches!(p.kind, ProbeKind::Discharge { .. }) && axis == up && up == 2 {
+                bail!(
+                    "probe '{}' is a discharge section, as tall as the domain, but a run over \
+                     several ranks can cut this case only along the vertical (its other axes \
+                     are periodic): the section would have water on every rank; run it on \
+                     one rank",
+                    p.name
+                );
+            }
             let Some(b) = p
                 .body
                 .filter(|_| !matches!(p.kind, ProbeKind::Front { .. }))
@@ -237,6 +246,10 @@ pub fn layers_read(p: &Probe, h: f64, grid: &Grid, axis: usize) -> Option<Range<
                 layer_of(patch.point[axis] + e),
             )
         }
+        ProbeKind::Discharge { from, to } => span(
+            layer_of(from[axis].min(to[axis]) - 2.0 * h),
+            layer_of(from[axis].max(to[axis]) + 2.0 * h),
+        ),
         ProbeKind::Front { .. } => None,
     }
 }

@@ -340,24 +340,39 @@ pub fn unpack_block(b: u32) -> [u32; 3] {
     [b & 0x7FF, (b >> 11) & 0x7FF, b >> 22]
 }
 
-/// Mirrors `InletDef` in shaders/open_boundaries.wgsl: an inlet's plane normal, speed, buffer
-/// depth, layer spacing, where its particles and columns start, and its buffer's top.
+/// Mirrors `InletDef` in shaders/open_boundaries.wgsl: an inlet's plane normal, where its
+/// inflow's segments start, buffer depth, layer spacing, where its particles and columns start,
+/// how many segments it has, and its buffer's top.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct InletDef {
     pub normal: [f32; 3],
-    pub speed: f32,
+    pub first_segment: u32,
     pub thickness: f32,
     pub spacing: f32,
     pub first_id: u32,
     pub n_columns: u32,
     pub first_column: u32,
-    pub pad: [u32; 3],
+    pub n_segments: u32,
+    pub pad: [u32; 2],
     /// The buffer's highest point in domain coordinates, read when `pressure` is
     /// `INLET_HYDROSTATIC`.
     pub surface: [f32; 3],
     /// `INLET_ZERO`, `INLET_HYDROSTATIC` or `INLET_EXTRAPOLATED` (the scenario's `InletPressure`).
     pub pressure: u32,
+}
+
+/// Mirrors `InflowSegment` in shaders/open_boundaries.wgsl: a piece of an inlet's hydrograph
+/// (`crate::hydrograph::Segment`), from its knot `t`: the distance travelled there, and the
+/// coefficients in τ = t − knot of the speed and of the distance travelled since.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct InflowSegment {
+    pub t: f32,
+    pub distance: f32,
+    pub pad: [u32; 2],
+    pub speed: [f32; 4],
+    pub moved: [f32; 4],
 }
 
 /// `InletDef::pressure` values, as the constants of the same names in
@@ -799,15 +814,22 @@ mod tests {
             InletDef,
             [
                 normal,
-                speed,
+                first_segment,
                 thickness,
                 spacing,
                 first_id,
                 n_columns,
                 first_column,
+                n_segments,
                 surface,
                 pressure
             ]
+        );
+        check_layout!(
+            &open_boundaries::SHADER,
+            "InflowSegment",
+            InflowSegment,
+            [t, distance, speed, moved]
         );
     }
 

@@ -9,6 +9,7 @@ pub mod eos;
 pub mod generate;
 pub mod gpu;
 pub mod grid;
+pub mod hydrograph;
 pub mod kernel;
 pub mod lagrangian;
 #[cfg(test)]

@@ -65,8 +65,11 @@ pub fn unmeasurable(sc: &Scenario) -> Vec<Option<String>> {
                 })
             }
             // A front is a max over all the fluid; a wall patch is resolved onto the wall's
-            // particles by the loader, which refuses a patch with none.
-            ProbeKind::Front { .. } | ProbeKind::WallPressure(_) => None,
+            // particles by the loader, which refuses a patch with none; no water through a
+            // section is a discharge of 0, which it measures.
+            ProbeKind::Front { .. } | ProbeKind::WallPressure(_) | ProbeKind::Discharge { .. } => {
+                None
+            }
         })
         .collect()
 }

@@ -26,12 +26,15 @@ use crate::ranks::Ranks;
 use crate::scenario::{Kind, OutputBoundary, ProbeKind, Scenario};
 use crate::sph::{check_capacity, DensityVariation, Solver, Unstable};
 
-/// Column name of a probe's CSV.
-pub fn probe_column(kind: &ProbeKind) -> &'static str {
+/// Column name of a probe's CSV in a case of dimension `dim`.
+pub fn probe_column(kind: &ProbeKind, dim: u32) -> &'static str {
     match kind {
         ProbeKind::Pressure { .. } | ProbeKind::WallPressure(_) => "pressure_pa",
         ProbeKind::Height { .. } => "height_m",
         ProbeKind::Front { .. } => "front_m",
+        // Per metre of width in 2D.
+        ProbeKind::Discharge { .. } if dim == 2 => "discharge_m2_s",
+        ProbeKind::Discharge { .. } => "discharge_m3_s",
     }
 }
 
@@ -703,7 +706,12 @@ impl<'a> Runner<'a> {
         // Rank 0 writes the tables.
         let names: Vec<(String, String)> = (sc.probes.iter())
             .filter(|_| first)
-            .map(|p| (p.name.clone(), probe_column(&p.kind).to_string()))
+            .map(|p| {
+                (
+                    p.name.clone(),
+                    probe_column(&p.kind, sc.physics.dim).to_string(),
+                )
+            })
             .collect();
         let probes = out.probe_writer(&names)?;
         let solver = match ranks {

@@ -5,6 +5,8 @@
 //! third component is zero, `y` is up in 2D and `z` is up in 3D (the "vertical axis" is
 //! `dimension - 1`).
 
+use crate::hydrograph::Hydrograph;
+
 /// The edge of the neighbour grid's cells (`[particles] cell` of a case).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CellEdge {
@@ -263,6 +265,23 @@ pub enum ProbeKind {
     /// columns' area.
     /// Needs [`WallParams::reactions`], which gives fixed boundary particles that force.
     WallPressure(WallPatch),
+    /// The fluid's discharge through a section (m³/s; 2D m²/s per metre of width): in 2D the
+    /// segment from `from` to `to`, in 3D the vertical plane through their line in plan,
+    /// bounded by the two points along it and by nothing vertically. Positive towards the
+    /// right of `from` → `to` (the side of [`ProbeKind::section_normal`]). Σ_j V_j (u_j·n)
+    /// w(d_j) over the fluid, w the kernel's 1D form of the distance d_j to the section
+    /// (docs/equations.md eq. 33).
+    Discharge { from: [f64; 3], to: [f64; 3] },
+}
+
+impl ProbeKind {
+    /// A discharge section's unit normal n (horizontal in 3D: the plan tangent t = (tx, ty)
+    /// turned clockwise, n = (ty, −tx)) and its length along t.
+    pub fn section_normal(from: [f64; 3], to: [f64; 3]) -> ([f64; 3], f64) {
+        let (tx, ty) = (to[0] - from[0], to[1] - from[1]);
+        let length = (tx * tx + ty * ty).sqrt();
+        ([ty / length, -tx / length, 0.0], length)
+    }
 }
 
 /// The boundary particles a wall-pressure probe sums over ([`WallPatch::resolve`]).
@@ -738,7 +757,8 @@ impl Outlet {
 }
 
 /// A velocity inlet (`[[inlet]]`, docs/cases.md "Inlets"): a buffer of particles on the
-/// fluid's lattice, `thickness` deep behind a plane, marching along `normal` at `speed` with
+/// fluid's lattice, `thickness` deep behind a plane, marching along `normal` at the speed of
+/// its `inflow` (constant or a hydrograph) with
 /// the pressure `pressure` gives it. A buffer particle that crosses the plane becomes
 /// fluid; behind the buffer wait as many further layers (dormant, in no cell) as the inflow
 /// takes until its stop time, each joining the buffer when it reaches the buffer's back.
@@ -749,8 +769,8 @@ pub struct Inlet {
     pub name: String,
     /// Unit normal of the plane, the direction of the inflow.
     pub normal: [f64; 3],
-    /// Inflow speed [m/s] (> 0).
-    pub speed: f64,
+    /// The inflow speed [m/s] in time (≥ 0).
+    pub inflow: Hydrograph,
     /// Buffer depth L behind the plane [m]: a whole number of layers, at least the kernel
     /// support 2h.
     pub thickness: f64,
@@ -781,10 +801,11 @@ pub enum InletPressure {
 
 impl Inlet {
     /// Signed distance from the plane along the normal at time `t` of the inlet's particle
-    /// `k` (index within the inlet): −(layer + ½) spacing + speed t.
+    /// `k` (index within the inlet): −(layer + ½) spacing + D(t), D the distance the inflow
+    /// has travelled.
     pub fn distance(&self, k: usize, t: f64) -> f64 {
         let layer = (k / self.columns.len()) as f64;
-        -(layer + 0.5) * self.spacing + self.speed * t
+        -(layer + 0.5) * self.spacing + self.inflow.distance(t)
     }
 
     /// The density the inlet pass gives a buffer particle at `x`: the Tait density of the
@@ -808,7 +829,11 @@ impl Inlet {
 
     /// Where particle `k` is at time `t` (if it is still in the inlet's hands).
     pub fn position(&self, k: usize, t: f64) -> [f64; 3] {
-        let s = self.distance(k, t);
+        self.position_at(k, self.distance(k, t))
+    }
+
+    /// Particle `k`'s place at the signed distance `s` from the plane.
+    pub fn position_at(&self, k: usize, s: f64) -> [f64; 3] {
         let c = self.columns[k % self.columns.len()];
         [0, 1, 2].map(|a| c[a] + s * self.normal[a])
     }

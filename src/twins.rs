@@ -64,12 +64,14 @@ fn every_twin_is_named_as_its_wgsl_function() {
         integrate::SHADER => [integrate::predict, integrate::correct, integrate::timestep],
         cell_list::SHADER => [cell_list::cell_key],
         bodies::SHADER => [bodies::body_move, bodies::body_force],
-        open_boundaries::SHADER => [open_boundaries::inlet_flow],
+        open_boundaries::SHADER => [open_boundaries::inflow_at, open_boundaries::inlet_flow],
         probes::SHADER => [
             probes::probe_pressure,
             probes::probe_height,
             probes::probe_height_search,
             probes::probe_front,
+            probes::section_weight,
+            probes::discharge_contribution,
         ],
     };
     let mut missing = Vec::new();

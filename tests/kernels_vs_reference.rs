@@ -696,6 +696,21 @@ fn probes_match_reference() {
                 body: None,
             },
         ];
+        // Discharge sections: across the block's middle, and an oblique one ending inside it.
+        let sections = [
+            ([centre[0], o, 0.0], [centre[0], o + BLOCK, 0.0]),
+            (
+                [o + 0.2 * BLOCK, o, 0.0],
+                [o + 0.7 * BLOCK, o + 0.6 * BLOCK, 0.0],
+            ),
+        ];
+        for (k, &(from, to)) in sections.iter().enumerate() {
+            sc.probes.push(Probe {
+                name: format!("q{k}"),
+                kind: ProbeKind::Discharge { from, to },
+                body: None,
+            });
+        }
         let solver = Solver::new(gpu(), &sc).unwrap();
         let (parts, _) = gpu_particles_and_codes(&solver);
         let gpu_values = solver.sample_probes().unwrap();
@@ -715,6 +730,23 @@ fn probes_match_reference() {
         assert!((gpu_values[1] - cpu[1]).abs() < 1e-4, "height");
         assert!((gpu_values[2] - cpu[2]).abs() < 1e-5, "front");
         assert!(cpu[1] > 0.5 * BLOCK, "the gauge must see the block");
+        for (k, &(from, to)) in sections.iter().enumerate() {
+            let q = reference::probes::probe_discharge(ph, &parts, from, to);
+            // The sum of the contributions' sizes: f32 rounding is relative to it.
+            let scale: f64 = (parts.iter())
+                .map(|p| reference::probes::discharge_contribution(ph, p, from, to).abs())
+                .sum();
+            let g = gpu_values[3 + k];
+            println!(
+                "dim {}: discharge {k} GPU {g:.6e} CPU {q:.6e} (of {scale:.3e})",
+                s.dim
+            );
+            assert!(scale > 0.0, "section {k} crosses the fluid");
+            assert!(
+                (g - q).abs() < 1e-5 * scale,
+                "discharge {k}: {g} against {q}"
+            );
+        }
     }
 }
 
@@ -941,10 +973,13 @@ fn continuous_fronts_leave_out_droplets_ahead_of_the_water() {
     }
 }
 
-/// Two inlets of different speeds, along +x (a hydrostatic buffer) and against the vertical axis
-/// (zero pressure), in an open domain (2D: 4 columns each; 3D: 3 × 3), 3 layers of buffer and
-/// 10 or 11 in all.
+/// Two inlets, along +x at a constant speed (a hydrostatic buffer) and against the vertical
+/// axis at a speed that rises, falls and rises again within the first steps (a monotone cubic
+/// hydrograph; zero pressure), in an open domain (2D: 4 columns each; 3D: 3 × 3), 3 layers of
+/// buffer and 10 or 11 in all.
 fn inlet_case(dim: u32) -> Scenario {
+    let hydrograph = std::env::temp_dir().join(format!("wgsph_inlet_{}.csv", std::process::id()));
+    std::fs::write(&hydrograph, "t_s,u_m_s\n0,3\n0.001,9\n0.002,5\n0.004,7\n").unwrap();
     let v = |c| toml_vector(dim, c);
     // (jet box, drop box, drop direction)
     let (jet, drop, down) = if dim == 2 {
@@ -974,7 +1009,8 @@ name = "drop"
 min_m = {}
 max_m = {}
 direction = {}
-velocity_m_s = 7.0
+velocity_file = {:?}
+interpolation = "cubic"
 stop_s = 0.031
 "#,
         v(jet.0),
@@ -983,6 +1019,7 @@ stop_s = 0.031
         v(drop.0),
         v(drop.1),
         v(down),
+        hydrograph.to_str().unwrap(),
     );
     unit_box_case(dim, down.map(|c| 9.81 * c), &tables)
 }
@@ -1034,9 +1071,11 @@ fn inlet_flow_matches_reference() {
             .map(|i| i.particles.len() / i.columns.len())
             .collect();
         assert_eq!(columns, if dim == 2 { [4, 4] } else { [9, 9] });
-        // The jet: 13 m/s for 0.016 s is 10.4 dx, 10 layers; the drop 7 m/s for 0.031 s, 10.85
-        // dx, 11 layers.
+        // The jet: 13 m/s for 0.016 s is 10.4 dx, 10 layers; the drop about 6 m/s for 4 ms and
+        // 7 m/s for 27 ms, 10.7 dx, 11 layers.
         assert_eq!(layers, [10, 11]);
+        let drop = &sc.inlets[1].inflow;
+        assert!((drop.distance(0.031) / 0.02 - 10.708).abs() < 1e-3);
         let mut solver = Solver::new(gpu(), &sc).unwrap();
         let mut rng = Rng(11 + dim as u64);
         let (mut joined, mut fluid_seen, mut heavy) = (0u32, 0usize, 0usize);
@@ -1074,8 +1113,16 @@ fn inlet_flow_matches_reference() {
                             assert!(e.is_finite());
                             worst = worst.max(e / sc.physics.dx);
                             if p.kind == reference::INLET {
+                                // The hydrograph's cubic in f32, at the f32 time.
                                 let v = g_vel.map(|c| c as f64);
-                                assert_eq!(v, p.vel.map(|c| c as f32 as f64), "velocity");
+                                let e_v = reference::sub(v, p.vel);
+                                let e_v = reference::dot(e_v, e_v).sqrt();
+                                let speed = reference::dot(p.vel, p.vel).sqrt();
+                                assert!(
+                                    e_v <= 1e-6 * speed.max(1.0),
+                                    "velocity {v:?} against {:?}",
+                                    p.vel
+                                );
                                 let e_rho = (g_rho as f64 - p.rho).abs() / p.rho;
                                 assert!(e_rho < 1e-6, "density {g_rho} against {}", p.rho);
                                 heavy += (p.rho > sc.physics.rho0) as usize;
@@ -1099,6 +1146,93 @@ fn inlet_flow_matches_reference() {
         assert!(heavy > 0, "the hydrostatic buffer is denser below its top");
         assert!(worst < 1e-5, "place error {worst} dx");
     }
+}
+
+/// A discharge hydrograph delivers its volume: a 2D inlet of 10 columns (0.2 m at dx = 0.02 m)
+/// fed by a trapezoid, 0 → 0.4 m²/s over 0.1 s, held to 0.6 s, back to 0 at 0.8 s, into an
+/// empty domain without gravity. The fluid particles the inlet has made, times the particle
+/// area, against ∫Q dt written out here: within half a layer (the place where the layers
+/// cross, eq. 32) at every sampled time, and within 1 % once its 0.26 m² have all come in.
+/// A discharge probe across the jet 0.34 m downstream reads 0 before the water comes and the
+/// plateau's 0.4 m²/s within 2 % while the plateau's water passes it (t = 0.45 s: water
+/// that crossed the plane at about 0.28 s).
+#[test]
+fn a_hydrograph_inlet_delivers_its_volume_and_a_section_measures_it() {
+    let q_file = std::env::temp_dir().join(format!("wgsph_q_{}.csv", std::process::id()));
+    std::fs::write(&q_file, "t_s,q_m2_s\n0,0\n0.1,0.4\n0.6,0.4\n0.8,0\n").unwrap();
+    let text = format!(
+        r#"dimension = 2
+[particles]
+dx_m = 0.02
+[physics]
+gravity_m_s2 = [0.0, 0.0]
+sound_speed_m_s = 15.0
+[time]
+end_s = 1.0
+output_every_s = 0.1
+[domain]
+min_m = [0.0, 0.0]
+max_m = [2.5, 1.0]
+[[inlet]]
+name = "river"
+min_m = [0.1, 0.4]
+max_m = [0.16, 0.6]
+direction = [1.0, 0.0]
+discharge_file = {:?}
+[[probe]]
+name = "Q"
+kind = "discharge"
+from_m = [0.5, 0.2]
+to_m = [0.5, 0.8]
+"#,
+        q_file.to_str().unwrap()
+    );
+    let sc = wgsph::case::load_str(&text, "hydrograph.toml", &[]).unwrap();
+    let inlet = &sc.inlets[0];
+    assert_eq!(inlet.columns.len(), 10);
+    // ∫₀ᵗ Q for the trapezoid.
+    let volume = |t: f64| -> f64 {
+        let ramp = |a: f64| 0.5 * 0.4 * (a / 0.1).min(1.0) * a.min(0.1) + 0.4 * (a - 0.1).max(0.0);
+        let up = ramp(t.min(0.6));
+        let down = (t.min(0.8) - 0.6).max(0.0);
+        up + 0.4 * down - 0.5 * 0.4 / 0.2 * down * down
+    };
+    assert!((volume(1.0) - 0.26).abs() < 1e-12);
+    let (dx, layer) = (0.02, 10.0 * 0.02 * 0.02);
+    let mut solver = Solver::new(gpu(), &sc).unwrap();
+    for t in [0.05, 0.3, 0.45, 0.7, 0.9] {
+        solver.advance_to(t).unwrap();
+        let q = solver.sample_probes().unwrap()[0];
+        println!("t = {t} s: the section reads {q:.4} m²/s");
+        if t == 0.05 {
+            assert_eq!(q, 0.0, "no water has reached the section");
+        } else if t == 0.45 {
+            assert!(
+                (q - 0.4).abs() < 0.02 * 0.4,
+                "t = {t}: {q} m²/s against 0.4"
+            );
+        }
+        let parts = solver.read_particles().unwrap();
+        let fluid = (inlet.particles.clone())
+            .filter(|&id| parts.kind[id] == reference::FLUID)
+            .count();
+        let delivered = fluid as f64 * dx * dx;
+        let expected = volume(solver.time());
+        println!(
+            "t = {:.3} s: {delivered:.4} m² delivered, {expected:.4} m² by the hydrograph",
+            solver.time()
+        );
+        assert!(
+            (delivered - expected).abs() <= 0.5 * layer + 1e-9,
+            "t = {t}: {delivered} m² against {expected}"
+        );
+    }
+    let parts = solver.read_particles().unwrap();
+    let fluid = (inlet.particles.clone())
+        .filter(|&id| parts.kind[id] == reference::FLUID)
+        .count();
+    let error = (fluid as f64 * dx * dx - 0.26).abs() / 0.26;
+    assert!(error < 0.01, "{:.2} % of the volume", 100.0 * error);
 }
 
 /// Outlets remove exactly the fluid particles whose predicted place lies in their boxes: one

@@ -10,12 +10,13 @@ use std::sync::Arc;
 use crate::scenario::{Motion, MotionLaw, Prescribed};
 
 use super::check::{
-    aabb, file_safe, initial_velocity, number, read_bounded, read_mesh, treatment, vector, Aabb,
-    Bound, Treatment, MAX_NAME_BYTES,
+    aabb, file_safe, initial_velocity, number, read_mesh, treatment, vector, Aabb, Bound,
+    Treatment, MAX_NAME_BYTES,
 };
 use super::error::{num, CaseError};
 use super::locate::Ctx;
 use super::schema::{MotionName, RawBody, RawMotion, ShapeName};
+use super::time_series;
 use crate::generate::mesh::Mesh;
 use crate::generate::polygon::Polygon;
 
@@ -582,8 +583,7 @@ fn sine_law(ctx: &Ctx<'_>, path: &str, m: &RawMotion, dim: usize) -> Result<Moti
     })
 }
 
-/// A motion time series: a CSV with `#` comments, an optional header line, and rows
-/// `t_s, dx_m, dy_m[, dz_m], angle_deg` (t strictly increasing).
+/// A motion time series: rows `t_s, dx_m, dy_m[, dz_m], angle_deg` (t strictly increasing).
 fn series(
     ctx: &Ctx<'_>,
     path: &str,
@@ -591,98 +591,24 @@ fn series(
     dim: usize,
     case_dir: &Path,
 ) -> Result<MotionLaw, CaseError> {
-    let full = case_dir.join(file);
-    // A file, not a device or a pipe (reading /dev/zero would never end), and of a size that
-    // a series can have.
-    const MAX_BYTES: u64 = 64 << 20;
-    if let Ok(meta) = std::fs::metadata(&full) {
-        let problem = if !meta.is_file() {
-            Some(format!("{} is not a regular file", full.display()))
-        } else if meta.len() > MAX_BYTES {
-            Some(format!(
-                "{} has {} bytes, more than the {MAX_BYTES} a motion series may have",
-                full.display(),
-                meta.len()
-            ))
-        } else {
-            None
-        };
-        if let Some(problem) = problem {
-            return Err(ctx.err(
-                path,
-                Some(format!("{file:?}")),
-                problem,
-                "give the path of a CSV file relative to the case file",
-            ));
-        }
-    }
-    let text = read_bounded(&full, 256 << 20).map_err(|e| {
-        ctx.err(
-            path,
-            Some(format!("{file:?}")),
-            format!("cannot read {}: {e}", full.display()),
-            "give the path of the CSV relative to the case file",
-        )
-    })?;
-    let columns = dim + 2;
-    let (mut t, mut translation, mut angle) = (Vec::new(), Vec::new(), Vec::new());
-    let mut header = false;
-    for (n, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
-        let bad = |problem: String| {
-            ctx.err(
-                path,
-                Some(format!("{file:?}")),
-                format!("{} line {}: {problem}", full.display(), n + 1),
-                format!(
-                    "write rows of {columns} numbers: t_s, dx_m, dy_m{}, angle_deg, with t \
-                     increasing",
-                    if dim == 3 { ", dz_m" } else { "" }
-                ),
-            )
-        };
-        let values = match values {
-            Ok(v) => v,
-            // One header line (before any data) is skipped.
-            Err(_) if t.is_empty() && !header => {
-                header = true;
-                continue;
-            }
-            // Other separators than the comma (issue 64: every row of a ';' file was taken
-            // for a header, and the file said to have no data rows).
-            Err(_) if line.contains([';', '\t']) || !line.contains(',') => {
-                return Err(bad(format!(
-                    "{line:?} is not {columns} comma-separated numbers (a CSV of this case \
-                     separates its columns by commas, not ';', tabs or spaces)"
-                )))
-            }
-            Err(_) => return Err(bad(format!("{line:?} is not {columns} numbers"))),
-        };
-        if values.len() != columns || values.iter().any(|v| !v.is_finite()) {
-            return Err(bad(format!("{line:?} is not {columns} finite numbers")));
-        }
-        if t.last().is_some_and(|&last| values[0] <= last) {
-            return Err(bad(format!("t = {} does not increase", values[0])));
-        }
-        t.push(values[0]);
-        let mut d = [0.0; 3];
-        d[..dim].copy_from_slice(&values[1..=dim]);
-        translation.push(d);
-        angle.push(values[dim + 1].to_radians());
-    }
-    if t.is_empty() {
-        return Err(ctx.err(
-            path,
-            Some(format!("{file:?}")),
-            format!("{} has no data rows", full.display()),
-            "add rows t_s, dx_m, dy_m[, dz_m], angle_deg",
-        ));
-    }
+    let columns: &[&str] = if dim == 3 {
+        &["t_s", "dx_m", "dy_m", "dz_m", "angle_deg"]
+    } else {
+        &["t_s", "dx_m", "dy_m", "angle_deg"]
+    };
+    let rows = time_series::read(ctx, path, file, case_dir, columns)?;
+    let t = rows.iter().map(|r| r.values[0]).collect();
+    let translation = (rows.iter())
+        .map(|r| {
+            let mut d = [0.0; 3];
+            d[..dim].copy_from_slice(&r.values[1..=dim]);
+            d
+        })
+        .collect();
+    let angle = rows
+        .iter()
+        .map(|r| r.values[dim + 1].to_radians())
+        .collect();
     Ok(MotionLaw::Series {
         t,
         translation,

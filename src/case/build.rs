@@ -757,13 +757,15 @@ impl Start {
                  realistic physics.rho0_kg_m3",
             ));
         }
-        if let Some((i, s)) = case.inlets.iter().enumerate().find(|(_, s)| s.speed >= c0) {
+        let too_fast = (case.inlets.iter().enumerate()).find(|(_, s)| s.max_speed() >= c0);
+        if let Some((i, s)) = too_fast {
             return Err(ctx.err(
-                &format!("inlet[{i}].velocity_m_s"),
-                Some(num(s.speed)),
+                &format!("inlet[{i}].{}", s.inflow_field),
+                None,
                 format!(
-                    "is not below the speed of sound c0 = {} m/s: weakly compressible SPH needs \
-                     flow speeds of about c0 / 10 or less",
+                    "makes an inflow speed of {} m/s, not below the speed of sound c0 = {} m/s: \
+                     weakly compressible SPH needs flow speeds of about c0 / 10 or less",
+                    num(s.max_speed()),
                     num(c0)
                 ),
                 format!(
@@ -830,7 +832,9 @@ fn sound_speed(
                 .map(|b| b.max[v] - floor(b))
                 .fold(0.0, f64::max);
             // Inflow faster than the fall speed sets the scale instead.
-            let inflow = case.inlets.iter().map(|s| s.speed).fold(0.0, f64::max);
+            let inflow = (case.inlets.iter())
+                .map(|s| s.max_speed())
+                .fold(0.0, f64::max);
             let c = k * (g * depth).sqrt().max(inflow);
             if !c.is_finite() || c <= 0.0 {
                 return Err(ctx.err(

@@ -280,6 +280,9 @@ fn check_probes_inside(ctx: &Ctx<'_>, case: &Case, d: &Aabb) -> Result<(), CaseE
             ProbeKind::Height { base } => ("base_m", *base),
             ProbeKind::Front { origin, .. } => ("origin_m", *origin),
             ProbeKind::WallPressure(patch) => ("point_m", patch.point),
+            // Either end outside.
+            ProbeKind::Discharge { from, to } if point_inside(*from, d, dim) => ("to_m", *to),
+            ProbeKind::Discharge { from, .. } => ("from_m", *from),
         };
         if !point_inside(point, d, dim) {
             // Say what the default domain encloses: removing the tank shrinks it to the fluid.

@@ -47,6 +47,7 @@ mod schema;
 mod solids;
 mod surface;
 mod terrain;
+mod time_series;
 mod validate;
 mod warnings;
 

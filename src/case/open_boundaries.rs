@@ -8,8 +8,12 @@
 use super::check::{aabb, number, vector, Aabb, Bound, AXES};
 use super::error::{num, CaseError};
 use super::locate::Ctx;
-use super::schema::{InletPressureName, RawInlet, RawOutlet};
+use std::path::Path;
+
+use super::schema::{InletPressureName, InterpolationName, RawInlet, RawOutlet};
+use super::time_series;
 use crate::generate::lattice::{range_points, Lattice};
+use crate::hydrograph::{Hydrograph, Interpolation};
 use crate::scenario::{Inlet, InletPressure, Kind, Outlet, Particle};
 
 /// An `[[inlet]]` as checked against the case, before the lattice is known.
@@ -20,17 +24,36 @@ pub(super) struct InletSpec {
     /// The flow axis and its sense (±1).
     pub axis: usize,
     pub sense: f64,
-    pub speed: f64,
+    /// The inflow in time: a speed [m/s], or a discharge [m³/s; 2D m²/s] where `discharge`.
+    pub inflow: Hydrograph,
+    pub discharge: bool,
+    /// The field that gives it (`velocity_m_s`, `discharge_file`, …).
+    pub inflow_field: &'static str,
+    /// The box's section across the flow [m², 2D m], for the speed a discharge makes before
+    /// the lattice is known.
+    pub box_section: f64,
     pub stop_s: f64,
     /// `pressure`.
     pub pressure: InletPressureName,
 }
 
+impl InletSpec {
+    /// The fastest inflow [m/s] (a discharge over the box's section), for the speed of sound.
+    pub fn max_speed(&self) -> f64 {
+        let speed = self.inflow.max_speed();
+        if self.discharge {
+            speed / self.box_section
+        } else {
+            speed
+        }
+    }
+}
+
 pub(super) fn validate(
     ctx: &Ctx<'_>,
     raw: &[RawInlet],
-    dim: usize,
-    end_s: f64,
+    (dim, end_s): (usize, f64),
+    case_dir: &Path,
 ) -> Result<Vec<InletSpec>, CaseError> {
     let mut out: Vec<InletSpec> = Vec::with_capacity(raw.len());
     for (i, r) in raw.iter().enumerate() {
@@ -72,14 +95,7 @@ pub(super) fn validate(
                 ));
             }
         };
-        let speed = number(
-            ctx,
-            &format!("{path}.velocity_m_s"),
-            r.velocity_m_s,
-            Bound::Positive,
-            "the inflow speed in m/s along direction",
-            "give a positive speed (fluid leaves through [[outlet]] boxes, not inlets)",
-        )?;
+        let (inflow, inflow_field) = inflow(ctx, &path, r, case_dir)?;
         // Particles are made for the inflow within the run only (a later stop is the end).
         let stop_s = match r.stop_s {
             None => end_s,
@@ -98,12 +114,133 @@ pub(super) fn validate(
             bx,
             axis,
             sense: d[axis],
-            speed,
+            inflow,
+            discharge: inflow_field.starts_with("discharge"),
+            inflow_field,
+            box_section: (0..dim)
+                .filter(|&b| b != axis)
+                .map(|b| bx.max[b] - bx.min[b])
+                .product(),
             stop_s,
             pressure: r.pressure.unwrap_or(InletPressureName::Zero),
         });
     }
     Ok(out)
+}
+
+/// An inlet's inflow: exactly one of a constant speed or discharge and a CSV of either in
+/// time; the hydrograph and the field that gave it.
+fn inflow(
+    ctx: &Ctx<'_>,
+    path: &str,
+    r: &RawInlet,
+    case_dir: &Path,
+) -> Result<(Hydrograph, &'static str), CaseError> {
+    let given: Vec<&'static str> = [
+        ("velocity_m_s", r.velocity_m_s.is_some()),
+        ("discharge_m3_s", r.discharge_m3_s.is_some()),
+        ("velocity_file", r.velocity_file.is_some()),
+        ("discharge_file", r.discharge_file.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(name, on)| on.then_some(name))
+    .collect();
+    let field = match given[..] {
+        [one] => one,
+        [] => {
+            return Err(ctx.err(
+                &format!("{path}.velocity_m_s"),
+                None,
+                "is missing: an inlet needs its inflow",
+                "give velocity_m_s or discharge_m3_s, or a CSV of either in time as \
+                 velocity_file or discharge_file",
+            ))
+        }
+        [first, second, ..] => {
+            return Err(ctx.err(
+                &format!("{path}.{second}"),
+                None,
+                format!("is given together with {first}: an inlet has one inflow"),
+                format!("keep one of {}", given.join(", ")),
+            ))
+        }
+    };
+    let interpolation = r.interpolation.map(|i| match i {
+        InterpolationName::Linear => Interpolation::Linear,
+        InterpolationName::Cubic => Interpolation::MonotoneCubic,
+    });
+    let file = r.velocity_file.as_ref().or(r.discharge_file.as_ref());
+    if let (Some(_), None) = (interpolation, file) {
+        return Err(ctx.err(
+            &format!("{path}.interpolation"),
+            None,
+            "joins the samples of a velocity_file or discharge_file, and the inlet has neither",
+            "remove it, or give the inflow as a CSV file",
+        ));
+    }
+    let what = if field.starts_with("velocity") {
+        "speed in m/s along direction"
+    } else {
+        "discharge in m³/s (2D: m²/s)"
+    };
+    let Some(file) = file else {
+        let value = r.velocity_m_s.or(r.discharge_m3_s).unwrap_or(f64::NAN);
+        let value = number(
+            ctx,
+            &format!("{path}.{field}"),
+            value,
+            Bound::Positive,
+            &format!("the inflow {what}"),
+            "give a positive value (fluid leaves through [[outlet]] boxes, not inlets)",
+        )?;
+        return Ok((Hydrograph::constant(value), field));
+    };
+    let column = if field == "velocity_file" {
+        "u_m_s"
+    } else {
+        "q_m3_s"
+    };
+    let field_path = format!("{path}.{field}");
+    let rows = time_series::read(ctx, &field_path, file, case_dir, &["t_s", column])?;
+    let bad = |line: usize, problem: String, fix: &str| {
+        ctx.err(
+            &field_path,
+            Some(format!("{file:?}")),
+            format!("{} line {line}: {problem}", case_dir.join(file).display()),
+            fix,
+        )
+    };
+    for row in &rows {
+        let [t, q] = row.values[..] else {
+            unreachable!("two columns")
+        };
+        if t < 0.0 {
+            return Err(bad(
+                row.line,
+                format!("t = {t} s is before the run starts at 0"),
+                "give times from 0 s on (a run starts at t = 0)",
+            ));
+        }
+        if q < 0.0 {
+            return Err(bad(
+                row.line,
+                format!("{column} = {q} is negative"),
+                "give an inflow of 0 or more: an inlet only brings water in (drain it through \
+                 an [[outlet]])",
+            ));
+        }
+    }
+    if rows.iter().all(|r| r.values[1] == 0.0) {
+        return Err(bad(
+            rows[0].line,
+            format!("the {what} is 0 at every time: the inlet brings no water"),
+            "give the inflow's values, or remove the inlet",
+        ));
+    }
+    let t: Vec<f64> = rows.iter().map(|r| r.values[0]).collect();
+    let u: Vec<f64> = rows.iter().map(|r| r.values[1]).collect();
+    let how = interpolation.unwrap_or(Interpolation::Linear);
+    Ok((Hydrograph::from_samples(&t, &u, how), field))
 }
 
 /// The inlet's geometry on the lattice, checked (errors name the field to fix): the lattice
@@ -117,6 +254,8 @@ pub(super) struct Layout {
     pub layers: usize,
     /// Columns (the front layer's points); counted before any is made.
     pub n_columns: f64,
+    /// The inflow speed in time.
+    inflow: Hydrograph,
 }
 
 impl Layout {
@@ -186,8 +325,15 @@ pub(super) fn layout(
         .filter(|&b| b != a)
         .map(|b| hi[b] - lo[b] + 1.0)
         .product();
-    // Layers crossing the plane by the stop: those with (layer + ½) dx ≤ speed × stop.
-    let delivered = (spec.speed * spec.stop_s / dx + 0.5).floor();
+    // A discharge is a speed over the section of the buffer's columns.
+    let inflow = if spec.discharge {
+        spec.inflow
+            .scaled(1.0 / (n_columns * dx.powi(lat.dim as i32 - 1)))
+    } else {
+        spec.inflow.clone()
+    };
+    // Layers crossing the plane by the stop: those with (layer + ½) dx ≤ D(stop).
+    let delivered = (inflow.distance(spec.stop_s) / dx + 0.5).floor();
     let buffer_layers = depth.min(1e15) as usize;
     Ok(Layout {
         front_lo,
@@ -197,6 +343,7 @@ pub(super) fn layout(
         buffer_layers,
         layers: buffer_layers.max(delivered.min(1e15) as usize),
         n_columns,
+        inflow,
     })
 }
 
@@ -221,7 +368,7 @@ pub(super) fn build(
     let inlet = Inlet {
         name: spec.name.clone(),
         normal,
-        speed: spec.speed,
+        inflow: layout.inflow,
         thickness: layout.buffer_layers as f64 * dx,
         spacing: dx,
         columns,
@@ -248,17 +395,14 @@ pub(super) fn build(
         }
         _ => 0.0,
     };
+    let speed = inlet.inflow.speed(0.0);
     for k in 0..n {
-        let t0 = if inlet.dormant(k) {
-            // At the buffer's back: the place it joins from.
-            (-inlet.thickness - inlet.distance(k, 0.0)) / inlet.speed
-        } else {
-            0.0
-        };
-        let pos = inlet.position(k, t0);
+        // A dormant particle waits at the buffer's back, the place it joins from.
+        let s = inlet.distance(k, 0.0).max(-inlet.thickness);
+        let pos = inlet.position_at(k, s);
         particles.push(Particle {
             pos,
-            vel: normal.map(|c| c * spec.speed),
+            vel: normal.map(|c| c * speed),
             rho: rho_at(depth(pos)),
             kind: Kind::Inlet,
         });

@@ -106,6 +106,7 @@ pub(super) fn probe(
             }
         }
         ProbeName::WallPressure => wall_pressure(ctx, &path, p, dim)?,
+        ProbeName::Discharge => discharge(ctx, &path, p, dim)?,
     };
     Ok(Checked::Sampled(
         Probe {
@@ -134,15 +135,20 @@ fn check_probe_fields(
         ProbeName::Front => ("front", &["origin_m", "axis"], &["continuous"]),
         ProbeName::Point => ("point", &["point_m"], &[]),
         ProbeName::WallPressure => ("wall_pressure", &["point_m", "normal", "radius_m"], &[]),
+        ProbeName::Discharge => ("discharge", &["from_m", "to_m"], &[]),
     };
-    if p.kind == ProbeName::Point && p.body.is_some() {
-        return Err(ctx.err(
-            &format!("{path}.body"),
-            None,
+    let unattached = match p.kind {
+        ProbeName::Point => Some(
             "is not used by a \"point\" probe: it follows the particle nearest to point_m, \
              whatever body that particle belongs to",
-            "remove body",
-        ));
+        ),
+        ProbeName::Discharge => {
+            Some("is not used by a \"discharge\" probe: its section stays where it is drawn")
+        }
+        _ => None,
+    };
+    if let (Some(problem), Some(_)) = (unattached, &p.body) {
+        return Err(ctx.err(&format!("{path}.body"), None, problem, "remove body"));
     }
     let fields = [
         ("point_m", &p.point_m),
@@ -151,6 +157,8 @@ fn check_probe_fields(
         ("origin_m", &p.origin_m),
         ("axis", &p.axis),
         ("normal", &p.normal),
+        ("from_m", &p.from_m),
+        ("to_m", &p.to_m),
     ];
     let present = fields
         .iter()
@@ -193,6 +201,28 @@ fn check_probe_fields(
         }
     }
     Ok(())
+}
+
+/// A discharge probe's section: from `from_m` to `to_m`, in 3D their line in plan (the
+/// section is the vertical plane through it), at least some length apart.
+fn discharge(ctx: &Ctx<'_>, path: &str, p: &RawProbe, dim: usize) -> Result<ProbeKind, CaseError> {
+    let get = |field: &str, v: &Option<Vec<f64>>, what: &str| {
+        field_vector(ctx, path, field, v, dim, what)
+    };
+    let from = get("from_m", &p.from_m, "one end of the section in metres")?;
+    let to = get("to_m", &p.to_m, "the other end of the section in metres")?;
+    let length = ((to[0] - from[0]).powi(2) + (to[1] - from[1]).powi(2)).sqrt();
+    if !(length.is_finite() && length > 1e-9) {
+        let plan = if dim == 3 { " in plan (x and y)" } else { "" };
+        return Err(ctx.err(
+            &format!("{path}.to_m"),
+            p.to_m.as_ref().map(|v| format!("{v:?}")),
+            format!("is where from_m is{plan}: the section has no length"),
+            "give the two ends of a line across the flow, e.g. from one side of a street to \
+             the other",
+        ));
+    }
+    Ok(ProbeKind::Discharge { from, to })
 }
 
 /// `{path}.{field}`, `v`: a vector of `dim` finite numbers (`what` it is); a missing one is

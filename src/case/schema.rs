@@ -66,9 +66,21 @@ pub(super) struct RawInlet {
     pub min_m: Vec<f64>,
     pub max_m: Vec<f64>,
     pub direction: Vec<f64>,
-    pub velocity_m_s: f64,
+    pub velocity_m_s: Option<f64>,
+    pub discharge_m3_s: Option<f64>,
+    pub velocity_file: Option<String>,
+    pub discharge_file: Option<String>,
+    pub interpolation: Option<InterpolationName>,
     pub stop_s: Option<f64>,
     pub pressure: Option<InletPressureName>,
+}
+
+/// How an inlet's hydrograph joins its samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum InterpolationName {
+    Linear,
+    Cubic,
 }
 
 /// The pressure of an inlet's buffer.
@@ -458,6 +470,9 @@ pub(super) struct RawProbe {
     pub radius_m: Option<f64>,
     /// The body the probe moves with ("tank" for a moving tank).
     pub body: Option<String>,
+    /// A discharge probe's section: from this point to `to_m` (in plan, in 3D).
+    pub from_m: Option<Vec<f64>>,
+    pub to_m: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -468,6 +483,7 @@ pub(super) enum ProbeName {
     Front,
     Point,
     WallPressure,
+    Discharge,
 }
 
 /// Help for one field: what it is and an example of a valid line.
@@ -690,12 +706,12 @@ pub(super) const FIELDS: &[FieldHelp] = &[
     f(
         "inlet",
         "a list of [[inlet]] tables",
-        "[[inlet]] with name, min_m, max_m, direction and velocity_m_s",
+        "[[inlet]] with name, min_m, max_m, direction and velocity_m_s (or a discharge)",
     ),
     f(
         "inlet[]",
         "an [[inlet]] table",
-        "[[inlet]] with name, min_m, max_m, direction and velocity_m_s",
+        "[[inlet]] with name, min_m, max_m, direction and velocity_m_s (or a discharge)",
     ),
     f(
         "inlet[].name",
@@ -721,6 +737,28 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "inlet[].velocity_m_s",
         "the inflow speed in m/s, along direction",
         "velocity_m_s = 1.0",
+    ),
+    f(
+        "inlet[].discharge_m3_s",
+        "the inflow's discharge in m³/s (2D: m²/s, per metre of width)",
+        "discharge_m3_s = 0.05",
+    ),
+    f(
+        "inlet[].velocity_file",
+        "a CSV of the inflow speed in time (t_s, u_m_s), relative to the case file",
+        "velocity_file = \"inflow_speed.csv\"",
+    ),
+    f(
+        "inlet[].discharge_file",
+        "a CSV of the discharge in time, a hydrograph (t_s, q_m3_s; 2D: m²/s), relative to \
+         the case file",
+        "discharge_file = \"hydrograph.csv\"",
+    ),
+    f(
+        "inlet[].interpolation",
+        "how a velocity_file's or discharge_file's samples are joined: linear or cubic \
+         (monotone)",
+        "interpolation = \"linear\"",
     ),
     f(
         "inlet[].pressure",
@@ -1056,6 +1094,16 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "probe[].axis",
         "the direction of a front probe",
         "axis = [1.0, 0.0]",
+    ),
+    f(
+        "probe[].from_m",
+        "one end of a discharge probe's section (3D: of its line in plan)",
+        "from_m = [2.0, 0.0, 0.0]",
+    ),
+    f(
+        "probe[].to_m",
+        "the other end of a discharge probe's section",
+        "to_m = [2.0, 1.0, 0.0]",
     ),
     f(
         "probe[].continuous",

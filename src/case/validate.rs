@@ -188,7 +188,7 @@ pub(super) fn validate(
     };
     check_probe_names(ctx, raw)?;
     let bodies = super::bodies::validate(ctx, &raw.body, dim, case_dir)?;
-    let inlets = super::open_boundaries::validate(ctx, &raw.inlet, dim, time.end_s)?;
+    let inlets = super::open_boundaries::validate(ctx, &raw.inlet, (dim, time.end_s), case_dir)?;
     let outlets = super::open_boundaries::validate_outlets(ctx, &raw.outlet, dim)?;
     let tank_moves = tank.as_ref().is_some_and(|t| t.motion.is_some());
     walls.friction_pairs =

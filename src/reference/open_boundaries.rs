@@ -15,6 +15,21 @@ pub struct Placed {
     pub joined: bool,
 }
 
+/// An inlet's inflow at time `t`: its speed and the distance it has carried the water
+/// (`crate::hydrograph`, exact in f64).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inflow {
+    pub speed: f64,
+    pub distance: f64,
+}
+
+pub fn inflow_at(inlet: &Inlet, t: f64) -> Inflow {
+    Inflow {
+        speed: inlet.inflow.speed(t),
+        distance: inlet.inflow.distance(t),
+    }
+}
+
 /// What the pass makes at time `t` of particle `k` of `inlet`, whose kind is `kind` and density
 /// `rho`: `None` where it leaves the particle alone (fluid already, or excluded and not due:
 /// still dormant, or past the plane, i.e. fluid that left the domain).
@@ -26,6 +41,7 @@ pub fn inlet_flow(
     t: f64,
     ph: &Physics,
 ) -> Option<Placed> {
+    let inflow = inflow_at(inlet, t);
     let s = inlet.distance(k, t);
     let joined = match kind {
         INLET => false,
@@ -35,7 +51,7 @@ pub fn inlet_flow(
     let pos = inlet.position(k, t);
     Some(Placed {
         pos,
-        vel: inlet.normal.map(|n| inlet.speed * n),
+        vel: inlet.normal.map(|n| inflow.speed * n),
         // An extrapolated buffer keeps the density its last extrapolation gave it.
         rho: match (inlet.pressure, kind) {
             (InletPressure::Extrapolated, INLET) => rho,
@@ -69,12 +85,13 @@ pub fn extrapolated_density(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::hydrograph::Hydrograph;
 
     fn inlet() -> Inlet {
         Inlet {
             name: "jet".into(),
             normal: [1.0, 0.0, 0.0],
-            speed: 2.0,
+            inflow: Hydrograph::constant(2.0),
             thickness: 0.04,
             spacing: 0.01,
             columns: vec![[0.1, 0.2, 0.0], [0.1, 0.21, 0.0]],

@@ -21,7 +21,8 @@ pub const SHADER: Shader = Shader {
     libs: &[PARTICLE_ID, NEIGHBOURS, MLS, FLUID_AT],
 };
 use crate::layout::{
-    pack_block, InletDef, OutletDef, Pos, INLET_EXTRAPOLATED, INLET_HYDROSTATIC, INLET_ZERO,
+    pack_block, InflowSegment, InletDef, OutletDef, Pos, INLET_EXTRAPOLATED, INLET_HYDROSTATIC,
+    INLET_ZERO,
 };
 use crate::scenario::{InletPressure, Scenario};
 
@@ -35,19 +36,22 @@ pub struct OpenBoundaries {
 
 /// The GPU tables of the scenario's inlets: their definitions and their columns' points (as
 /// positions in the grid's blocks).
-pub fn inlet_tables(sc: &Scenario, grid: &Grid) -> (Vec<InletDef>, Vec<Pos>) {
+pub fn inlet_tables(sc: &Scenario, grid: &Grid) -> InletTables {
     let mut defs = Vec::with_capacity(sc.inlets.len());
     let mut columns = Vec::new();
+    let mut segments = Vec::new();
     for inlet in &sc.inlets {
+        let inflow = inlet.inflow.segments();
         defs.push(InletDef {
             normal: inlet.normal.map(|c| c as f32),
-            speed: inlet.speed as f32,
+            first_segment: segments.len() as u32,
             thickness: inlet.thickness as f32,
             spacing: inlet.spacing as f32,
             first_id: inlet.particles.start as u32,
             n_columns: inlet.columns.len() as u32,
             first_column: columns.len() as u32,
-            pad: [0; 3],
+            n_segments: inflow.len() as u32,
+            pad: [0; 2],
             surface: match inlet.pressure {
                 InletPressure::Hydrostatic { surface } => {
                     [0, 1, 2].map(|a| (surface[a] - grid.origin[a]) as f32)
@@ -67,8 +71,28 @@ pub fn inlet_tables(sc: &Scenario, grid: &Grid) -> (Vec<InletDef>, Vec<Pos>) {
                 block: pack_block(b),
             }
         }));
+        segments.extend(inflow.iter().map(|s| InflowSegment {
+            t: s.t as f32,
+            distance: s.distance as f32,
+            pad: [0; 2],
+            speed: s.speed.map(|c| c as f32),
+            moved: s.distance_coefficients().map(|c| c as f32),
+        }));
     }
-    (defs, columns)
+    InletTables {
+        defs,
+        columns,
+        segments,
+    }
+}
+
+/// The GPU tables of a scenario's inlets ([`inlet_tables`]).
+pub struct InletTables {
+    pub defs: Vec<InletDef>,
+    /// Each column's point on its inlet's plane, as a position in the grid's blocks.
+    pub columns: Vec<Pos>,
+    /// The inlets' hydrographs, piece after piece.
+    pub segments: Vec<InflowSegment>,
 }
 
 /// The outlets' boxes in domain coordinates (from the grid's origin); in 2D z spans [−1, 1].
@@ -108,23 +132,26 @@ impl OpenBoundaries {
             !sc.inlets.is_empty() || !sc.outlets.is_empty(),
             "the case has no inlets or outlets"
         );
-        let (mut defs, mut columns) = inlet_tables(sc, grid);
+        let mut tables = inlet_tables(sc, grid);
         let mut outlets = outlet_table(sc, grid);
         // A binding cannot be empty.
-        if defs.is_empty() {
-            defs.push(InletDef::default());
-            columns.push(Pos::default());
+        if tables.defs.is_empty() {
+            tables.defs.push(InletDef::default());
+            tables.columns.push(Pos::default());
+            tables.segments.push(InflowSegment::default());
         }
         if outlets.is_empty() {
             outlets.push(OutletDef::default());
         }
-        let defs = storage_init(device, "inlets", &defs);
-        let columns = storage_init(device, "inlet columns", &columns);
+        let defs = storage_init(device, "inlets", &tables.defs);
+        let columns = storage_init(device, "inlet columns", &tables.columns);
+        let segments = storage_init(device, "inflow segments", &tables.segments);
         let outlets = storage_init(device, "outlets", &outlets);
         let bufs = |p: usize| {
             b.at(p)
                 .with("inlets", &defs)
                 .with("inlet_columns", &columns)
+                .with("inflow_segments", &segments)
                 .with("outlets", &outlets)
         };
         let kernel = |entry: &str| ParityKernel::new(device, module, entry, bufs);

@@ -9,7 +9,7 @@ use super::shader::{NEIGHBOURS, WALL_PATCH, WORKGROUP_MAX};
 use crate::body::Pose;
 use crate::gpu::buffers::{read, storage, storage_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
-use crate::gpu::shader::Shader;
+use crate::gpu::shader::{Shader, WORKGROUP_SIZE};
 
 pub const SHADER: Shader = Shader {
     name: "probes",
@@ -26,6 +26,7 @@ pub const PROBE_HEIGHT: u32 = 1;
 pub const PROBE_FRONT: u32 = 2;
 pub const PROBE_WALL_PRESSURE: u32 = 3;
 pub const PROBE_FRONT_CONTINUOUS: u32 = 4;
+pub const PROBE_DISCHARGE: u32 = 5;
 
 /// Bins along a continuous front's axis (probes.wgsl, `probe_front_walk`): the kernel support
 /// 2h wide, enough of them to cover the domain's diagonal from anywhere in it.
@@ -119,6 +120,8 @@ pub fn probe_defs(
 ) -> Vec<ProbeDef> {
     let rel = |p: &[f64; 3]| [0, 1, 2].map(|a| (p[a] - origin[a]) as f32);
     let mut next_word = 0;
+    let discharges = discharge_count(probes) as u32;
+    let mut next_discharge = 0;
     (probes.iter().zip(faces))
         .map(|(p, &face)| match &p.kind {
             ProbeKind::Pressure { point } => ProbeDef {
@@ -167,8 +170,29 @@ pub fn probe_defs(
                 face,
                 ..Default::default()
             },
+            ProbeKind::Discharge { from, to } => {
+                let (normal, length) = ProbeKind::section_normal(*from, *to);
+                next_discharge += 1;
+                ProbeDef {
+                    point: rel(from),
+                    kind: PROBE_DISCHARGE,
+                    axis: normal.map(|a| a as f32),
+                    radius: length as f32,
+                    face,
+                    bins: next_discharge - 1,
+                    words: discharges,
+                    ..Default::default()
+                }
+            }
         })
         .collect()
+}
+
+/// How many of `probes` are discharge probes.
+pub fn discharge_count(probes: &[Probe]) -> usize {
+    (probes.iter())
+        .filter(|p| matches!(p.kind, ProbeKind::Discharge { .. }))
+        .count()
 }
 
 /// `probe` where its body has taken it: a point given at t = 0 goes to x_c + R (x0 − x_c0)
@@ -198,6 +222,8 @@ pub fn moved(probe: &Probe, center0: [f64; 3], pose: &Pose) -> Probe {
             normal: (pose.rotation * DVec3::from_array(patch.normal)).to_array(),
             ..*patch
         }),
+        // A section is not attached to a body (the case reader refuses it).
+        ProbeKind::Discharge { .. } => probe.kind.clone(),
     };
     Probe {
         kind,
@@ -222,6 +248,8 @@ pub struct Probes {
     front_walk: ParityKernel,
     front_continuous: ParityKernel,
     height: ParityKernel,
+    discharge_sums: ParityKernel,
+    discharge_total: ParityKernel,
     /// The continuous fronts' bits of wet bins and ends (`probe_front_walk`).
     front_bins: wgpu::Buffer,
     kinds: Vec<u32>,
@@ -244,9 +272,15 @@ impl Probes {
         blind: Vec<bool>,
     ) -> Result<Self> {
         let front_bins = storage(device, "front bins", 4 * front_bin_words(defs) as u64);
+        // A sum per workgroup of the particle arrays and discharge probe (one word at least).
+        let groups = b.n.div_ceil(WORKGROUP_SIZE) as u64;
+        let sums = (groups * discharge_count(probes) as u64).max(1);
+        let discharge_sums = storage(device, "discharge sums", 4 * sums);
         let kernel = |entry| {
             ParityKernel::new(device, module, entry, |p| {
-                b.at(p).with("front_bins", &front_bins)
+                (b.at(p))
+                    .with("front_bins", &front_bins)
+                    .with("discharge_sums", &discharge_sums)
             })
         };
         Ok(Self {
@@ -255,6 +289,8 @@ impl Probes {
             front_walk: kernel("probe_front_walk")?,
             front_continuous: kernel("probe_front_continuous")?,
             height: kernel("probe_height_search")?,
+            discharge_sums: kernel("probe_discharge_sums")?,
+            discharge_total: kernel("probe_discharge_total")?,
             kinds: defs.iter().map(|d| d.kind).collect(),
             scales: probes
                 .iter()
@@ -303,6 +339,11 @@ impl Probes {
         self.points.dispatch(&mut pass, p, self.kinds.len() as u32);
         if self.has_continuous() || self.kinds.contains(&PROBE_FRONT) {
             self.front.dispatch(&mut pass, p, self.n);
+        }
+        if self.kinds.contains(&PROBE_DISCHARGE) {
+            self.discharge_sums.dispatch(&mut pass, p, self.n);
+            self.discharge_total
+                .dispatch(&mut pass, p, self.kinds.len() as u32);
         }
     }
 

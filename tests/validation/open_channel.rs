@@ -216,11 +216,12 @@ fn street(dx: f64, end_s: f64, building: bool) -> Scenario {
     sc
 }
 
-/// Particles of `sc`'s first inlet through its plane by `t`: (layer + ½) dx ≤ U t.
+/// Particles of `sc`'s first inlet through its plane by `t`: (layer + ½) dx ≤ D(t).
 fn injected(sc: &Scenario, t: f64) -> usize {
     let inlet = &sc.inlets[0];
     let layers = inlet.particles.len() / inlet.columns.len();
-    let crossed = ((inlet.speed * t / sc.physics.dx + 0.5).floor() as usize).min(layers);
+    let travelled = inlet.inflow.distance(t);
+    let crossed = ((travelled / sc.physics.dx + 0.5).floor() as usize).min(layers);
     crossed * inlet.columns.len()
 }
 

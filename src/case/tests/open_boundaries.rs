@@ -162,3 +162,168 @@ fn outlet_errors_name_the_field_and_the_fix() {
         &["outlet[1].name", "also the name of outlet[0]"],
     );
 }
+
+/// The injection case with its nozzle's speed replaced by `inflow` (TOML lines).
+fn injection_with(inflow: &str) -> String {
+    let text = INJECTION.replace("velocity_m_s = 1.5\n", &format!("{inflow}\n"));
+    assert_ne!(text, INJECTION);
+    text
+}
+
+#[test]
+fn a_hydrograph_inlet_makes_the_layers_its_volume_takes() {
+    let dir = folder("hydrograph");
+    // A triangle: 0 at 0 s, 0.06 m²/s at 0.4 s, 0 at 0.8 s; ∫Q = 0.024 m², over the nozzle's 8
+    // columns of 5 mm (0.04 m) a distance of 0.6 m: 120 layers.
+    std::fs::write(
+        dir.join("q.csv"),
+        "# a triangle hydrograph\nt_s,q_m2_s\n0,0\n0.4,0.06\n0.8,0\n",
+    )
+    .unwrap();
+    let s = load_in(&dir, &injection_with("discharge_file = \"q.csv\"")).unwrap();
+    let inlet = &s.inlets[0];
+    assert_eq!(inlet.particles.len(), 8 * 120);
+    assert!((inlet.inflow.speed(0.4) - 1.5).abs() < 1e-12);
+    assert!((inlet.inflow.distance(2.0) - 0.6).abs() < 1e-12);
+    // The particles start still; a constant discharge is a constant speed.
+    assert_eq!(s.particles[inlet.particles.start].vel, [0.0, 0.0, 0.0]);
+    let q = load_in(&dir, &injection_with("discharge_m3_s = 0.02")).unwrap();
+    assert!((q.inlets[0].inflow.speed(0.3) - 0.5).abs() < 1e-12);
+    // A speed in time and the cubic's join.
+    std::fs::write(dir.join("u.csv"), "0,0.5\n0.5,1.0\n1.0,0.5\n").unwrap();
+    let u = load_in(
+        &dir,
+        &injection_with("velocity_file = \"u.csv\"\ninterpolation = \"cubic\""),
+    )
+    .unwrap();
+    let h = &u.inlets[0].inflow;
+    assert_eq!(h.speed(0.5), 1.0);
+    assert!(
+        h.speed(0.25) > 0.75,
+        "the cubic rounds the rise: {}",
+        h.speed(0.25)
+    );
+}
+
+#[test]
+fn bad_hydrographs_are_refused_naming_the_file_line_and_fix() {
+    let dir = folder("bad_hydrograph");
+    let refused = |rows: &str, words: &[&str]| {
+        std::fs::write(dir.join("q.csv"), rows).unwrap();
+        let text = injection_with("discharge_file = \"q.csv\"");
+        assert_refused(load_in(&dir, &text), words, rows);
+    };
+    refused(
+        "0,0.1\n0.5,0.2\n0.5,0.3\n",
+        &[
+            "inlet[0].discharge_file",
+            "q.csv line 3",
+            "does not increase",
+        ],
+    );
+    refused(
+        "-1,0.1\n0.5,0.2\n",
+        &["q.csv line 1", "before the run starts", "from 0 s on"],
+    );
+    refused(
+        "0,0.1\n0.5,-0.2\n",
+        &["q.csv line 2", "q_m3_s = -0.2 is negative", "[[outlet]]"],
+    );
+    refused("0,0\n1,0\n", &["is 0 at every time", "remove the inlet"]);
+    refused("t;q\n0;1\n", &["comma-separated", "t_s, q_m3_s"]);
+    refused("# nothing\n", &["no data rows", "add rows t_s, q_m3_s"]);
+    // One inflow, and interpolation only with a file.
+    let both = injection_with("discharge_m3_s = 0.02\nvelocity_m_s = 1.0");
+    assert_refused(
+        load_in(&dir, &both),
+        &[
+            "inlet[0].discharge_m3_s",
+            "together with velocity_m_s",
+            "keep one",
+        ],
+        &both,
+    );
+    let none = injection_with("");
+    assert_refused(
+        load_in(&dir, &none),
+        &["inlet[0].velocity_m_s", "is missing", "discharge_file"],
+        &none,
+    );
+    let lone = injection_with("velocity_m_s = 1.0\ninterpolation = \"cubic\"");
+    assert_refused(
+        load_in(&dir, &lone),
+        &["inlet[0].interpolation", "remove it"],
+        &lone,
+    );
+    let missing = injection_with("velocity_file = \"no_such.csv\"");
+    assert_refused(
+        load_in(&dir, &missing),
+        &[
+            "inlet[0].velocity_file",
+            "no_such.csv",
+            "relative to the case file",
+        ],
+        &missing,
+    );
+    // Faster than sound at its peak.
+    std::fs::write(dir.join("u.csv"), "0,1\n0.2,45\n0.4,1\n").unwrap();
+    let fast = injection_with("velocity_file = \"u.csv\"");
+    assert_refused(
+        load_in(&dir, &fast),
+        &["inlet[0].velocity_file", "45 m/s", "speed of sound"],
+        &fast,
+    );
+}
+
+/// A discharge probe across the injection's lower chamber.
+fn with_section(fields: &str) -> String {
+    format!("{INJECTION}\n[[probe]]\nname = \"Q\"\nkind = \"discharge\"\n{fields}\n")
+}
+
+#[test]
+fn discharge_sections_are_read_and_bad_ones_refused() {
+    let s = load_str(
+        &with_section("from_m = [0.3, 0.0]\nto_m = [0.3, 0.2]"),
+        "x.toml",
+        &[],
+    )
+    .unwrap();
+    let q = s.probes.iter().find(|p| p.name == "Q").unwrap();
+    let ProbeKind::Discharge { from, to } = q.kind else {
+        panic!("{:?}", q.kind)
+    };
+    assert_eq!((from, to), ([0.3, 0.0, 0.0], [0.3, 0.2, 0.0]));
+    // Drawn upwards, the section counts flow along +x.
+    let (n, length) = ProbeKind::section_normal(from, to);
+    assert_eq!((n, length), ([1.0, 0.0, 0.0], 0.2));
+    assert_err(
+        &with_section("from_m = [0.3, 0.0]"),
+        &[],
+        None,
+        &["probe[", "to_m", "is required for a \"discharge\" probe"],
+    );
+    assert_err(
+        &with_section("from_m = [0.3, 0.1]\nto_m = [0.3, 0.1]"),
+        &[],
+        None,
+        &["to_m", "the section has no length"],
+    );
+    assert_err(
+        &with_section("from_m = [0.3, 0.0]\nto_m = [0.3, 0.2]\nbody = \"tank\""),
+        &[],
+        None,
+        &["body", "its section stays where it is drawn", "remove body"],
+    );
+    assert_err(
+        &with_section("from_m = [0.3, 0.0]\nto_m = [0.3, 9.0]"),
+        &[],
+        None,
+        &["to_m", "lies outside"],
+    );
+    assert_err(
+        &with_section("from_m = [0.3, 0.0]\nto_m = [0.3, 0.2]\npoint_m = [0.1, 0.1]"),
+        &[],
+        None,
+        &["point_m", "is not used by a \"discharge\" probe"],
+    );
+}
