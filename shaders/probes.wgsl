@@ -16,12 +16,6 @@ struct ProbeDef {
 
 const NO_FACE: u32 = 0xFFFFFFFFu;
 
-const PROBE_PRESSURE: u32 = 0u;
-const PROBE_HEIGHT: u32 = 1u;
-const PROBE_FRONT: u32 = 2u;
-const PROBE_WALL_PRESSURE: u32 = 3u;
-const PROBE_FRONT_CONTINUOUS: u32 = 4u;
-const PROBE_DISCHARGE: u32 = 5u;
 
 @group(0) @binding(1) var<storage, read> pos: array<Pos>;
 @group(0) @binding(2) var<storage, read> velrho: array<vec4<f32>>;

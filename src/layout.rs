@@ -362,6 +362,18 @@ pub struct InletDef {
     pub pressure: u32,
 }
 
+/// What a probe samples: `ProbeDef::kind` holds its code, the WGSL constant `PROBE_*` of the
+/// same number (`crate::sph::shader::WgslEnum`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProbeCode {
+    Pressure,
+    Height,
+    Front,
+    WallPressure,
+    FrontContinuous,
+    Discharge,
+}
+
 /// Mirrors `InflowSegment` in shaders/open_boundaries.wgsl: a piece of an inlet's hydrograph
 /// (`crate::hydrograph::Segment`), from its knot `t`: the distance travelled there, and the
 /// coefficients in τ = t − knot of the speed and of the distance travelled since.

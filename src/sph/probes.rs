@@ -16,17 +16,11 @@ pub const SHADER: Shader = Shader {
     source: include_str!("../../shaders/probes.wgsl"),
     libs: &[PARTICLE_ID, NEIGHBOURS, WORKGROUP_MAX, WALL_PATCH],
 };
-use crate::layout::{Pos, ProbeDef, NO_FACE};
+use super::shader::WgslEnum;
+use crate::layout::{Pos, ProbeCode, ProbeDef, NO_FACE};
 use crate::ranks::Ranks;
 use crate::scenario::{Probe, ProbeKind, TrackedPoint, WallParams, WallPatch};
 use glam::DVec3;
-
-pub const PROBE_PRESSURE: u32 = 0;
-pub const PROBE_HEIGHT: u32 = 1;
-pub const PROBE_FRONT: u32 = 2;
-pub const PROBE_WALL_PRESSURE: u32 = 3;
-pub const PROBE_FRONT_CONTINUOUS: u32 = 4;
-pub const PROBE_DISCHARGE: u32 = 5;
 
 /// Bins along a continuous front's axis (probes.wgsl, `probe_front_walk`): the kernel support
 /// 2h wide, enough of them to cover the domain's diagonal from anywhere in it.
@@ -72,7 +66,7 @@ impl FrontBins {
 /// The words of `front_bins` the probes `defs` use (at least one, so the buffer exists).
 pub fn front_bin_words(defs: &[ProbeDef]) -> usize {
     (defs.iter())
-        .filter(|d| d.kind == PROBE_FRONT_CONTINUOUS)
+        .filter(|d| d.kind == ProbeCode::FrontContinuous.code())
         .map(|d| (d.bins + d.words + 1) as usize)
         .max()
         .unwrap_or(1)
@@ -126,13 +120,13 @@ pub fn probe_defs(
         .map(|(p, &face)| match &p.kind {
             ProbeKind::Pressure { point } => ProbeDef {
                 point: rel(point),
-                kind: PROBE_PRESSURE,
+                kind: ProbeCode::Pressure.code(),
                 face,
                 ..Default::default()
             },
             ProbeKind::Height { base } => ProbeDef {
                 point: rel(base),
-                kind: PROBE_HEIGHT,
+                kind: ProbeCode::Height.code(),
                 face,
                 ..Default::default()
             },
@@ -144,7 +138,7 @@ pub fn probe_defs(
                 let norm = axis.iter().map(|a| a * a).sum::<f64>().sqrt();
                 let def = ProbeDef {
                     point: rel(o),
-                    kind: PROBE_FRONT,
+                    kind: ProbeCode::Front.code(),
                     axis: axis.map(|a| (a / norm) as f32),
                     face,
                     ..Default::default()
@@ -155,7 +149,7 @@ pub fn probe_defs(
                 let first = next_word;
                 next_word += bins.words + 1;
                 ProbeDef {
-                    kind: PROBE_FRONT_CONTINUOUS,
+                    kind: ProbeCode::FrontContinuous.code(),
                     bins: first,
                     words: bins.words,
                     bin_width: bins.width as f32,
@@ -164,7 +158,7 @@ pub fn probe_defs(
             }
             ProbeKind::WallPressure(patch) => ProbeDef {
                 point: rel(&patch.point),
-                kind: PROBE_WALL_PRESSURE,
+                kind: ProbeCode::WallPressure.code(),
                 axis: patch.normal.map(|a| a as f32),
                 radius: patch.radius as f32,
                 face,
@@ -175,7 +169,7 @@ pub fn probe_defs(
                 next_discharge += 1;
                 ProbeDef {
                     point: rel(from),
-                    kind: PROBE_DISCHARGE,
+                    kind: ProbeCode::Discharge.code(),
                     axis: normal.map(|a| a as f32),
                     radius: length as f32,
                     face,
@@ -186,6 +180,11 @@ pub fn probe_defs(
             }
         })
         .collect()
+}
+
+/// The probe kind of a `ProbeDef::kind` code.
+fn probe_code(code: u32) -> ProbeCode {
+    ProbeCode::VARIANTS[code as usize].0
 }
 
 /// How many of `probes` are discharge probes.
@@ -252,7 +251,7 @@ pub struct Probes {
     discharge_total: ParityKernel,
     /// The continuous fronts' bits of wet bins and ends (`probe_front_walk`).
     front_bins: wgpu::Buffer,
-    kinds: Vec<u32>,
+    kinds: Vec<ProbeCode>,
     /// What a probe's word is multiplied by: −m/area for wall pressures (the GPU sums the
     /// boundary particles' rates along the normal), 1 otherwise.
     scales: Vec<f64>,
@@ -291,7 +290,7 @@ impl Probes {
             height: kernel("probe_height_search")?,
             discharge_sums: kernel("probe_discharge_sums")?,
             discharge_total: kernel("probe_discharge_total")?,
-            kinds: defs.iter().map(|d| d.kind).collect(),
+            kinds: defs.iter().map(|d| probe_code(d.kind)).collect(),
             scales: probes
                 .iter()
                 .map(|p| match &p.kind {
@@ -333,14 +332,14 @@ impl Probes {
         });
         // The gauges' search over the particles first: `probe_points` interpolates where it
         // found the surface (probes.wgsl).
-        if self.kinds.contains(&PROBE_HEIGHT) {
+        if self.kinds.contains(&ProbeCode::Height) {
             self.height.dispatch(&mut pass, p, self.n);
         }
         self.points.dispatch(&mut pass, p, self.kinds.len() as u32);
-        if self.has_continuous() || self.kinds.contains(&PROBE_FRONT) {
+        if self.has_continuous() || self.kinds.contains(&ProbeCode::Front) {
             self.front.dispatch(&mut pass, p, self.n);
         }
-        if self.kinds.contains(&PROBE_DISCHARGE) {
+        if self.kinds.contains(&ProbeCode::Discharge) {
             self.discharge_sums.dispatch(&mut pass, p, self.n);
             self.discharge_total
                 .dispatch(&mut pass, p, self.kinds.len() as u32);
@@ -363,7 +362,7 @@ impl Probes {
     }
 
     pub fn has_continuous(&self) -> bool {
-        self.kinds.contains(&PROBE_FRONT_CONTINUOUS)
+        self.kinds.contains(&ProbeCode::FrontContinuous)
     }
 
     /// The continuous fronts' bits of wet bins.
@@ -374,7 +373,7 @@ impl Probes {
     /// Whether probe `k` is a front: a maximum over the fluid, whose words combine over ranks
     /// by their maximum (`ordered_bits` keeps the order of the values).
     pub fn is_front(&self, k: usize) -> bool {
-        matches!(self.kinds[k], PROBE_FRONT | PROBE_FRONT_CONTINUOUS)
+        matches!(self.kinds[k], ProbeCode::Front | ProbeCode::FrontContinuous)
     }
 
     /// Values from the raw words read back.
@@ -387,7 +386,7 @@ impl Probes {
             .map(|(((&k, &scale), &w), &blind)| {
                 if blind {
                     f64::NAN
-                } else if k == PROBE_FRONT || k == PROBE_FRONT_CONTINUOUS {
+                } else if matches!(k, ProbeCode::Front | ProbeCode::FrontContinuous) {
                     decode_ordered(w) as f64
                 } else {
                     scale * f32::from_bits(w) as f64

@@ -13,7 +13,7 @@ use super::initial::Present;
 use crate::gpu::kernel::ShaderModule;
 use crate::gpu::shader::{compose as compose_shader, Shader, WORKGROUP_SIZE};
 use crate::grid::Grid;
-use crate::layout::IdSplit;
+use crate::layout::{IdSplit, ProbeCode};
 use crate::scenario::{
     DeltaSphForm, GhostCorrection, KernelKind, RepulsiveForm, Scenario, Viscosity,
 };
@@ -99,6 +99,19 @@ impl WgslEnum for RepulsiveForm {
     const VARIANTS: &'static [(Self, &'static str)] = &[
         (RepulsiveForm::LennardJones, "LENNARD_JONES"),
         (RepulsiveForm::MonaghanKajtar, "MONAGHAN_KAJTAR"),
+    ];
+}
+
+/// Values of `ProbeDef::kind`.
+impl WgslEnum for ProbeCode {
+    const PREFIX: &'static str = "PROBE";
+    const VARIANTS: &'static [(Self, &'static str)] = &[
+        (ProbeCode::Pressure, "PRESSURE"),
+        (ProbeCode::Height, "HEIGHT"),
+        (ProbeCode::Front, "FRONT"),
+        (ProbeCode::WallPressure, "WALL_PRESSURE"),
+        (ProbeCode::FrontContinuous, "FRONT_CONTINUOUS"),
+        (ProbeCode::Discharge, "DISCHARGE"),
     ];
 }
 
@@ -216,6 +229,7 @@ impl ShaderConfig {
         out += &ViscosityForm::declarations();
         out += &RepulsiveForm::declarations();
         out += &GhostCorrection::declarations();
+        out += &ProbeCode::declarations();
         out += &format!(
             "const DIM: u32 = {dim}u;\nconst KERNEL: u32 = {kernel};\n\
              const VISCOSITY: u32 = {visc};\nconst ENERGY: bool = {energy};\n\
@@ -306,6 +320,13 @@ mod tests {
         for (c, name) in [
             (GhostCorrection::Shepard, "GHOST_SHEPARD"),
             (GhostCorrection::Mls, "GHOST_MLS"),
+        ] {
+            let decl = format!("const {name}: u32 = {}u;", c.code());
+            assert!(src.contains(&decl), "{decl}");
+        }
+        for (c, name) in [
+            (ProbeCode::Pressure, "PROBE_PRESSURE"),
+            (ProbeCode::Discharge, "PROBE_DISCHARGE"),
         ] {
             let decl = format!("const {name}: u32 = {}u;", c.code());
             assert!(src.contains(&decl), "{decl}");
