@@ -656,6 +656,38 @@ mod tests {
         assert!(e.contains("probe 'height' is a wave gauge"), "{e}");
     }
 
+    /// A discharge section reads the layers within 2h of it: few across it, all of its length
+    /// along it; the cuts of two ranks of the dam break (along the vertical: its tank is taller
+    /// than wide) keep a level section across the tank on one rank.
+    #[test]
+    fn a_discharge_section_reads_the_layers_within_the_support_of_it() {
+        let section = "\n[[probe]]\nname = \"Q\"\nkind = \"discharge\"\nfrom_m = [0.55, 0.3]\n\
+                       to_m = [0.05, 0.3]\n";
+        let text = std::fs::read_to_string("cases/dam_break_2d.toml").unwrap() + section;
+        let sc = crate::case::load_str(&text, "q.toml", &[]).unwrap();
+        let g = ranks_grid(&sc).unwrap();
+        let q = sc.probes.iter().position(|p| p.name == "Q").unwrap();
+        let h = sc.physics.h;
+        let across = layers_read(&sc.probes[q], h, &g, 1).unwrap();
+        let along = layers_read(&sc.probes[q], h, &g, 0).unwrap();
+        let layer = |x: f64, a: usize| ((x - g.origin[a]) / g.cell_size[a]).floor() as u32;
+        assert!(across.start <= layer(0.3 - 2.0 * h, 1) && layer(0.3 + 2.0 * h, 1) < across.end);
+        assert!(
+            across.len() as f64 <= 4.0 * h / g.cell_size[1] + 5.0,
+            "{across:?}"
+        );
+        assert!(
+            along.start <= layer(0.05, 0) && layer(0.55, 0) < along.end,
+            "{along:?}"
+        );
+        let slabs = slabs_for(&sc, 2).unwrap();
+        assert_eq!(slabs.axis, 1);
+        assert!((0..2).any(|r| {
+            let own = slabs.range(r);
+            own.start <= across.start && across.end <= own.end
+        }));
+    }
+
     /// A probe on the rolling sloshing tank reads, over the run, the layers of its whole path
     /// (which the cuts then keep whole): more than where it stands at t = 0, and they hold it at
     /// every probe time. One on a free body reads those where it stands at the start.

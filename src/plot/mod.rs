@@ -268,12 +268,14 @@ pub fn compare(sim: &[(f64, f64)], reference: &[(f64, f64)]) -> Option<ErrorSumm
 }
 
 /// Axis label of a probe column: `pressure_pa` → "pressure [Pa]", `height_m` → "height [m]",
-/// `front_m` → "front [m]"; anything else as written.
+/// `front_m` → "front [m]", `discharge_m3_s` → "discharge [m³/s]"; anything else as written.
 pub fn axis_label(column: &str) -> String {
     match column {
         "pressure_pa" => "pressure [Pa]".into(),
         "height_m" => "height [m]".into(),
         "front_m" => "front [m]".into(),
+        "discharge_m3_s" => "discharge [m³/s]".into(),
+        "discharge_m2_s" => "discharge [m²/s]".into(),
         c => match c.rsplit_once('_') {
             Some((q, "m")) => format!("{q} [m]"),
             Some((q, "pa")) => format!("{q} [Pa]"),
@@ -901,6 +903,8 @@ mod tests {
         assert_eq!(axis_label("pressure_pa"), "pressure [Pa]");
         assert_eq!(axis_label("height_m"), "height [m]");
         assert_eq!(axis_label("front_m"), "front [m]");
+        assert_eq!(axis_label("discharge_m3_s"), "discharge [m³/s]");
+        assert_eq!(axis_label("discharge_m2_s"), "discharge [m²/s]");
         assert_eq!(axis_label("speed"), "speed");
     }
 
