@@ -693,7 +693,8 @@ fn a_probe_on_an_unknown_body_is_refused() {
 /// position and displacement at every probe time.
 #[test]
 fn a_tracked_point_follows_its_particle_on_a_rigid_body() {
-    point_follows_its_particle("cases/floating_box_2d.toml", "corner", 0.1);
+    // Released 2 cm above its draft, the box sinks about 3 mm in 0.04 s.
+    point_follows_its_particle("cases/floating_box_2d.toml", "corner", 0.04);
 }
 
 #[test]

@@ -470,14 +470,19 @@ fn a_solid_case_runs_and_writes_the_stress() {
     }
 }
 
-/// `wgsph validate` on its cheapest case: the report has the case's rows with numeric errors,
-/// bounds and verdicts, links the plot, the PNG exists, and the exit status is 0 exactly when
-/// every row passes (the 2D tank's bottom probe reads +3.2 %, over its ±2 %: docs/validation.md).
+/// `wgsph validate --quick` on the 2D dam break, as a user runs it: the report has the case's
+/// rows with numeric errors, bounds and verdicts ("info" for the rows reported, not judged),
+/// links the plot, the PNG and the probe table exist, the table is printed, and the exit status
+/// is 0 exactly when every judged row passes. And they pass: the front's speed over
+/// T ∈ [1, 3], once the column has collapsed and before it reaches the far wall, within the
+/// quick mode's bound of Martin & Moyce's (independent of the experiment's time origin). (Once
+/// tests/validation/cases.rs's `dam_break_2d_front_speed_matches_martin_moyce`, through the
+/// library: one run of the case in CI, not two.)
 #[test]
-fn validate_quick_writes_the_report_and_plots() {
+fn validate_quick_writes_the_report_and_plots_and_the_front_speed_passes() {
     let out = temp_dir("validate");
     let o = wgsph()
-        .args(["validate", "--quick", "--case", "hydrostatic_2d", "--out"])
+        .args(["validate", "--quick", "--case", "dam_break_2d", "--out"])
         .arg(&out)
         .output()
         .unwrap();
@@ -485,44 +490,46 @@ fn validate_quick_writes_the_report_and_plots() {
     let report = std::fs::read_to_string(out.join("report.md"))
         .unwrap_or_else(|e| panic!("{e}\n{stdout}\n{}", String::from_utf8_lossy(&o.stderr)));
     assert!(report.contains("quick mode"), "{report}");
-    assert!(report.contains("--case hydrostatic_2d"), "{report}");
+    assert!(report.contains("--case dam_break_2d"), "{report}");
     // The results table: the case's rows before the wall-time table.
     let rows: Vec<&str> = (report.lines())
         .take_while(|l| !l.starts_with("## "))
-        .filter(|l| l.starts_with("| hydrostatic_2d |"))
+        .filter(|l| l.starts_with("| dam_break_2d |"))
         .collect();
     let verdict = |l: &str| l.split('|').map(str::trim).nth(5).unwrap_or("").to_string();
-    assert!(rows.len() >= 3, "{report}");
+    assert!(rows.len() >= 6, "{report}");
     assert!(
         rows.iter()
-            .all(|r| ["PASS", "FAIL"].contains(&verdict(r).as_str())),
+            .all(|r| ["PASS", "FAIL", "info"].contains(&verdict(r).as_str())),
         "{report}"
     );
+    let judged = || rows.iter().filter(|r| verdict(r) != "info");
     assert_eq!(
         o.status.success(),
-        rows.iter().all(|r| verdict(r) == "PASS"),
+        judged().all(|r| verdict(r) == "PASS"),
         "{report}"
     );
     let row = *rows
         .iter()
-        .find(|l| l.starts_with("| hydrostatic_2d | bottom pressure"))
-        .unwrap_or_else(|| panic!("no pressure row in\n{report}"));
+        .find(|l| l.starts_with("| dam_break_2d | front speed dZ/dT over T ∈ [1, 3] |"))
+        .unwrap_or_else(|| panic!("no front speed row in\n{report}"));
     let cells: Vec<&str> = row.split('|').map(str::trim).collect();
     // ["", case, metric, error, bound, result, ""]
     let error: f64 = cells[3].trim_end_matches('%').trim().parse().unwrap();
     assert!(error.is_finite(), "{row}");
-    assert_eq!(cells[4], "±2 %", "{row}");
-    assert_eq!(cells[5] == "PASS", error.abs() < 2.0, "{row}");
-    assert!(report.contains("| hydrostatic_2d | fluid particles lost | 0 | ≤ 0 | PASS |"));
+    assert_eq!(cells[4], "±10 %", "{row}");
+    assert_eq!(cells[5] == "PASS", error.abs() < 10.0, "{row}");
     assert!(
-        report.contains("](hydrostatic_2d/plots/p_bottom.png)"),
+        report.contains("](dam_break_2d/plots/front.png)"),
         "{report}"
     );
-    let png = std::fs::read(out.join("hydrostatic_2d/plots/p_bottom.png")).unwrap();
+    let png = std::fs::read(out.join("dam_break_2d/plots/front.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
-    assert!(out.join("hydrostatic_2d/probes/p_bottom.csv").is_file());
+    assert!(out.join("dam_break_2d/probes/front.csv").is_file());
     // The table is also printed.
     assert!(stdout.contains(row), "{stdout}");
+    // The validation itself.
+    assert!(judged().count() >= 1 && o.status.success(), "{report}");
 }
 
 /// An unknown case, or one its mode does not run, is refused before anything runs, naming the
