@@ -24,9 +24,9 @@ pub(super) struct InletSpec {
     /// The flow axis and its sense (±1).
     pub axis: usize,
     pub sense: f64,
-    /// The inflow in time: a speed [m/s], or a discharge [m³/s; 2D m²/s] where `discharge`.
+    /// The inflow in time: a speed [m/s], or a discharge [m³/s; 2D m²/s] where it is given as
+    /// one ([`InletSpec::is_discharge`]).
     pub inflow: Hydrograph,
-    pub discharge: bool,
     /// The field that gives it (`velocity_m_s`, `discharge_file`, …).
     pub inflow_field: &'static str,
     /// The box's section across the flow [m², 2D m], for the speed a discharge makes before
@@ -38,10 +38,15 @@ pub(super) struct InletSpec {
 }
 
 impl InletSpec {
+    /// Whether `inflow` is a discharge (`discharge_m3_s`, `discharge_file`), not a speed.
+    pub fn is_discharge(&self) -> bool {
+        self.inflow_field.starts_with("discharge")
+    }
+
     /// The fastest inflow [m/s] (a discharge over the box's section), for the speed of sound.
     pub fn max_speed(&self) -> f64 {
         let speed = self.inflow.max_speed();
-        if self.discharge {
+        if self.is_discharge() {
             speed / self.box_section
         } else {
             speed
@@ -115,7 +120,6 @@ pub(super) fn validate(
             axis,
             sense: d[axis],
             inflow,
-            discharge: inflow_field.starts_with("discharge"),
             inflow_field,
             box_section: (0..dim)
                 .filter(|&b| b != axis)
@@ -326,7 +330,7 @@ pub(super) fn layout(
         .map(|b| hi[b] - lo[b] + 1.0)
         .product();
     // A discharge is a speed over the section of the buffer's columns.
-    let inflow = if spec.discharge {
+    let inflow = if spec.is_discharge() {
         spec.inflow
             .scaled(1.0 / (n_columns * dx.powi(lat.dim as i32 - 1)))
     } else {

@@ -211,7 +211,7 @@ fn discharge(ctx: &Ctx<'_>, path: &str, p: &RawProbe, dim: usize) -> Result<Prob
     };
     let from = get("from_m", &p.from_m, "one end of the section in metres")?;
     let to = get("to_m", &p.to_m, "the other end of the section in metres")?;
-    let length = ((to[0] - from[0]).powi(2) + (to[1] - from[1]).powi(2)).sqrt();
+    let (_, length) = ProbeKind::section_normal(from, to);
     if !(length.is_finite() && length > 1e-9) {
         let plan = if dim == 3 { " in plan (x and y)" } else { "" };
         return Err(ctx.err(
