@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::layout::{Pos, SimState, SolidState, ID_MASK, KIND_SHIFT};
+use crate::layout::{MapCell, Pos, SimState, SolidState, ID_MASK, KIND_SHIFT};
 use crate::output::write_atomic;
 use crate::scenario::{Kind, Scenario};
 use crate::sph::state::SolverState;
@@ -234,6 +234,9 @@ pub fn fingerprint(sc: &Scenario) -> u64 {
     if !sc.points.is_empty() {
         h.update(format!("|{:?}", sc.points).as_bytes());
     }
+    if let Some(maps) = &sc.maps {
+        h.update(format!("|{maps:?}").as_bytes());
+    }
     if !sc.inlets.is_empty() || !sc.outlets.is_empty() {
         h.update(format!("|{:?}|{:?}", sc.inlets, sc.outlets).as_bytes());
     }
@@ -271,6 +274,9 @@ impl Checkpoint {
         }
         if let Some(solid) = &s.solid {
             sections.push(("solid", bytemuck::cast_slice(solid)));
+        }
+        if let Some(maps) = &s.maps {
+            sections.push(("maps", bytemuck::cast_slice(maps)));
         }
         let o = &self.outputs;
         let header = Header {
@@ -391,6 +397,11 @@ impl Checkpoint {
         } else {
             None
         };
+        let maps = if h.sections.iter().any(|(n, _)| n == "maps") {
+            Some(pod_vec::<MapCell>(section("maps")?, "maps")?)
+        } else {
+            None
+        };
         let fingerprint = u64::from_str_radix(&h.fingerprint, 16).context("bad fingerprint")?;
         Ok(Checkpoint {
             case_name: h.case_name,
@@ -432,6 +443,7 @@ impl Checkpoint {
                 energy,
                 solid,
                 bodies: h.body_bits.into_iter().map(f64::from_bits).collect(),
+                maps,
             },
             subdomain: h.subdomain,
         })
@@ -554,6 +566,16 @@ mod tests {
                         .collect(),
                 ),
                 bodies: vec![1.0 / 7.0; crate::body::SAVED_PER_BODY],
+                maps: Some(
+                    (0..5)
+                        .map(|i| MapCell {
+                            max_depth: i as f32 * 0.25,
+                            arrival: if i == 0 { -1.0 } else { 0.1 * i as f32 },
+                            wet_samples: i,
+                            ..MapCell::UNSEEN
+                        })
+                        .collect(),
+                ),
             },
             subdomain: None,
         }
@@ -622,6 +644,7 @@ mod tests {
         let mut no_energy = c.clone();
         no_energy.solver.energy = None;
         no_energy.solver.solid = None;
+        no_energy.solver.maps = None;
         no_energy.write(&path).unwrap();
         assert_eq!(Checkpoint::read(&path).unwrap(), no_energy);
         // A rank's part of a run over ranks: its counts and cuts.

@@ -184,6 +184,49 @@ pub struct ProbeDef {
     pub bin_width: f32,
 }
 
+/// Mirrors `MapGrid` in shaders/flood_maps.wgsl: a flood map's plan grid in domain
+/// coordinates, and the sample's time.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct MapGrid {
+    pub origin: [f32; 2],
+    pub cell: f32,
+    pub nx: u32,
+    pub ny: u32,
+    pub wet_depth: f32,
+    pub time: f32,
+    pub pad: u32,
+}
+
+/// Mirrors `MapCell` in shaders/flood_maps.wgsl: a map cell's record (`arrival` −1 before the
+/// cell is reached).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct MapCell {
+    pub depth: f32,
+    pub u: f32,
+    pub v: f32,
+    pub max_depth: f32,
+    pub max_speed: f32,
+    pub max_hazard: f32,
+    pub arrival: f32,
+    pub wet_samples: u32,
+}
+
+impl MapCell {
+    /// A cell no sample has seen.
+    pub const UNSEEN: MapCell = MapCell {
+        depth: 0.0,
+        u: 0.0,
+        v: 0.0,
+        max_depth: 0.0,
+        max_speed: 0.0,
+        max_hazard: 0.0,
+        arrival: -1.0,
+        wet_samples: 0,
+    };
+}
+
 /// `ProbeDef::face` of a probe that is not a fixed wall's sensor.
 pub const NO_FACE: u32 = u32::MAX;
 
@@ -525,7 +568,9 @@ mod tests {
     use crate::sph::passes::SHADERS;
     use crate::sph::shader::{compose, ShaderConfig, ViscosityForm};
     use crate::sph::total_lagrangian;
-    use crate::sph::{bodies, elastic, halo, integrate, interaction, open_boundaries, probes};
+    use crate::sph::{
+        bodies, elastic, flood_maps, halo, integrate, interaction, open_boundaries, probes,
+    };
     use wgpu::naga;
 
     /// (size, [(member name, offset)]) of a struct type named `name` in the composed `pass`.
@@ -891,6 +936,27 @@ mod tests {
             "ProbeDef",
             ProbeDef,
             [point, kind, axis, radius, face, bins, words, bin_width]
+        );
+        check_layout!(
+            &flood_maps::SHADER,
+            "MapGrid",
+            MapGrid,
+            [origin, cell, nx, ny, wet_depth, time, pad]
+        );
+        check_layout!(
+            &flood_maps::SHADER,
+            "MapCell",
+            MapCell,
+            [
+                depth,
+                u,
+                v,
+                max_depth,
+                max_speed,
+                max_hazard,
+                arrival,
+                wet_samples
+            ]
         );
         check_layout!(
             &interaction::SHADER,

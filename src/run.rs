@@ -16,6 +16,7 @@ use crate::checkpoint::{
 };
 use crate::decomposition::slabs_for;
 use crate::gpu::GpuContext;
+use crate::output::flood_maps::{ground_layer, map_layers, MAPS_DIR};
 use crate::output::{
     FirstPositions, OutputDir, ParticleFile, Piece, ProbeWriter, RunSummary, SNAPSHOTS_DIR,
 };
@@ -355,6 +356,7 @@ fn start(
     let mut runner = Runner::create(ctx, sc, dir, options, ranks)?;
     runner.write_particles()?;
     runner.record_probes()?;
+    runner.solver.sample_maps()?;
     runner.bodies.record(&runner.solver, runner.ranks)?;
     runner.go(progress)
 }
@@ -803,6 +805,35 @@ impl<'a> Runner<'a> {
         Ok(())
     }
 
+    /// The flood maps so far (`[maps]`): `DIR/maps/*.asc` and their pictures.
+    fn write_maps(&mut self) -> Result<()> {
+        let (Some(maps), Some(cells)) = (&self.sc.maps, self.solver.map_cells()?) else {
+            return Ok(());
+        };
+        let origin = self.sc.world_origin_m;
+        let ground = ground_layer(maps, origin);
+        let layers = map_layers(maps, &cells, origin);
+        let title = format!("{}, t = 0 to {:.4} s", self.sc.name, self.solver.time());
+        let out = &mut self.outputs.out;
+        out.write_maps(std::slice::from_ref(&ground))?;
+        out.write_maps(&layers)?;
+        for layer in &layers {
+            let path = out
+                .path()
+                .join(MAPS_DIR)
+                .join(format!("{}.png", layer.stem));
+            out.claim(&path)?;
+            crate::plot::flood_map::draw_map(
+                &path,
+                &layer.grid,
+                &ground.grid,
+                &title,
+                layer.label,
+            )?;
+        }
+        Ok(())
+    }
+
     /// Every rank's part of the run, on rank 0 (every rank together); None for one whole run.
     fn rank_summaries(&self) -> Result<Option<Vec<crate::ranks::RankSummary>>> {
         let Some(r) = self.ranks else {
@@ -870,6 +901,7 @@ impl<'a> Runner<'a> {
         };
         self.probes.flush()?;
         self.bodies.csv.flush()?;
+        self.write_maps()?;
         let end = self.status();
         progress.finish(&end);
         let resume_hint = match self.last_checkpoint {
@@ -1014,6 +1046,7 @@ impl<'a> Runner<'a> {
         }
         self.solver.clear_density_peaks();
         self.record_probes()?;
+        self.solver.sample_maps()?;
         self.bodies.record(&self.solver, self.ranks)?;
         if self.solver.time() >= self.next_output - 1e-9 * every_out {
             self.write_particles()?;

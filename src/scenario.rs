@@ -738,6 +738,40 @@ pub struct Scenario {
     /// positions are local, so that f32 keeps them to a fraction of dx), else zero. What the
     /// run writes is in the scenario's coordinates; `run.json` records this origin.
     pub world_origin_m: [f64; 3],
+    /// Flood maps over a plan grid (`[maps]`; 3D cases only).
+    pub maps: Option<FloodMaps>,
+}
+
+/// Flood maps (`[maps]`, docs/cases.md "Flood maps"): a plan grid of square cells over which
+/// the water's depth and depth-averaged velocity are sampled at every probe time, and their
+/// extremes over the run kept (shaders/flood_maps.wgsl).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FloodMaps {
+    /// The centre of the south-west cell, in the scenario's coordinates.
+    pub first_centre: [f64; 2],
+    /// The cells' size [m].
+    pub cell: f64,
+    pub nx: usize,
+    pub ny: usize,
+    /// The depth a cell must reach for its time of arrival [m].
+    pub wet_depth: f64,
+    /// The ground under each cell's centre (the scenario's vertical coordinate), row by row
+    /// from the south: what the depth is measured from.
+    pub ground: Vec<f64>,
+}
+
+impl FloodMaps {
+    pub fn cells(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// The centre of cell `c` (row by row from the south).
+    pub fn centre(&self, c: usize) -> [f64; 2] {
+        [
+            self.first_centre[0] + (c % self.nx) as f64 * self.cell,
+            self.first_centre[1] + (c / self.nx) as f64 * self.cell,
+        ]
+    }
 }
 
 /// An outlet (`[[outlet]]`, docs/cases.md "Outlets"): a box that removes every fluid particle

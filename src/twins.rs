@@ -5,8 +5,8 @@
 use crate::gpu::shader::Shader;
 use crate::sph::shader::{compose, ShaderConfig};
 use crate::sph::{
-    bodies, cell_list, density_filter, elastic, ghost, integrate, interaction, open_boundaries,
-    probes,
+    bodies, cell_list, density_filter, elastic, flood_maps, ghost, integrate, interaction,
+    open_boundaries, probes,
 };
 
 /// (shader, WGSL function) of each twin; `$twin` must exist and end in the WGSL name.
@@ -72,6 +72,18 @@ fn every_twin_is_named_as_its_wgsl_function() {
             probes::probe_front,
             probes::section_weight,
             probes::discharge_contribution,
+        ],
+        flood_maps::SHADER => [
+            flood_maps::map_sums,
+            flood_maps::water_fraction,
+            flood_maps::map_cell_centre,
+            flood_maps::map_point,
+            flood_maps::map_top_index,
+            flood_maps::map_surface_search,
+            flood_maps::map_depth,
+            flood_maps::map_velocity,
+            flood_maps::map_accumulate,
+            flood_maps::map_sample,
         ],
     };
     let mut missing = Vec::new();

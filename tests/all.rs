@@ -18,6 +18,7 @@ mod density_filter;
 mod determinism;
 mod elastic;
 mod energy;
+mod flood_maps;
 mod instability;
 mod kernels_vs_reference;
 #[cfg(feature = "mpi")]

@@ -750,6 +750,81 @@ fn probes_match_reference() {
     }
 }
 
+/// Flood maps on random particles: every cell's record after two samples (at two times, the
+/// second seeing the same particles) against the twin's, over a grid that covers the block
+/// and dry land around it, on a ground that varies from cell to cell.
+#[test]
+fn flood_maps_match_reference() {
+    for s in setups().into_iter().filter(|s| s.dim == 3) {
+        let mut sc = random_scenario(&s);
+        let dx = sc.physics.dx;
+        let o = 0.5 * (s.domain - BLOCK);
+        let mut rng = Rng(s.seed + 100);
+        let cell = 2.0 * dx;
+        let (nx, ny) = (12, 10);
+        let first_centre = [o - 0.07, o - 0.05];
+        // The floor's top face, 1.5 dx over the block's lowest row, give or take 0.2 dx.
+        let ground = (0..nx * ny)
+            .map(|_| o + (1.5 + rng.range(-0.2, 0.2)) * dx)
+            .collect();
+        let maps = FloodMaps {
+            first_centre,
+            cell,
+            nx,
+            ny,
+            wet_depth: 0.1,
+            ground,
+        };
+        sc.maps = Some(maps.clone());
+        let solver = Solver::new(gpu(), &sc).unwrap();
+        let (parts, _) = gpu_particles_and_codes(&solver);
+        solver.sample_maps().unwrap();
+        solver.sample_maps().unwrap();
+        let gpu_cells = solver.map_cells().unwrap().unwrap();
+        let ph = &sc.physics;
+        let (t, top) = (solver.time(), s.domain);
+        let (mut wet, mut worst_depth, mut worst_speed) = (0, 0.0f64, 0.0f64);
+        for (c, g) in gpu_cells.iter().enumerate() {
+            let once =
+                reference::flood_maps::map_sample(ph, &parts, &maps, c, top, Default::default(), t);
+            let cpu = reference::flood_maps::map_sample(ph, &parts, &maps, c, top, once, t);
+            assert_eq!(g.wet_samples, cpu.wet_samples, "cell {c}: wet samples");
+            assert_eq!(g.arrival >= 0.0, cpu.arrival.is_some(), "cell {c}: arrival");
+            if let Some(a) = cpu.arrival {
+                assert!((g.arrival as f64 - a).abs() < 1e-6, "cell {c}: arrival {a}");
+            }
+            let speed = |v: [f64; 2]| (v[0] * v[0] + v[1] * v[1]).sqrt();
+            for (what, gv, cv) in [
+                ("depth", g.depth as f64, cpu.depth),
+                ("max depth", g.max_depth as f64, cpu.max_depth),
+            ] {
+                // The lattice steps by h/4 from an f32 ground: as the gauges', 1e-4 m.
+                assert!((gv - cv).abs() < 1e-4, "cell {c}: {what} {gv} against {cv}");
+                worst_depth = worst_depth.max((gv - cv).abs());
+            }
+            for (what, gv, cv) in [
+                ("u", g.u as f64, cpu.velocity[0]),
+                ("v", g.v as f64, cpu.velocity[1]),
+                ("max speed", g.max_speed as f64, cpu.max_speed),
+                ("max hazard", g.max_hazard as f64, cpu.max_hazard),
+            ] {
+                assert!((gv - cv).abs() < 2e-4, "cell {c}: {what} {gv} against {cv}");
+                worst_speed = worst_speed.max((gv - cv).abs());
+            }
+            assert!(cpu.max_speed >= speed(cpu.velocity) - 1e-12);
+            wet += (cpu.wet_samples > 0) as usize;
+        }
+        println!(
+            "domain {}: {wet} of {} cells wet; worst depth {worst_depth:.1e} m, velocity \
+             {worst_speed:.1e} m/s",
+            s.domain,
+            nx * ny
+        );
+        // The block covers about half the cells; the rest is dry land.
+        assert!(wet > nx * ny / 4 && wet < nx * ny, "{wet} wet cells");
+    }
+}
+
 /// The lattice from the origin to `max`, its two lowest rows (along the last axis of `dim`) a
 /// wall and the rest water jittered by ±0.2 dx, its densities 1000 kg/m³ each moved by up to
 /// ±`rho_jitter` of it (no draw when 0).

@@ -100,3 +100,51 @@ def test_body_and_point_tables_equal_their_csv(tmp_path):
     assert run.body("box")["y_m"][0] == 0.32
     with pytest.raises(KeyError, match="body_box"):
         run.table("body_boat")
+
+
+MAPS_CASE = """
+name = "maps_tank"
+dimension = 3
+[particles]
+dx_m = 0.04
+[physics]
+gravity_m_s2 = [0.0, 0.0, -9.81]
+sound_speed_coef = 10.0
+[time]
+end_s = 0.02
+output_every_s = 0.02
+[tank]
+min_m = [0.0, 0.0, 0.0]
+max_m = [0.4, 0.2, 0.3]
+layers = 3
+open_top = true
+[[fluid_block]]
+min_m = [0.0, 0.0, 0.0]
+max_m = [0.2, 0.2, 0.12]
+[maps]
+cell_m = 0.05
+"""
+
+
+def test_flood_maps_are_arrays_of_their_grids(tmp_path):
+    case = wgsph.Case.from_toml(MAPS_CASE, str(tmp_path / "maps_tank.toml"))
+    run = wgsph.run(case, out=tmp_path / "out", adapter=ADAPTER, progress=False)
+    assert "max_depth_m" in run.maps() and "arrival_s" in run.maps()
+    depth = run.map("max_depth_m")
+    path = tmp_path / "out" / "maps" / "max_depth_m.asc"
+    lines = path.read_text().splitlines()
+    header = dict(l.split() for l in lines[:6])
+    rows = [[float(v) for v in l.split()] for l in lines[6:]]
+    # The file lists rows from the north; the array's row 0 is the south.
+    expected = np.array(rows[::-1])
+    values = depth["values"]
+    assert values.shape == (int(header["nrows"]), int(header["ncols"]))
+    assert np.array_equal(np.isnan(values), expected == -9999.0)
+    wet = ~np.isnan(values)
+    assert np.array_equal(values[wet], expected[wet])
+    # The water 0.12 m deep over the tank's west half; the rest never wet.
+    assert 0.10 < np.nanmax(values) < 0.14
+    assert wet.any() and not wet.all()
+    assert depth["x"][0] == float(header["xllcorner"]) + 0.025
+    with pytest.raises(KeyError, match="max_depth_m"):
+        run.map("max_deep")

@@ -107,6 +107,13 @@ class Run:
     def probe(self, name: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """``(t, values)`` of a probe (or ``table.column``), float64; NaN where it had no
         value. ``KeyError`` names the probes there are."""
+    def maps(self) -> List[str]:
+        """The flood maps' names (``maps/<name>.asc``: ``max_depth_m``, ``arrival_s``, …),
+        sorted; empty for a case without ``[maps]``."""
+    def map(self, name: str) -> Dict[str, npt.NDArray[np.float64]]:
+        """A flood map: ``values`` (rows × columns, row 0 the southernmost, NaN where the map
+        has no value: a cell never wet), ``x`` and ``y`` (the cells' centres, world
+        coordinates). ``KeyError`` names the maps there are."""
     def table(self, name: str) -> Dict[str, npt.NDArray[np.float64]]:
         """``probes/<name>.csv`` (``body_<body>``, ``point_<point>``) as a dict of float64
         arrays, time ``t_s`` first."""

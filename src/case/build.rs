@@ -1556,6 +1556,9 @@ fn finish(
         &particles,
         h,
     ));
+    let maps = (case.maps.as_ref())
+        .map(|m| super::maps::resolve(ctx, m, &domain, (&particles, &bodies), dx))
+        .transpose()?;
     let n_particles = particles.len();
     let mut sc = Scenario {
         name: case.name,
@@ -1580,6 +1583,7 @@ fn finish(
         outlets: case.outlets,
         warnings,
         world_origin_m: case.terrain.as_ref().map_or([0.0; 3], |t| t.origin),
+        maps,
     };
     let fast = super::runnable::check(
         ctx,
@@ -1739,6 +1743,7 @@ pub(super) fn build_solid_case(
         outlets: Vec::new(),
         warnings: Vec::new(),
         world_origin_m: [0.0; 3],
+        maps: None,
     };
     // Without fluid no speed of sound to warn against.
     super::runnable::check(ctx, &sc, None, &[], (false, &[]))?;

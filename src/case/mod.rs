@@ -39,6 +39,7 @@ mod fill;
 mod friction;
 mod limits;
 mod locate;
+mod maps;
 mod open_boundaries;
 mod overrides;
 mod probes;

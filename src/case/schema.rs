@@ -39,6 +39,17 @@ pub(super) struct RawCase {
     pub outlet: Vec<RawOutlet>,
     #[serde(default)]
     pub friction: Vec<RawFriction>,
+    pub maps: Option<RawMaps>,
+}
+
+/// Flood maps: `[maps]` (`docs/cases.md`, "Flood maps").
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawMaps {
+    pub cell_m: Option<f64>,
+    pub min_m: Option<Vec<f64>>,
+    pub max_m: Option<Vec<f64>>,
+    pub wet_depth_m: Option<f64>,
 }
 
 /// A pair's own friction coefficient: `[[friction]]` (`docs/cases.md`, "Friction").
@@ -770,6 +781,31 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "inlet[].stop_s",
         "when the inflow stops, in seconds (default: time.end_s)",
         "stop_s = 0.5",
+    ),
+    f(
+        "maps",
+        "flood maps over a plan grid (3D cases)",
+        "[maps] with cell_m = 0.1",
+    ),
+    f(
+        "maps.cell_m",
+        "the map cells' size in metres, at least particles.dx_m (default: 2 dx)",
+        "cell_m = 0.1",
+    ),
+    f(
+        "maps.min_m",
+        "the south-west corner of the mapped area in plan, in metres (default: the domain's)",
+        "min_m = [0.0, 0.0]",
+    ),
+    f(
+        "maps.max_m",
+        "the north-east corner of the mapped area in plan, in metres (default: the domain's)",
+        "max_m = [2.0, 1.0]",
+    ),
+    f(
+        "maps.wet_depth_m",
+        "the depth a cell must reach for its time of arrival, in metres (default: dx)",
+        "wet_depth_m = 0.01",
     ),
     f(
         "outlet",

@@ -1436,6 +1436,7 @@ fn nothing_panics_on_hostile_values() {
 
 mod buildings;
 mod fill;
+mod maps;
 mod open_boundaries;
 mod shapes;
 mod solids;

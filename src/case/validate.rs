@@ -114,6 +114,8 @@ pub(super) struct Case {
     pub solids: Vec<super::solids::SolidSpec>,
     pub inlets: Vec<super::open_boundaries::InletSpec>,
     pub outlets: Vec<crate::scenario::Outlet>,
+    /// `[maps]`: flood maps, their ground found once the particles are built.
+    pub maps: Option<super::maps::MapsSpec>,
 }
 
 impl Case {
@@ -190,6 +192,7 @@ pub(super) fn validate(
     let bodies = super::bodies::validate(ctx, &raw.body, dim, case_dir)?;
     let inlets = super::open_boundaries::validate(ctx, &raw.inlet, (dim, time.end_s), case_dir)?;
     let outlets = super::open_boundaries::validate_outlets(ctx, &raw.outlet, dim)?;
+    let maps = super::maps::validate(ctx, raw.maps.as_ref(), dim, dx)?;
     let tank_moves = tank.as_ref().is_some_and(|t| t.motion.is_some());
     walls.friction_pairs =
         super::friction::pairs(ctx, &raw.friction, &bodies, &solids, tank_moves)?;
@@ -242,6 +245,7 @@ pub(super) fn validate(
         solids,
         inlets,
         outlets,
+        maps,
     })
 }
 

@@ -17,12 +17,15 @@
 //! DIR/probes/<name>.csv                 "t_s,<column>" time series per probe
 //! DIR/run.json                          run summary
 //! DIR/snapshots/NNNNNN.png              with --snapshots: a picture of each particle snapshot
+//! DIR/maps/<quantity>.asc, .png         with [maps]: flood maps (ESRI ASCII grids, pictures)
 //! DIR/surface.pvd, DIR/surface/surface_NNNNNN.vtu   `wgsph surface`: the water's surface
 //! ```
 
 mod atomic;
 #[cfg(test)]
 mod damaged_files;
+pub mod esri_ascii;
+pub mod flood_maps;
 mod lock;
 mod manifest;
 mod particle_file;

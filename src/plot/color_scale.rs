@@ -136,11 +136,11 @@ impl ColorScale {
     }
 }
 
-/// The colour bar of `scale` in `area`, labelled with `field` and its unit.
+/// The colour bar of `scale` in `area`, labelled `label` (what it shows, with its unit).
 pub(super) fn draw_colorbar<'a>(
     area: &DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>,
     scale: &ColorScale,
-    field: SnapshotField,
+    label: &str,
 ) -> std::result::Result<(), Box<dyn std::error::Error + 'a>> {
     let (lo, hi) = scale.range();
     let mut bar = ChartBuilder::on(area)
@@ -156,7 +156,7 @@ pub(super) fn draw_colorbar<'a>(
         .disable_y_mesh()
         .disable_x_axis()
         .y_label_formatter(&|v| format!("{v:.decimals$}"))
-        .y_desc(field.label())
+        .y_desc(label)
         .label_style(("sans-serif", 13))
         .axis_desc_style(("sans-serif", 14))
         .draw()?;

@@ -14,6 +14,7 @@
 
 pub mod animation;
 pub mod color_scale;
+pub mod flood_map;
 pub mod perspective;
 pub mod snapshot;
 
@@ -24,6 +25,7 @@ use std::str::FromStr;
 use anyhow::{anyhow, bail, Context, Result};
 use plotters::prelude::*;
 
+use crate::output::flood_maps::{map_label, GROUND_MAP, MAPS_DIR};
 pub use crate::output::PLOTS_DIR;
 use crate::output::{fmt_f64, write_atomic, Manifest, PROBES_DIR, RUN_SUMMARY_FILE};
 /// Error summary written next to the plots when references are given.
@@ -459,8 +461,13 @@ pub fn plot_run(dir: &Path, opts: &PlotOptions) -> Result<PlotReport> {
     let case = case_name(dir);
     let main_label = opts.label.clone().unwrap_or_else(|| case.clone());
     let mut names = probe_names(dir)?;
-    if names.is_empty() {
-        bail!("{} has no probe CSV", dir.join(PROBES_DIR).display());
+    let maps = map_stems(dir)?;
+    if names.is_empty() && maps.is_empty() {
+        bail!(
+            "{} has no probe CSV and {} no map",
+            dir.join(PROBES_DIR).display(),
+            dir.join(MAPS_DIR).display()
+        );
     }
     for want in opts
         .probes
@@ -546,6 +553,11 @@ pub fn plot_run(dir: &Path, opts: &PlotOptions) -> Result<PlotReport> {
         render_png(&png, &title, "t [s]", &axis_label(&main.columns.1), &curves)?;
         report.pngs.push(png);
     }
+    if opts.probes.is_empty() {
+        report
+            .pngs
+            .extend(draw_run_maps(dir, &case, &maps, &mut manifest)?);
+    }
     if !opts.references.is_empty() {
         let path = plots.join(ERRORS_FILE);
         let text = errors_csv(&report.errors);
@@ -554,6 +566,59 @@ pub fn plot_run(dir: &Path, opts: &PlotOptions) -> Result<PlotReport> {
         report.errors_csv = Some(path);
     }
     Ok(report)
+}
+
+/// The flood maps of the run in `dir` (`maps/<stem>.asc`, the ground's left out), sorted.
+fn map_stems(dir: &Path) -> Result<Vec<String>> {
+    let Ok(entries) = std::fs::read_dir(dir.join(MAPS_DIR)) else {
+        return Ok(Vec::new());
+    };
+    let mut stems: Vec<String> = (entries.flatten())
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter_map(|n| n.strip_suffix(".asc").map(str::to_string))
+        .filter(|n| n != GROUND_MAP)
+        .collect();
+    stems.sort();
+    Ok(stems)
+}
+
+/// Reads the ESRI ASCII grid at `path`; errors name the file.
+fn read_map(path: &Path) -> Result<crate::generate::terrain::ElevationGrid> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    crate::generate::terrain::parse_asc(&text).map_err(|e| {
+        anyhow!(
+            "{}{}: {}; fix: {}",
+            path.display(),
+            e.line.map(|l| format!(":{l}")).unwrap_or_default(),
+            e.problem,
+            e.fix
+        )
+    })
+}
+
+/// Draws each of the run's maps `stems` over the hillshade of its ground (`maps/ground_m.asc`)
+/// to `plots/map_<stem>.png`, as the run drew them in `maps/`.
+fn draw_run_maps(
+    dir: &Path,
+    case: &str,
+    stems: &[String],
+    manifest: &mut Manifest,
+) -> Result<Vec<PathBuf>> {
+    if stems.is_empty() {
+        return Ok(Vec::new());
+    }
+    let ground = read_map(&dir.join(MAPS_DIR).join(format!("{GROUND_MAP}.asc")))?;
+    let mut pngs = Vec::new();
+    for stem in stems {
+        let map = read_map(&dir.join(MAPS_DIR).join(format!("{stem}.asc")))?;
+        let png = dir.join(PLOTS_DIR).join(format!("map_{stem}.png"));
+        manifest.claim_path(&png)?;
+        let label = map_label(stem).unwrap_or(stem);
+        flood_map::draw_map(&png, &map, &ground, case, label)?;
+        pngs.push(png);
+    }
+    Ok(pngs)
 }
 
 /// errors.csv text: a header and one row per comparison.

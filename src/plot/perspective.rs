@@ -495,7 +495,7 @@ impl PerspectiveView {
             (12, 10),
         )?;
         let (_, bar) = body.split_horizontally(PICTURE.0);
-        draw_colorbar(&bar, &self.scale, self.field)?;
+        draw_colorbar(&bar, &self.scale, self.field.label())?;
         root.present()?;
         Ok(())
     }

@@ -335,7 +335,7 @@ impl SnapshotView {
                 color.filled(),
             )
         }))?;
-        draw_colorbar(&bar, &self.scale, self.field)?;
+        draw_colorbar(&bar, &self.scale, self.field.label())?;
         root.present()?;
         Ok(chart.as_coord_spec().clone())
     }

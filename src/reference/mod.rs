@@ -8,6 +8,7 @@ pub mod bodies;
 pub mod cell_list;
 pub mod density_filter;
 pub mod elastic;
+pub mod flood_maps;
 pub mod ghost;
 pub mod integrate;
 pub mod interaction;

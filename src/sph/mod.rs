@@ -12,6 +12,7 @@ pub mod capacity;
 pub mod cell_list;
 pub mod density_filter;
 pub mod elastic;
+pub mod flood_maps;
 pub mod ghost;
 pub mod halo;
 #[cfg(feature = "test-hooks")]
@@ -224,6 +225,12 @@ impl Solver {
         capacity::check_ids(n)?;
         if subdomain.is_none() {
             check_capacity(ctx, n)?;
+        }
+        if subdomain.is_some() && sc.maps.is_some() {
+            bail!(
+                "flood maps ([maps]) are not yet made over several ranks: run the case on one \
+                 rank, or remove [maps]"
+            );
         }
         let mut grid = match subdomain {
             Some(_) => crate::decomposition::ranks_grid(sc)?,
@@ -844,6 +851,32 @@ impl Solver {
             .encode(&mut encoder, &self.buffers, self.parity);
         self.queue.submit([encoder.finish()]);
         Ok(self.passes.probes.decode(&self.probe_words()?))
+    }
+
+    /// Samples the flood maps (`[maps]`) at the current time; nothing without maps.
+    pub fn sample_maps(&self) -> Result<()> {
+        let Some(maps) = &self.passes.flood_maps else {
+            return Ok(());
+        };
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        maps.encode(&self.queue, &mut encoder, self.parity, self.time());
+        self.queue.submit([encoder.finish()]);
+        self.faults.check()
+    }
+
+    /// The flood maps' cell records (`[maps]`), row by row from the south; None without maps.
+    pub fn map_cells(&self) -> Result<Option<Vec<crate::layout::MapCell>>> {
+        (self.passes.flood_maps.as_ref())
+            .map(|m| m.read(&self.device, &self.queue))
+            .transpose()
+    }
+
+    /// Puts back the flood maps' records of a checkpoint.
+    pub fn restore_map_cells(&self, cells: &[crate::layout::MapCell]) -> Result<()> {
+        match &self.passes.flood_maps {
+            Some(m) => m.restore(&self.queue, cells),
+            None => bail!("the checkpoint has flood maps and the case has no [maps]"),
+        }
     }
 
     /// Moves the probes attached to bodies to where their bodies are now; returns them, all

@@ -9,6 +9,7 @@ use super::buffers::ParticleBuffers;
 use super::cell_list::{self, CellList};
 use super::density_filter::{self, DensityFilter};
 use super::elastic::{self, Elastic};
+use super::flood_maps::{self, FloodMapPass};
 use super::ghost::{self, Ghost};
 use super::halo::{self, Halo};
 use super::integrate::{self, Integrate};
@@ -25,7 +26,7 @@ use crate::layout::{BodyMotion, HaloCtl, ProbeDef};
 use crate::scenario::{Kind, OverlapExchange, Scenario, SolidFormulation};
 
 /// Every pass's shader, for the checks that compose them all.
-pub const SHADERS: [&Shader; 13] = [
+pub const SHADERS: [&Shader; 14] = [
     &cell_list::SHADER,
     &cell_list::SCAN_SHADER,
     &interaction::SHADER,
@@ -39,6 +40,7 @@ pub const SHADERS: [&Shader; 13] = [
     &open_boundaries::SHADER,
     &halo::SHADER,
     &overlap::SHADER,
+    &flood_maps::SHADER,
 ];
 
 /// The passes of a run; those of what the case lacks are `None`.
@@ -60,6 +62,8 @@ pub struct Passes {
     pub probes: Probes,
     /// Tracked points of bodies.
     pub points: Option<PointTracker>,
+    /// Flood maps (`[maps]`).
+    pub flood_maps: Option<FloodMapPass>,
     /// A subdomain's halo and migrants (`Solver::subdomain`); None in a whole run.
     pub halo: Option<Halo>,
     /// A subdomain whose steps may overlap the exchange (`time.overlap_exchange`): its
@@ -170,6 +174,11 @@ impl Passes {
                     .collect(),
             )?,
             points: PointTracker::new(device, &probe_module, b, &sc.points)?,
+            flood_maps: (sc.maps.as_ref())
+                .map(|m| {
+                    FloodMapPass::new(device, &shader(&flood_maps::SHADER)?, b, m, grid.origin)
+                })
+                .transpose()?,
             halo,
         })
     }
@@ -180,6 +189,7 @@ impl Passes {
             + self.elastic.as_ref().map_or(0, |e| e.bytes())
             + self.halo.as_ref().map_or(0, |h| h.bytes())
             + self.overlap.as_ref().map_or(0, |o| o.bytes())
+            + self.flood_maps.as_ref().map_or(0, |m| m.bytes())
     }
 
     /// The stages of one step on the arrays of parity `p`, in order (the sort moves them to

@@ -46,6 +46,8 @@ pub struct SolverState {
     pub solid: Option<Vec<SolidState>>,
     /// [`crate::body::BodySet::save`], empty without bodies.
     pub bodies: Vec<f64>,
+    /// The flood maps' cell records (`[maps]`), when the case has maps.
+    pub maps: Option<Vec<crate::layout::MapCell>>,
 }
 
 impl Solver {
@@ -85,6 +87,7 @@ impl Solver {
                 None => None,
             },
             bodies: self.bodies().map(|b| b.save()).unwrap_or_default(),
+            maps: self.map_cells()?,
         })
     }
 
@@ -144,6 +147,11 @@ impl Solver {
         q.write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&s.sim));
         if let Some(f) = &self.passes.density_filter {
             f.set_last_applied(q, s.filter_last);
+        }
+        match (&s.maps, &self.passes.flood_maps) {
+            (Some(cells), _) => self.restore_map_cells(cells)?,
+            (None, Some(_)) => bail!("the saved state has no flood maps; this case has [maps]"),
+            (None, None) => {}
         }
         match &mut self.bodies {
             Some(host) => host.set.restore(&s.bodies)?,

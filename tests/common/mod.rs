@@ -173,6 +173,7 @@ pub fn scenario(
         outlets: Vec::new(),
         warnings: Vec::new(),
         world_origin_m: [0.0; 3],
+        maps: None,
         domain,
         particles,
         probes,
