@@ -25,7 +25,7 @@ budget=${2:-540}
 wgsph=${WGSPH:-target/release/wgsph}
 tests=${VALIDATION_TESTS:-}
 cap=${ITEM_CAP_S:-300}
-all="info bench_spheric2 bench_spheric2_2h bench_spheric2_1M bench_spheric2_1M_2h bench_spheric2_4M bench_spheric2_13M bench_dam_break_3d bench_dam_break_3d_1M bench_street_flood_3d
+all="info validate:sfz_building_3d sfz_0.056 bench_spheric2 bench_spheric2_2h bench_spheric2_1M bench_spheric2_1M_2h bench_spheric2_4M bench_spheric2_13M bench_dam_break_3d bench_dam_break_3d_1M bench_street_flood_3d
 validate:floating_box_2d validate:water_entry_cylinder_2d validate:water_entry_cylinder_2d_rho1000
 validate:sloshing_2d validate:oscillating_plate_2d validate:oscillating_plate_tl_2d
 validate:elastic_gate_2d sloshing_3d street_flood_3d street_flood_3d_open validate:dam_break_3d
@@ -64,6 +64,10 @@ command_of() {
     # The street with and without its building to 10 s (docs/validation.md, "Street flood").
     street_flood_3d) echo "$wgsph run cases/street_flood_3d.toml --set time.end_s=10 --out $dir" ;;
     street_flood_3d_open) echo "$wgsph run cases/street_flood_3d.toml --set time.end_s=10 --set obstacle[3].enabled=false --set probe[5].enabled=false --out $dir" ;;
+    # Soares-Frazão & Zech's building at a second dx (validate:sfz_building_3d runs dx = 0.04 m),
+    # the flume cut as full mode cuts it (src/validation/sfz.rs), for the convergence of the
+    # gauges' depths: `wgsph plot DIR --reference G1=tests/data/sfz_2007_building_G1_depth.csv …`.
+    sfz_*) echo "$wgsph run cases/sfz_building_3d.toml --set particles.dx_m=${item#sfz_} --set time.end_s=13 --set time.probe_every_s=0.02 --set tank.max_m=[12.0,1.8,0.8] --set outlet[0].min_m=[11.7,-1.8,-0.1] --set outlet[0].max_m=[12.0,1.8,0.8] --out $dir" ;;
     # SPHERIC Test 2's 6 s at coarser dx, probes on the box's faces every 5 ms: with the
     # shipped dx (validate:dam_break_3d) the convergence study of docs/validation.md.
     spheric_*) echo "$wgsph run cases/dam_break_3d.toml --set particles.dx_m=${item#spheric_} --set time.probe_every_s=0.005 --set time.output_every_s=1 --out $dir" ;;

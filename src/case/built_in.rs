@@ -93,6 +93,12 @@ pub static BUILT_IN: &[BuiltIn] = &[
         name: "dam_break_3d",
         file: "cases/dam_break_3d.toml",
         text: include_str!("../../cases/dam_break_3d.toml"),
+    }, // Its bed, dam and building are files beside it (cases/sfz_building/): it loads from the
+    // repository root only.
+    BuiltIn {
+        name: "sfz_building_3d",
+        file: "cases/sfz_building_3d.toml",
+        text: include_str!("../../cases/sfz_building_3d.toml"),
     },
 ];
 

@@ -4,7 +4,8 @@
 //! directory), the `--set` overrides of the quick and the full mode, the reference with its
 //! citation, and the function that turns the run's outputs (probe CSVs, body CSVs, run.json)
 //! into metrics and figures. The metrics live in one file per case family ([`hydrostatic`],
-//! [`dam_break`], [`lobovsky`], [`bodies`], [`sloshing`], [`plate`], [`gate`], [`spheric`]); the
+//! [`dam_break`], [`lobovsky`], [`bodies`], [`sloshing`], [`plate`], [`gate`], [`spheric`],
+//! [`sfz`]); the
 //! integration tests
 //! (`tests/validation/`) call
 //! the same functions, so a bound asserted in CI and a row of the report are the same code.
@@ -20,6 +21,7 @@ pub mod hydrostatic;
 pub mod lobovsky;
 pub mod plate;
 mod report;
+pub mod sfz;
 pub mod sloshing;
 pub mod spheric;
 
@@ -288,6 +290,13 @@ pub static CASES: &[Case] = &[
         citation: spheric::CITATION,
         overrides: spheric::overrides,
         evaluate: spheric::evaluate,
+    },    Case {
+        name: "sfz_building_3d",
+        file: "cases/sfz_building_3d.toml",
+        reference: sfz::REFERENCE,
+        citation: sfz::CITATION,
+        overrides: sfz::overrides,
+        evaluate: sfz::evaluate,
     },
 ];
 
@@ -623,6 +632,38 @@ pub fn validate(
 /// `(t, value)` of `DIR/probes/<probe>.csv`.
 pub fn probe_series(dir: &Path, probe: &str) -> Result<Vec<(f64, f64)>> {
     Ok(plot::read_csv(&dir.join(PROBES_DIR).join(format!("{probe}.csv")))?.points)
+}
+
+/// The first time `series` reaches `level`.
+pub fn arrival(series: &[(f64, f64)], level: f64) -> Option<f64> {
+    series.iter().find(|p| p.1 >= level).map(|p| p.0)
+}
+
+/// (t, value) of the largest value of `series`.
+pub fn peak(series: &[(f64, f64)]) -> (f64, f64) {
+    series
+        .iter()
+        .filter(|p| p.1.is_finite())
+        .fold((f64::NAN, f64::NEG_INFINITY), |a, p| {
+            if p.1 > a.1 {
+                *p
+            } else {
+                a
+            }
+        })
+}
+
+/// The samples of `series` in [from, to].
+pub fn within(series: &[(f64, f64)], (from, to): (f64, f64)) -> Vec<(f64, f64)> {
+    (series.iter())
+        .filter(|p| p.0 >= from && p.0 <= to)
+        .copied()
+        .collect()
+}
+
+/// The mean value of `series`.
+pub fn mean(series: &[(f64, f64)]) -> f64 {
+    series.iter().map(|p| p.1).sum::<f64>() / series.len() as f64
 }
 
 /// `(t, column)` of a body's table, `DIR/probes/body_<body>.csv` (`t_s` first, then the

@@ -13,8 +13,8 @@ use std::path::Path;
 use anyhow::{anyhow, Result};
 
 use super::{
-    lost_particles, probe_series, reference_curve, sim_curve, Bound, Evaluation, Figure, Metric,
-    Mode, Unit,
+    arrival, lost_particles, mean, peak, probe_series, reference_curve, sim_curve, within, Bound,
+    Evaluation, Figure, Metric, Mode, Unit,
 };
 use crate::plot::{compare, moving_average, parse_table_column, ErrorSummary};
 use crate::scenario::Scenario;
@@ -81,38 +81,6 @@ pub fn overrides(mode: Mode) -> Option<Vec<String>> {
 /// The experiment's series `column` (t [s], value).
 pub fn experiment(column: &str) -> Result<Vec<(f64, f64)>> {
     Ok(parse_table_column(DATA, REFERENCE, column)?.points)
-}
-
-/// The first time `series` reaches `level`.
-fn arrival(series: &[(f64, f64)], level: f64) -> Option<f64> {
-    series.iter().find(|p| p.1 >= level).map(|p| p.0)
-}
-
-/// (t, value) of the largest value of `series`.
-fn peak(series: &[(f64, f64)]) -> (f64, f64) {
-    series
-        .iter()
-        .filter(|p| p.1.is_finite())
-        .fold((f64::NAN, f64::NEG_INFINITY), |a, p| {
-            if p.1 > a.1 {
-                *p
-            } else {
-                a
-            }
-        })
-}
-
-/// The samples of `series` in [from, to].
-fn within(series: &[(f64, f64)], (from, to): (f64, f64)) -> Vec<(f64, f64)> {
-    (series.iter())
-        .filter(|p| p.0 >= from && p.0 <= to)
-        .copied()
-        .collect()
-}
-
-/// The mean value of `series`.
-fn mean(series: &[(f64, f64)]) -> f64 {
-    series.iter().map(|p| p.1).sum::<f64>() / series.len() as f64
 }
 
 /// The rows of the comparison; [`full_bound`] says which are judged.
