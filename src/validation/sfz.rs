@@ -171,7 +171,7 @@ mod tests {
             .collect();
         assert_eq!(first[1], 0.85);
         assert!(
-            first[..5].iter().all(|&t| t >= 0.85 && t < 3.0),
+            first[..5].iter().all(|t| (0.85..3.0).contains(t)),
             "{first:?}"
         );
         assert_eq!(experiment("G6").unwrap()[0], (0.0, 0.4));
