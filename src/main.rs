@@ -571,6 +571,13 @@ fn bench(
     );
     print_traffic(&r.traffic);
     println!("dispatches/step {}", r.dispatches_per_step);
+    if let Some(sample) = r.map_sample_s {
+        let step = r.wall_s / steps as f64;
+        println!(
+            "map sample s    {sample:.4e} (the time of {:.1} steps)",
+            sample / step
+        );
+    }
     if let Some(times) = &r.stages {
         print_stages(times, &r.traffic, steps, n);
     }

@@ -358,6 +358,7 @@ pub fn bench<'py>(
             .collect::<Vec<_>>()
     });
     d.set_item("stages", stages)?;
+    d.set_item("map_sample_s", r.map_sample_s)?;
     Ok(d)
 }
 

@@ -177,7 +177,8 @@ def bench(
 ) -> Dict[str, Any]:
     """Times ``steps`` steps after ``warmup``, as ``wgsph bench``: particle_steps_per_s,
     simulated_s_per_wall_s, neighbours per particle, ...; with ``stages``, each stage's GPU
-    time as (name, seconds) pairs (needs timestamp queries)."""
+    time as (name, seconds) pairs (needs timestamp queries); for a case with ``[maps]``,
+    ``map_sample_s``, the wall time of one flood-map sample (else None)."""
 
 def validate(
     out: _Path,

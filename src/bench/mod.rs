@@ -173,6 +173,23 @@ pub struct BenchReport {
     pub traffic: Traffic,
     /// Each stage's GPU time over as many steps again, when asked for.
     pub stages: Option<Vec<StageTime>>,
+    /// With `[maps]`: the wall time of one flood-map sample, s (the mean of [`MAP_SAMPLES`],
+    /// the records read back once after them).
+    pub map_sample_s: Option<f64>,
+}
+
+/// The flood-map samples [`measure`] times.
+pub const MAP_SAMPLES: u32 = 5;
+
+/// The mean wall time of one flood-map sample of `solver`'s present state, s.
+fn time_map_samples(solver: &Solver) -> Result<f64> {
+    solver.map_cells()?;
+    let start = Instant::now();
+    for _ in 0..MAP_SAMPLES {
+        solver.sample_maps()?;
+    }
+    solver.map_cells()?;
+    Ok(start.elapsed().as_secs_f64() / MAP_SAMPLES as f64)
 }
 
 impl BenchReport {
@@ -231,6 +248,10 @@ pub fn measure(
         true => Some(solver.profile_steps(steps)?),
         false => None,
     };
+    let map_sample_s = match sc.maps {
+        Some(_) => Some(time_map_samples(&solver)?),
+        None => None,
+    };
     Ok(BenchReport {
         case: sc.name.clone(),
         adapter: ctx.describe(),
@@ -244,6 +265,7 @@ pub fn measure(
         counts,
         traffic,
         stages,
+        map_sample_s,
     })
 }
 

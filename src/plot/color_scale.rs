@@ -136,6 +136,16 @@ impl ColorScale {
     }
 }
 
+/// The plotting area of a picture of an `lx` × `ly` extent, px: its longer side `long_side`,
+/// the other in proportion (square cells look square) but at least `min_side`.
+pub(super) fn plot_area(lx: f64, ly: f64, long_side: f64, min_side: f64) -> (f64, f64) {
+    if lx >= ly {
+        (long_side, (long_side * ly / lx).max(min_side))
+    } else {
+        ((long_side * lx / ly).max(min_side), long_side)
+    }
+}
+
 /// The colour bar of `scale` in `area`, labelled `label` (what it shows, with its unit).
 pub(super) fn draw_colorbar<'a>(
     area: &DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>,

@@ -14,7 +14,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::color_scale::{
-    draw_colorbar, ColorScale, BACKGROUND, COLORBAR_WIDTH, MARGIN, X_LABEL_AREA,
+    draw_colorbar, plot_area, ColorScale, BACKGROUND, COLORBAR_WIDTH, MARGIN, X_LABEL_AREA,
 };
 use super::{register_font, AXIS_LIMIT, AXIS_RESOLUTION};
 use crate::generate::terrain::ElevationGrid;
@@ -232,17 +232,7 @@ fn value_scale(values: &[f64]) -> Option<ColorScale> {
 /// unless its shorter side would fall under [`PLOT_MIN_SIDE`].
 fn image_size(extent: &[Range<f64>; 2]) -> (u32, u32) {
     let [lx, ly] = extent.clone().map(|r| r.end - r.start);
-    let (pw, ph) = if lx >= ly {
-        (
-            PLOT_LONG_SIDE,
-            (PLOT_LONG_SIDE * ly / lx).max(PLOT_MIN_SIDE),
-        )
-    } else {
-        (
-            (PLOT_LONG_SIDE * lx / ly).max(PLOT_MIN_SIDE),
-            PLOT_LONG_SIDE,
-        )
-    };
+    let (pw, ph) = plot_area(lx, ly, PLOT_LONG_SIDE, PLOT_MIN_SIDE);
     (
         pw.round() as u32 + Y_LABEL_AREA + 2 * MARGIN + COLORBAR_WIDTH,
         ph.round() as u32 + X_LABEL_AREA + 2 * MARGIN + TITLE_HEIGHT,

@@ -17,8 +17,8 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::color_scale::{
-    draw_colorbar, ColorScale, SnapshotField, BACKGROUND, COLORBAR_WIDTH, MARGIN, WALL_COLOR,
-    X_LABEL_AREA,
+    draw_colorbar, plot_area, ColorScale, SnapshotField, BACKGROUND, COLORBAR_WIDTH, MARGIN,
+    WALL_COLOR, X_LABEL_AREA,
 };
 use super::perspective::PerspectiveView;
 use super::{register_font, write_png};
@@ -226,17 +226,7 @@ impl SnapshotView {
     /// Image size: the plotting area keeps the domain's aspect ratio.
     fn size(&self) -> (u32, u32) {
         let (lx, ly) = (self.x.end - self.x.start, self.y.end - self.y.start);
-        let (pw, ph) = if lx >= ly {
-            (
-                PLOT_LONG_SIDE,
-                (PLOT_LONG_SIDE * ly / lx).max(PLOT_MIN_SIDE),
-            )
-        } else {
-            (
-                (PLOT_LONG_SIDE * lx / ly).max(PLOT_MIN_SIDE),
-                PLOT_LONG_SIDE,
-            )
-        };
+        let (pw, ph) = plot_area(lx, ly, PLOT_LONG_SIDE, PLOT_MIN_SIDE);
         (
             pw.round() as u32 + Y_LABEL_AREA + 2 * MARGIN + COLORBAR_WIDTH,
             ph.round() as u32 + X_LABEL_AREA + 2 * MARGIN + TITLE_HEIGHT,
