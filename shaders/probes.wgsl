@@ -82,6 +82,17 @@ fn probe_pressure(x: vec3<f32>) -> f32 {
 
 const HEIGHT_STEPS_PER_H: f32 = 4.0;
 
+// What a gauge's surface is where half of: the fluid's share of the kernel, Σ W V (a wave
+// gauge, `kind = "height"`), or the water's share of what the walls leave of it, ψ (a depth
+// gauge, `kind = "depth"`, lib/water_fraction.wgsl: the flood maps' criterion, which finds a
+// sheet one particle deep and the surface beside a wall).
+fn gauge_fraction(kind: u32, x: vec3<f32>) -> f32 {
+    if (kind == PROBE_DEPTH) {
+        return water_fraction(map_sums(x));
+    }
+    return fluid_sums(x).volume;
+}
+
 // The gauge's lattice point k on the line through x.
 fn height_point(x: vec3<f32>, k: u32) -> vec3<f32> {
     var p = x;
@@ -107,7 +118,7 @@ fn probe_height_search(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(n
     let support2 = 4.0 * params.h * params.h;
     for (var k = 0u; k < params.n_probes; k++) {
         let def = probes[k];
-        if (def.kind != PROBE_HEIGHT) {
+        if (def.kind != PROBE_HEIGHT && def.kind != PROBE_DEPTH) {
             continue;
         }
         var across = xi - def.point;
@@ -128,7 +139,7 @@ fn probe_height_search(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(n
             if (u32(kk) + 1u <= atomicLoad(&probe_out[k])) {
                 break;
             }
-            if (fluid_sums(height_point(def.point, u32(kk))).volume >= 0.5) {
+            if (gauge_fraction(def.kind, height_point(def.point, u32(kk))) >= 0.5) {
                 atomicMax(&probe_out[k], u32(kk) + 1u);
                 break;
             }
@@ -136,18 +147,18 @@ fn probe_height_search(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(n
     }
 }
 
-// The height above x of the surface `probe_height_search` found (`found`: its k + 1, 0 where
-// no point of the line reaches Σ W V = ½: a dry gauge reads 0), interpolated linearly between
-// that point and the one above it, and at most the domain top.
-fn probe_height(x: vec3<f32>, found: u32) -> f32 {
+// The height above the gauge's foot x of the surface `probe_height_search` found (`found`: its
+// k + 1, 0 where no point of the line reaches ½: a dry gauge reads 0), interpolated linearly
+// between that point and the one above it, and at most the domain top.
+fn probe_height(kind: u32, x: vec3<f32>, found: u32) -> f32 {
     if (found == 0u) {
         return 0.0;
     }
     let up = DIM - 1u;
     let p = height_point(x, found - 1u);
     let above = height_point(x, found);
-    let v = fluid_sums(p).volume;
-    let v_above = fluid_sums(above).volume;
+    let v = gauge_fraction(kind, p);
+    let v_above = gauge_fraction(kind, above);
     let t = clamp((v - 0.5) / max(v - v_above, 1e-6), 0.0, 1.0);
     return min(mix(p[up], above[up], t), params.domain_size[up]) - x[up];
 }
@@ -214,8 +225,9 @@ fn probe_points(@builtin(global_invocation_id) gid: vec3<u32>) {
     let def = probes[k];
     if (def.kind == PROBE_PRESSURE) {
         atomicStore(&probe_out[k], bitcast<u32>(probe_pressure(def.point)));
-    } else if (def.kind == PROBE_HEIGHT) {
-        atomicStore(&probe_out[k], bitcast<u32>(probe_height(def.point, atomicLoad(&probe_out[k]))));
+    } else if (def.kind == PROBE_HEIGHT || def.kind == PROBE_DEPTH) {
+        let found = atomicLoad(&probe_out[k]);
+        atomicStore(&probe_out[k], bitcast<u32>(probe_height(def.kind, def.point, found)));
     } else if (def.kind == PROBE_WALL_PRESSURE) {
         atomicStore(&probe_out[k], bitcast<u32>(probe_wall_force(def)));
     }

@@ -238,7 +238,7 @@ pub fn layers_read(p: &Probe, h: f64, grid: &Grid, axis: usize) -> Option<Range<
         |lo: i64, hi: i64| Some((lo - 1).clamp(0, layers) as u32..(hi + 2).clamp(0, layers) as u32);
     match &p.kind {
         ProbeKind::Pressure { point } => span(layer_of(point[axis]) - 1, layer_of(point[axis]) + 1),
-        ProbeKind::Height { base } => span(layer_of(base[axis]) - 1, layer_of(base[axis]) + 1),
+        ProbeKind::Height { base, .. } => span(layer_of(base[axis]) - 1, layer_of(base[axis]) + 1),
         ProbeKind::WallPressure(patch) => {
             let e = patch.radius + 4.0 * h;
             span(

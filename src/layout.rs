@@ -415,6 +415,7 @@ pub enum ProbeCode {
     WallPressure,
     FrontContinuous,
     Discharge,
+    Depth,
 }
 
 /// Mirrors `InflowSegment` in shaders/open_boundaries.wgsl: a piece of an inlet's hydrograph

@@ -51,7 +51,7 @@ pub fn unmeasurable(sc: &Scenario) -> Vec<Option<String>> {
                     fmt_point(point, dim)
                 )
             }),
-            ProbeKind::Height { base } => {
+            ProbeKind::Height { base, .. } => {
                 let up = dim as usize - 1;
                 let mut top = *base;
                 top[up] = sc.domain.max[up];

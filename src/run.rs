@@ -24,14 +24,21 @@ use crate::plot::color_scale::SnapshotField;
 use crate::plot::snapshot::{draw_particle_file, SnapshotPainter};
 use crate::progress::{Progress, RunStatus};
 use crate::ranks::Ranks;
-use crate::scenario::{Kind, OutputBoundary, ProbeKind, Scenario};
+use crate::scenario::{GaugeSurface, Kind, OutputBoundary, ProbeKind, Scenario};
 use crate::sph::{check_capacity, DensityVariation, Solver, Unstable};
 
 /// Column name of a probe's CSV in a case of dimension `dim`.
 pub fn probe_column(kind: &ProbeKind, dim: u32) -> &'static str {
     match kind {
         ProbeKind::Pressure { .. } | ProbeKind::WallPressure(_) => "pressure_pa",
-        ProbeKind::Height { .. } => "height_m",
+        ProbeKind::Height {
+            surface: GaugeSurface::FluidHalf,
+            ..
+        } => "height_m",
+        ProbeKind::Height {
+            surface: GaugeSurface::WaterFraction,
+            ..
+        } => "depth_m",
         ProbeKind::Front { .. } => "front_m",
         // Per metre of width in 2D.
         ProbeKind::Discharge { .. } if dim == 2 => "discharge_m2_s",

@@ -243,13 +243,27 @@ pub struct Domain {
     pub max: [f64; 3],
 }
 
+/// Where a gauge finds the water's surface (`ProbeKind::Height`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GaugeSurface {
+    /// Where the fluid fills half the kernel, Σ W V = ½: a wave gauge (`kind = "height"`).
+    FluidHalf,
+    /// Where the water fills half of what the walls leave of the kernel, ψ = ½ (docs/equations.md
+    /// eq. 34, the flood maps' criterion): a depth gauge (`kind = "depth"`), which reads a sheet
+    /// one particle deep and the surface beside a wall.
+    WaterFraction,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub enum ProbeKind {
     /// Pressure at a point, kernel-interpolated (Shepard-normalised) from fluid particles.
     Pressure { point: [f64; 3] },
-    /// Water height along the vertical line through `base` (a wave gauge): highest fluid
-    /// particle near the line, measured from `base`'s vertical coordinate.
-    Height { base: [f64; 3] },
+    /// Water height along the vertical line through `base`, measured from `base`'s vertical
+    /// coordinate: the highest point where `surface` reaches ½.
+    Height {
+        base: [f64; 3],
+        surface: GaugeSurface,
+    },
     /// Surge front: largest (x − origin)·axis over fluid particles, or with `continuous` over
     /// the water that reaches along the axis from the origin without a gap: fluid projected
     /// onto the axis in bins of the kernel support 2h, the front ends at the first empty bin

@@ -69,6 +69,7 @@ fn every_twin_is_named_as_its_wgsl_function() {
             probes::probe_pressure,
             probes::probe_height,
             probes::probe_height_search,
+            probes::gauge_fraction,
             probes::probe_front,
             probes::section_weight,
             probes::discharge_contribution,

@@ -5,7 +5,7 @@
 use crate::common::*;
 use wgsph::layout::MapCell;
 use wgsph::progress::LogLines;
-use wgsph::scenario::{FloodMaps, Scenario};
+use wgsph::scenario::{FloodMaps, GaugeSurface, Probe, ProbeKind, Scenario};
 use wgsph::sph::Solver;
 
 /// A tank `side` m square (walls 3 layers, open top) holding water `depth` m deep (a whole
@@ -102,16 +102,42 @@ fn a_still_tanks_depth_map_reads_its_depth_and_nodata_over_the_walls() {
 }
 
 /// Films one and two particles deep (dx = 0.02 m) on a tank's floor read wet everywhere, their
-/// depths their thickness within dx/4 (measured: 0.0187 and 0.0399 m): the normalised criterion ψ = φ_f / (1 − φ_s) sees a sheet the
+/// depths their thickness within dx/4 (measured: 0.0187 and 0.0399 m), and so does a depth
+/// gauge (`kind = "depth"`) in the middle (0.0188 and 0.0399 m; a wave gauge there reads
+/// 0.0166 and 0.0399 m): the normalised criterion ψ = φ_f / (1 − φ_s) sees a sheet the
 /// gauges' φ_f ≥ ½ cannot (docs/design/flood_maps.md).
 #[test]
 fn films_one_and_two_particles_deep_read_wet() {
     let dx = 0.02;
     for layers in [1.0, 2.0] {
-        let sc = tank(0.2, layers * dx, dx, 0.04, true);
+        let mut sc = tank(0.2, layers * dx, dx, 0.04, true);
+        // A depth gauge and a wave gauge on one line in the middle, their feet on the floor.
+        for (name, surface) in [
+            ("depth", GaugeSurface::WaterFraction),
+            ("height", GaugeSurface::FluidHalf),
+        ] {
+            sc.probes.push(Probe {
+                name: name.into(),
+                kind: ProbeKind::Height {
+                    base: [0.1, 0.1, 0.0],
+                    surface,
+                },
+                body: None,
+            });
+        }
         let maps = sc.maps.clone().unwrap();
         let solver = Solver::new(gpu(), &sc).unwrap();
         solver.sample_maps().unwrap();
+        let gauges = solver.sample_probes().unwrap();
+        println!(
+            "{layers} layer(s): depth gauge {:.4} m, wave gauge {:.4} m",
+            gauges[0], gauges[1]
+        );
+        assert!(
+            (gauges[0] - layers * dx).abs() <= 0.25 * dx,
+            "depth gauge {}",
+            gauges[0]
+        );
         let cells = solver.map_cells().unwrap().unwrap();
         let depths: Vec<f64> = (cells_over(&maps, &cells, 0.2).into_iter())
             .filter(|(_, inside, _)| *inside)

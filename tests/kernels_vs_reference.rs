@@ -683,7 +683,10 @@ fn probes_match_reference() {
             },
             Probe {
                 name: "h".into(),
-                kind: ProbeKind::Height { base },
+                kind: ProbeKind::Height {
+                    base,
+                    surface: GaugeSurface::FluidHalf,
+                },
                 body: None,
             },
             Probe {
@@ -711,14 +714,43 @@ fn probes_match_reference() {
                 body: None,
             });
         }
+        // A depth gauge on the same line, and one at the block's edge with its foot on the
+        // floor's face (the floor fills half the kernel there).
+        let dx = sc.physics.dx;
+        let edge = match s.dim {
+            2 => [o + 0.5 * dx, o + 1.5 * dx, 0.0],
+            _ => [o + 0.5 * dx, centre[1], o + 1.5 * dx],
+        };
+        let depth_bases = [base, edge];
+        for (k, &b) in depth_bases.iter().enumerate() {
+            sc.probes.push(Probe {
+                name: format!("d{k}"),
+                kind: ProbeKind::Height {
+                    base: b,
+                    surface: GaugeSurface::WaterFraction,
+                },
+                body: None,
+            });
+        }
         let solver = Solver::new(gpu(), &sc).unwrap();
         let (parts, _) = gpu_particles_and_codes(&solver);
         let gpu_values = solver.sample_probes().unwrap();
         let ph = &sc.physics;
         let top = s.domain;
+        for (k, &b) in depth_bases.iter().enumerate() {
+            let cpu =
+                reference::probes::probe_height(ph, &parts, (b, GaugeSurface::WaterFraction), top);
+            let g = gpu_values[3 + sections.len() + k];
+            println!("dim {}: depth gauge {k} GPU {g} CPU {cpu}", s.dim);
+            assert!((g - cpu).abs() < 1e-4, "depth gauge {k}: {g} against {cpu}");
+        }
+        assert!(
+            gpu_values[3 + sections.len()] > 0.5 * BLOCK,
+            "the depth gauge must see the block"
+        );
         let cpu = [
             reference::probes::probe_pressure(ph, &parts, centre),
-            reference::probes::probe_height(ph, &parts, base, top),
+            reference::probes::probe_height(ph, &parts, (base, GaugeSurface::FluidHalf), top),
             reference::probes::probe_front(&parts, [0.01, 0.02, 0.0], axis),
         ];
         println!("dim {}: GPU {gpu_values:?} CPU {cpu:?}", s.dim);
@@ -900,7 +932,10 @@ fn height_probes_match_reference_in_a_tall_domain() {
             .enumerate()
             .map(|(k, &base)| Probe {
                 name: format!("h{k}"),
-                kind: ProbeKind::Height { base },
+                kind: ProbeKind::Height {
+                    base,
+                    surface: GaugeSurface::FluidHalf,
+                },
                 body: None,
             })
             .collect();
@@ -917,7 +952,12 @@ fn height_probes_match_reference_in_a_tall_domain() {
         let (parts, _) = gpu_particles_and_codes(&solver);
         let gpu_values = solver.sample_probes().unwrap();
         for (k, base) in bases.iter().enumerate() {
-            let cpu = reference::probes::probe_height(&sc.physics, &parts, *base, tall);
+            let cpu = reference::probes::probe_height(
+                &sc.physics,
+                &parts,
+                (*base, GaugeSurface::FluidHalf),
+                tall,
+            );
             println!("dim {dim} gauge {k}: GPU {} CPU {cpu}", gpu_values[k]);
             assert!(
                 (gpu_values[k] - cpu).abs() < 1e-4,

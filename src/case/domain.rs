@@ -277,7 +277,7 @@ fn check_probes_inside(ctx: &Ctx<'_>, case: &Case, d: &Aabb) -> Result<(), CaseE
         let (field, point) = match &p.kind {
             ProbeKind::Pressure { point } if case.face_normals[i].is_some() => ("face_m", *point),
             ProbeKind::Pressure { point } => ("point_m", *point),
-            ProbeKind::Height { base } => ("base_m", *base),
+            ProbeKind::Height { base, .. } => ("base_m", *base),
             ProbeKind::Front { origin, .. } => ("origin_m", *origin),
             ProbeKind::WallPressure(patch) => ("point_m", patch.point),
             // Either end outside.

@@ -5,7 +5,8 @@
 
 use crate::probe_reach::fmt_point;
 use crate::scenario::{
-    Body, Particle, Probe, ProbeKind, TrackedPoint, WallParams, WallPatch, FACE_UNBOUNDED,
+    Body, GaugeSurface, Particle, Probe, ProbeKind, TrackedPoint, WallParams, WallPatch,
+    FACE_UNBOUNDED,
 };
 
 use super::check::{file_safe, vector, MAX_NAME_BYTES};
@@ -79,8 +80,12 @@ pub(super) fn probe(
         ProbeName::Pressure => ProbeKind::Pressure {
             point: get("point_m", &p.point_m, "the sampling point in metres")?,
         },
-        ProbeName::Height => ProbeKind::Height {
+        ProbeName::Height | ProbeName::Depth => ProbeKind::Height {
             base: get("base_m", &p.base_m, "the foot of the gauge line in metres")?,
+            surface: match p.kind {
+                ProbeName::Depth => GaugeSurface::WaterFraction,
+                _ => GaugeSurface::FluidHalf,
+            },
         },
         ProbeName::Front => {
             let origin = get(
@@ -131,6 +136,7 @@ fn check_probe_fields(
         ProbeName::Pressure if p.face_m.is_some() => ("pressure", &["face_m", "normal"], &[]),
         ProbeName::Pressure => ("pressure", &["point_m"], &[]),
         ProbeName::Height => ("height", &["base_m"], &[]),
+        ProbeName::Depth => ("depth", &["base_m"], &[]),
         // The furthest particle unless `continuous`.
         ProbeName::Front => ("front", &["origin_m", "axis"], &["continuous"]),
         ProbeName::Point => ("point", &["point_m"], &[]),

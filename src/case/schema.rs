@@ -495,6 +495,7 @@ pub(super) enum ProbeName {
     Point,
     WallPressure,
     Discharge,
+    Depth,
 }
 
 /// Help for one field: what it is and an example of a valid line.
@@ -1118,7 +1119,7 @@ pub(super) const FIELDS: &[FieldHelp] = &[
     ),
     f(
         "probe[].base_m",
-        "the foot of a height gauge",
+        "the foot of a height or depth gauge",
         "base_m = [0.5, 0.0]",
     ),
     f(

@@ -228,7 +228,8 @@ fn hydrostatic_2d_builds() {
     assert_eq!(
         s.probes[1].kind,
         ProbeKind::Height {
-            base: [0.5, 0.0, 0.0]
+            base: [0.5, 0.0, 0.0],
+            surface: crate::scenario::GaugeSurface::FluidHalf,
         }
     );
     // The floor sensor: the 4 columns within 0.05 m of x = 0.5 (0.47 … 0.53), its radius

@@ -1,7 +1,8 @@
 //! Twin of shaders/probes.wgsl.
 
+use super::flood_maps::{map_sums, water_fraction};
 use super::{dot, kernel, pressure, sub, RefParticle, EXCLUDED, FLUID, INLET};
-use crate::scenario::{Physics, WallParams, WallPatch};
+use crate::scenario::{GaugeSurface, Physics, WallParams, WallPatch};
 
 /// (Σ W V, Σ P W V) over fluid particles at x.
 fn sums(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> (f64, f64) {
@@ -74,14 +75,28 @@ fn height_point(ph: &Physics, base: [f64; 3], k: usize) -> [f64; 3] {
     x
 }
 
+/// What a gauge's surface is where half of (probes.wgsl): Σ W V over the fluid (a wave gauge)
+/// or the water's share ψ of what the walls leave of the kernel (a depth gauge).
+pub fn gauge_fraction(
+    ph: &Physics,
+    parts: &[RefParticle],
+    surface: GaugeSurface,
+    x: [f64; 3],
+) -> f64 {
+    match surface {
+        GaugeSurface::FluidHalf => sums(ph, parts, x).0,
+        GaugeSurface::WaterFraction => water_fraction(map_sums(ph, parts, x)),
+    }
+}
+
 /// The highest lattice index k whose point lies on the line through `base` between it and
-/// `top` (the domain top) and has Σ W V ≥ ½; None where there is none (a dry gauge). By its
-/// definition: a walk down the lattice from the highest point a fluid particle's support
-/// reaches (the GPU spreads the same search over the particles, probes.wgsl).
+/// `top` (the domain top) and where `surface`'s fraction reaches ½; None where there is none
+/// (a dry gauge). By its definition: a walk down the lattice from the highest point a fluid
+/// particle's support reaches (the GPU spreads the same search over the particles, probes.wgsl).
 pub fn probe_height_search(
     ph: &Physics,
     parts: &[RefParticle],
-    base: [f64; 3],
+    (base, surface): ([f64; 3], GaugeSurface),
     top: f64,
 ) -> Option<usize> {
     let up = ph.dim as usize - 1;
@@ -103,20 +118,25 @@ pub fn probe_height_search(
     let k_reach = (((reach - base[up]) / step).floor() as usize + 1).min(k_top);
     (0..=k_reach)
         .rev()
-        .find(|&k| sums(ph, parts, height_point(ph, base, k)).0 >= 0.5)
+        .find(|&k| gauge_fraction(ph, parts, surface, height_point(ph, base, k)) >= 0.5)
 }
 
 /// Height above `base` of the surface on the vertical line through it: the point
 /// `probe_height_search` finds, interpolated linearly towards the lattice point above where
-/// Σ W V = ½, at most `top`; 0 where none is found.
-pub fn probe_height(ph: &Physics, parts: &[RefParticle], base: [f64; 3], top: f64) -> f64 {
+/// `surface`'s fraction is ½, at most `top`; 0 where none is found.
+pub fn probe_height(
+    ph: &Physics,
+    parts: &[RefParticle],
+    (base, surface): ([f64; 3], GaugeSurface),
+    top: f64,
+) -> f64 {
     let up = ph.dim as usize - 1;
-    let Some(k) = probe_height_search(ph, parts, base, top) else {
+    let Some(k) = probe_height_search(ph, parts, (base, surface), top) else {
         return 0.0;
     };
     let (x, above) = (height_point(ph, base, k), height_point(ph, base, k + 1));
-    let v = sums(ph, parts, x).0;
-    let v_above = sums(ph, parts, above).0;
+    let v = gauge_fraction(ph, parts, surface, x);
+    let v_above = gauge_fraction(ph, parts, surface, above);
     let t = ((v - 0.5) / (v - v_above).max(1e-6)).clamp(0.0, 1.0);
     (x[up] + (above[up] - x[up]) * t).min(top) - base[up]
 }

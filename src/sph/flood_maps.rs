@@ -5,7 +5,7 @@
 use anyhow::{ensure, Result};
 
 use super::buffers::ParticleBuffers;
-use super::shader::NEIGHBOURS;
+use super::shader::{NEIGHBOURS, WATER_FRACTION};
 use crate::gpu::buffers::{read, storage, storage_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
 use crate::gpu::shader::Shader;
@@ -15,7 +15,7 @@ use crate::scenario::FloodMaps;
 pub const SHADER: Shader = Shader {
     name: "flood_maps",
     source: include_str!("../../shaders/flood_maps.wgsl"),
-    libs: &[NEIGHBOURS],
+    libs: &[NEIGHBOURS, WATER_FRACTION],
 };
 
 /// The GPU's view of `maps`: its grid in domain coordinates (from `origin`, the domain's min

@@ -5,7 +5,7 @@ use anyhow::{bail, Result};
 
 use super::buffers::ParticleBuffers;
 use super::shader::PARTICLE_ID;
-use super::shader::{NEIGHBOURS, WALL_PATCH, WORKGROUP_MAX};
+use super::shader::{NEIGHBOURS, WALL_PATCH, WATER_FRACTION, WORKGROUP_MAX};
 use crate::body::Pose;
 use crate::gpu::buffers::{read, storage, storage_init};
 use crate::gpu::kernel::{ParityKernel, ShaderModule};
@@ -14,12 +14,18 @@ use crate::gpu::shader::{Shader, WORKGROUP_SIZE};
 pub const SHADER: Shader = Shader {
     name: "probes",
     source: include_str!("../../shaders/probes.wgsl"),
-    libs: &[PARTICLE_ID, NEIGHBOURS, WORKGROUP_MAX, WALL_PATCH],
+    libs: &[
+        PARTICLE_ID,
+        NEIGHBOURS,
+        WORKGROUP_MAX,
+        WALL_PATCH,
+        WATER_FRACTION,
+    ],
 };
 use super::shader::WgslEnum;
 use crate::layout::{Pos, ProbeCode, ProbeDef, NO_FACE};
 use crate::ranks::Ranks;
-use crate::scenario::{Probe, ProbeKind, TrackedPoint, WallParams, WallPatch};
+use crate::scenario::{GaugeSurface, Probe, ProbeKind, TrackedPoint, WallParams, WallPatch};
 use glam::DVec3;
 
 /// Bins along a continuous front's axis (probes.wgsl, `probe_front_walk`): the kernel support
@@ -124,9 +130,13 @@ pub fn probe_defs(
                 face,
                 ..Default::default()
             },
-            ProbeKind::Height { base } => ProbeDef {
+            ProbeKind::Height { base, surface } => ProbeDef {
                 point: rel(base),
-                kind: ProbeCode::Height.code(),
+                kind: match surface {
+                    GaugeSurface::FluidHalf => ProbeCode::Height,
+                    GaugeSurface::WaterFraction => ProbeCode::Depth,
+                }
+                .code(),
                 face,
                 ..Default::default()
             },
@@ -206,7 +216,10 @@ pub fn moved(probe: &Probe, center0: [f64; 3], pose: &Pose) -> Probe {
         ProbeKind::Pressure { point } => ProbeKind::Pressure {
             point: place(point),
         },
-        ProbeKind::Height { base } => ProbeKind::Height { base: place(base) },
+        ProbeKind::Height { base, surface } => ProbeKind::Height {
+            base: place(base),
+            surface: *surface,
+        },
         ProbeKind::Front {
             origin,
             axis,
@@ -332,7 +345,7 @@ impl Probes {
         });
         // The gauges' search over the particles first: `probe_points` interpolates where it
         // found the surface (probes.wgsl).
-        if self.kinds.contains(&ProbeCode::Height) {
+        if self.kinds.contains(&ProbeCode::Height) || self.kinds.contains(&ProbeCode::Depth) {
             self.height.dispatch(&mut pass, p, self.n);
         }
         self.points.dispatch(&mut pass, p, self.kinds.len() as u32);

@@ -34,6 +34,9 @@ pub const PARTICLE_ID: &str = include_str!("../../shaders/lib/particle_id.wgsl")
 /// A subdomain's slab and which of its particles read nothing the exchange brings
 /// (`shaders/lib/slab.wgsl`).
 pub const SLAB: &str = include_str!("../../shaders/lib/slab.wgsl");
+/// The water's share of what the walls leave of the kernel (`shaders/lib/water_fraction.wgsl`;
+/// needs `NEIGHBOURS`).
+pub const WATER_FRACTION: &str = include_str!("../../shaders/lib/water_fraction.wgsl");
 /// A wall-pressure sensor's patch of boundary particles (`shaders/lib/wall_patch.wgsl`).
 pub const WALL_PATCH: &str = include_str!("../../shaders/lib/wall_patch.wgsl");
 
@@ -112,6 +115,7 @@ impl WgslEnum for ProbeCode {
         (ProbeCode::WallPressure, "WALL_PRESSURE"),
         (ProbeCode::FrontContinuous, "FRONT_CONTINUOUS"),
         (ProbeCode::Discharge, "DISCHARGE"),
+        (ProbeCode::Depth, "DEPTH"),
     ];
 }
 
