@@ -72,8 +72,10 @@ pub(super) fn terrain(
             "the world point at the case's origin",
         )?,
     };
+    let grid = grid.shifted(origin);
+    check_near_origin(ctx, &grid, origin)?;
     Ok(Some(Terrain {
-        grid: grid.shifted(origin),
+        grid,
         origin,
         wall,
         layers,
@@ -117,6 +119,49 @@ enum GridFormat {
 }
 
 /// The grid in `file` (relative to `case_dir`), by its extension.
+/// How far from the case's origin a terrain may lie, m: f32 positions there are still good to
+/// 0.06 m (a finer case wants a nearer origin; one further off is a wrong `origin_m`).
+const MAX_FROM_ORIGIN_M: f64 = 1e6;
+
+/// The grid moved by −`origin` must lie within [`MAX_FROM_ORIGIN_M`] of the case's origin in
+/// plan and elevation: `terrain.origin_m` far from the grid (another datum, a typo, a value of
+/// 10¹⁸) puts the ground where no water, wall or domain of the case is, and the errors it would
+/// cause later would name another field.
+fn check_near_origin(
+    ctx: &Ctx<'_>,
+    grid: &ElevationGrid,
+    origin: [f64; 3],
+) -> Result<(), CaseError> {
+    let (sw, ne) = grid.extent();
+    let (lo, hi) = (grid.z.iter()).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &z| {
+        (lo.min(z), hi.max(z))
+    });
+    let far = [sw[0], sw[1], ne[0], ne[1], lo, hi]
+        .iter()
+        .map(|v| v.abs())
+        .fold(0.0, f64::max);
+    if far <= MAX_FROM_ORIGIN_M {
+        return Ok(());
+    }
+    Err(ctx.err(
+        "terrain.origin_m",
+        Some(format!(
+            "[{}, {}, {}]",
+            num(origin[0]),
+            num(origin[1]),
+            num(origin[2])
+        )),
+        format!(
+            "puts the grid {} m from the case's origin (the case's coordinates are the world's \
+             minus origin_m), more than {} m",
+            num(far),
+            num(MAX_FROM_ORIGIN_M)
+        ),
+        "give a world point near the grid, in its units and datum (by default its south-west \
+         corner at elevation 0)",
+    ))
+}
+
 fn read_grid(ctx: &Ctx<'_>, file: &str, case_dir: &Path) -> Result<ElevationGrid, CaseError> {
     let full = case_dir.join(file);
     let refuse = |problem: String, fix: &str| {

@@ -220,7 +220,7 @@ fn bad_terrains_are_refused_naming_the_field_and_the_fix() {
         tilted_grid().replace("ncols 6", "ncols 7"),
     )
     .unwrap();
-    let cases: [(String, &[&str]); 10] = [
+    let cases: [(String, &[&str]); 13] = [
         (TWO_D.to_string(), &["terrain", "2D", "dimension = 3"]),
         (
             case("").replace("ground.asc", "none.asc"),
@@ -254,9 +254,33 @@ fn bad_terrains_are_refused_naming_the_field_and_the_fix() {
             case("nodata_elevation_m = 1.0"),
             &["terrain.nodata_elevation_m", r#"nodata = "elevation""#],
         ),
+        // UTM coordinates taken as the case's: the grid 5 400 km away.
         (
             case("origin_m = [0.0, 0.0, 0.0]"),
+            &[
+                "terrain.origin_m",
+                "5400000.6 m from the case's origin",
+                "near the grid",
+            ],
+        ),
+        // An origin 2 km off: the grid lies outside the domain.
+        (
+            case(&format!("origin_m = [{}, {}, 0.0]", WEST - 2000.0, SOUTH)),
             &["terrain.file", "no particle column", "origin_m"],
+        ),
+        // An origin far from the grid (the case fuzzer's i64::MIN) is named, not the fill it
+        // would leave without ground.
+        (
+            case("origin_m = [0.0, 0.0, -9223372036854775808]"),
+            &[
+                "terrain.origin_m",
+                "from the case's origin",
+                "near the grid",
+            ],
+        ),
+        (
+            case(&format!("origin_m = [{}, 3.0e6, 0.0]", WEST)),
+            &["terrain.origin_m", "more than 1000000 m"],
         ),
     ];
     for (text, words) in cases {
