@@ -75,11 +75,10 @@ fn every_twin_is_named_as_its_wgsl_function() {
             probes::discharge_contribution,
         ],
         flood_maps::SHADER => [
-            flood_maps::map_sums,
-            flood_maps::water_fraction,
+            water_fraction::map_sums,
+            water_fraction::water_fraction,
             flood_maps::map_cell_centre,
             flood_maps::map_point,
-            flood_maps::map_top_index,
             flood_maps::map_surface_search,
             flood_maps::map_depth,
             flood_maps::map_velocity,

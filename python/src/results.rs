@@ -8,7 +8,7 @@ use pyo3::exceptions::{PyIndexError, PyKeyError};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};
 
-use wgsph::output::flood_maps::MAPS_DIR;
+use wgsph::output::flood_maps::{map_stems, read_map};
 use wgsph::output::{particle_files, ParticleFile, PARTICLES_DIR, PROBES_DIR, RUN_SUMMARY_FILE};
 
 use crate::errors::{to_py, WgsphError};
@@ -273,32 +273,19 @@ impl Run {
 
     /// The flood maps' names (`maps/<name>.asc`: `max_depth_m`, `arrival_s`, …), sorted;
     /// empty for a case without `[maps]`.
-    fn maps(&self) -> PyResult<Vec<String>> {
-        let Ok(entries) = std::fs::read_dir(self.dir.join(MAPS_DIR)) else {
-            return Ok(Vec::new());
-        };
-        let mut names: Vec<String> = (entries.flatten())
-            .filter_map(|e| e.file_name().into_string().ok())
-            .filter_map(|n| n.strip_suffix(".asc").map(str::to_string))
-            .collect();
-        names.sort();
-        Ok(names)
+    fn maps(&self) -> Vec<String> {
+        map_stems(&self.dir)
     }
 
     /// A flood map as a dict: `values`, a float64 array of shape (rows, columns), row 0 the
     /// southernmost, NaN where the map has no value (a cell never wet); `x` and `y`, the cells'
     /// centres in world coordinates along each axis. Read with the engine's ESRI ASCII reader.
     fn map<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>> {
-        let names = self.maps()?;
+        let names = self.maps();
         if !names.iter().any(|n| n == name) {
             return Err(self.unknown("map", name, &names));
         }
-        let path = self.dir.join(MAPS_DIR).join(format!("{name}.asc"));
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| WgsphError::new_err(format!("cannot read {}: {e}", path.display())))?;
-        let grid = wgsph::generate::terrain::parse_asc(&text).map_err(|e| {
-            WgsphError::new_err(format!("{}: {} ({})", path.display(), e.problem, e.fix))
-        })?;
+        let grid = read_map(&self.dir, name).map_err(to_py)?;
         let along = |a: usize, n: usize| -> Vec<f64> {
             (0..n)
                 .map(|i| grid.first_centre[a] + i as f64 * grid.cell[a])

@@ -2,7 +2,7 @@
 //! (3D, cells of at least dx, an area inside the domain, a grid the GPU can hold), and the
 //! ground under each cell found from the fixed walls' particles once they are built.
 
-use crate::scenario::{Body, Domain, FloodMaps, Kind, Particle};
+use crate::scenario::{Body, Domain, FloodMaps, Particle};
 
 use super::check::{number, vector, Bound};
 use super::error::{num, CaseError};
@@ -167,7 +167,7 @@ fn two_digits_up(x: f64) -> f64 {
 /// particles within dx/2 of it in plan (terrain, buildings' roofs, a tank's floor, obstacles;
 /// not a moving body's), `floor` where there is none. Cells are at least dx, so a particle is
 /// within dx/2 of at most the centre nearest it.
-pub(super) fn ground_under(
+fn ground_under(
     maps: &FloodMaps,
     particles: &[Particle],
     bodies: &[Body],
@@ -178,7 +178,7 @@ pub(super) fn ground_under(
     let fixed = (particles.iter().enumerate())
         .filter(|(i, _)| moving.is_none_or(|m| *i < m))
         .map(|(_, p)| p)
-        .filter(|p| !matches!(p.kind, Kind::Fluid | Kind::Inlet | Kind::Solid));
+        .filter(|p| p.kind.is_boundary());
     let mut top = vec![f64::NEG_INFINITY; maps.cells()];
     let reach = 0.5 * dx * (1.0 + 1e-9);
     for p in fixed {

@@ -5,10 +5,11 @@
 use super::esri_ascii::asc_text;
 use super::write_atomic;
 use super::OutputError;
-use crate::generate::terrain::ElevationGrid;
+use crate::generate::terrain::{parse_asc, ElevationGrid};
 use crate::layout::MapCell;
 use crate::scenario::FloodMaps;
-use anyhow::{Context, Result};
+use anyhow::{anyhow, Context, Result};
+use std::path::Path;
 
 /// The folder of the maps inside the output directory.
 pub const MAPS_DIR: &str = "maps";
@@ -119,6 +120,36 @@ pub fn map_layers(maps: &FloodMaps, cells: &[MapCell], origin: [f64; 3]) -> Vec<
             grid: grid_of(maps, origin, cells.iter().map(value).collect()),
         })
         .collect()
+}
+
+/// The stems of the maps a run in `dir` wrote (`maps/<stem>.asc`, the ground's included),
+/// sorted; none when it has no maps.
+pub fn map_stems(dir: &Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(dir.join(MAPS_DIR)) else {
+        return Vec::new();
+    };
+    let mut stems: Vec<String> = (entries.flatten())
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter_map(|n| n.strip_suffix(".asc").map(str::to_string))
+        .collect();
+    stems.sort();
+    stems
+}
+
+/// The map `stem` of the run in `dir`, as written; errors name the file.
+pub fn read_map(dir: &Path, stem: &str) -> Result<ElevationGrid> {
+    let path = dir.join(MAPS_DIR).join(format!("{stem}.asc"));
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    parse_asc(&text).map_err(|e| {
+        anyhow!(
+            "{}{}: {}; fix: {}",
+            path.display(),
+            e.line.map(|l| format!(":{l}")).unwrap_or_default(),
+            e.problem,
+            e.fix
+        )
+    })
 }
 
 impl super::OutputDir {

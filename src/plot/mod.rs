@@ -25,7 +25,7 @@ use std::str::FromStr;
 use anyhow::{anyhow, bail, Context, Result};
 use plotters::prelude::*;
 
-use crate::output::flood_maps::{map_label, GROUND_MAP, MAPS_DIR};
+use crate::output::flood_maps::{map_label, map_stems, read_map, GROUND_MAP, MAPS_DIR};
 pub use crate::output::PLOTS_DIR;
 use crate::output::{fmt_f64, write_atomic, Manifest, PROBES_DIR, RUN_SUMMARY_FILE};
 /// Error summary written next to the plots when references are given.
@@ -461,7 +461,9 @@ pub fn plot_run(dir: &Path, opts: &PlotOptions) -> Result<PlotReport> {
     let case = case_name(dir);
     let main_label = opts.label.clone().unwrap_or_else(|| case.clone());
     let mut names = probe_names(dir)?;
-    let maps = map_stems(dir)?;
+    let maps: Vec<String> = (map_stems(dir).into_iter())
+        .filter(|s| s != GROUND_MAP)
+        .collect();
     if names.is_empty() && maps.is_empty() {
         bail!(
             "{} has no probe CSV and {} no map",
@@ -568,35 +570,6 @@ pub fn plot_run(dir: &Path, opts: &PlotOptions) -> Result<PlotReport> {
     Ok(report)
 }
 
-/// The flood maps of the run in `dir` (`maps/<stem>.asc`, the ground's left out), sorted.
-fn map_stems(dir: &Path) -> Result<Vec<String>> {
-    let Ok(entries) = std::fs::read_dir(dir.join(MAPS_DIR)) else {
-        return Ok(Vec::new());
-    };
-    let mut stems: Vec<String> = (entries.flatten())
-        .filter_map(|e| e.file_name().into_string().ok())
-        .filter_map(|n| n.strip_suffix(".asc").map(str::to_string))
-        .filter(|n| n != GROUND_MAP)
-        .collect();
-    stems.sort();
-    Ok(stems)
-}
-
-/// Reads the ESRI ASCII grid at `path`; errors name the file.
-fn read_map(path: &Path) -> Result<crate::generate::terrain::ElevationGrid> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    crate::generate::terrain::parse_asc(&text).map_err(|e| {
-        anyhow!(
-            "{}{}: {}; fix: {}",
-            path.display(),
-            e.line.map(|l| format!(":{l}")).unwrap_or_default(),
-            e.problem,
-            e.fix
-        )
-    })
-}
-
 /// Draws each of the run's maps `stems` over the hillshade of its ground (`maps/ground_m.asc`)
 /// to `plots/map_<stem>.png`, as the run drew them in `maps/`.
 fn draw_run_maps(
@@ -608,10 +581,10 @@ fn draw_run_maps(
     if stems.is_empty() {
         return Ok(Vec::new());
     }
-    let ground = read_map(&dir.join(MAPS_DIR).join(format!("{GROUND_MAP}.asc")))?;
+    let ground = read_map(dir, GROUND_MAP)?;
     let mut pngs = Vec::new();
     for stem in stems {
-        let map = read_map(&dir.join(MAPS_DIR).join(format!("{stem}.asc")))?;
+        let map = read_map(dir, stem)?;
         let png = dir.join(PLOTS_DIR).join(format!("map_{stem}.png"));
         manifest.claim_path(&png)?;
         let label = map_label(stem).unwrap_or(stem);

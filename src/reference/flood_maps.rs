@@ -1,56 +1,17 @@
 //! Twin of shaders/flood_maps.wgsl, in the scenario's coordinates.
 
-use super::{dot, kernel, sub, RefParticle, EXCLUDED, FLUID, INLET};
-use crate::scenario::{FloodMaps, Physics};
-
-/// Lattice points per h over a map cell (`MAP_STEPS_PER_H`).
-pub const MAP_STEPS_PER_H: f64 = 4.0;
-/// The walls' share of the kernel beyond which ψ is not formed (`MAP_MAX_SOLID_SHARE`).
-pub const MAP_MAX_SOLID_SHARE: f64 = 0.9;
-
-/// The fluid's and the walls' shares of the kernel at a point, and the fluid's Σ v W V in plan.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct MapSums {
-    pub fluid: f64,
-    pub solid: f64,
-    pub momentum: [f64; 2],
-}
-
-pub fn map_sums(ph: &Physics, parts: &[RefParticle], x: [f64; 3]) -> MapSums {
-    let mut s = MapSums::default();
-    for p in parts {
-        let d = sub(x, p.pos);
-        let r2 = dot(d, d);
-        if r2 >= 4.0 * ph.h * ph.h || p.kind == EXCLUDED || p.kind == INLET {
-            continue;
-        }
-        let w = kernel::w(ph.kernel, ph.dim, ph.h, r2.sqrt());
-        if p.kind == FLUID {
-            let wv = w * ph.particle_mass / p.rho;
-            s.fluid += wv;
-            s.momentum[0] += wv * p.vel[0];
-            s.momentum[1] += wv * p.vel[1];
-        } else {
-            s.solid += w * ph.particle_mass / ph.rho0;
-        }
-    }
-    s
-}
-
-/// ψ = φ_f / (1 − φ_s), 0 inside the walls.
-pub fn water_fraction(s: MapSums) -> f64 {
-    if s.solid > MAP_MAX_SOLID_SHARE {
-        return 0.0;
-    }
-    s.fluid / (1.0 - s.solid)
-}
+use super::probes::{probe_height_search, surface_height, HEIGHT_STEPS_PER_H};
+use super::water_fraction::map_sums;
+use super::RefParticle;
+use crate::scenario::{FloodMaps, GaugeSurface, Physics};
 
 pub fn map_cell_centre(maps: &FloodMaps, c: usize) -> [f64; 2] {
     maps.centre(c)
 }
 
 fn map_step(ph: &Physics) -> f64 {
-    ph.h / MAP_STEPS_PER_H
+    // `MAP_STEPS_PER_H`: the gauges' lattice (`map_foot`).
+    ph.h / HEIGHT_STEPS_PER_H
 }
 
 /// The lattice point k over cell c.
@@ -59,14 +20,15 @@ pub fn map_point(ph: &Physics, maps: &FloodMaps, c: usize, k: usize) -> [f64; 3]
     [x, y, maps.ground[c] + k as f64 * map_step(ph)]
 }
 
-/// The highest lattice index over cell c at or below `top`.
-pub fn map_top_index(ph: &Physics, maps: &FloodMaps, c: usize, top: f64) -> usize {
-    ((top - maps.ground[c]) / map_step(ph)).floor().max(0.0) as usize
+/// The foot of cell c's lattice: its centre on the ground. A map cell's column is a depth
+/// gauge's line (the same lattice of h/4 from the foot), so the twin of its search and depth is
+/// the gauges' (`probes::probe_height_search`, `probes::surface_height`).
+fn map_foot(ph: &Physics, maps: &FloodMaps, c: usize) -> ([f64; 3], GaugeSurface) {
+    (map_point(ph, maps, c, 0), GaugeSurface::WaterFraction)
 }
 
 /// The highest lattice index k over cell c (at most `top`) where ψ ≥ ½; None where there is
-/// none. By its definition: a walk down from the highest point a fluid particle's support
-/// reaches (the GPU spreads the same search over the particles).
+/// none.
 pub fn map_surface_search(
     ph: &Physics,
     parts: &[RefParticle],
@@ -74,19 +36,7 @@ pub fn map_surface_search(
     c: usize,
     top: f64,
 ) -> Option<usize> {
-    let [cx, cy] = map_cell_centre(maps, c);
-    let reach = (parts.iter())
-        .filter(|p| p.kind == FLUID)
-        .filter(|p| (p.pos[0] - cx).powi(2) + (p.pos[1] - cy).powi(2) < 4.0 * ph.h * ph.h)
-        .map(|p| p.pos[2] + 2.0 * ph.h)
-        .fold(f64::NEG_INFINITY, f64::max);
-    if reach < maps.ground[c] {
-        return None;
-    }
-    let k_reach = ((reach - maps.ground[c]) / map_step(ph)).floor() as usize + 1;
-    (0..=k_reach.min(map_top_index(ph, maps, c, top)))
-        .rev()
-        .find(|&k| water_fraction(map_sums(ph, parts, map_point(ph, maps, c, k))) >= 0.5)
+    probe_height_search(ph, parts, map_foot(ph, maps, c), top)
 }
 
 /// The depth over cell c of the surface found at lattice index `found` (None: a dry cell),
@@ -99,12 +49,7 @@ pub fn map_depth(
     found: Option<usize>,
     top: f64,
 ) -> Option<f64> {
-    let k = found?;
-    let psi_at = |k| water_fraction(map_sums(ph, parts, map_point(ph, maps, c, k)));
-    let (psi, psi_above) = (psi_at(k), psi_at(k + 1));
-    let t = ((psi - 0.5) / (psi - psi_above).max(1e-6)).clamp(0.0, 1.0);
-    let z = (maps.ground[c] + (k as f64 + t) * map_step(ph)).min(top);
-    Some(z - maps.ground[c])
+    found.map(|k| surface_height(ph, parts, map_foot(ph, maps, c), k, top))
 }
 
 /// The fluid's plan velocity at x, Shepard-interpolated (0 where no fluid is near).

@@ -16,6 +16,7 @@ pub mod mls;
 pub mod open_boundaries;
 pub mod probes;
 pub mod total_lagrangian;
+pub mod water_fraction;
 
 use crate::kernel;
 use crate::scenario::{Kind, Physics, Viscosity};

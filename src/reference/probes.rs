@@ -1,6 +1,6 @@
 //! Twin of shaders/probes.wgsl.
 
-use super::flood_maps::{map_sums, water_fraction};
+use super::water_fraction::{map_sums, water_fraction};
 use super::{dot, kernel, pressure, sub, RefParticle, EXCLUDED, FLUID, INLET};
 use crate::scenario::{GaugeSurface, Physics, WallParams, WallPatch};
 
@@ -127,13 +127,23 @@ pub fn probe_height_search(
 pub fn probe_height(
     ph: &Physics,
     parts: &[RefParticle],
+    gauge: ([f64; 3], GaugeSurface),
+    top: f64,
+) -> f64 {
+    probe_height_search(ph, parts, gauge, top)
+        .map_or(0.0, |k| surface_height(ph, parts, gauge, k, top))
+}
+
+/// The height above `base` of the surface found at lattice index `k`: interpolated linearly
+/// towards the point above where `surface`'s fraction is ½, at most `top`.
+pub fn surface_height(
+    ph: &Physics,
+    parts: &[RefParticle],
     (base, surface): ([f64; 3], GaugeSurface),
+    k: usize,
     top: f64,
 ) -> f64 {
     let up = ph.dim as usize - 1;
-    let Some(k) = probe_height_search(ph, parts, (base, surface), top) else {
-        return 0.0;
-    };
     let (x, above) = (height_point(ph, base, k), height_point(ph, base, k + 1));
     let v = gauge_fraction(ph, parts, surface, x);
     let v_above = gauge_fraction(ph, parts, surface, above);
