@@ -78,8 +78,7 @@ pub fn plan(
             ck_path.display()
         ),
     };
-    // `..Default::default()` fills the fields the `test-hooks` feature adds.
-    #[allow(clippy::needless_update)]
+    // `..Default::default()` fills the rest (the tests' hook among them).
     let options = RunOptions {
         snapshot_png: ck
             .snapshot_field
