@@ -78,7 +78,8 @@ pub fn plan(
             ck_path.display()
         ),
     };
-    // `..Default::default()` fills the rest (the tests' hook among them).
+    // `..Default::default()` fills the fields the `test-hooks` feature adds.
+    #[allow(clippy::needless_update)]
     let options = RunOptions {
         snapshot_png: ck
             .snapshot_field

@@ -66,7 +66,7 @@ pub struct RunOptions {
     pub case_build_s: Option<f64>,
     /// Test hook: destroys the GPU device at the first probe interval after this simulated
     /// time, as a driver reset would.
-    #[doc(hidden)]
+    #[cfg(feature = "test-hooks")]
     pub lose_device_after_s: Option<f64>,
 }
 
@@ -1029,6 +1029,7 @@ impl<'a> Runner<'a> {
     fn probe_interval(&mut self, t: f64, progress: &mut dyn Progress) -> Result<bool> {
         let sc = self.sc;
         let every_out = sc.time.output_every_s;
+        #[cfg(feature = "test-hooks")]
         if self
             .options
             .lose_device_after_s

@@ -220,7 +220,8 @@ pub fn run(
     let sc = case.scenario.clone();
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
     let flag = Arc::new(AtomicBool::new(false));
-    // `..Default::default()` fills the rest (the engine's tests' hook among them).
+    // `..Default::default()` fills the fields the engine's `test-hooks` feature adds.
+    #[allow(clippy::needless_update)]
     let options = RunOptions {
         snapshot_png: snapshots.then(|| field.unwrap_or_default()),
         checkpoint: checkpoint_policy(checkpoint_every)?

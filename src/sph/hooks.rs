@@ -1,8 +1,6 @@
-//! Test hooks: re-running one pass on the current arrays, reading what only the tests compare,
-//! breaking the device. Hidden from the documentation and not part of the API. They are
-//! compiled in every build rather than behind a feature: a feature turned on through a
-//! dev-dependency on the crate itself made the unit tests' build wait for the library's, two
-//! minutes of CI's build one after the other (docs/performance.md, "CI's build").
+//! Test hooks (feature `test-hooks`, which the crate's own tests turn on): re-running one pass
+//! on the current arrays, reading what only the tests compare, breaking the device. Not part of
+//! the public API of a default build.
 
 use anyhow::{bail, Result};
 
@@ -10,7 +8,6 @@ use super::Solver;
 use crate::gpu::buffers::read;
 use crate::layout::{SimState, SymRate};
 
-#[doc(hidden)]
 impl Solver {
     /// Test hook: how many times a subdomain's halo packing buffer grew (`Halo::reserve`).
     pub fn halo_growths(&self) -> u32 {

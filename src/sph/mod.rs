@@ -15,6 +15,7 @@ pub mod elastic;
 pub mod flood_maps;
 pub mod ghost;
 pub mod halo;
+#[cfg(feature = "test-hooks")]
 mod hooks;
 pub mod initial;
 pub mod integrate;
