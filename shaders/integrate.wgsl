@@ -166,7 +166,10 @@ fn timestep() {
     }
     let max_speed = bitcast<f32>(atomicLoad(&state.max_speed_bits));
     let max_accel = bitcast<f32>(atomicLoad(&state.max_accel_bits));
-    var dt = params.cfl * params.h / max(max_speed, 1e-12);
+    // With nothing live (an empty domain whose inlet's level has not reached a column yet), the
+    // sound speed alone: a step of any length would carry the first columns to flow past
+    // their buffer.
+    var dt = params.cfl * params.h / select(max_speed, params.c0, max_speed == 0.0);
     if (max_accel > 0.0) {
         dt = min(dt, params.cfl * sqrt(params.h / max_accel));
     }

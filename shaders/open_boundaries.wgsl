@@ -20,6 +20,26 @@ struct InletDef {
     pad1: u32,
     surface: vec3<f32>,         // the buffer's highest point (domain coordinates)
     pressure: u32,              // INLET_ZERO, INLET_HYDROSTATIC or INLET_EXTRAPOLATED
+    first_window: u32,          // a level-driven inlet's first entry in `flow_windows`
+    n_windows: u32,             // 0: no level, every column flows
+    first_level: u32,           // its level's first piece in `inflow_segments`
+    n_level: u32,
+    up: vec3<f32>,              // against gravity: heights are measured along it
+    pad2: u32,
+}
+
+// A time [start, end) a column of a level-driven inlet flows (src/scenario.rs `FlowWindow`):
+// the level is above the column's point on the plane, and the water the inflow carries there
+// has come D_c(t) = before + D(t); from `end` to its next window it has come `after`.
+struct FlowWindow {
+    column: u32,
+    start: f32,
+    end: f32,
+    before: f32,
+    after: f32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 // A piece of an inlet's inflow speed in time, from its knot t on (src/hydrograph.rs): with
@@ -57,6 +77,8 @@ struct OutletDef {
 @group(0) @binding(7) var<storage, read> outlets: array<OutletDef>;
 @group(0) @binding(8) var<storage, read> cell_start: array<u32>;
 @group(0) @binding(9) var<storage, read> inflow_segments: array<InflowSegment>;
+// The level-driven inlets' windows, by inlet, then column, then time.
+@group(0) @binding(10) var<storage, read> flow_windows: array<FlowWindow>;
 
 // The inlet whose particle `id` is (ids are consecutive per inlet, inlets in id order).
 fn inlet_of(id: u32) -> u32 {
@@ -75,8 +97,14 @@ struct Inflow {
 }
 
 fn inflow_at(inlet: InletDef, t: f32) -> Inflow {
-    var lo = inlet.first_segment;
-    var hi = inlet.first_segment + inlet.n_segments;
+    return piecewise_at(inlet.first_segment, inlet.n_segments, t);
+}
+
+// The `n` pieces of `inflow_segments` from `first` at time t: their value and its integral
+// from 0 (an inflow's speed and distance; a level's height in its `speed`).
+fn piecewise_at(first: u32, n: u32, t: f32) -> Inflow {
+    var lo = first;
+    var hi = first + n;
     while (hi - lo > 1u) {
         let mid = (lo + hi) / 2u;
         if (inflow_segments[mid].t <= t) {
@@ -90,6 +118,40 @@ fn inflow_at(inlet: InletDef, t: f32) -> Inflow {
     let u = s.speed[0] + tau * (s.speed[1] + tau * (s.speed[2] + tau * s.speed[3]));
     let d = s.distance + tau * (s.moved[0] + tau * (s.moved[1] + tau * (s.moved[2] + tau * s.moved[3])));
     return Inflow(u, d);
+}
+
+// Whether `column` of `inlet` flows at time t, and how far the inflow has carried its water
+// (`inflow` its inflow at t): every column, the whole D(t), without a level; with one, from
+// the column's last window that started by t (src/scenario.rs `FlowWindow::travel`).
+struct Travel {
+    flows: bool,
+    distance: f32,
+}
+
+fn travel(inlet: InletDef, column: u32, t: f32, inflow: Inflow) -> Travel {
+    if (inlet.n_windows == 0u) {
+        return Travel(true, inflow.distance);
+    }
+    // The first window after (column, t), by bisection.
+    var lo = inlet.first_window;
+    var hi = inlet.first_window + inlet.n_windows;
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        let w = flow_windows[mid];
+        if (w.column < column || (w.column == column && w.start <= t)) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    if (lo == inlet.first_window || flow_windows[lo - 1u].column != column) {
+        return Travel(false, 0.0);
+    }
+    let w = flow_windows[lo - 1u];
+    if (t < w.end) {
+        return Travel(true, w.before + inflow.distance);
+    }
+    return Travel(false, w.after);
 }
 
 // Signed distance of inlet particle k (of `inlet`) from the plane when its inflow has carried
@@ -114,19 +176,37 @@ fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     }
     let inlet = inlets[inlet_of(id)];
     let k = id - inlet.first_id;
-    let inflow = inflow_at(inlet, state.t_base + state.t_rel + state.dt);
-    let s = inlet_distance(inlet, k, inflow.distance);
+    let t = state.t_base + state.t_rel + state.dt;
+    let inflow = inflow_at(inlet, t);
+    let column = k % inlet.n_columns;
+    let travelled = travel(inlet, column, t, inflow);
+    let s = inlet_distance(inlet, k, travelled.distance);
+    let placed = move_by(inlet_columns[inlet.first_column + column], s * inlet.normal).pos;
+    if (!travelled.flows) {
+        // The level left the column: a buffer particle waits where it stands, out of every
+        // cell, and counts as joined no more.
+        if (kind == KIND_INLET) {
+            pos[i] = placed;
+            velrho[i] = vec4<f32>(0.0, 0.0, 0.0, velrho[i].w);
+            code[i] = with_kind(c, KIND_EXCLUDED);
+            atomicSub(&state.inlet_joined, 1u);
+        }
+        return;
+    }
     if (kind == KIND_EXCLUDED) {
         if (s < -inlet.thickness || s >= 0.0) {
             return;
         }
         atomicAdd(&state.inlet_joined, 1u);
     }
-    let column = inlet_columns[inlet.first_column + k % inlet.n_columns];
-    let placed = move_by(column, s * inlet.normal).pos;
     var rho = params.rho0;
     if (inlet.pressure == INLET_HYDROSTATIC) {
-        let p = params.rho0 * max(dot(params.gravity, domain_pos(placed) - inlet.surface), 0.0);
+        // Below the buffer's top, or below the level where the inlet has one.
+        var surface = inlet.surface;
+        if (inlet.n_level > 0u) {
+            surface = piecewise_at(inlet.first_level, inlet.n_level, t).speed * inlet.up;
+        }
+        let p = params.rho0 * max(dot(params.gravity, domain_pos(placed) - surface), 0.0);
         rho = params.rho0 * pow(1.0 + p / params.tait_b, 1.0 / params.gamma);
     } else if (inlet.pressure == INLET_EXTRAPOLATED && kind == KIND_INLET) {
         // The density extrapolated in the last step: a particle that crosses the plane enters

@@ -152,6 +152,51 @@ impl Hydrograph {
     }
 }
 
+impl Hydrograph {
+    /// The times its value is above `z`, for a hydrograph joined linearly (a water level in
+    /// time): the maximal intervals [start, end) in increasing order, the last one's end
+    /// infinite where the value stays above. A value that only touches `z` is not above it.
+    pub fn intervals_above(&self, z: f64) -> Vec<(f64, f64)> {
+        let mut out = Vec::new();
+        // The start of the interval still open at the previous piece's end.
+        let mut open: Option<f64> = None;
+        for (k, s) in self.segments.iter().enumerate() {
+            assert!(
+                s.speed[2] == 0.0 && s.speed[3] == 0.0,
+                "a hydrograph joined linearly"
+            );
+            let end = self.segments.get(k + 1).map_or(f64::INFINITY, |n| n.t);
+            let (v, slope) = (s.speed[0], s.speed[1]);
+            // Where v + slope·(t − s.t) > z on this piece.
+            let crossing = s.t + (z - v) / slope;
+            let (lo, hi) = match slope {
+                0.0 if v > z => (s.t, end),
+                0.0 => (end, end),
+                _ if slope > 0.0 => (crossing.max(s.t), end),
+                _ => (s.t, crossing.min(end)),
+            };
+            if lo >= hi {
+                if let Some(start) = open.take() {
+                    out.push((start, s.t));
+                }
+                continue;
+            }
+            if lo > s.t {
+                if let Some(start) = open.take() {
+                    out.push((start, s.t));
+                }
+            }
+            let start = *open.get_or_insert(lo);
+            if hi < end {
+                out.push((start, hi));
+                open = None;
+            }
+        }
+        out.extend(open.map(|start| (start, f64::INFINITY)));
+        out
+    }
+}
+
 /// The knot slopes of the monotone cubic through `(t, u)`: the mean of the secants on either
 /// side (one-sided at the ends), zero at an extreme or a flat piece, and scaled down where
 /// α² + β² > 9 so that every piece stays monotone (Fritsch & Carlson 1980, section 4).
@@ -283,6 +328,37 @@ mod tests {
                 last = s;
             }
         }
+    }
+
+    /// The intervals above a level against the level sampled every 0.1 ms: rising through it,
+    /// staying above, falling, rising to touch it at a knot, held above after the last sample.
+    #[test]
+    fn intervals_above_a_level_are_where_the_level_is_above_it() {
+        let h = Hydrograph::from_samples(
+            &[0.5, 1.0, 2.0, 3.0, 4.0, 5.0],
+            &[0.1, 0.3, 0.3, 0.2, 0.25, 0.4],
+            Interpolation::Linear,
+        );
+        let z = 0.25;
+        let got = h.intervals_above(z);
+        assert_eq!(got.len(), 2, "{got:?}");
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert!(close(got[0].0, 0.875) && close(got[0].1, 2.5), "{got:?}");
+        // Touching 0.25 at t = 4 is not above it: the second interval starts there.
+        assert!(close(got[1].0, 4.0) && got[1].1.is_infinite(), "{got:?}");
+        for k in 0..60_000 {
+            let t = k as f64 * 1e-4;
+            let inside = got.iter().any(|&(a, b)| a <= t && t < b);
+            let above = h.speed(t) > z;
+            let near = got.iter().any(|&(a, b)| close(t, a) || close(t, b));
+            assert!(
+                inside == above || near,
+                "t = {t}: {} against {got:?}",
+                h.speed(t)
+            );
+        }
+        assert!(h.intervals_above(0.5).is_empty());
+        assert_eq!(h.intervals_above(0.0), vec![(0.0, f64::INFINITY)]);
     }
 
     #[test]

@@ -143,7 +143,9 @@ pub struct SimState {
     pub steps: u32,
     /// The host's base time as f32 (inlets place their particles at t_base + t_rel).
     pub t_base: f32,
-    /// Dormant inlet particles that have joined a buffer since t = 0.
+    /// Dormant inlet particles that have joined a buffer since t = 0, less the buffer particles
+    /// a level inlet made wait again: a net count, negative in two's complement where more
+    /// left than joined ([`SimState::net_joined`]).
     pub inlet_joined: u32,
     /// Fluid particles removed by outlets since t = 0.
     pub drained: u32,
@@ -157,6 +159,13 @@ pub struct SimState {
     pub density_variation_peak: f32,
     pub beyond_warn_peak: u32,
     pub beyond_stop_peak: u32,
+}
+
+impl SimState {
+    /// `inlet_joined` as the signed count it is.
+    pub fn net_joined(&self) -> i64 {
+        self.inlet_joined as i32 as i64
+    }
 }
 
 /// Mirrors `Pos`: offset from the block's lower corner + packed block coordinates.
@@ -403,6 +412,28 @@ pub struct InletDef {
     pub surface: [f32; 3],
     /// `INLET_ZERO`, `INLET_HYDROSTATIC` or `INLET_EXTRAPOLATED` (the scenario's `InletPressure`).
     pub pressure: u32,
+    /// A level-driven inlet's windows in the `FlowWindow` table (none: every column flows).
+    pub first_window: u32,
+    pub n_windows: u32,
+    /// Its level's pieces in the `InflowSegment` table, heights in domain coordinates.
+    pub first_level: u32,
+    pub n_level: u32,
+    /// The unit vector against gravity (a level inlet's).
+    pub up: [f32; 3],
+    pub pad2: u32,
+}
+
+/// Mirrors `FlowWindow` in shaders/open_boundaries.wgsl (`crate::scenario::FlowWindow`): a time
+/// a column of a level-driven inlet flows and how far its water has come.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct FlowWindow {
+    pub column: u32,
+    pub start: f32,
+    pub end: f32,
+    pub before: f32,
+    pub after: f32,
+    pub pad: [u32; 3],
 }
 
 /// What a probe samples: `ProbeDef::kind` holds its code, the WGSL constant `PROBE_*` of the
@@ -880,8 +911,19 @@ mod tests {
                 first_column,
                 n_segments,
                 surface,
-                pressure
+                pressure,
+                first_window,
+                n_windows,
+                first_level,
+                n_level,
+                up
             ]
+        );
+        check_layout!(
+            &open_boundaries::SHADER,
+            "FlowWindow",
+            FlowWindow,
+            [column, start, end, before, after]
         );
         check_layout!(
             &open_boundaries::SHADER,

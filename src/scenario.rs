@@ -831,6 +831,93 @@ pub struct Inlet {
     pub particles: std::ops::Range<usize>,
     /// The buffer's pressure.
     pub pressure: InletPressure,
+    /// The water level that wets its columns, where one is given (`level_file`).
+    pub level: Option<InletLevel>,
+}
+
+/// The water level on a level-driven inlet's plane (`level_file`): a column flows while the
+/// level is above its point on the plane, as DualSPHysics' inlets with a variable surface
+/// (Tafuni et al. 2018) wet only the buffer below it; a column above stands still and its
+/// particles wait, out of every cell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InletLevel {
+    /// The level [m], the height along `up` of the water's surface in time, joined linearly
+    /// (a stage hydrograph; its "speed" is the height).
+    pub level: Hydrograph,
+    /// The unit vector against gravity, the direction heights are measured along.
+    pub up: [f64; 3],
+    /// When each column flows, ordered by column, then time.
+    pub windows: Vec<FlowWindow>,
+}
+
+/// A time a column of a level-driven inlet flows, [start, end), and how far its water has
+/// come: D_c(t) = `before` + D(t) within it, D the inflow's distance (eq. 32), and `after` from
+/// its end to the column's next window.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlowWindow {
+    pub column: usize,
+    pub start: f64,
+    /// Infinite where the level never falls below the column again.
+    pub end: f64,
+    pub before: f64,
+    pub after: f64,
+}
+
+impl FlowWindow {
+    /// Whether a column whose windows are `windows` (in time order) flows at time `t`, and how
+    /// far `inflow` has carried its water.
+    pub fn travel(windows: &[FlowWindow], inflow: &Hydrograph, t: f64) -> Travel {
+        let k = windows.partition_point(|w| w.start <= t);
+        match k.checked_sub(1).map(|k| windows[k]) {
+            Some(w) if t < w.end => Travel {
+                flows: true,
+                distance: w.before + inflow.distance(t),
+            },
+            Some(w) => Travel {
+                flows: false,
+                distance: w.after,
+            },
+            None => Travel {
+                flows: false,
+                distance: 0.0,
+            },
+        }
+    }
+
+    /// The windows of column `column` at height `z` under `level`: the times the level is
+    /// above it, each with the distance `inflow` carries the column's water before it and by
+    /// its end (an open window's `after` is infinite).
+    pub fn of_column(
+        column: usize,
+        z: f64,
+        level: &Hydrograph,
+        inflow: &Hydrograph,
+    ) -> Vec<FlowWindow> {
+        let mut carried = 0.0;
+        (level.intervals_above(z).into_iter())
+            .map(|(start, end)| {
+                let before = carried - inflow.distance(start);
+                carried = match end.is_finite() {
+                    true => before + inflow.distance(end),
+                    false => f64::INFINITY,
+                };
+                FlowWindow {
+                    column,
+                    start,
+                    end,
+                    before,
+                    after: carried,
+                }
+            })
+            .collect()
+    }
+}
+
+/// Whether a column flows at a time, and how far its water has come.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Travel {
+    pub flows: bool,
+    pub distance: f64,
 }
 
 /// The pressure (through the density) of an inlet's buffer particles.
@@ -848,21 +935,40 @@ pub enum InletPressure {
 }
 
 impl Inlet {
-    /// Signed distance from the plane along the normal at time `t` of the inlet's particle
-    /// `k` (index within the inlet): −(layer + ½) spacing + D(t), D the distance the inflow
-    /// has travelled.
-    pub fn distance(&self, k: usize, t: f64) -> f64 {
-        let layer = (k / self.columns.len()) as f64;
-        -(layer + 0.5) * self.spacing + self.inflow.distance(t)
+    /// Whether column `column` flows at time `t`, and how far the inflow has carried its water:
+    /// D(t) for every column of an inlet without a level; with one, D_c(t) = ∫₀ᵗ u 1[level >
+    /// the column's height], from the column's windows.
+    pub fn travel(&self, column: usize, t: f64) -> Travel {
+        let Some(level) = &self.level else {
+            return Travel {
+                flows: true,
+                distance: self.inflow.distance(t),
+            };
+        };
+        let w = &level.windows;
+        let (from, to) = (
+            w.partition_point(|w| w.column < column),
+            w.partition_point(|w| w.column <= column),
+        );
+        FlowWindow::travel(&w[from..to], &self.inflow, t)
     }
 
-    /// The density the inlet pass gives a buffer particle at `x`: the Tait density of the
-    /// hydrostatic pressure below the surface, or ρ0 (which an extrapolated buffer's pressure
-    /// then replaces, after the sort).
-    pub fn density(&self, x: [f64; 3], ph: &Physics) -> f64 {
+    /// Signed distance from the plane along the normal at time `t` of the inlet's particle
+    /// `k` (index within the inlet): −(layer + ½) spacing + D_c(t), D_c the distance the
+    /// inflow has carried its column's water ([`Inlet::travel`]).
+    pub fn distance(&self, k: usize, t: f64) -> f64 {
+        let layer = (k / self.columns.len()) as f64;
+        -(layer + 0.5) * self.spacing + self.travel(k % self.columns.len(), t).distance
+    }
+
+    /// The density the inlet pass gives a buffer particle at `x` at time `t`: the Tait density
+    /// of the hydrostatic pressure below the surface (the level's, where it has one), or ρ0
+    /// (which an extrapolated buffer's pressure then replaces, after the sort).
+    pub fn density(&self, x: [f64; 3], t: f64, ph: &Physics) -> f64 {
         match self.pressure {
             InletPressure::Zero | InletPressure::Extrapolated => ph.rho0,
-            InletPressure::Hydrostatic { surface: s } => {
+            InletPressure::Hydrostatic { surface } => {
+                let s = self.surface(surface, t);
                 let head: f64 = (0..3).map(|a| ph.gravity[a] * (x[a] - s[a])).sum();
                 let p = ph.rho0 * head.max(0.0);
                 ph.rho0 * (1.0 + p / ph.tait_b()).powf(1.0 / ph.gamma)
@@ -870,9 +976,19 @@ impl Inlet {
         }
     }
 
-    /// Whether particle `k` waits behind the buffer at t = 0.
+    /// A point of the water's surface at time `t`: `top`, the buffer's highest point, or a
+    /// point at the level's height.
+    fn surface(&self, top: [f64; 3], t: f64) -> [f64; 3] {
+        match &self.level {
+            None => top,
+            Some(l) => l.up.map(|c| c * l.level.speed(t)),
+        }
+    }
+
+    /// Whether particle `k` waits at t = 0: behind the buffer, or in a column the level does
+    /// not reach.
     pub fn dormant(&self, k: usize) -> bool {
-        self.distance(k, 0.0) < -self.thickness
+        !self.travel(k % self.columns.len(), 0.0).flows || self.distance(k, 0.0) < -self.thickness
     }
 
     /// Where particle `k` is at time `t` (if it is still in the inlet's hands).

@@ -102,7 +102,7 @@ struct SimState {
     excluded: u32,              // particles in the excluded slot at the last sort
     steps: u32,                 // steps taken with dt > 0 since the host's base
     t_base: f32,                // the host's base time (f32): t = t_base + t_rel, for inlets
-    inlet_joined: atomic<u32>,  // dormant inlet particles that joined a buffer (cumulative)
+    inlet_joined: atomic<u32>,  // dormant inlet particles that joined a buffer, less those that left one (net, two's complement)
     drained: atomic<u32>,       // fluid particles removed by outlets (cumulative)
     // The weakly-compressible check: this step's largest |ρ/ρ0 − 1| over the fluid (f32 bits)
     // and its fluid particles beyond params.density_warn and params.density_stop; then the

@@ -597,7 +597,13 @@ fn inlet_layouts(
                 "make the buffer box touch other parts without overlapping them",
             ));
         }
-        inlet_layouts.push(super::open_boundaries::layout(ctx, i, s, lat, h)?);
+        inlet_layouts.push(super::open_boundaries::layout(
+            ctx,
+            i,
+            s,
+            lat,
+            (h, case.gravity),
+        )?);
     }
     Ok(inlet_layouts)
 }

@@ -14,7 +14,7 @@ use super::schema::{InletPressureName, InterpolationName, RawInlet, RawOutlet};
 use super::time_series;
 use crate::generate::lattice::{range_points, Lattice};
 use crate::hydrograph::{Hydrograph, Interpolation};
-use crate::scenario::{Inlet, InletPressure, Kind, Outlet, Particle};
+use crate::scenario::{FlowWindow, Inlet, InletLevel, InletPressure, Kind, Outlet, Particle};
 
 /// An `[[inlet]]` as checked against the case, before the lattice is known.
 #[derive(Clone, Debug)]
@@ -35,6 +35,8 @@ pub(super) struct InletSpec {
     pub stop_s: f64,
     /// `pressure`.
     pub pressure: InletPressureName,
+    /// `level_file`'s level in time [m], joined linearly.
+    pub level: Option<Hydrograph>,
 }
 
 impl InletSpec {
@@ -101,6 +103,7 @@ pub(super) fn validate(
             }
         };
         let (inflow, inflow_field) = inflow(ctx, &path, r, case_dir)?;
+        let level = level(ctx, &path, r, inflow_field, case_dir)?;
         // Particles are made for the inflow within the run only (a later stop is the end).
         let stop_s = match r.stop_s {
             None => end_s,
@@ -127,9 +130,59 @@ pub(super) fn validate(
                 .product(),
             stop_s,
             pressure: r.pressure.unwrap_or(InletPressureName::Zero),
+            level,
         });
     }
     Ok(out)
+}
+
+/// A level-driven inlet's level (`level_file`): rows `t_s, level_m`, times from 0 on, joined
+/// linearly. Given with a speed only: the level sets which columns flow, so with a discharge
+/// the speed would have to follow the wetted section, which this inlet does not do.
+fn level(
+    ctx: &Ctx<'_>,
+    path: &str,
+    r: &RawInlet,
+    inflow_field: &str,
+    case_dir: &Path,
+) -> Result<Option<Hydrograph>, CaseError> {
+    let Some(file) = &r.level_file else {
+        return Ok(None);
+    };
+    let field_path = format!("{path}.level_file");
+    if !inflow_field.starts_with("velocity") {
+        return Err(ctx.err(
+            &field_path,
+            Some(format!("{file:?}")),
+            format!(
+                "is given with {inflow_field}: a level inlet takes the speed the water enters \
+                 with, and the level sets its wetted section"
+            ),
+            "give the inflow as velocity_m_s or velocity_file (the discharge is then the speed \
+             times the wetted section), or remove level_file",
+        ));
+    }
+    let rows = time_series::read(ctx, &field_path, file, case_dir, &["t_s", "level_m"])?;
+    if let Some(row) = rows.iter().find(|row| row.values[0] < 0.0) {
+        return Err(ctx.err(
+            &field_path,
+            Some(format!("{file:?}")),
+            format!(
+                "{} line {}: t = {} s is before the run starts at 0",
+                case_dir.join(file).display(),
+                row.line,
+                row.values[0]
+            ),
+            "give times from 0 s on (a run starts at t = 0)",
+        ));
+    }
+    let t: Vec<f64> = rows.iter().map(|r| r.values[0]).collect();
+    let h: Vec<f64> = rows.iter().map(|r| r.values[1]).collect();
+    Ok(Some(Hydrograph::from_samples(
+        &t,
+        &h,
+        Interpolation::Linear,
+    )))
 }
 
 /// An inlet's inflow: exactly one of a constant speed or discharge and a CSV of either in
@@ -280,7 +333,7 @@ pub(super) fn layout(
     i: usize,
     spec: &InletSpec,
     lat: &Lattice,
-    h: f64,
+    (h, gravity): (f64, [f64; 3]),
 ) -> Result<Layout, CaseError> {
     let path = format!("inlet[{i}]");
     let (dx, a) = (lat.dx, spec.axis);
@@ -336,8 +389,41 @@ pub(super) fn layout(
     } else {
         spec.inflow.clone()
     };
-    // Layers crossing the plane by the stop: those with (layer + ½) dx ≤ D(stop).
-    let delivered = (inflow.distance(spec.stop_s) / dx + 0.5).floor();
+    // Layers crossing the plane by the stop: those with (layer + ½) dx ≤ D(stop), for the
+    // column that flows longest (under a level, the lowest: it is wet whenever one above is).
+    let carried = match &spec.level {
+        None => inflow.distance(spec.stop_s),
+        Some(level) => {
+            let up = up(ctx, &path, gravity)?;
+            let mut lowest = f64::INFINITY;
+            for corner in 0..1usize << lat.dim {
+                let idx = [0, 1, 2].map(|b| {
+                    let hi_end = b < lat.dim && corner >> b & 1 == 1;
+                    (if hi_end { front_hi[b] } else { front_lo[b] }) as i64
+                });
+                let mut p = lat.pos(idx);
+                p[a] = plane;
+                lowest = lowest.min((0..3).map(|b| up[b] * p[b]).sum());
+            }
+            let windows = FlowWindow::of_column(0, lowest, level, &inflow);
+            if windows.first().is_none_or(|w| w.start >= spec.stop_s) {
+                return Err(ctx.err(
+                    &format!("{path}.level_file"),
+                    None,
+                    format!(
+                        "never rises above the inlet's lowest column, {} m high, before the \
+                         inflow stops at {} s: the inlet brings no water",
+                        num(lowest),
+                        num(spec.stop_s)
+                    ),
+                    "give levels in the case's coordinates (the height against gravity), above \
+                     the inlet box's bottom",
+                ));
+            }
+            FlowWindow::travel(&windows, &inflow, spec.stop_s).distance
+        }
+    };
+    let delivered = (carried / dx + 0.5).floor();
     let buffer_layers = depth.min(1e15) as usize;
     Ok(Layout {
         front_lo,
@@ -349,6 +435,20 @@ pub(super) fn layout(
         n_columns,
         inflow,
     })
+}
+
+/// The unit vector against `gravity`, the direction a level's heights are measured along.
+fn up(ctx: &Ctx<'_>, path: &str, gravity: [f64; 3]) -> Result<[f64; 3], CaseError> {
+    let g = gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if g.is_nan() || g <= 0.0 {
+        return Err(ctx.err(
+            &format!("{path}.level_file"),
+            None,
+            "needs gravity to tell which way is up, and physics.gravity_m_s2 is zero",
+            "give physics.gravity_m_s2, or remove level_file",
+        ));
+    }
+    Ok(gravity.map(|c| -c / g))
 }
 
 /// The inlet's particles (buffer layers at their places, the waiting ones stacked at the
@@ -369,6 +469,21 @@ pub(super) fn build(
     let mut normal = [0.0; 3];
     normal[spec.axis] = spec.sense;
     let n = columns.len() * layout.layers;
+    let level = spec.level.as_ref().map(|level| {
+        let g = gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let up = gravity.map(|c| -c / g);
+        let windows = (columns.iter().enumerate())
+            .flat_map(|(c, p)| {
+                let z = (0..3).map(|b| up[b] * p[b]).sum();
+                FlowWindow::of_column(c, z, level, &layout.inflow)
+            })
+            .collect();
+        InletLevel {
+            level: level.clone(),
+            up,
+            windows,
+        }
+    });
     let inlet = Inlet {
         name: spec.name.clone(),
         normal,
@@ -377,6 +492,7 @@ pub(super) fn build(
         spacing: dx,
         columns,
         particles: start..start + n,
+        level,
         pressure: match spec.pressure {
             InletPressureName::Zero => InletPressure::Zero,
             InletPressureName::Extrapolated => InletPressure::Extrapolated,
@@ -400,6 +516,13 @@ pub(super) fn build(
         _ => 0.0,
     };
     let speed = inlet.inflow.speed(0.0);
+    let depth = |x: [f64; 3]| match &inlet.level {
+        // Below the level at the start.
+        Some(l) if matches!(inlet.pressure, InletPressure::Hydrostatic { .. }) => {
+            (l.level.speed(0.0) - (0..3).map(|b| l.up[b] * x[b]).sum::<f64>()).max(0.0)
+        }
+        _ => depth(x),
+    };
     for k in 0..n {
         // A dormant particle waits at the buffer's back, the place it joins from.
         let s = inlet.distance(k, 0.0).max(-inlet.thickness);

@@ -84,6 +84,7 @@ pub(super) struct RawInlet {
     pub interpolation: Option<InterpolationName>,
     pub stop_s: Option<f64>,
     pub pressure: Option<InletPressureName>,
+    pub level_file: Option<String>,
 }
 
 /// How an inlet's hydrograph joins its samples.
@@ -777,6 +778,12 @@ pub(super) const FIELDS: &[FieldHelp] = &[
         "the buffer's pressure: zero (a free jet) or hydrostatic below the box's top (an open \
          channel's inflow)",
         "pressure = \"hydrostatic\"",
+    ),
+    f(
+        "inlet[].level_file",
+        "a CSV of the water level on the inlet's plane in time (t_s, level_m, the height \
+         against gravity): only the columns below it flow",
+        "level_file = \"stage.csv\"",
     ),
     f(
         "inlet[].stop_s",

@@ -74,7 +74,10 @@ pub fn timestep(ph: &Physics, cfl: f64, parts: &[RefParticle], rates: &[[f64; 4]
             max_speed = max_speed.max(sound_speed(ph, p.rho) + v);
         }
     }
-    let mut dt = cfl * ph.h / max_speed.max(1e-12);
+    if max_speed == 0.0 {
+        max_speed = ph.c0;
+    }
+    let mut dt = cfl * ph.h / max_speed;
     if max_accel > 0.0 {
         dt = dt.min(cfl * (ph.h / max_accel).sqrt());
     }

@@ -11,8 +11,10 @@ pub struct Placed {
     pub vel: [f64; 3],
     pub rho: f64,
     pub kind: u32,
-    /// It was dormant and joined the buffer in this pass.
-    pub joined: bool,
+    /// +1 where it was dormant and joined the buffer in this pass, −1 where it left the buffer
+    /// to wait again (its column above the level), 0 otherwise: the pass's change of
+    /// `inlet_joined`.
+    pub joined: i32,
 }
 
 /// An inlet's inflow at time `t`: its speed and the distance it has carried the water
@@ -42,20 +44,31 @@ pub fn inlet_flow(
     ph: &Physics,
 ) -> Option<Placed> {
     let inflow = inflow_at(inlet, t);
+    let travel = inlet.travel(k % inlet.columns.len(), t);
     let s = inlet.distance(k, t);
+    let pos = inlet.position_at(k, s);
+    if !travel.flows {
+        // A buffer particle whose column the level left waits where it stands.
+        return (kind == INLET).then_some(Placed {
+            pos,
+            vel: [0.0; 3],
+            rho,
+            kind: EXCLUDED,
+            joined: -1,
+        });
+    }
     let joined = match kind {
-        INLET => false,
-        EXCLUDED if (-inlet.thickness..0.0).contains(&s) => true,
+        INLET => 0,
+        EXCLUDED if (-inlet.thickness..0.0).contains(&s) => 1,
         _ => return None,
     };
-    let pos = inlet.position(k, t);
     Some(Placed {
         pos,
         vel: inlet.normal.map(|n| inflow.speed * n),
         // An extrapolated buffer keeps the density its last extrapolation gave it.
         rho: match (inlet.pressure, kind) {
             (InletPressure::Extrapolated, INLET) => rho,
-            _ => inlet.density(pos, ph),
+            _ => inlet.density(pos, t, ph),
         },
         kind: if s >= 0.0 { FLUID } else { INLET },
         joined,
@@ -97,6 +110,7 @@ mod tests {
             columns: vec![[0.1, 0.2, 0.0], [0.1, 0.21, 0.0]],
             particles: 10..30,
             pressure: InletPressure::Zero,
+            level: None,
         }
     }
 
@@ -120,7 +134,7 @@ mod tests {
         assert!((first.pos[0] - 0.101).abs() < 1e-12 && (first.pos[1] - 0.21).abs() < 1e-12);
         assert_eq!(first.vel, [2.0, 0.0, 0.0]);
         let joined = inlet_flow(&inlet, 8, EXCLUDED, ph.rho0, t, ph).unwrap();
-        assert!(joined.joined && joined.kind == INLET);
+        assert!(joined.joined == 1 && joined.kind == INLET);
         assert!((joined.pos[0] - (0.1 - 0.039)).abs() < 1e-12);
         // Layer 5 still waits; a fluid particle is left alone, and so is an excluded one past
         // the plane (it was fluid and left the domain).
@@ -165,6 +179,6 @@ mod tests {
             p.rho
         );
         assert!(p.rho > ph.rho0);
-        assert_eq!(inlet.density([0.0, 0.3, 0.0], ph), ph.rho0);
+        assert_eq!(inlet.density([0.0, 0.3, 0.0], 0.0, ph), ph.rho0);
     }
 }

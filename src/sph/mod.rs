@@ -398,9 +398,9 @@ impl Solver {
     pub fn fluid_counted(&self) -> u64 {
         let joined = match &self.ranked {
             Some(ranked) => ranked.joined,
-            None => self.state.inlet_joined as u64,
+            None => self.state.net_joined(),
         };
-        (self.n_fluid_at_start + joined).saturating_sub(self.drained())
+        ((self.n_fluid_at_start as i64 + joined).max(0) as u64).saturating_sub(self.drained())
     }
 
     /// Starts the density peaks anew (after the run has looked at them for a probe interval).
@@ -430,9 +430,7 @@ impl Solver {
         if let Some(ranked) = &self.ranked {
             return ranked.excluded;
         }
-        let dormant = self
-            .dormant_at_start
-            .saturating_sub(self.state.inlet_joined);
+        let dormant = (self.dormant_at_start as i64 - self.state.net_joined()).max(0) as u32;
         let s = &self.state;
         s.excluded.saturating_sub(dormant).saturating_sub(s.drained) as u64
     }

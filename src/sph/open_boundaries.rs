@@ -21,8 +21,8 @@ pub const SHADER: Shader = Shader {
     libs: &[PARTICLE_ID, NEIGHBOURS, MLS, FLUID_AT],
 };
 use crate::layout::{
-    pack_block, InflowSegment, InletDef, OutletDef, Pos, INLET_EXTRAPOLATED, INLET_HYDROSTATIC,
-    INLET_ZERO,
+    pack_block, FlowWindow, InflowSegment, InletDef, OutletDef, Pos, INLET_EXTRAPOLATED,
+    INLET_HYDROSTATIC, INLET_ZERO,
 };
 use crate::scenario::{InletPressure, Scenario};
 
@@ -40,8 +40,22 @@ pub fn inlet_tables(sc: &Scenario, grid: &Grid) -> InletTables {
     let mut defs = Vec::with_capacity(sc.inlets.len());
     let mut columns = Vec::new();
     let mut segments = Vec::new();
+    let mut windows = Vec::new();
     for inlet in &sc.inlets {
         let inflow = inlet.inflow.segments();
+        let level = inlet.level.as_ref();
+        let first_window = windows.len() as u32;
+        let first_level = (segments.len() + inflow.len()) as u32;
+        if let Some(l) = level {
+            windows.extend(l.windows.iter().map(|w| FlowWindow {
+                column: w.column as u32,
+                start: w.start as f32,
+                end: w.end.min(f32::MAX as f64) as f32,
+                before: w.before as f32,
+                after: w.after.min(f32::MAX as f64) as f32,
+                pad: [0; 3],
+            }));
+        }
         defs.push(InletDef {
             normal: inlet.normal.map(|c| c as f32),
             first_segment: segments.len() as u32,
@@ -63,6 +77,12 @@ pub fn inlet_tables(sc: &Scenario, grid: &Grid) -> InletTables {
                 InletPressure::Hydrostatic { .. } => INLET_HYDROSTATIC,
                 InletPressure::Extrapolated => INLET_EXTRAPOLATED,
             },
+            first_window,
+            n_windows: windows.len() as u32 - first_window,
+            first_level,
+            n_level: level.map_or(0, |l| l.level.segments().len() as u32),
+            up: level.map_or([0.0; 3], |l| l.up.map(|c| c as f32)),
+            pad2: 0,
         });
         columns.extend(inlet.columns.iter().map(|&c| {
             let (off, b) = grid.to_block(c);
@@ -78,11 +98,24 @@ pub fn inlet_tables(sc: &Scenario, grid: &Grid) -> InletTables {
             speed: s.speed.map(|c| c as f32),
             moved: s.distance_coefficients().map(|c| c as f32),
         }));
+        // A level's pieces: its height from the grid's origin in `speed` (their integral is
+        // never read).
+        if let Some(l) = level {
+            let origin: f64 = (0..3).map(|a| l.up[a] * grid.origin[a]).sum();
+            segments.extend(l.level.segments().iter().map(|s| InflowSegment {
+                t: s.t as f32,
+                distance: 0.0,
+                pad: [0; 2],
+                speed: [s.speed[0] - origin, s.speed[1], s.speed[2], s.speed[3]].map(|c| c as f32),
+                moved: [0.0; 4],
+            }));
+        }
     }
     InletTables {
         defs,
         columns,
         segments,
+        windows,
     }
 }
 
@@ -91,8 +124,10 @@ pub struct InletTables {
     pub defs: Vec<InletDef>,
     /// Each column's point on its inlet's plane, as a position in the grid's blocks.
     pub columns: Vec<Pos>,
-    /// The inlets' hydrographs, piece after piece.
+    /// The inlets' hydrographs, piece after piece (an inlet's inflow, then its level).
     pub segments: Vec<InflowSegment>,
+    /// The level-driven inlets' windows.
+    pub windows: Vec<FlowWindow>,
 }
 
 /// The outlets' boxes in domain coordinates (from the grid's origin); in 2D z spans [−1, 1].
@@ -140,18 +175,23 @@ impl OpenBoundaries {
             tables.columns.push(Pos::default());
             tables.segments.push(InflowSegment::default());
         }
+        if tables.windows.is_empty() {
+            tables.windows.push(FlowWindow::default());
+        }
         if outlets.is_empty() {
             outlets.push(OutletDef::default());
         }
         let defs = storage_init(device, "inlets", &tables.defs);
         let columns = storage_init(device, "inlet columns", &tables.columns);
         let segments = storage_init(device, "inflow segments", &tables.segments);
+        let windows = storage_init(device, "flow windows", &tables.windows);
         let outlets = storage_init(device, "outlets", &outlets);
         let bufs = |p: usize| {
             b.at(p)
                 .with("inlets", &defs)
                 .with("inlet_columns", &columns)
                 .with("inflow_segments", &segments)
+                .with("flow_windows", &windows)
                 .with("outlets", &outlets)
         };
         let kernel = |entry: &str| ParityKernel::new(device, module, entry, bufs);

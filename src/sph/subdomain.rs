@@ -38,9 +38,10 @@ pub struct Ranked {
     pub(super) excluded: u64,
     /// Fluid particles of the whole run the outlets removed (each rank's GPU counts its own).
     pub(super) drained: u64,
-    /// Inlet particles of the whole run that joined (each rank's GPU counts its own).
+    /// Inlet particles of the whole run that joined, less those a level made wait again (each
+    /// rank's GPU counts its own).
     #[serde(default)]
-    pub(super) joined: u64,
+    pub(super) joined: i64,
     /// Where the first step unpacks (no sort has run yet): after the own particles.
     first_tail: Option<u32>,
     /// This rank's totals: halo copies and migrants sent, and their bytes.
@@ -880,16 +881,18 @@ impl Solver {
             local.beyond_warn_peak as f64,
             local.beyond_stop_peak as f64,
             local.drained as f64,
-            local.inlet_joined as f64,
+            // A net count: a rank whose particles left a buffer more than joined one holds a
+            // negative count, in two's complement.
+            local.inlet_joined as i32 as f64,
         ]);
         let peak = -ranks.min(-(local.density_variation_peak as f64));
         let ranked = self.ranked.as_mut().expect("a subdomain");
         ranked.drained = sums[4] as u64;
-        ranked.joined = sums[5] as u64;
+        ranked.joined = sums[5] as i64;
         // What is neither live on a rank nor drained left the domain (the drained are
         // excluded too, but counted apart, as one whole run counts them); the inlet particles
         // that joined add to the live.
-        ranked.excluded = (ranked.live_at_start + ranked.joined)
+        ranked.excluded = ((ranked.live_at_start as i64 + ranked.joined).max(0) as u64)
             .saturating_sub(sums[0] as u64)
             .saturating_sub(ranked.drained);
         self.state = gpu;

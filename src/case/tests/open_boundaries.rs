@@ -205,6 +205,99 @@ fn a_hydrograph_inlet_makes_the_layers_its_volume_takes() {
     );
 }
 
+/// A level-driven nozzle (0.30–0.34 m high, 8 rows at dx = 5 mm, centres from 0.3025 m): its
+/// columns flow while the level is above their centres, each carrying its own distance, and the
+/// layers are made for the lowest, which flows longest.
+#[test]
+fn a_level_inlet_wets_the_columns_below_its_level() {
+    let dir = folder("level");
+    // Up from 0.31 m to 0.35 m over 0.4 s, held there.
+    std::fs::write(dir.join("h.csv"), "t_s,level_m\n0,0.31\n0.4,0.35\n").unwrap();
+    let s = load_in(
+        &dir,
+        &injection_with("velocity_m_s = 1.5\nlevel_file = \"h.csv\""),
+    )
+    .unwrap();
+    let inlet = &s.inlets[0];
+    let level = inlet.level.as_ref().expect("a level");
+    assert_eq!(level.up, [0.0, 1.0, 0.0]);
+    // The two lowest rows (0.3025, 0.3075 m) flow from the start; the top row (0.3375 m) from
+    // t = 0.4 · 0.0275 / 0.04 = 0.275 s.
+    let rows: Vec<usize> = (0..8)
+        .map(|c| (inlet.columns[c][1] * 1e4).round() as usize)
+        .collect();
+    assert_eq!(rows[0], 3025);
+    let top = (0..8).max_by_key(|&c| rows[c]).unwrap();
+    let low = (0..8).min_by_key(|&c| rows[c]).unwrap();
+    assert!(inlet.travel(low, 0.0).flows && !inlet.travel(top, 0.2).flows);
+    let w = level.windows.iter().find(|w| w.column == top).unwrap();
+    assert!(
+        (w.start - 0.275).abs() < 1e-12 && w.end.is_infinite(),
+        "{w:?}"
+    );
+    assert!((inlet.travel(top, 0.5).distance - 1.5 * (0.5 - 0.275)).abs() < 1e-12);
+    assert!((inlet.travel(low, 0.5).distance - 0.75).abs() < 1e-12);
+    // 1.5 m/s for 1 s at the lowest row: 300 layers; the waiting ones include the columns the
+    // level does not reach at t = 0.
+    assert_eq!(inlet.particles.len(), 8 * 300);
+    let wet = (0..8).filter(|&c| inlet.travel(c, 0.0).flows).count();
+    assert_eq!(wet, 2);
+    assert_eq!(s.dormant_count(), 8 * 300 - wet * 6);
+}
+
+#[test]
+fn bad_levels_are_refused_naming_the_field_and_fix() {
+    let dir = folder("bad_level");
+    std::fs::write(dir.join("h.csv"), "0,0.31\n0.4,0.35\n").unwrap();
+    let with = |inflow: &str| injection_with(&format!("{inflow}\nlevel_file = \"h.csv\""));
+    let q = with("discharge_m3_s = 0.02");
+    assert_refused(
+        load_in(&dir, &q),
+        &[
+            "inlet[0].level_file",
+            "discharge_m3_s",
+            "velocity_m_s or velocity_file",
+        ],
+        &q,
+    );
+    let still = with("velocity_m_s = 1.5").replace("[0.0, -9.81]", "[0.0, 0.0]");
+    assert_refused(
+        load_in(&dir, &still),
+        &[
+            "inlet[0].level_file",
+            "needs gravity",
+            "physics.gravity_m_s2",
+        ],
+        &still,
+    );
+    // Above the nozzle only after its stop at 1 s.
+    std::fs::write(dir.join("low.csv"), "0,0.2\n0.5,0.3\n1.5,0.3\n3,0.4\n").unwrap();
+    let low = injection_with("velocity_m_s = 1.5\nlevel_file = \"low.csv\"");
+    assert_refused(
+        load_in(&dir, &low),
+        &[
+            "inlet[0].level_file",
+            "never rises above",
+            "0.3025 m",
+            "brings no water",
+        ],
+        &low,
+    );
+    std::fs::write(dir.join("h.csv"), "-1,0.31\n0.4,0.35\n").unwrap();
+    let early = with("velocity_m_s = 1.5");
+    assert_refused(
+        load_in(&dir, &early),
+        &["h.csv line 1", "before the run starts", "from 0 s on"],
+        &early,
+    );
+    std::fs::write(dir.join("h.csv"), "0,0.31\n0.4,nan\n").unwrap();
+    assert_refused(
+        load_in(&dir, &early),
+        &["inlet[0].level_file", "h.csv line 2"],
+        &early,
+    );
+}
+
 #[test]
 fn bad_hydrographs_are_refused_naming_the_file_line_and_fix() {
     let dir = folder("bad_hydrograph");
