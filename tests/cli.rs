@@ -4,7 +4,7 @@
 use std::process::Command;
 
 fn wgsph() -> Command {
-    crate::common::one_lavapipe_thread_each();
+    crate::common::lavapipe_for_tests();
     Command::new(env!("CARGO_BIN_EXE_wgsph"))
 }
 

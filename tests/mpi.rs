@@ -28,7 +28,7 @@ fn mpirun(test: &str, ranks: u32, limit: Duration) -> (bool, String) {
 
 /// `mpirun -np RANKS`, to be given the program.
 fn mpirun_np(ranks: u32) -> Command {
-    crate::common::one_lavapipe_thread_each();
+    crate::common::lavapipe_for_tests();
     let mut command = Command::new("mpirun");
     // Ranks waiting on a message yield their core: OpenMPI spins by default where it counts a
     // core a rank, and the harness runs two jobs at once on CI's two cores (this binary took
@@ -526,7 +526,7 @@ fn resume(dir: &std::path::Path, end: &str) -> Vec<std::ffi::OsString> {
 
 /// One whole run of `args` on lavapipe.
 fn on_one_rank(args: Vec<std::ffi::OsString>) {
-    crate::common::one_lavapipe_thread_each();
+    crate::common::lavapipe_for_tests();
     let o = Command::new(env!("CARGO_BIN_EXE_wgsph"))
         .args(args)
         .args(["--adapter", "cpu"])

@@ -342,7 +342,7 @@ fn resume_is_bit_identical_for_an_injection() {
 }
 
 fn wgsph() -> Command {
-    crate::common::one_lavapipe_thread_each();
+    crate::common::lavapipe_for_tests();
     Command::new(env!("CARGO_BIN_EXE_wgsph"))
 }
 
@@ -558,7 +558,7 @@ fn resume_refuses_a_different_case() {
 
 #[test]
 fn a_lost_device_stops_the_solver_with_a_message() {
-    crate::common::one_lavapipe_thread_each();
+    crate::common::lavapipe_for_tests();
     let ctx =
         wgsph::gpu::GpuContext::new(wgsph::gpu::AdapterChoice::resolve(None).unwrap()).unwrap();
     let sc = load("cases/hydrostatic_2d.toml", &["time.end_s=0.05"]);
@@ -590,7 +590,7 @@ fn a_device_lost_mid_run_keeps_the_last_checkpoint_and_resumes() {
     let straight = temp_dir("lost-straight");
     run_to_end(&sc, &straight);
     // Its own device: this one gets destroyed.
-    crate::common::one_lavapipe_thread_each();
+    crate::common::lavapipe_for_tests();
     let ctx =
         wgsph::gpu::GpuContext::new(wgsph::gpu::AdapterChoice::resolve(None).unwrap()).unwrap();
     let dir = temp_dir("lost");
@@ -623,7 +623,7 @@ fn a_device_lost_mid_run_keeps_the_last_checkpoint_and_resumes() {
 
 #[test]
 fn a_case_too_large_for_the_adapter_fails_before_the_run_starts() {
-    crate::common::one_lavapipe_thread_each();
+    crate::common::lavapipe_for_tests();
     let ctx = wgsph::gpu::GpuContext::with_limits(
         wgsph::gpu::AdapterChoice::resolve(None).unwrap(),
         |l| l.max_storage_buffer_binding_size = 16 * 1000,

@@ -57,19 +57,37 @@ impl Drop for Scratch {
     }
 }
 
-/// One lavapipe thread per device (`LP_NUM_THREADS=1`, unless set already), for this process
-/// and what it starts: the harness runs a test per core side by side, each on a device of its
-/// own ([`gpu`]), and lavapipe gives every device a thread per core, so on 2 cores two tests
-/// kept four threads busy. With one each, `wall_treatments` ran in 90 s instead of 135 s,
-/// `mpi` (two ranks a job) in 182 s instead of 214 s (docs/performance.md, 2026-12-06). A
-/// single run is faster with the threads (`wgsph run` keeps lavapipe's default). Set once,
-/// before this process opens a device (every test opens its own through here or after it
-/// called this), so no thread reads the environment from C while it changes.
-pub fn one_lavapipe_thread_each() {
+/// lavapipe set for the tests, for this process and what it starts (each setting unless it is
+/// set already):
+/// - one thread per device (`LP_NUM_THREADS=1`): the harness runs a test per core side by side,
+///   each on a device of its own ([`gpu`]), and lavapipe gives every device a thread per core,
+///   so on 2 cores two tests kept four threads busy. With one each, `wall_treatments` ran in
+///   90 s instead of 135 s, `mpi` (two ranks a job) in 182 s instead of 214 s
+///   (docs/performance.md, 2026-12-06). A single run is faster with the threads (`wgsph run`
+///   keeps lavapipe's default).
+/// - shaders compiled for 4-wide vectors (`LP_NATIVE_VECTOR_WIDTH=128`, not the 8 of AVX2):
+///   LLVM compiles each pipeline faster, and a clean machine (CI) compiles every shader the
+///   tests use once; our kernels, which gather their neighbours, run as fast (the
+///   `kernels_vs_reference` tests from an empty shader cache 129 s instead of 172 s, with a
+///   full one 84 s against 78 s; the 3D dam break's conservation test 54.6 s against 54.3 s).
+/// - a shader cache of the tests' own (`MESA_SHADER_CACHE_DIR` in the target directory), so
+///   that shaders of that width never mix with lavapipe's default ones in the user's cache.
+///
+/// Set once, before this process opens a device (every test opens its own through here or
+/// after it called this), so no thread reads the environment from C while it changes.
+pub fn lavapipe_for_tests() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
-        if std::env::var_os("LP_NUM_THREADS").is_none() {
-            std::env::set_var("LP_NUM_THREADS", "1");
+        let cache = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("mesa_shader_cache");
+        let settings = [
+            ("LP_NUM_THREADS", "1".into()),
+            ("LP_NATIVE_VECTOR_WIDTH", "128".into()),
+            ("MESA_SHADER_CACHE_DIR", cache.into_os_string()),
+        ];
+        for (name, value) in settings {
+            if std::env::var_os(name).is_none() {
+                std::env::set_var(name, value);
+            }
         }
     });
 }
@@ -80,7 +98,7 @@ pub fn one_lavapipe_thread_each() {
 /// lavapipe, two tests on a shared device took 2.8 times as long as on a device each). The
 /// device is leaked, a few MB per test.
 pub fn gpu() -> &'static GpuContext {
-    one_lavapipe_thread_each();
+    lavapipe_for_tests();
     thread_local! {
         static CTX: &'static GpuContext = Box::leak(Box::new({
             let choice = AdapterChoice::resolve(None).expect("WGSPH_ADAPTER");
