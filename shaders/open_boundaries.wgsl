@@ -24,8 +24,6 @@ struct InletDef {
     n_windows: u32,             // 0: no level, every column flows
     first_level: u32,           // its level's first piece in `inflow_segments`
     n_level: u32,
-    up: vec3<f32>,              // against gravity: heights are measured along it
-    pad2: u32,
 }
 
 // A time [start, end) a column of a level-driven inlet flows (src/scenario.rs `FlowWindow`):
@@ -201,10 +199,12 @@ fn inlet_flow(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     }
     var rho = params.rho0;
     if (inlet.pressure == INLET_HYDROSTATIC) {
-        // Below the buffer's top, or below the level where the inlet has one.
+        // Below the buffer's top, or below the level where the inlet has one (its height
+        // along −g; the case refuses a level without gravity).
         var surface = inlet.surface;
         if (inlet.n_level > 0u) {
-            surface = piecewise_at(inlet.first_level, inlet.n_level, t).speed * inlet.up;
+            let up = -normalize(params.gravity);
+            surface = piecewise_at(inlet.first_level, inlet.n_level, t).speed * up;
         }
         let p = params.rho0 * max(dot(params.gravity, domain_pos(placed) - surface), 0.0);
         rho = params.rho0 * pow(1.0 + p / params.tait_b, 1.0 / params.gamma);

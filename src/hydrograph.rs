@@ -150,9 +150,7 @@ impl Hydrograph {
             .collect();
         Self { segments }
     }
-}
 
-impl Hydrograph {
     /// The times its value is above `z`, for a hydrograph joined linearly (a water level in
     /// time): the maximal intervals [start, end) in increasing order, the last one's end
     /// infinite where the value stays above. A value that only touches `z` is not above it.

@@ -418,9 +418,6 @@ pub struct InletDef {
     /// Its level's pieces in the `InflowSegment` table, heights in domain coordinates.
     pub first_level: u32,
     pub n_level: u32,
-    /// The unit vector against gravity (a level inlet's).
-    pub up: [f32; 3],
-    pub pad2: u32,
 }
 
 /// Mirrors `FlowWindow` in shaders/open_boundaries.wgsl (`crate::scenario::FlowWindow`): a time
@@ -915,8 +912,7 @@ mod tests {
                 first_window,
                 n_windows,
                 first_level,
-                n_level,
-                up
+                n_level
             ]
         );
         check_layout!(

@@ -978,7 +978,7 @@ impl Inlet {
 
     /// A point of the water's surface at time `t`: `top`, the buffer's highest point, or a
     /// point at the level's height.
-    fn surface(&self, top: [f64; 3], t: f64) -> [f64; 3] {
+    pub fn surface(&self, top: [f64; 3], t: f64) -> [f64; 3] {
         match &self.level {
             None => top,
             Some(l) => l.up.map(|c| c * l.level.speed(t)),
@@ -989,11 +989,6 @@ impl Inlet {
     /// not reach.
     pub fn dormant(&self, k: usize) -> bool {
         !self.travel(k % self.columns.len(), 0.0).flows || self.distance(k, 0.0) < -self.thickness
-    }
-
-    /// Where particle `k` is at time `t` (if it is still in the inlet's hands).
-    pub fn position(&self, k: usize, t: f64) -> [f64; 3] {
-        self.position_at(k, self.distance(k, t))
     }
 
     /// Particle `k`'s place at the signed distance `s` from the plane.

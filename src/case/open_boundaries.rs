@@ -13,6 +13,7 @@ use std::path::Path;
 use super::schema::{InletPressureName, InterpolationName, RawInlet, RawOutlet};
 use super::time_series;
 use crate::generate::lattice::{range_points, Lattice};
+use crate::generate::triangle::{dot, sub};
 use crate::hydrograph::{Hydrograph, Interpolation};
 use crate::scenario::{FlowWindow, Inlet, InletLevel, InletPressure, Kind, Outlet, Particle};
 
@@ -403,7 +404,7 @@ pub(super) fn layout(
                 });
                 let mut p = lat.pos(idx);
                 p[a] = plane;
-                lowest = lowest.min((0..3).map(|b| up[b] * p[b]).sum());
+                lowest = lowest.min(dot(up, p));
             }
             let windows = FlowWindow::of_column(0, lowest, level, &inflow);
             if windows.first().is_none_or(|w| w.start >= spec.stop_s) {
@@ -437,18 +438,23 @@ pub(super) fn layout(
     })
 }
 
-/// The unit vector against `gravity`, the direction a level's heights are measured along.
+/// The unit vector against `gravity`, the direction a level's heights are measured along;
+/// `None` without gravity.
+fn up_of(gravity: [f64; 3]) -> Option<[f64; 3]> {
+    let g = dot(gravity, gravity).sqrt();
+    (g > 0.0).then(|| gravity.map(|c| -c / g))
+}
+
+/// [`up_of`], or the error a level inlet without gravity gets.
 fn up(ctx: &Ctx<'_>, path: &str, gravity: [f64; 3]) -> Result<[f64; 3], CaseError> {
-    let g = gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
-    if g.is_nan() || g <= 0.0 {
-        return Err(ctx.err(
+    up_of(gravity).ok_or_else(|| {
+        ctx.err(
             &format!("{path}.level_file"),
             None,
             "needs gravity to tell which way is up, and physics.gravity_m_s2 is zero",
             "give physics.gravity_m_s2, or remove level_file",
-        ));
-    }
-    Ok(gravity.map(|c| -c / g))
+        )
+    })
 }
 
 /// The inlet's particles (buffer layers at their places, the waiting ones stacked at the
@@ -469,14 +475,10 @@ pub(super) fn build(
     let mut normal = [0.0; 3];
     normal[spec.axis] = spec.sense;
     let n = columns.len() * layout.layers;
-    let level = spec.level.as_ref().map(|level| {
-        let g = gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
-        let up = gravity.map(|c| -c / g);
+    // `layout` refused a level without gravity.
+    let level = (spec.level.as_ref().zip(up_of(gravity))).map(|(level, up)| {
         let windows = (columns.iter().enumerate())
-            .flat_map(|(c, p)| {
-                let z = (0..3).map(|b| up[b] * p[b]).sum();
-                FlowWindow::of_column(c, z, level, &layout.inflow)
-            })
+            .flat_map(|(c, &p)| FlowWindow::of_column(c, dot(up, p), level, &layout.inflow))
             .collect();
         InletLevel {
             level: level.clone(),
@@ -508,21 +510,14 @@ pub(super) fn build(
             },
         },
     };
-    let g = gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
-    let depth = |x: [f64; 3]| match inlet.pressure {
-        InletPressure::Hydrostatic { surface: s } if g > 0.0 => {
-            (0..3).map(|a| gravity[a] * (x[a] - s[a])).sum::<f64>() / g
+    // Below the surface at the start: the box's top, or the level.
+    let depth = |x: [f64; 3]| match (inlet.pressure, up_of(gravity)) {
+        (InletPressure::Hydrostatic { surface }, Some(up)) => {
+            dot(up, sub(inlet.surface(surface, 0.0), x)).max(0.0)
         }
         _ => 0.0,
     };
     let speed = inlet.inflow.speed(0.0);
-    let depth = |x: [f64; 3]| match &inlet.level {
-        // Below the level at the start.
-        Some(l) if matches!(inlet.pressure, InletPressure::Hydrostatic { .. }) => {
-            (l.level.speed(0.0) - (0..3).map(|b| l.up[b] * x[b]).sum::<f64>()).max(0.0)
-        }
-        _ => depth(x),
-    };
     for k in 0..n {
         // A dormant particle waits at the buffer's back, the place it joins from.
         let s = inlet.distance(k, 0.0).max(-inlet.thickness);

@@ -81,8 +81,6 @@ pub fn inlet_tables(sc: &Scenario, grid: &Grid) -> InletTables {
             n_windows: windows.len() as u32 - first_window,
             first_level,
             n_level: level.map_or(0, |l| l.level.segments().len() as u32),
-            up: level.map_or([0.0; 3], |l| l.up.map(|c| c as f32)),
-            pad2: 0,
         });
         columns.extend(inlet.columns.iter().map(|&c| {
             let (off, b) = grid.to_block(c);

@@ -882,8 +882,8 @@ impl Solver {
             local.beyond_stop_peak as f64,
             local.drained as f64,
             // A net count: a rank whose particles left a buffer more than joined one holds a
-            // negative count, in two's complement.
-            local.inlet_joined as i32 as f64,
+            // negative one.
+            local.net_joined() as f64,
         ]);
         let peak = -ranks.min(-(local.density_variation_peak as f64));
         let ranked = self.ranked.as_mut().expect("a subdomain");
